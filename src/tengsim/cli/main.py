@@ -1,0 +1,54 @@
+"""Entry point ``tengsim``: dispatches to one module per subcommand.
+
+Each subcommand module defines ``register(subparsers)`` which adds its parser and sets
+``func`` (called with the parsed namespace, returns an exit code).
+"""
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+
+from tengsim.errors import TengsimError
+
+SUBCOMMANDS = ["contact", "device", "reproduce", "run", "plot"]
+
+
+def build_parser() -> argparse.ArgumentParser:
+    from tengsim import __version__
+
+    p = argparse.ArgumentParser(
+        prog="tengsim",
+        description="Adhesive contact of micro-structured TENG interfaces and the device output.",
+    )
+    p.add_argument("--version", action="version", version=f"tengsim {__version__}")
+    sub = p.add_subparsers(dest="command", metavar="COMMAND")
+    for name in SUBCOMMANDS:
+        try:
+            mod = importlib.import_module(f"tengsim.cli.{name}")
+        except ModuleNotFoundError as exc:  # subcommand not built yet
+            if exc.name != f"tengsim.cli.{name}":
+                raise
+            continue
+        mod.register(sub)
+    return p
+
+
+def main(argv=None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if not getattr(args, "func", None):
+        parser.print_help()
+        return 2
+    try:
+        return int(args.func(args) or 0)
+    except TengsimError as exc:
+        print(f"tengsim: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("tengsim: interrupted; no partial output was written", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())
