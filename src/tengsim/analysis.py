@@ -1,0 +1,94 @@
+"""Per-state analysis: force (Eq. 10), contact length by Greenwood's tensile peak, contact areas."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from tengsim.grid import Grid
+
+
+def force(P: np.ndarray, grid: Grid) -> float:
+    """Paper Eq. (10): F = (1/3π) ∬ P dX dY over the cell."""
+    return float(P.sum() * grid.area / (3 * np.pi))
+
+
+def _parabolic_min(f: np.ndarray, i: int) -> float:
+    """Sub-pixel position (in index units) of a discrete minimum at i, by a parabola through 3 points."""
+    if i <= 0 or i >= len(f) - 1:
+        return float(i)
+    a, b, c = f[i - 1], f[i], f[i + 1]
+    den = a - 2 * b + c
+    if den <= 0:
+        return float(i)
+    return i + 0.5 * (a - c) / den
+
+
+def tensile_peak_offset(profile: np.ndarray) -> float:
+    """Distance (index units) from profile[0] (the apex) to the innermost tensile pressure minimum.
+
+    Walk outward from the apex; the contact edge is the first local minimum of P with P < 0 that
+    follows the compressive (or least tensile) core.  If the apex itself is the minimum, return 0.
+    The innermost rule ignores the spurious tensile extremum of a free cell at its boundary.
+    """
+    f = np.asarray(profile, dtype=float)
+    n = len(f)
+    if n < 3 or (f[0] < 0 and f[1] >= f[0]):
+        return 0.0  # the apex is itself the tensile minimum: no contact patch
+    for i in range(1, n - 1):
+        if f[i] < 0 and f[i] <= f[i - 1] and f[i] < f[i + 1]:
+            return _parabolic_min(f, i)
+    return float(n - 1)  # minimum at the grid edge
+
+
+def contact_length(P: np.ndarray, grid: Grid, apex: tuple[int, int]) -> float:
+    """Greenwood contact length Λc = |2Xc| (paper Section 3): twice the distance from the apex to the
+    tensile pressure peak along the X row through the apex, averaged over the +X and −X sides.
+    """
+    i0, j0 = apex
+    row = P[:, j0]
+    right = tensile_peak_offset(row[i0:])
+    left = tensile_peak_offset(row[i0::-1])
+    return float((right + left) * grid.dx)
+
+
+def repulsive_area(P: np.ndarray, grid: Grid) -> float:
+    """Area where the pressure is repulsive (P > 0): a second contact-area definition."""
+    return float(np.count_nonzero(P > 0) * grid.area)
+
+
+def gap_area(H: np.ndarray, grid: Grid, threshold: float = 0.0) -> float:
+    """Area where the gap H = h/ε − 1 is below ``threshold`` (h below ε(1 + threshold))."""
+    return float(np.count_nonzero(H <= threshold) * grid.area)
+
+
+def apex_index(U0: np.ndarray) -> tuple[int, int]:
+    """Grid index of the highest point (smallest initial gap); the centre pixel wins ties."""
+    m = U0.min()
+    idx = np.argwhere(U0 <= m + 1e-12)
+    c = np.array(U0.shape) // 2
+    k = np.argmin(((idx - c) ** 2).sum(axis=1))
+    return tuple(int(v) for v in idx[k])
+
+
+@dataclass(frozen=True)
+class StateSummary:
+    """Scalar outputs of one equilibrium."""
+
+    F: float
+    contact_length: float
+    area_repulsive: float
+    min_gap: float
+    max_pressure: float
+    min_pressure: float
+
+
+def summarize(P: np.ndarray, H: np.ndarray, grid: Grid, apex: tuple[int, int]) -> StateSummary:
+    return StateSummary(
+        F=force(P, grid),
+        contact_length=contact_length(P, grid, apex),
+        area_repulsive=repulsive_area(P, grid),
+        min_gap=float(H.min()),
+        max_pressure=float(P.max()),
+        min_pressure=float(P.min()),
+    )

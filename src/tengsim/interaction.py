@@ -1,0 +1,125 @@
+"""Surface interaction laws: pressure P(g) and energy per area Φ(g) of the gap g = H + 1 = h/ε.
+
+Positive P is repulsive and P = −dΦ/dg.  Units: P in W/ε, Φ in W (paper Eq. 7).
+
+Every law is made safe for any trial gap (a solver's line search may try g <= 0): below ``g_safe``
+the pressure continues linearly with the slope it has there (Φ quadratic), so P and Φ stay finite and
+C¹; physical equilibria never reach g_safe.  States are always judged by the residual of Eq. (9).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from tengsim.errors import TengsimError, positive
+
+
+class Law:
+    """Base class: subclasses give the raw law for g >= g_safe via ``_raw(g) -> (Φ, P, dP/dg)``."""
+
+    g_safe: float
+
+    def _raw(self, g):  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    def _safe(self):
+        gs = np.array([self.g_safe])
+        phi, p, dp = self._raw(gs)
+        return float(phi[0]), float(p[0]), float(dp[0])
+
+    def evaluate(self, g: np.ndarray):
+        """Return (Φ, P) at gaps g (arrays of g's shape)."""
+        g = np.asarray(g, dtype=float)
+        low = g < self.g_safe
+        if not low.any():
+            phi, p, _ = self._raw(g)
+            return phi, p
+        gg = np.where(low, self.g_safe, g)
+        phi, p, _ = self._raw(gg)
+        phs, ps, dps = self._safe()
+        t = g - self.g_safe
+        p = np.where(low, ps + dps * t, p)
+        phi = np.where(low, phs - ps * t - 0.5 * dps * t * t, phi)
+        return phi, p
+
+    def pressure(self, g):
+        return self.evaluate(g)[1]
+
+    def energy(self, g):
+        return self.evaluate(g)[0]
+
+    def stiffness(self, g):
+        """−dP/dg = Φ''(g), the local interaction stiffness."""
+        g = np.asarray(g, dtype=float)
+        gg = np.maximum(g, self.g_safe)
+        return -self._raw(gg)[2]
+
+    def params(self) -> dict:
+        d = dict(self.__dict__)
+        d["law"] = type(self).__name__
+        return d
+
+
+@dataclass(frozen=True)
+class LJ93(Law):
+    """The paper's law, Eq. (2)/(8): P = (8/3)[g⁻⁹ − g⁻³], Φ = (1/3)g⁻⁸ − (4/3)g⁻².
+
+    A 9-3 law in pressure (8-2 in energy, Derjaguin): Φ(1) = −1 (the work of adhesion W),
+    P(1) = 0, tensile peak P_min = −(16/9)·3^{-1/2}·... at g = 3^{1/6}.
+    """
+
+    g_safe: float = 0.6
+
+    def __post_init__(self):
+        if not 0 < self.g_safe < 1:
+            raise TengsimError(f"g_safe must lie in (0, 1), got {self.g_safe!r}")
+
+    def _raw(self, g):
+        inv = 1.0 / g
+        i2 = inv * inv
+        i3 = i2 * inv
+        i8 = i2 * i2
+        i8 *= i8
+        i9 = i8 * inv
+        phi = i8 / 3.0 - (4.0 / 3.0) * i2
+        p = (8.0 / 3.0) * (i9 - i3)
+        dp = (8.0 / 3.0) * (-9.0 * i9 + 3.0 * i3) * inv
+        return phi, p, dp
+
+
+@dataclass(frozen=True)
+class Repulsive(Law):
+    """Non-adhesive wall: P = c g^{−k}, Φ = c g^{1−k}/(k − 1) (k > 1); for Hertz-type checks.
+
+    With c = 8/3, k = 9 it is the repulsive half of the paper's law; the wall sits near g ≈ 1.
+    """
+
+    scale: float = 8.0 / 3.0
+    exponent: float = 9.0
+    g_safe: float = 0.6
+
+    def __post_init__(self):
+        positive("scale", self.scale)
+        if not self.exponent > 1:
+            raise TengsimError(f"exponent must be > 1, got {self.exponent!r}")
+        if not 0 < self.g_safe < 1:
+            raise TengsimError(f"g_safe must lie in (0, 1), got {self.g_safe!r}")
+
+    def _raw(self, g):
+        k, c = self.exponent, self.scale
+        gk = g ** (-k)
+        p = c * gk
+        phi = c * gk * g / (k - 1)
+        dp = -k * p / g
+        return phi, p, dp
+
+
+def make_law(name: str) -> Law:
+    """Law by name: 'lj93' (the paper's, default) or 'repulsive'."""
+    key = name.lower().replace("-", "").replace("_", "")
+    if key in ("lj93", "lj", "paper", "lj82"):
+        return LJ93()
+    if key in ("repulsive", "hertz", "nonadhesive"):
+        return Repulsive()
+    raise TengsimError(f"unknown interaction law {name!r} (choose 'lj93' or 'repulsive')")

@@ -1,0 +1,162 @@
+"""Result of an approach–retraction run: curves, maps, events and every parameter; NetCDF/CSV out."""
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from tengsim.grid import Grid
+
+_trapz = getattr(np, "trapezoid", None) or np.trapz
+
+CURVE_COLUMNS = ["branch", "D", "F", "contact_length", "area_repulsive", "converged", "residual",
+                 "iterations", "n_conv", "on_grid", "jump", "min_gap", "max_pressure",
+                 "min_pressure", "energy", "seconds"]
+
+
+@dataclass(frozen=True)
+class Jump:
+    """A discontinuity on a branch: the state jumped between D_before and D_after."""
+
+    branch: str
+    D_before: float
+    D_after: float
+    F_before: float
+    F_after: float
+    length_before: float
+    length_after: float
+
+    @property
+    def kind(self) -> str:
+        if self.branch == "approach":
+            return "jump-in" if self.length_after >= self.length_before else "jump"
+        return "jump-out" if self.length_after <= self.length_before else "jump"
+
+
+@dataclass
+class ContactResult:
+    """Curves (one entry per equilibrium, in path order), maps at chosen D, and parameters."""
+
+    table: dict
+    grid: Grid
+    maps: list = field(default_factory=list)
+    params: dict = field(default_factory=dict)
+    seconds: float = 0.0
+    final_state: object = None
+
+    @classmethod
+    def from_rows(cls, rows, maps, grid, seconds=0.0, final_state=None):
+        table = {k: np.array([r[k] for r in rows]) for k in CURVE_COLUMNS}
+        return cls(table=table, grid=grid, maps=maps, seconds=seconds, final_state=final_state)
+
+    # ---- selections -------------------------------------------------------------------------
+    def branch(self, name: str) -> dict:
+        """Columns restricted to one branch ('approach' or 'retraction'), in path order."""
+        m = self.table["branch"] == name
+        return {k: v[m] for k, v in self.table.items()}
+
+    @property
+    def all_converged(self) -> bool:
+        return bool(np.all(self.table["converged"]))
+
+    # ---- events -----------------------------------------------------------------------------
+    @property
+    def jumps(self) -> list[Jump]:
+        out = []
+        t = self.table
+        for i in np.flatnonzero(t["jump"]):
+            if i == 0 or t["branch"][i - 1] != t["branch"][i]:
+                continue
+            out.append(Jump(str(t["branch"][i]), float(t["D"][i - 1]), float(t["D"][i]),
+                            float(t["F"][i - 1]), float(t["F"][i]),
+                            float(t["contact_length"][i - 1]), float(t["contact_length"][i])))
+        return out
+
+    @property
+    def pull_off_force(self) -> float:
+        """Most tensile force on the retraction branch (the pull-off force, F of Eq. 10)."""
+        r = self.branch("retraction")
+        if len(r["F"]) == 0:
+            return float("nan")
+        return float(np.min(r["F"]))
+
+    @property
+    def hysteresis(self) -> float:
+        """∮ F dD between approach and retraction (energy lost per cycle, units 3π W ε ℓ²... of F·D)."""
+        a, r = self.branch("approach"), self.branch("retraction")
+        if len(r["D"]) < 2:
+            return 0.0
+        ia = np.argsort(a["D"])
+        ir = np.argsort(r["D"])
+        return float(_trapz(a["F"][ia], a["D"][ia]) - _trapz(r["F"][ir], r["D"][ir]))
+
+    def transition_D(self, full_length: float, tol: float | None = None) -> float:
+        """First approach D at which Λc reaches ``full_length`` (within ``tol``, default 1.5 dx):
+        the partial-to-full contact transition of paper Fig. 4(a); linearly interpolated."""
+        tol = 1.5 * self.grid.dx if tol is None else tol
+        a = self.branch("approach")
+        L = a["contact_length"]
+        hit = np.flatnonzero(L >= full_length - tol)
+        if len(hit) == 0:
+            return float("nan")
+        i = hit[0]
+        if i == 0:
+            return float(a["D"][0])
+        x0, x1, y0, y1 = a["D"][i - 1], a["D"][i], L[i - 1], L[i]
+        target = full_length - tol
+        if y1 == y0:
+            return float(x1)
+        return float(x0 + (target - y0) * (x1 - x0) / (y1 - y0))
+
+    # ---- output -----------------------------------------------------------------------------
+    def to_dataset(self):
+        """xarray Dataset: curves along dim 'step', maps along ('map', 'x', 'y'), parameters in attrs."""
+        import xarray as xr
+
+        t = self.table
+        data = {k: ("step", t[k].astype(str) if k == "branch" else t[k]) for k in CURVE_COLUMNS}
+        for k in ("converged", "on_grid", "jump"):
+            data[k] = ("step", t[k].astype(np.int8))
+        ds = xr.Dataset(data)
+        units = {"D": "ε (rigid approach, Eq. 7)", "F": "3π W ε m²/n² (Eq. 7/10)",
+                 "contact_length": "ε m/n (Λc, Eq. 7)", "residual": "ε (max |r| of Eq. 9)",
+                 "area_repulsive": "(ε m/n)²"}
+        for k, u in units.items():
+            ds[k].attrs["units"] = u
+        if self.maps:
+            ds = ds.assign(
+                map_branch=("map", np.array([m["branch"] for m in self.maps])),
+                map_D=("map", np.array([m["D"] for m in self.maps])),
+                P=(("map", "x", "y"), np.stack([m["P"] for m in self.maps])),
+                H=(("map", "x", "y"), np.stack([m["H"] for m in self.maps])),
+            )
+        ds = ds.assign_coords(x=("x", self.grid.x), y=("y", self.grid.y))
+        ds.attrs["params"] = json.dumps(self.params, default=str)
+        ds.attrs["pull_off_F"] = self.pull_off_force
+        ds.attrs["n_unconverged"] = int(np.count_nonzero(~t["converged"].astype(bool)))
+        ds.attrs["jumps"] = json.dumps([j.__dict__ for j in self.jumps])
+        ds.attrs["seconds"] = self.seconds
+        for k, v in self.params.items():
+            if isinstance(v, (int, float, str)) and not isinstance(v, bool):
+                ds.attrs[k] = v
+        return ds
+
+    def csv_columns(self) -> dict:
+        t = self.table
+        return {k: t[k] for k in CURVE_COLUMNS}
+
+    def save(self, path) -> None:
+        """Write ``.csv`` (curves, parameters in '#' header lines) or ``.nc`` (everything), atomically."""
+        from pathlib import Path
+
+        from tengsim import io
+        from tengsim.errors import TengsimError
+
+        suffix = Path(path).suffix.lower()
+        if suffix == ".csv":
+            io.write_csv(path, self.csv_columns(), header=self.params)
+        elif suffix in (".nc", ".netcdf", ".nc4"):
+            io.write_dataset(self.to_dataset(), path)
+        else:
+            raise TengsimError(f"unknown output format {suffix!r} for {path} (use .csv or .nc)")

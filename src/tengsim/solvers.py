@@ -1,0 +1,280 @@
+"""Equilibrium solvers for Eq. (9): find a stable state H of one rigid approach D from a start state.
+
+Notation (dimensionless, paper Eq. 7): gap g = H + 1, initial gap g0 = U0 − D + 1, surface
+displacement w = K q of an "elastic pressure" field q, so g = g0 + w.  The total energy of the cell is
+
+    E(q) = ΔA [ ½ q·K q + Σ Φ(g0 + K q) ],
+
+whose stationary points satisfy q = P(g), i.e. H = −D + U0 + K P(H): exactly Eq. (9).  The residual
+of Eq. (9), r = H − (−D + U0 + K P(H)) = w − K P(g), in units of ε, is how every state is judged.
+A solver returns an :class:`Equilibrium` and never silently returns an unconverged one: ``converged``
+is False and ``message`` says why.
+
+Both solvers descend E, so from a warm start they settle in a local minimum: a stable equilibrium.
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from tengsim.errors import TengsimError
+
+
+@dataclass
+class Problem:
+    """One equilibrium problem: initial gap g0 = U0 − D + 1, a law and a kernel."""
+
+    g0: np.ndarray
+    law: object
+    kernel: object
+
+    @property
+    def dA(self) -> float:
+        return self.kernel.grid.area
+
+
+@dataclass
+class State:
+    """Solver state: q (elastic pressure) and w = K q (surface displacement)."""
+
+    q: np.ndarray
+    w: np.ndarray
+
+    @classmethod
+    def zero(cls, shape) -> "State":
+        return cls(np.zeros(shape), np.zeros(shape))
+
+    def copy(self) -> "State":
+        return State(self.q.copy(), self.w.copy())
+
+
+@dataclass
+class Equilibrium:
+    """A solved state with its convergence record."""
+
+    state: State
+    H: np.ndarray
+    P: np.ndarray
+    residual: float          # max |r| of Eq. (9), units of ε
+    converged: bool
+    iterations: int
+    n_conv: int              # convolutions (FFT pairs) spent
+    energy: float
+    seconds: float
+    message: str = ""
+
+    @property
+    def force_sum(self) -> float:  # pragma: no cover - convenience
+        return float(self.P.sum())
+
+
+def _finish(problem, state, P, r, energy, converged, it, n_conv, t0, msg):
+    H = problem.g0 + state.w - 1.0
+    res = float(np.max(np.abs(r)))
+    return Equilibrium(state, H, P, res, converged, it, n_conv, float(energy), time.perf_counter() - t0, msg)
+
+
+@dataclass(frozen=True)
+class FastSolver:
+    """L-BFGS on E(q) in the metric of the elastic kernel (K-preconditioned), strong-Wolfe line search.
+
+    Each iteration spends exactly one convolution, K P(g) at the new state: the direction's image
+    K d is assembled from stored images (K s = Δw, K y = Δr, K G = r), and the line search along d
+    needs only element-wise work, since g(α) = g + α K d.  Converged when max|r| <= ``tol``.
+    """
+
+    tol: float = 1e-6
+    max_iter: int = 3000
+    memory: int = 10
+    name: str = "fast"
+
+    def __post_init__(self):
+        if not self.tol > 0:
+            raise TengsimError(f"tol must be > 0, got {self.tol!r}")
+        if int(self.memory) < 1:
+            raise TengsimError(f"memory must be >= 1, got {self.memory!r}")
+
+    def solve(self, problem: Problem, start: State) -> Equilibrium:
+        t0 = time.perf_counter()
+        K, law, g0, dA = problem.kernel, problem.law, problem.g0, problem.dA
+        q, w = start.q.copy(), start.w.copy()
+        g = g0 + w
+        phi, P = law.evaluate(g)
+        r = w - K.apply(P)
+        n_conv = 1
+        G = q - P
+        E = dA * (0.5 * np.vdot(q, w) + phi.sum())
+        S, KS, Y, KY, RHO = [], [], [], [], []
+        for it in range(self.max_iter + 1):
+            rmax = float(np.max(np.abs(r)))
+            if not math.isfinite(rmax):
+                return _finish(problem, State(q, w), P, r, E, False, it, n_conv, t0, "non-finite residual")
+            if rmax <= self.tol:
+                return _finish(problem, State(q, w), P, r, E, True, it, n_conv, t0, "converged")
+            if it == self.max_iter:
+                break
+            # two-loop recursion in the K inner product <a, b> = dA a·K b
+            v, Kv = G.copy(), r.copy()
+            alphas = []
+            for s, ks, y, ky, rho in zip(reversed(S), reversed(KS), reversed(Y), reversed(KY), reversed(RHO)):
+                a = rho * dA * np.vdot(s, Kv)
+                v -= a * y
+                Kv -= a * ky
+                alphas.append(a)
+            if S:
+                gamma = np.vdot(S[-1], KY[-1]) / np.vdot(Y[-1], KY[-1])
+                v *= gamma
+                Kv *= gamma
+            for s, ks, y, ky, rho, a in zip(S, KS, Y, KY, RHO, reversed(alphas)):
+                b = rho * dA * np.vdot(y, Kv)
+                v += (a - b) * s
+                Kv += (a - b) * ks
+            d, Kd = -v, -Kv
+            slope = dA * np.vdot(r, d)
+            if not slope < 0:  # not a descent direction: restart from the preconditioned gradient
+                S, KS, Y, KY, RHO = [], [], [], [], []
+                d, Kd = -G, -r
+                slope = -dA * np.vdot(G, r)
+            alpha, E_new, phi_new, P_new = _wolfe(law, g, Kd, q, w, d, E, slope, dA, first=not S)
+            if alpha is None:
+                return _finish(problem, State(q, w), P, r, E, False, it, n_conv, t0, "line search failed")
+            s, ks = alpha * d, alpha * Kd
+            q = q + s
+            w = w + ks
+            g = g0 + w
+            P = P_new
+            r_new = w - K.apply(P)
+            n_conv += 1
+            G_new = q - P
+            y, ky = G_new - G, r_new - r
+            sy = np.vdot(s, ky)
+            if sy > 1e-14 * max(abs(np.vdot(s, ks)), 1e-300):
+                S.append(s), KS.append(ks), Y.append(y), KY.append(ky), RHO.append(1.0 / (dA * sy))
+                if len(S) > self.memory:
+                    for lst in (S, KS, Y, KY, RHO):
+                        lst.pop(0)
+            r, G, E = r_new, G_new, E_new
+        return _finish(problem, State(q, w), P, r, E, False, self.max_iter, n_conv, t0,
+                       f"not converged in {self.max_iter} iterations")
+
+
+def _wolfe(law, g, Kd, q, w, d, E0, slope0, dA, first, c1=1e-4, c2=0.9, max_eval=30):
+    """Strong-Wolfe line search along d; element-wise only (no convolution).
+
+    E(α) = dA[½ q·w + α d·w + ½ α² d·K d + Σ Φ(g + α K d)],
+    E'(α) = dA[d·w + α d·K d − P(g + α K d)·K d].
+    """
+    qw = 0.5 * np.vdot(q, w)
+    a0 = np.vdot(d, w)
+    a1 = np.vdot(d, Kd)
+
+    def f(alpha):
+        phi, P = law.evaluate(g + alpha * Kd)
+        e = dA * (qw + alpha * a0 + 0.5 * alpha * alpha * a1 + phi.sum())
+        de = dA * (a0 + alpha * a1 - np.vdot(P, Kd))
+        return e, de, phi, P
+
+    alpha = 1.0
+    if first:  # scale the first trial step so that the gap moves by at most 0.25 ε
+        m = float(np.max(np.abs(Kd)))
+        if m > 0.25:
+            alpha = 0.25 / m
+    lo, hi = 0.0, None
+    e_lo, de_lo = E0, slope0
+    for _ in range(max_eval):
+        e, de, phi, P = f(alpha)
+        if not np.isfinite(e):
+            hi, e_hi = alpha, np.inf
+        elif e > E0 + c1 * alpha * slope0 or (hi is None and lo > 0 and e >= e_lo):
+            hi = alpha
+        else:
+            if abs(de) <= -c2 * slope0:
+                return alpha, e, phi, P
+            if de > 0:
+                hi = alpha
+            else:
+                lo, e_lo, de_lo = alpha, e, de
+        if hi is None:
+            alpha = 2.0 * alpha
+        else:
+            # safeguarded interpolation: quadratic from (lo, e_lo, de_lo) and the trial, else bisect
+            alpha_new = 0.5 * (lo + hi)
+            alpha = alpha_new
+    # accept any decrease after the budget (Armijo point), else fail
+    if lo > 0:
+        e, de, phi, P = f(lo)
+        return lo, e, phi, P
+    return None, None, None, None
+
+
+@dataclass(frozen=True)
+class VSRSolver:
+    """Virtual-state relaxation (the paper's method): pseudo-time relaxation of Eq. (9).
+
+    Evolution equation:  dH/dτ = −r(H),  r(H) = H − (−D + U0 + K P(H)),
+    integrated by explicit Euler in τ with an adaptive step Δτ (grown ×1.2 after a step that lowers
+    ‖r‖₂, halved and retried after one that raises it).  It is a K-preconditioned gradient flow of
+    the energy (dE/dτ = −ΔA r·K⁻¹r <= 0), so it comes to rest in a stable equilibrium.
+    One convolution per pseudo-time step.
+    """
+
+    tol: float = 1e-6
+    max_iter: int = 200000
+    dt0: float = 0.5
+    name: str = "vsr"
+
+    def __post_init__(self):
+        if not self.tol > 0:
+            raise TengsimError(f"tol must be > 0, got {self.tol!r}")
+
+    def solve(self, problem: Problem, start: State) -> Equilibrium:
+        t0 = time.perf_counter()
+        K, law, g0 = problem.kernel, problem.law, problem.g0
+        w = start.w.copy()
+        P = law.pressure(g0 + w)
+        r = w - K.apply(P)
+        n_conv = 1
+        norm = float(np.linalg.norm(r))
+        dt = self.dt0
+        it = 0
+        while it < self.max_iter:
+            rmax = float(np.max(np.abs(r)))
+            if rmax <= self.tol:
+                break
+            if not math.isfinite(rmax):
+                break
+            w_try = w - dt * r
+            P_try = law.pressure(g0 + w_try)
+            r_try = w_try - K.apply(P_try)
+            n_conv += 1
+            it += 1
+            n_try = float(np.linalg.norm(r_try))
+            if n_try <= norm:
+                w, P, r, norm = w_try, P_try, r_try, n_try
+                dt = min(dt * 1.2, 1.0)
+            else:
+                dt *= 0.5
+                if dt < 1e-12:
+                    break
+        rmax = float(np.max(np.abs(r)))
+        ok = rmax <= self.tol
+        phi, _ = law.evaluate(g0 + w)
+        # q = P at equilibrium: keep it so a fast solve can continue from a VSR state
+        energy = problem.dA * (0.5 * np.vdot(P, w) + phi.sum())
+        msg = "converged" if ok else f"not converged in {it} pseudo-time steps (max|r| = {rmax:.2e})"
+        return _finish(problem, State(P.copy(), w), P, r, energy, ok, it, n_conv, t0, msg)
+
+
+SOLVERS = {"fast": FastSolver, "vsr": VSRSolver}
+
+
+def make_solver(name: str, tol: float = 1e-6, **kw):
+    """Solver by name: 'fast' (L-BFGS) or 'vsr' (the paper's relaxation)."""
+    try:
+        cls = SOLVERS[name]
+    except KeyError:
+        raise TengsimError(f"unknown solver {name!r} (choose 'fast' or 'vsr')") from None
+    return cls(tol=tol, **kw)

@@ -1,0 +1,146 @@
+"""Physical units at the edges: quantity parsing and the paper's scaling (Eq. 7)."""
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass
+
+from tengsim.errors import TengsimError, positive
+
+_PREFIX = {"": 1.0, "k": 1e3, "M": 1e6, "G": 1e9, "m": 1e-3, "u": 1e-6, "µ": 1e-6, "μ": 1e-6,
+           "n": 1e-9, "p": 1e-12, "c": 1e-2}
+_BASE = {
+    "m": ("length", 1.0),
+    "Pa": ("pressure", 1.0),
+    "N/m2": ("pressure", 1.0),
+    "J/m2": ("energy/area", 1.0),
+    "N/m": ("energy/area", 1.0),
+    "N": ("force", 1.0),
+    "C/m2": ("charge/area", 1.0),
+    "F/m": ("permittivity", 1.0),
+    "ohm": ("resistance", 1.0),
+    "Ohm": ("resistance", 1.0),
+    "Hz": ("frequency", 1.0),
+    "s": ("time", 1.0),
+    "g": ("mass", 1e-3),
+    "kg": ("mass", 1.0),
+}
+_NUM = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
+
+
+def parse_quantity(text, kind: str | None = None, name: str = "value") -> float:
+    """'0.59MPa' → 590000.0 (SI).  A bare number is taken as SI.  ``kind`` checks the dimension.
+
+    Units: m, Pa, N/m2, J/m2, N/m, N, C/m2, ohm, Hz, s, g, kg, with prefixes k M G m u µ n p c
+    (e.g. um, mJ/m2, uC/m2, MOhm, cm).  'm2' and '^2' are both accepted.
+    """
+    if isinstance(text, (int, float)):
+        v = float(text)
+    else:
+        s = str(text).strip().replace(" ", "").replace("^2", "2").replace("²", "2")
+        m = re.fullmatch(f"({_NUM})(.*)", s)
+        if not m:
+            raise TengsimError(f"cannot read {name} = {text!r} as a number with a unit")
+        v = float(m.group(1))
+        unit = m.group(2)
+        if unit:
+            found = None
+            for base, (dim, f) in _BASE.items():
+                for pre, pf in _PREFIX.items():
+                    if unit == pre + base and (found is None or len(base) > len(found[0])):
+                        found = (base, dim, f * pf)
+            if found is None:
+                raise TengsimError(f"unknown unit {unit!r} in {name} = {text!r}")
+            _, dim, factor = found
+            if kind and dim != kind:
+                raise TengsimError(f"{name} = {text!r} is a {dim}, expected a {kind}")
+            v *= factor
+    if not math.isfinite(v):
+        raise TengsimError(f"{name} must be finite, got {text!r}")
+    return v
+
+
+@dataclass(frozen=True)
+class PaperScaling:
+    """The paper's dimensionless variables (Eq. 7) for a pyramid of base m, height n in pitch L.
+
+    Give ε directly or the Tabor parameter μ = (m W / (n E* ε))^{2/3}; SI units throughout.
+    """
+
+    E_star: float
+    W: float
+    m: float
+    n: float
+    L: float
+    eps: float
+
+    def __post_init__(self):
+        for k in ("E_star", "W", "m", "n", "L", "eps"):
+            positive(k, getattr(self, k))
+        if self.m > self.L:
+            raise TengsimError(f"pyramid base m = {self.m:g} m is wider than its pitch L = {self.L:g} m")
+
+    @classmethod
+    def from_tabor(cls, E_star, W, m, n, L, mu) -> "PaperScaling":
+        mu = positive("tabor", mu)
+        eps = m * W / (n * positive("E_star", E_star) * mu**1.5)
+        return cls(E_star, W, m, n, L, eps)
+
+    @property
+    def mu(self) -> float:
+        return (self.m * self.W / (self.n * self.E_star * self.eps)) ** (2.0 / 3.0)
+
+    @property
+    def N(self) -> float:
+        return self.n / (2 * self.eps)
+
+    @property
+    def cell(self) -> float:
+        """L̄ = L n/(ε m)."""
+        return self.L * self.n / (self.eps * self.m)
+
+    @property
+    def lateral(self) -> float:
+        """Length of one unit of X: ε m/n (m)."""
+        return self.eps * self.m / self.n
+
+    def length(self, X):
+        """Dimensionless in-plane length (e.g. Λc) → metres: λc = Λc ε m/n."""
+        return X * self.lateral
+
+    def force(self, F):
+        """Dimensionless F (Eq. 10) → newtons per cell: f = 3π m² W ε F/n²."""
+        return F * 3 * math.pi * self.m**2 * self.W * self.eps / self.n**2
+
+    def pressure(self, F):
+        """Nominal pressure on the array f/L² (Pa)."""
+        return self.force(F) / self.L**2
+
+    def displacement(self, D):
+        """D → α = D ε (m)."""
+        return D * self.eps
+
+    def params(self) -> dict:
+        return {"E_star_Pa": self.E_star, "W_J_m2": self.W, "base_m": self.m, "height_m": self.n,
+                "pitch_m": self.L, "eps_m": self.eps, "tabor": self.mu}
+
+
+# The paper's three groups (Section 3): pitch L, base m, height n in metres; E* = 0.59 MPa,
+# W = 54 mJ/m², μ = 0.5.
+PAPER_GROUPS = {
+    "A": dict(L=2.0e-6, m=1.0e-6, n=0.7e-6),
+    "B": dict(L=5.0e-6, m=2.5e-6, n=1.75e-6),
+    "C": dict(L=10.0e-6, m=5.0e-6, n=3.5e-6),
+}
+PAPER_E_STAR = 0.59e6
+PAPER_W = 54e-3
+PAPER_TABOR = 0.5
+
+
+def paper_scaling(group: str) -> PaperScaling:
+    """The paper's scaling for pyramid group 'A', 'B' or 'C'."""
+    try:
+        g = PAPER_GROUPS[group.upper()]
+    except KeyError:
+        raise TengsimError(f"unknown pyramid group {group!r} (choose A, B or C)") from None
+    return PaperScaling.from_tabor(PAPER_E_STAR, PAPER_W, g["m"], g["n"], g["L"], PAPER_TABOR)
