@@ -34,7 +34,7 @@ class RunSettings:
 
     @classmethod
     def preset(cls, quick: bool) -> "RunSettings":
-        return cls(dx=0.25, d_step=0.25, tol=1e-5) if quick else cls()
+        return cls(dx=0.15, d_step=0.25, tol=1e-5) if quick else cls()
 
 
 def group_shape(group: str) -> Pyramid:

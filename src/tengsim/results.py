@@ -91,21 +91,20 @@ class ContactResult:
         ir = np.argsort(r["D"])
         return float(_trapz(a["F"][ia], a["D"][ia]) - _trapz(r["F"][ir], r["D"][ir]))
 
-    def transition_D(self, full_length: float, tol: float | None = None) -> float:
-        """First approach D at which Λc reaches ``full_length`` (within ``tol``, default 1.5 dx):
-        the partial-to-full contact transition of paper Fig. 4(a); linearly interpolated."""
-        tol = 1.5 * self.grid.dx if tol is None else tol
+    def transition_D(self, full_length: float, fraction: float = 0.95) -> float:
+        """First approach D at which Λc reaches ``fraction`` × ``full_length`` (linear interpolation):
+        the partial-to-full contact transition of paper Fig. 4(a).  NaN if never reached."""
         a = self.branch("approach")
         L = a["contact_length"]
-        hit = np.flatnonzero(L >= full_length - tol)
+        target = fraction * full_length
+        hit = np.flatnonzero(L >= target)
         if len(hit) == 0:
             return float("nan")
         i = hit[0]
         if i == 0:
             return float(a["D"][0])
         x0, x1, y0, y1 = a["D"][i - 1], a["D"][i], L[i - 1], L[i]
-        target = full_length - tol
-        if y1 == y0:
+        if a["jump"][i] or y1 == y0:
             return float(x1)
         return float(x0 + (target - y0) * (x1 - x0) / (y1 - y0))
 
