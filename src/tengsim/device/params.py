@@ -1,0 +1,253 @@
+"""Device parameters (paper Section 5, Eqs. 13-24) and the charged-area models.
+
+All inputs are SI. The dimensionless groups of Eq. (23) are derived here so that the
+integrator works on the well-scaled core of Eq. (24).
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+
+from tengsim.errors import TengsimError, finite, positive, require
+
+EPS0 = 8.8541878128e-12
+"""Vacuum permittivity (F/m, CODATA 2018); the paper rounds it to 8.85e-12."""
+
+FORCE_MODELS = ("field", "eq20", "none")
+AREA_PRESSURES = ("applied", "contact")
+AREA_MEMORIES = ("max", "release")
+INITIAL_CHARGES = ("zero", "rest")
+
+
+@dataclass(frozen=True)
+class ConstantArea:
+    """Charged area A = fraction * S, independent of pressure (flat interface, Fig. 7)."""
+
+    fraction: float = 1.0
+
+    def __post_init__(self):
+        f = finite("area fraction", self.fraction)
+        require(0.0 <= f <= 1.0, f"area fraction must be in [0, 1], got {self.fraction!r}")
+        object.__setattr__(self, "fraction", f)
+
+    @property
+    def initial_fraction(self) -> float:
+        """A flat device is taken as charged from the start."""
+        return self.fraction
+
+    def __call__(self, pressure_Pa):
+        return np.full_like(np.asarray(pressure_Pa, dtype=float), self.fraction)
+
+    def to_dict(self) -> dict:
+        return {"kind": "constant", "fraction": self.fraction}
+
+
+@dataclass(frozen=True, eq=False)
+class AreaTable:
+    """Charged-area fraction A/S = lambda_c^2/L^2 against pressure (Fig. 8a), linearly interpolated.
+
+    Outside the table the end values are held. The polymer is uncharged until first contact.
+    """
+
+    pressure_Pa: np.ndarray
+    area_fraction: np.ndarray
+
+    def __post_init__(self):
+        try:
+            p = np.array(self.pressure_Pa, dtype=float).ravel()
+            a = np.array(self.area_fraction, dtype=float).ravel()
+        except (TypeError, ValueError):
+            raise TengsimError("area table must hold numbers") from None
+        require(p.size >= 2, f"area table needs at least 2 points, got {p.size}")
+        require(p.size == a.size, f"area table: {p.size} pressures but {a.size} area fractions")
+        require(bool(np.all(np.isfinite(p)) and np.all(np.isfinite(a))), "area table holds non-finite values")
+        require(bool(np.all(np.diff(p) > 0)), "area table pressures must be strictly increasing")
+        bad = a[(a < 0) | (a > 1)]
+        require(bad.size == 0, f"area fractions must be in [0, 1], got {bad[:3].tolist()}")
+        p.setflags(write=False)
+        a.setflags(write=False)
+        object.__setattr__(self, "pressure_Pa", p)
+        object.__setattr__(self, "area_fraction", a)
+
+    @classmethod
+    def from_table(cls, table) -> "AreaTable":
+        """Wrap any object with ``pressure_Pa`` and ``area_fraction`` (e.g. the contact engine's)."""
+        return cls(table.pressure_Pa, table.area_fraction)
+
+    @property
+    def initial_fraction(self) -> float:
+        return 0.0
+
+    def __call__(self, pressure_Pa):
+        return np.interp(np.asarray(pressure_Pa, dtype=float), self.pressure_Pa, self.area_fraction)
+
+    def to_dict(self) -> dict:
+        return {"kind": "table", "pressure_Pa": self.pressure_Pa.tolist(),
+                "area_fraction": self.area_fraction.tolist()}
+
+
+def _choice(name, value, allowed):
+    require(value in allowed, f"{name} must be one of {list(allowed)}, got {value!r}")
+    return value
+
+
+@dataclass(frozen=True)
+class DeviceParams:
+    """A conductor-to-dielectric contact-separation TENG (Fig. 6), SI units.
+
+    ``load_ohm`` = 0 is the short-circuit limit, ``math.inf`` the open circuit.
+    ``damping_ratio`` zeta adds c = 2 zeta sqrt(M k_e) to Eq. (13).
+    ``force_model``: "field" (default, (sigma A - Q)^2 / (2 eps0 S)), "eq20" (Eq. 20, sign
+    corrected, 1/d regularised by ``eq20_reg`` d0) or "none".
+    """
+
+    mass_kg: float
+    stiffness_N_per_m: float
+    area_m2: float
+    thickness_m: float
+    gap_m: float
+    eps_r: float
+    sigma_C_per_m2: float
+    load_ohm: float = 1.0e6
+    damping_ratio: float = 0.7
+    area: ConstantArea | AreaTable = field(default_factory=ConstantArea)
+    force_model: str = "field"
+    eq20_reg: float = 1.0e-3
+    area_pressure: str = "applied"
+    area_memory: str = "max"
+    initial_charge: str = "zero"
+
+    def __post_init__(self):
+        for name in ("mass_kg", "stiffness_N_per_m", "area_m2", "thickness_m", "gap_m", "eps_r",
+                     "sigma_C_per_m2", "eq20_reg"):
+            object.__setattr__(self, name, positive(name, getattr(self, name)))
+        try:
+            r = float(self.load_ohm)
+        except (TypeError, ValueError):
+            raise TengsimError(f"load_ohm must be a number, got {self.load_ohm!r}") from None
+        require(r >= 0 and r == r, f"load_ohm must be >= 0 (0 = short, inf = open), got {self.load_ohm!r}")
+        object.__setattr__(self, "load_ohm", r)
+        z = finite("damping_ratio", self.damping_ratio)
+        require(z >= 0, f"damping_ratio must be >= 0, got {self.damping_ratio!r}")
+        object.__setattr__(self, "damping_ratio", z)
+        require(isinstance(self.area, (ConstantArea, AreaTable)),
+                f"area must be ConstantArea or AreaTable, got {type(self.area).__name__}")
+        _choice("force_model", self.force_model, FORCE_MODELS)
+        _choice("area_pressure", self.area_pressure, AREA_PRESSURES)
+        _choice("area_memory", self.area_memory, AREA_MEMORIES)
+        _choice("initial_charge", self.initial_charge, INITIAL_CHARGES)
+
+    # --- scales and dimensionless groups (Eq. 23) ---
+    @property
+    def time_scale(self) -> float:
+        """sqrt(M / k_e) (s)."""
+        return math.sqrt(self.mass_kg / self.stiffness_N_per_m)
+
+    @property
+    def voltage_scale(self) -> float:
+        """sigma d0 / eps0 (V): V_OC of a fully charged plate at the rest gap (Eq. 17)."""
+        return self.sigma_C_per_m2 * self.gap_m / EPS0
+
+    @property
+    def charge_scale(self) -> float:
+        """sigma S (C)."""
+        return self.sigma_C_per_m2 * self.area_m2
+
+    @property
+    def energy_scale(self) -> float:
+        """k_e d0^2 (J)."""
+        return self.stiffness_N_per_m * self.gap_m ** 2
+
+    @property
+    def load_mode(self) -> str:
+        """"short" (R = 0), "open" (R = inf) or "finite"."""
+        if self.load_ohm == 0:
+            return "short"
+        return "open" if math.isinf(self.load_ohm) else "finite"
+
+    @property
+    def gamma2(self) -> float:
+        """d0 sqrt(M/k_e) / (eps0 S R) (Eq. 23); inf for a short, 0 for an open circuit."""
+        if self.load_mode == "short":
+            return math.inf
+        return self.gap_m * self.time_scale / (EPS0 * self.area_m2 * self.load_ohm)
+
+    @property
+    def gamma3(self) -> float:
+        """T / (eps_r d0) (Eq. 23)."""
+        return self.thickness_m / (self.eps_r * self.gap_m)
+
+    @property
+    def kappa(self) -> float:
+        """S sigma^2 / (eps0 d0 k_e): gamma4 of Eq. (23) with A = S."""
+        return self.area_m2 * self.sigma_C_per_m2 ** 2 / (EPS0 * self.gap_m * self.stiffness_N_per_m)
+
+    @property
+    def damping_N_s_per_m(self) -> float:
+        return 2.0 * self.damping_ratio * math.sqrt(self.mass_kg * self.stiffness_N_per_m)
+
+    def replace(self, **changes) -> "DeviceParams":
+        return dataclasses.replace(self, **changes)
+
+    def to_dict(self) -> dict:
+        d = asdict(self)
+        d["area"] = self.area.to_dict()
+        if math.isinf(self.load_ohm):
+            d["load_ohm"] = "inf"
+        return d
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "DeviceParams":
+        """Build from a plain mapping (config file); ``area`` is a number or {pressure_Pa, area_fraction}."""
+        require(isinstance(d, dict), f"device parameters must be a mapping, got {type(d).__name__}")
+        d = dict(d)
+        allowed = {f.name for f in cls.__dataclass_fields__.values()}
+        unknown = sorted(set(d) - allowed)
+        require(not unknown, f"unknown device parameter(s): {unknown}")
+        area = d.get("area", None)
+        if area is None:
+            d.pop("area", None)
+        elif isinstance(area, dict):
+            kind = area.get("kind", "table" if "pressure_Pa" in area else "constant")
+            if kind == "constant":
+                d["area"] = ConstantArea(area.get("fraction", 1.0))
+            else:
+                require("pressure_Pa" in area and "area_fraction" in area,
+                        "area table needs 'pressure_Pa' and 'area_fraction'")
+                d["area"] = AreaTable(area["pressure_Pa"], area["area_fraction"])
+        else:
+            d["area"] = ConstantArea(area)
+        if isinstance(d.get("load_ohm"), str):
+            require(d["load_ohm"].lower() in ("inf", "open"), f"load_ohm must be a number or 'inf', got {d['load_ohm']!r}")
+            d["load_ohm"] = math.inf
+        missing = [f.name for f in dataclasses.fields(cls)
+                   if f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING
+                   and f.name not in d]
+        require(not missing, f"missing device parameter(s): {missing}")
+        return cls(**d)
+
+
+@dataclass(frozen=True)
+class SolverOptions:
+    """Integrator settings for the flight phases (scipy.integrate.solve_ivp)."""
+
+    method: str = "LSODA"
+    rtol: float = 1e-8
+    atol: float = 1e-10
+    max_step: float = math.inf
+
+    def __post_init__(self):
+        _choice("method", self.method, ("RK45", "DOP853", "Radau", "BDF", "LSODA"))
+        for name in ("rtol", "atol", "max_step"):
+            v = float(getattr(self, name))
+            require(v > 0, f"{name} must be > 0, got {getattr(self, name)!r}")
+            object.__setattr__(self, name, v)
+
+    def to_dict(self) -> dict:
+        d = asdict(self)
+        if math.isinf(self.max_step):
+            d["max_step"] = None
+        return d

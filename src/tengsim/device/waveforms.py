@@ -1,0 +1,225 @@
+"""Applied pressure P_a(t) of Eq. (13): square wave, staircase (Fig. 8), sine, user table.
+
+Every waveform is right-continuous, vectorised (``wf(t)`` in Pa) and lists the times where it
+jumps or kinks (``breakpoints``) so that the integrator never steps across one.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from tengsim.errors import TengsimError, finite, positive, require
+
+
+def _duty(duty):
+    d = finite("duty", duty)
+    require(0 < d < 1, f"duty must be in (0, 1), got {duty!r}")
+    return d
+
+
+def _grid_breaks(period, duty, t0, t1):
+    k0 = max(0, math.floor(t0 / period) - 1)
+    k1 = math.ceil(t1 / period) + 1
+    ks = np.arange(k0, k1 + 1)
+    b = np.concatenate([ks * period, (ks + duty) * period])
+    return np.unique(b[(b > t0) & (b < t1)])
+
+
+@dataclass(frozen=True)
+class SquareWave:
+    """P = amplitude for the first ``duty`` of each period, ``low_Pa`` otherwise (Fig. 7)."""
+
+    amplitude_Pa: float
+    frequency_Hz: float
+    duty: float = 0.5
+    low_Pa: float = 0.0
+
+    def __post_init__(self):
+        object.__setattr__(self, "amplitude_Pa", finite("amplitude_Pa", self.amplitude_Pa))
+        object.__setattr__(self, "frequency_Hz", positive("frequency_Hz", self.frequency_Hz))
+        object.__setattr__(self, "duty", _duty(self.duty))
+        object.__setattr__(self, "low_Pa", finite("low_Pa", self.low_Pa))
+
+    @property
+    def period(self) -> float:
+        return 1.0 / self.frequency_Hz
+
+    duration = None
+
+    def __call__(self, t):
+        t = np.asarray(t, dtype=float)
+        phase = np.mod(t, self.period) / self.period
+        return np.where(phase < self.duty, self.amplitude_Pa, self.low_Pa)
+
+    def breakpoints(self, t0: float, t1: float) -> np.ndarray:
+        return _grid_breaks(self.period, self.duty, t0, t1)
+
+    def to_dict(self) -> dict:
+        return {"kind": "square", "amplitude_Pa": self.amplitude_Pa, "frequency_Hz": self.frequency_Hz,
+                "duty": self.duty, "low_Pa": self.low_Pa}
+
+
+@dataclass(frozen=True)
+class Staircase:
+    """Square wave whose k-th pulse has amplitude ``amplitudes_Pa[k]`` (Fig. 8); zero afterwards."""
+
+    amplitudes_Pa: tuple
+    frequency_Hz: float
+    duty: float = 0.5
+
+    def __post_init__(self):
+        try:
+            amps = tuple(float(a) for a in self.amplitudes_Pa)
+        except (TypeError, ValueError):
+            raise TengsimError(f"amplitudes_Pa must be numbers, got {self.amplitudes_Pa!r}") from None
+        require(len(amps) >= 1, "amplitudes_Pa must hold at least one amplitude")
+        require(all(math.isfinite(a) for a in amps), f"amplitudes_Pa must be finite, got {amps}")
+        object.__setattr__(self, "amplitudes_Pa", amps)
+        object.__setattr__(self, "frequency_Hz", positive("frequency_Hz", self.frequency_Hz))
+        object.__setattr__(self, "duty", _duty(self.duty))
+
+    @classmethod
+    def linear(cls, start_Pa: float, stop_Pa: float, step_Pa: float, frequency_Hz: float, duty: float = 0.5):
+        """Amplitudes start, start + step, ..., stop (inclusive), e.g. 10 -> 150 kPa by 10 kPa."""
+        step = positive("step_Pa", step_Pa)
+        n = int(round((float(stop_Pa) - float(start_Pa)) / step))
+        require(n >= 0, f"stop_Pa {stop_Pa!r} is below start_Pa {start_Pa!r}")
+        return cls(tuple(float(start_Pa) + k * step for k in range(n + 1)), frequency_Hz, duty)
+
+    @property
+    def period(self) -> float:
+        return 1.0 / self.frequency_Hz
+
+    @property
+    def duration(self) -> float:
+        return len(self.amplitudes_Pa) * self.period
+
+    def __call__(self, t):
+        t = np.asarray(t, dtype=float)
+        k = np.floor(t / self.period).astype(int)
+        phase = t / self.period - k
+        amps = np.asarray(self.amplitudes_Pa)
+        inside = (k >= 0) & (k < amps.size)
+        a = amps[np.clip(k, 0, amps.size - 1)]
+        return np.where(inside & (phase < self.duty), a, 0.0)
+
+    def breakpoints(self, t0: float, t1: float) -> np.ndarray:
+        return _grid_breaks(self.period, self.duty, t0, t1)
+
+    def to_dict(self) -> dict:
+        return {"kind": "staircase", "amplitudes_Pa": list(self.amplitudes_Pa),
+                "frequency_Hz": self.frequency_Hz, "duty": self.duty}
+
+
+@dataclass(frozen=True)
+class Sine:
+    """P = offset + amplitude sin(2 pi f t + phase); offset = amplitude, phase = -pi/2 gives 0 -> 2A."""
+
+    amplitude_Pa: float
+    frequency_Hz: float
+    offset_Pa: float = 0.0
+    phase_rad: float = 0.0
+
+    def __post_init__(self):
+        for name in ("amplitude_Pa", "offset_Pa", "phase_rad"):
+            object.__setattr__(self, name, finite(name, getattr(self, name)))
+        object.__setattr__(self, "frequency_Hz", positive("frequency_Hz", self.frequency_Hz))
+
+    @property
+    def period(self) -> float:
+        return 1.0 / self.frequency_Hz
+
+    duration = None
+
+    def __call__(self, t):
+        t = np.asarray(t, dtype=float)
+        return self.offset_Pa + self.amplitude_Pa * np.sin(2 * np.pi * self.frequency_Hz * t + self.phase_rad)
+
+    def breakpoints(self, t0: float, t1: float) -> np.ndarray:
+        return np.empty(0)
+
+    def to_dict(self) -> dict:
+        return {"kind": "sine", "amplitude_Pa": self.amplitude_Pa, "frequency_Hz": self.frequency_Hz,
+                "offset_Pa": self.offset_Pa, "phase_rad": self.phase_rad}
+
+
+@dataclass(frozen=True, eq=False)
+class TableWaveform:
+    """User table (t_s, pressure_Pa); ``kind`` "linear" or "step" (hold previous); end value held.
+
+    With ``periodic`` the table repeats with period t_s[-1] (t_s[0] must be 0).
+    """
+
+    t_s: np.ndarray
+    pressure_Pa: np.ndarray
+    kind: str = "linear"
+    periodic: bool = False
+
+    def __post_init__(self):
+        try:
+            t = np.array(self.t_s, dtype=float).ravel()
+            p = np.array(self.pressure_Pa, dtype=float).ravel()
+        except (TypeError, ValueError):
+            raise TengsimError("waveform table must hold numbers") from None
+        require(t.size >= 2 and t.size == p.size,
+                f"waveform table needs >= 2 equal-length columns, got {t.size} times and {p.size} pressures")
+        require(bool(np.all(np.isfinite(t)) and np.all(np.isfinite(p))), "waveform table holds non-finite values")
+        require(bool(np.all(np.diff(t) > 0)), "waveform table times must be strictly increasing")
+        require(self.kind in ("linear", "step"), f"kind must be 'linear' or 'step', got {self.kind!r}")
+        if self.periodic:
+            require(t[0] == 0.0, f"a periodic table must start at t = 0, got {t[0]!r}")
+        t.setflags(write=False)
+        p.setflags(write=False)
+        object.__setattr__(self, "t_s", t)
+        object.__setattr__(self, "pressure_Pa", p)
+
+    @property
+    def period(self):
+        return float(self.t_s[-1]) if self.periodic else None
+
+    @property
+    def duration(self):
+        return None if self.periodic else float(self.t_s[-1])
+
+    def __call__(self, t):
+        t = np.asarray(t, dtype=float)
+        if self.periodic:
+            t = np.mod(t, self.t_s[-1])
+        if self.kind == "linear":
+            return np.interp(t, self.t_s, self.pressure_Pa)
+        i = np.clip(np.searchsorted(self.t_s, t, side="right") - 1, 0, self.t_s.size - 1)
+        return self.pressure_Pa[i]
+
+    def breakpoints(self, t0: float, t1: float) -> np.ndarray:
+        if self.periodic:
+            per = self.t_s[-1]
+            ks = np.arange(max(0, math.floor(t0 / per) - 1), math.ceil(t1 / per) + 2)
+            b = (ks[:, None] * per + self.t_s[None, :]).ravel()
+        else:
+            b = self.t_s
+        return np.unique(b[(b > t0) & (b < t1)])
+
+    def to_dict(self) -> dict:
+        return {"kind": "table", "t_s": self.t_s.tolist(), "pressure_Pa": self.pressure_Pa.tolist(),
+                "interp": self.kind, "periodic": self.periodic}
+
+
+def waveform_from_dict(d: dict):
+    """Build a waveform from a config mapping with ``kind`` square / staircase / sine / table."""
+    require(isinstance(d, dict), f"waveform must be a mapping, got {type(d).__name__}")
+    d = dict(d)
+    kind = d.pop("kind", None)
+    makers = {"square": SquareWave, "staircase": Staircase, "sine": Sine}
+    try:
+        if kind in makers:
+            return makers[kind](**d)
+        if kind == "table":
+            interp = d.pop("interp", "linear")
+            return TableWaveform(d.pop("t_s"), d.pop("pressure_Pa"), interp, bool(d.pop("periodic", False)), **d)
+    except TypeError as exc:
+        raise TengsimError(f"waveform {kind!r}: {exc}") from None
+    except KeyError as exc:
+        raise TengsimError(f"waveform {kind!r} needs {exc}") from None
+    raise TengsimError(f"waveform kind must be square, staircase, sine or table, got {kind!r}")
