@@ -8,3 +8,5 @@ from tengsim.device.waveforms import Sine, SquareWave, Staircase, TableWaveform,
 from tengsim.device.formulas import (CMEOCycle, cmeo_cycle, eq20_force, electrostatic_energy, field_force,
                                      fom_structural, isc_apart, qsc_apart, voc_apart, voc_from_contact_length,
                                      voc_polymer, voltage)
+from tengsim.device.analysis import (FigureOfMerit, ResistanceSweep, StaticVoltageCurve, VQCycle, figure_of_merit,
+                                     resistance_sweep, steady_charge, voc_from_area, vq_cycle)

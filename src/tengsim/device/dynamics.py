@@ -8,9 +8,9 @@ Rules the paper leaves open (see docs/device.md):
 
 * Impact (gap reaches 0 with ydot > 0): perfectly inelastic; ydot -> 0, the kinetic energy
   1/2 M ydot^2 is booked as impact loss. The plate then stays at y = d0.
-* In contact: F_e = 0 (paper, after Eq. 22), Q relaxes through R with V = -Q T/(eps_r eps0 S)
-  (Eq. 22), solved exactly. Release when the net force toward the polymer,
-  P_a S - k_e d0, turns negative (the reaction would have to pull).
+* In contact: the plate does not move (F_e plays no role, as the paper says after Eq. 22); Q relaxes
+  through R with V = -Q T/(eps_r eps0 S) (Eq. 22), solved exactly. Release when the force the
+  plate would feel at y = d0, P_a S - k_e d0 + F_e, turns negative (the reaction would have to pull).
 * Charged area: while in contact A follows A(P); the polymer keeps its charge, so in flight A is
   the largest area reached so far ("max") or the area at release ("release").
 """
@@ -26,7 +26,7 @@ from scipy.optimize import brentq
 
 from tengsim.device.params import DeviceParams, SolverOptions
 from tengsim.device.result import DeviceResult
-from tengsim.errors import positive, require
+from tengsim.errors import finite, positive, require
 
 _NSTATE = 7  # y, v, Q, W_applied, W_electric, E_load, E_damping
 
@@ -100,11 +100,12 @@ def _area_fraction(core: _Core, tb):
 
 
 def simulate(params: DeviceParams, waveform, t_end: float, *, dt_out: float | None = None,
-             options: SolverOptions | None = None, progress: bool = False) -> DeviceResult:
+             options: SolverOptions | None = None, progress: bool = False,
+             q0_C: float | None = None) -> DeviceResult:
     """Integrate Eqs. (13)-(22) from rest (y = 0) over [0, t_end] s; returns a :class:`DeviceResult`.
 
     Output rows: a uniform grid of step ``dt_out`` (default 2e-5 s) plus the instant just before
-    each impact, so that impact peaks are not missed.
+    each impact, so that impact peaks are not missed. ``q0_C`` overrides ``params.initial_charge``.
     """
     require(isinstance(params, DeviceParams), f"params must be DeviceParams, got {type(params).__name__}")
     t_end = positive("t_end", t_end)
@@ -123,7 +124,9 @@ def simulate(params: DeviceParams, waveform, t_end: float, *, dt_out: float | No
     s = np.zeros(_NSTATE)
     if params.initial_charge == "rest" or params.load_mode == "short":
         s[2] = g1 / (core.g3 + 1.0)  # Q_SC at the rest gap: V = 0
-    contact = False
+    if q0_C is not None and params.load_mode != "short":
+        s[2] = finite("q0_C", q0_C) / params.charge_scale
+    contact = released = False
     e_impact = 0.0
     rows_t, rows_s, rows_c, rows_g, rows_ei = [], [], [], [], []
     impacts, releases = [], []
@@ -134,7 +137,7 @@ def simulate(params: DeviceParams, waveform, t_end: float, *, dt_out: float | No
 
     def emit(tbs, states, is_contact, g1s, ei):
         rows_t.append(np.atleast_1d(tbs))
-        rows_s.append(np.atleast_2d(states))
+        rows_s.append(np.array(np.atleast_2d(states), dtype=float))  # copy: s is reused
         rows_c.append(np.full(np.size(tbs), is_contact))
         rows_g.append(np.broadcast_to(g1s, np.shape(np.atleast_1d(tbs))).astype(float))
         rows_ei.append(np.full(np.size(tbs), ei))
@@ -149,25 +152,29 @@ def simulate(params: DeviceParams, waveform, t_end: float, *, dt_out: float | No
         while a < b - eps_t:
             switches += 1
             require(switches < 10000, f"contact chatter near t = {a * tau:.6g} s (over 10000 switches)")
-            net = core.pbar(a) - 1.0  # Pbar - ybar at y = d0; F_e = 0 in contact
-            if not contact and s[0] >= 1.0 - 1e-12 and (s[1] > 0 or net > 0):
+            net = core.pbar(a) - 1.0 + core.force(1.0, s[2], g1)  # net pull toward the polymer at y = d0
+            if not contact and not released and s[0] >= 1.0 - 1e-12 and (s[1] > 0 or net > 0):
                 if s[1] > 0:  # impact at a segment boundary
                     e_impact += 0.5 * s[1] ** 2
                     impacts.append(a * tau)
                 contact, s[0], s[1] = True, 1.0, 0.0
             if contact:
                 if net < 0:  # the reaction would have to pull: release now
-                    contact = False
+                    contact, released = False, True
                     releases.append(a * tau)
                     continue
+                lam = 0.0 if core.mode == "open" else (math.inf if core.mode == "short" else core.g2 * core.g3)
+                q_in = _contact_charge(s[2], lam, a)
+
+                def pull(x):
+                    return core.pbar(x) - 1.0 + core.force(1.0, q_in(x), g1)
+
                 t_rel = b
                 tt = np.linspace(a, b, 65)
-                f = core.pbar(tt) - 1.0
-                neg = np.nonzero(f < 0)[0]
+                neg = np.nonzero(pull(tt) < 0)[0]
                 if neg.size:
                     j = neg[0]
-                    t_rel = brentq(lambda x: core.pbar(x) - 1.0, tt[j - 1], tt[j], xtol=1e-14)
-                lam = 0.0 if core.mode == "open" else (math.inf if core.mode == "short" else core.g2 * core.g3)
+                    t_rel = brentq(pull, tt[j - 1], tt[j], xtol=1e-14)
                 tg = grid_in(a, t_rel)
                 q0, e0 = s[2], s[5]
                 decay = np.exp(-lam * (tg - a)) if lam < math.inf else np.zeros_like(tg)
@@ -186,11 +193,12 @@ def simulate(params: DeviceParams, waveform, t_end: float, *, dt_out: float | No
                 s[2] = q0 * dec
                 g1 = _contact_area(core, g1, a, t_rel)
                 if t_rel < b - eps_t:
-                    contact = False
+                    contact, released = False, True
                     releases.append(t_rel * tau)
                 a = t_rel
                 continue
             # flight
+            released = False
             core.g1 = g1
             tg = grid_in(a, b)
             sol = solve_ivp(core.rhs, (a, b), s, method=opts.method, t_eval=np.append(tg, b),
@@ -230,6 +238,13 @@ def simulate(params: DeviceParams, waveform, t_end: float, *, dt_out: float | No
         contact=np.concatenate(rows_c)[order], area_fraction=np.concatenate(rows_g)[order],
         impact_energy=np.concatenate(rows_ei)[order], impacts=np.array(impacts), releases=np.array(releases),
         nfev=nfev, wall_s=time.perf_counter() - wall0)
+
+
+def _contact_charge(q0: float, lam: float, a: float):
+    """Qbar(tbar) in contact: exact decay through R with V = -Q T/(eps_r eps0 S) (Eq. 22)."""
+    if lam == math.inf:
+        return lambda x: 0.0 * np.asarray(x)
+    return lambda x: q0 * np.exp(-lam * (np.asarray(x) - a))
 
 
 def _contact_area(core: _Core, g1: float, a: float, b: float) -> float:

@@ -77,13 +77,13 @@ def fig7_summary(result: DeviceResult, skip_cycles: int = 1) -> dict:
 
 
 def fig8_summary(result: DeviceResult) -> dict:
-    """V_OC per pressure step: the largest Eq. (17) voltage during each period of the staircase."""
+    """V_OC per pressure step: the largest Eq. (17) voltage after that step's release (Fig. 8b)."""
     wf = result.waveform
     require(hasattr(wf, "amplitudes_Pa"), "fig8_summary needs a Staircase run")
     per = wf.period
     steps, vocs = [], []
     for k, amp in enumerate(wf.amplitudes_Pa):
-        m = (result.t >= k * per) & (result.t < (k + 1) * per)
+        m = (result.t >= (k + wf.duty) * per) & (result.t < (k + 1) * per)
         vocs.append(float(np.max(result.V_oc[m])) if np.any(m) else math.nan)
         steps.append(float(amp))
     peak_v = [float(np.max(np.abs(result.V[(result.t >= k * per) & (result.t < (k + 1) * per)])))
