@@ -1,0 +1,95 @@
+"""Figures for the device model (Agg backend; PNG or PDF by extension, written atomically)."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from tengsim.errors import require
+
+
+def _figure(nrows, ncols, size):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt, *plt.subplots(nrows, ncols, figsize=size, squeeze=False)
+
+
+def _save(plt, fig, path):
+    from tengsim.io import atomic_path
+
+    path = Path(path)
+    fmt = path.suffix.lower().lstrip(".")
+    require(fmt in ("png", "pdf", "svg"), f"plot path must end in .png, .pdf or .svg, got {str(path)!r}")
+    fig.tight_layout()
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, format=fmt, dpi=150)
+    plt.close(fig)
+
+
+def plot_fig7(result, path) -> None:
+    """Nine panels as in Fig. 7: P_a S, y, ydot, Q, I, V, I_SC, V_OC, power against t."""
+    plt, fig, ax = _figure(3, 3, (12, 9))
+    t = result.t * 1e3
+    S = result.params.area_m2
+    panels = [("applied force (N)", result.P_a * S), ("displacement y (mm)", result.y * 1e3),
+              ("velocity (m/s)", result.ydot), ("charge Q (nC)", result.Q * 1e9), ("current I (uA)", result.I * 1e6),
+              ("voltage V (V)", result.V), ("I_SC (uA)", result.I_sc * 1e6), ("V_OC (V)", result.V_oc),
+              ("power (uW)", result.power * 1e6)]
+    for a, (label, y) in zip(ax.ravel(), panels):
+        a.plot(t, y, lw=0.8)
+        a.set_xlabel("t (ms)")
+        a.set_ylabel(label)
+    _save(plt, fig, path)
+
+
+def plot_fig8(result, path, table=None) -> None:
+    """Fig. 8: (a) A/S against pressure, (b) V_OC(t) under the staircase, with the per-step V_OC."""
+    from tengsim.device.paper import fig8_summary
+
+    plt, fig, ax = _figure(1, 2, (12, 4.5))
+    area = result.params.area
+    p = np.asarray(getattr(area, "pressure_Pa", np.linspace(0, 1.5e5, 50)))
+    ax[0, 0].plot(p / 1e3, area(p), "-")
+    ax[0, 0].set_xlabel("applied pressure (kPa)")
+    ax[0, 0].set_ylabel("charged area A/S")
+    ax[0, 1].plot(result.t, result.V_oc, lw=0.8, label="V_OC(t), Eq. 17")
+    s = fig8_summary(result)
+    per = result.waveform.period
+    tk = (np.arange(len(s["voc_steps_V"])) + 0.75) * per
+    ax[0, 1].plot(tk, s["voc_steps_V"], "o", ms=3, label="per step")
+    ax[0, 1].set_xlabel("t (s)")
+    ax[0, 1].set_ylabel("V_OC (V)")
+    ax[0, 1].legend()
+    _save(plt, fig, path)
+
+
+def plot_vq_cycle(result, path, cycle: int = -1) -> None:
+    """V-Q loop of one settled cycle with the cycle for maximised energy output (Zi et al. 2015)."""
+    from tengsim.device.analysis import vq_cycle
+
+    vq = vq_cycle(result, cycle)
+    plt, fig, ax = _figure(1, 1, (6, 5))
+    a = ax[0, 0]
+    a.plot(vq.charge_C * 1e9, vq.voltage_V, label=f"run, E = {vq.energy_J:.3g} J")
+    a.plot(vq.cmeo.charge_C * 1e9, vq.cmeo.voltage_V, "--", label=f"CMEO, E_m = {vq.cmeo.energy_J:.3g} J")
+    a.set_xlabel("Q (nC)")
+    a.set_ylabel("V (V)")
+    a.legend()
+    _save(plt, fig, path)
+
+
+def plot_resistance_sweep(sweep, path) -> None:
+    """Mean power and energy per cycle against load R, optimum marked."""
+    plt, fig, ax = _figure(1, 2, (11, 4.5))
+    ax[0, 0].loglog(sweep.load_ohm, sweep.average_power_W, "o-")
+    ax[0, 0].axvline(sweep.optimum_ohm, color="k", ls=":")
+    ax[0, 0].set_xlabel("load R (ohm)")
+    ax[0, 0].set_ylabel("mean power (W)")
+    ax[0, 1].loglog(sweep.load_ohm, sweep.peak_voltage_V, "o-", label="peak V (V)")
+    ax[0, 1].loglog(sweep.load_ohm, sweep.peak_current_A * 1e6, "s-", label="peak I (uA)")
+    ax[0, 1].set_xlabel("load R (ohm)")
+    ax[0, 1].legend()
+    _save(plt, fig, path)
