@@ -125,3 +125,21 @@ def plot_fig5(curves: dict, path) -> None:
     ax.grid(alpha=0.3, which="both")
     ax.legend()
     save(fig, path)
+
+
+def plot_timeseries(data, path, title: str = "") -> None:
+    """Device time series read back from a file (columns t, y, Q, I, V, V_oc, I_sc)."""
+    plt = _plt()
+    names = [("y", "y (m)"), ("Q", "Q (C)"), ("I", "I (A)"), ("V", "V (V)"), ("V_oc", "$V_{OC}$ (V)"),
+             ("I_sc", "$I_{SC}$ (A)")]
+    have = [(k, lab) for k, lab in names if k in data]
+    fig, axs = plt.subplots(len(have), 1, figsize=(7, 1.6 * len(have)), sharex=True, squeeze=False)
+    t = np.asarray(data["t"])
+    for ax, (k, lab) in zip(axs[:, 0], have):
+        ax.plot(t, np.asarray(data[k]), lw=0.8)
+        ax.set_ylabel(lab)
+        ax.grid(alpha=0.3)
+    axs[-1, 0].set_xlabel("t (s)")
+    if title:
+        fig.suptitle(title)
+    save(fig, path)

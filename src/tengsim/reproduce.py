@@ -81,8 +81,8 @@ def reproduce(out_dir, quick: bool = False, progress_factory=None, log=None,
         # Fig. 7: flat device, 10 N square wave at 5 Hz
         say("device: Fig. 7 (flat device, 10 N square wave at 5 Hz)")
         r7 = run_fig7(cycles=cycles or (4 if quick else 8))
-        r7.save(stage / "fig7.csv")
-        r7.save(stage / "fig7.nc")
+        r7.write_csv(stage / "fig7.csv")
+        io.write_dataset(r7.to_dataset(), stage / "fig7.nc")
         dplots.plot_fig7(r7, stage / "fig7.png")
         dplots.plot_fig7(r7, stage / "fig7.pdf")
         summary["fig7"] = fig7_summary(r7)
@@ -90,8 +90,8 @@ def reproduce(out_dir, quick: bool = False, progress_factory=None, log=None,
         if "A" in tables:
             say("device: Fig. 8 (group A, 10 -> 150 kPa staircase at 2 Hz)")
             r8 = run_fig8(area_table=tables["A"])
-            r8.save(stage / "fig8.csv")
-            r8.save(stage / "fig8.nc")
+            r8.write_csv(stage / "fig8.csv")
+            io.write_dataset(r8.to_dataset(), stage / "fig8.nc")
             dplots.plot_fig8(r8, stage / "fig8.png")
             dplots.plot_fig8(r8, stage / "fig8.pdf")
             summary["fig8"] = fig8_summary(r8)

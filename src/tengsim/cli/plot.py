@@ -28,8 +28,8 @@ def run(args) -> int:
 
         plot_curves(obj, out, title=src.name)
     else:
-        from tengsim.device import plots as dplots
+        from tengsim.plots import plot_timeseries
 
-        dplots.plot_timeseries(obj, out)
+        plot_timeseries(obj, out, title=src.name)
     print(f"wrote {out}")
     return 0
