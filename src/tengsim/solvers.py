@@ -89,6 +89,7 @@ class FastSolver:
     tol: float = 1e-6
     max_iter: int = 3000
     memory: int = 10
+    resync: int = 25
     name: str = "fast"
 
     def __post_init__(self):
@@ -108,6 +109,7 @@ class FastSolver:
         G = q - P
         E = dA * (0.5 * np.vdot(q, w) + phi.sum())
         S, KS, Y, KY, RHO = [], [], [], [], []
+
         for it in range(self.max_iter + 1):
             rmax = float(np.max(np.abs(r)))
             if not math.isfinite(rmax):
@@ -124,8 +126,9 @@ class FastSolver:
                 v -= a * y
                 Kv -= a * ky
                 alphas.append(a)
-            if S:
-                gamma = np.vdot(S[-1], KY[-1]) / np.vdot(Y[-1], KY[-1])
+            yky = np.vdot(Y[-1], KY[-1]) if S else 0.0
+            if S and yky > 0:
+                gamma = np.vdot(S[-1], KY[-1]) / yky
                 v *= gamma
                 Kv *= gamma
             for s, ks, y, ky, rho, a in zip(S, KS, Y, KY, RHO, reversed(alphas)):
@@ -133,18 +136,31 @@ class FastSolver:
                 v += (a - b) * s
                 Kv += (a - b) * ks
             d, Kd = -v, -Kv
-            slope = dA * np.vdot(r, d)
+            # E and E'(0) from the line function itself, so the search is self-consistent
+            E = dA * (0.5 * np.vdot(q, w) + phi.sum())
+            slope = dA * (np.vdot(d, w) - np.vdot(P, Kd))
             if not slope < 0:  # not a descent direction: restart from the preconditioned gradient
                 S, KS, Y, KY, RHO = [], [], [], [], []
                 d, Kd = -G, -r
-                slope = -dA * np.vdot(G, r)
+                slope = dA * (np.vdot(d, w) - np.vdot(P, Kd))
             alpha, E_new, phi_new, P_new = _wolfe(law, g, Kd, q, w, d, E, slope, dA, first=not S)
             if alpha is None:
                 return _finish(problem, State(q, w), P, r, E, False, it, n_conv, t0, "line search failed")
             s, ks = alpha * d, alpha * Kd
             q = q + s
-            w = w + ks
-            g = g0 + w
+            phi = phi_new
+            if (it + 1) % self.resync == 0:
+                # the images K d are assembled, not convolved: round-off lets w drift from K q;
+                # re-anchor w = K q (one extra convolution) so the metric stays exact
+                w_exact = K.apply(q)
+                n_conv += 1
+                ks = w_exact - w
+                w = w_exact
+                g = g0 + w
+                phi, P_new = law.evaluate(g)
+            else:
+                w = w + ks
+                g = g0 + w
             P = P_new
             r_new = w - K.apply(P)
             n_conv += 1
@@ -156,20 +172,24 @@ class FastSolver:
                 if len(S) > self.memory:
                     for lst in (S, KS, Y, KY, RHO):
                         lst.pop(0)
-            r, G, E = r_new, G_new, E_new
+            r, G = r_new, G_new
         return _finish(problem, State(q, w), P, r, E, False, self.max_iter, n_conv, t0,
                        f"not converged in {self.max_iter} iterations")
 
 
-def _wolfe(law, g, Kd, q, w, d, E0, slope0, dA, first, c1=1e-4, c2=0.9, max_eval=30):
-    """Strong-Wolfe line search along d; element-wise only (no convolution).
+def _wolfe(law, g, Kd, q, w, d, E0, slope0, dA, first, c1=1e-4, c2=0.9, max_eval=40):
+    """Line search along d; element-wise only (no convolution).
 
     E(α) = dA[½ q·w + α d·w + ½ α² d·K d + Σ Φ(g + α K d)],
     E'(α) = dA[d·w + α d·K d − P(g + α K d)·K d].
+    Accepts the strong Wolfe conditions, or near round-off the approximate Wolfe conditions of
+    Hager & Zhang (2005): E(α) <= E(0) + 1e-11|E(0)| and 0.9 E'(0) <= E'(α) <= −0.8 E'(0).
+    The bracket is narrowed by safeguarded secant steps on E'.
     """
     qw = 0.5 * np.vdot(q, w)
     a0 = np.vdot(d, w)
     a1 = np.vdot(d, Kd)
+    eps_E = 1e-11 * max(1.0, abs(E0))
 
     def f(alpha):
         phi, P = law.evaluate(g + alpha * Kd)
@@ -182,31 +202,35 @@ def _wolfe(law, g, Kd, q, w, d, E0, slope0, dA, first, c1=1e-4, c2=0.9, max_eval
         m = float(np.max(np.abs(Kd)))
         if m > 0.25:
             alpha = 0.25 / m
-    lo, hi = 0.0, None
-    e_lo, de_lo = E0, slope0
+    lo, de_lo = 0.0, slope0
+    hi, de_hi = None, None
+    best = None
     for _ in range(max_eval):
         e, de, phi, P = f(alpha)
         if not np.isfinite(e):
-            hi, e_hi = alpha, np.inf
-        elif e > E0 + c1 * alpha * slope0 or (hi is None and lo > 0 and e >= e_lo):
-            hi = alpha
+            hi, de_hi = alpha, None
         else:
-            if abs(de) <= -c2 * slope0:
+            wolfe = e <= E0 + c1 * alpha * slope0 and abs(de) <= -c2 * slope0
+            approx = e <= E0 + eps_E and c2 * slope0 <= de <= -0.8 * slope0
+            if wolfe or approx:
                 return alpha, e, phi, P
-            if de > 0:
-                hi = alpha
+            if e <= E0 + eps_E and (best is None or abs(de) < best[0]):
+                best = (abs(de), alpha, e, phi, P)
+            if e > E0 + c1 * alpha * slope0 + eps_E or de > 0:
+                hi, de_hi = alpha, (de if e <= E0 + eps_E or de > 0 else None)
             else:
-                lo, e_lo, de_lo = alpha, e, de
+                lo, de_lo = alpha, de
         if hi is None:
             alpha = 2.0 * alpha
+            continue
+        width = hi - lo
+        if de_hi is not None and de_hi > de_lo:
+            cand = lo - de_lo * width / (de_hi - de_lo)
         else:
-            # safeguarded interpolation: quadratic from (lo, e_lo, de_lo) and the trial, else bisect
-            alpha_new = 0.5 * (lo + hi)
-            alpha = alpha_new
-    # accept any decrease after the budget (Armijo point), else fail
-    if lo > 0:
-        e, de, phi, P = f(lo)
-        return lo, e, phi, P
+            cand = lo + 0.5 * width
+        alpha = min(max(cand, lo + 0.1 * width), hi - 0.1 * width)
+    if best is not None:
+        return best[1], best[2], best[3], best[4]
     return None, None, None, None
 
 
