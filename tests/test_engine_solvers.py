@@ -1,0 +1,162 @@
+"""Engine checks on the solvers: VSR (the paper's relaxation) and FastSolver (L-BFGS) agree on the
+equilibria of a warm-started D sequence; the fast solver spends far fewer convolutions; converged
+states are stable (Hessian of E(q) positive definite) and satisfy Eq. (9) recomputed independently
+(direct O(n²) sum with the exact pixel influence coefficients).
+"""
+from __future__ import annotations
+
+from functools import lru_cache
+
+import numpy as np
+import pytest
+
+from tengsim.analysis import apex_index, contact_length, force
+from tengsim.geometry import Paraboloid, Pyramid
+from tengsim.interaction import LJ93, Repulsive
+from tengsim.kernels import FreeKernel, pixel_influence
+from tengsim.solvers import FastSolver, Problem, State, VSRSolver
+
+MU = 0.5
+DS = (0.0, 0.5, 1.0, 1.5, 2.0, 2.5)
+TOL = 1e-8       # FastSolver
+TOL_VSR = 1e-6   # VSR (see the xfail below: it stalls above 1e-7)
+
+
+def _group_a(dx=0.2):
+    shape = Pyramid(0.946, 3.78)
+    grid = shape.grid(dx)
+    return grid, shape.gap(grid), FreeKernel(grid, MU**1.5)
+
+
+@lru_cache(maxsize=None)
+def sequence(solver_name):
+    grid, U0, K = _group_a()
+    solver = FastSolver(TOL) if solver_name == "fast" else VSRSolver(TOL_VSR)
+    st, out = State.zero(grid.shape), []
+    for D in DS:
+        eq = solver.solve(Problem(U0 - D + 1.0, LJ93(), K), st)
+        st = eq.state
+        out.append(eq)
+    return grid, U0, K, out
+
+
+def test_vsr_and_fast_agree():
+    """F and Λc of VSR and FastSolver agree to 1e-4 at every D (group A, μ = 0.5, dx = 0.2)."""
+    grid, U0, _, fast = sequence("fast")
+    _, _, _, vsr = sequence("vsr")
+    apex = apex_index(U0)
+    for a, b in zip(fast, vsr):
+        assert a.converged and b.converged, (a.message, b.message)
+        assert force(a.P, grid) == pytest.approx(force(b.P, grid), abs=1e-4)
+        assert contact_length(a.P, grid, apex) == pytest.approx(contact_length(b.P, grid, apex), abs=1e-4)
+        assert np.max(np.abs(a.H - b.H)) < 1e-4
+
+
+def test_fast_solver_uses_far_fewer_convolutions():
+    """Measured ratio ≈ 20–50; asserted >= 5."""
+    fast = sum(eq.n_conv for eq in sequence("fast")[3])
+    vsr = sum(eq.n_conv for eq in sequence("vsr")[3])
+    assert vsr >= 5 * fast, (vsr, fast)
+
+
+def _dense_K(grid, coupling):
+    X, Y = grid.mesh()
+    x, y = X.ravel(), Y.ravel()
+    return (coupling / np.pi) * pixel_influence(x[:, None] - x[None, :], y[:, None] - y[None, :], grid.dx, grid.dy)
+
+
+@pytest.mark.parametrize("solver_name", ["fast", "vsr"])
+def test_residual_recomputed_independently(solver_name):
+    """H − (−D + U0 + K P(H)) with K the dense O(n²) matrix of pixel coefficients: max < tol."""
+    grid, U0, K, eqs = sequence(solver_name)
+    Kd = _dense_K(grid, K.coupling)
+    law = LJ93()
+    tol = TOL if solver_name == "fast" else TOL_VSR
+    for D, eq in zip(DS, eqs):
+        assert eq.converged, eq.message
+        P = law.pressure(eq.H + 1.0)
+        assert np.allclose(P, eq.P, rtol=1e-12, atol=1e-14)
+        r = eq.H - (-D + U0 + (Kd @ P.ravel()).reshape(grid.shape))
+        assert np.max(np.abs(r)) <= tol * 1.01
+
+
+def test_converged_states_are_stable():
+    """Smallest eigenvalue of ΔA(K + K diag(Φ'') K) > 0 at every converged state (dense, 361×361);
+    the attractive zone has Φ'' < 0, so positivity is not automatic."""
+    grid, U0, K, eqs = sequence("fast")
+    Kd = _dense_K(grid, K.coupling)
+    law = LJ93()
+    some_negative = False
+    for eq in eqs:
+        k = law.stiffness(eq.H + 1.0).ravel()
+        some_negative |= bool((k < 0).any())
+        Hm = grid.area * (Kd + Kd @ (k[:, None] * Kd))
+        Hm = 0.5 * (Hm + Hm.T)
+        lam = np.linalg.eigvalsh(Hm)
+        assert lam[0] > 1e-8 * lam[-1], lam[0]
+    assert some_negative
+
+
+def test_hessian_check_detects_instability():
+    """Control: the same Hessian test on a state with a strongly negative stiffness field is indefinite
+    (so the stability test above can fail)."""
+    grid, U0, K, _ = sequence("fast")
+    Kd = _dense_K(grid, K.coupling)
+    k = np.full(grid.nx * grid.ny, LJ93().stiffness(np.array([1.5]))[0]) * 50
+    Hm = grid.area * (Kd + Kd @ (k[:, None] * Kd))
+    assert np.linalg.eigvalsh(0.5 * (Hm + Hm.T))[0] < 0
+
+
+def test_stability_eigsh_on_sphere():
+    """Larger grid, matrix-free: eigsh on a LinearOperator applying the Hessian with FFT
+    convolutions (K symmetric), sphere μ = 1 just after contact; smallest eigenvalue > 0."""
+    from scipy.sparse.linalg import LinearOperator, eigsh
+
+    shape = Paraboloid(1.0, 8.0)
+    grid = shape.grid(0.4)
+    K = FreeKernel(grid, 1.0)
+    law = LJ93()
+    U0 = shape.gap(grid)
+    st = State.zero(grid.shape)
+    for D in (-1.0, -0.5, 0.0, 0.5):
+        eq = FastSolver(1e-8).solve(Problem(U0 - D + 1.0, law, K), st)
+        assert eq.converged
+        st = eq.state
+    k = law.stiffness(eq.H + 1.0)
+    n = grid.nx * grid.ny
+
+    def mv(v):
+        v = v.reshape(grid.shape)
+        Kv = K.apply(v)
+        return (grid.area * (Kv + K.apply(k * Kv))).ravel()
+
+    op = LinearOperator((n, n), matvec=mv, dtype=float)
+    lam_min = eigsh(op, k=1, which="SA", return_eigenvectors=False, tol=1e-10, maxiter=50000)[0]
+    # cross-check with the dense matrix on this small grid
+    Kd = _dense_K(grid, K.coupling)
+    kk = k.ravel()
+    dense_min = np.linalg.eigvalsh(grid.area * (Kd + Kd @ (kk[:, None] * Kd)))[0]
+    assert lam_min == pytest.approx(dense_min, rel=1e-5, abs=1e-10)
+    assert (k < 0).any()
+    assert lam_min > 0
+
+
+def test_fast_solver_reaches_default_tol_on_hertz_with_large_indentation():
+    """Regression: convex problem (Repulsive law), E ~ 1e3, default tol 1e-6.  Before cc0bf2e the
+    energy-value Armijo test stalled at max|r| ~ 4e-6 ('line search failed': c1·α·slope ~ 4e-14
+    below the round-off of E ~ 3e-13)."""
+    shape = Paraboloid(0.1, 9.0)
+    grid = shape.grid(0.2)
+    K = FreeKernel(grid, 10.0)
+    for D in (60.0, 90.0, 150.0):
+        eq = FastSolver(1e-6).solve(Problem(shape.gap(grid) - D + 1.0, Repulsive(), K), State.zero(grid.shape))
+        assert eq.converged, eq.message
+
+
+@pytest.mark.xfail(strict=True, reason="engine bug: VSRSolver stalls at max|r| ~ 2.4e-6 for tol=1e-7 "
+                   "(group A, μ=0.5, dx=0.2, D=0, zero start) although it passes 1e-6 after 75 steps; "
+                   "the energy-based step acceptance rejects steps near round-off")
+def test_vsr_reaches_tighter_tol():
+    grid, U0, K = _group_a()
+    eq = VSRSolver(1e-7, max_iter=20000).solve(Problem(U0 - 0.0 + 1.0, LJ93(), K), State.zero(grid.shape))
+    assert eq.converged, eq.message
