@@ -31,14 +31,17 @@ class Grid:
 
     @classmethod
     def square(cls, length: float, dx: float, odd: bool = True) -> "Grid":
-        """A square grid of side ``length`` with spacing close to ``dx`` (rounded so it tiles)."""
+        """A square grid of side ``length`` with spacing close to (at most) ``dx``: the pixel count is
+        the next FFT-friendly one (odd, prime factors 3 to 13 only, by default)."""
         length = positive("cell length", length)
         dx = positive("dx", dx)
         if dx > length / 3:
             raise TengsimError(f"dx={dx} is too coarse for a cell of length {length} (need >= 3 pixels)")
+        from tengsim import _fft
+
         n = max(3, int(round(length / dx)))
-        if odd and n % 2 == 0:
-            n += 1
+        # FFT-friendly pixel counts (small prime factors), odd so that a pixel sits on the apex
+        n = _fft.fast_odd_len(n) if odd else _fft.fast_len(n)
         return cls(n, n, length / n, length / n)
 
     @property

@@ -61,9 +61,9 @@ class FreeKernel:
 
     def apply(self, p: np.ndarray) -> np.ndarray:
         """w = K p on the cell (one convolution)."""
-        spec = _fft.rfft2(p, s=self.padded_shape)
+        spec = _fft.rfft2_padded(p, self.padded_shape)
         spec *= self._spectrum
-        return _fft.irfft2(spec, s=self.padded_shape)[: self.grid.nx, : self.grid.ny]
+        return _fft.irfft2_cropped(spec, self.padded_shape, self.grid.shape)
 
     def params(self) -> dict:
         return {"boundary": "free", "coupling": self.coupling}
