@@ -61,3 +61,16 @@ def test_tensile_peak_innermost():
     assert tensile_peak_offset(f) == pytest.approx(3 + 0.5 * (0.5 - (-0.2)) / (0.5 - 2 * -1.0 + -0.2))
     # apex is itself the tensile minimum: no contact
     assert tensile_peak_offset(np.array([-1.0, -0.5, -0.2, -0.1])) == 0.0
+
+
+def test_periodic_overcompression_is_flagged():
+    """Periodic cell pressed far beyond flattening: gaps leave the law's range and are flagged."""
+    import tengsim as ts
+
+    res = ts.simulate(ts.Pyramid(0.946, 3.78), 0.5, 0.3, ts.PathSpec(-1, 4, 0.5, retract=False),
+                      boundary="periodic")
+    flags = res.table["in_law_range"]
+    D = res.table["D"]
+    assert flags[D <= 1.0].all()          # before the cell flattens, everything is physical
+    assert not flags[-1]                  # at D = 4 (> mean pyramid height 1.73) it is not
+    assert "safe limit" in res.params["warning"]

@@ -42,9 +42,17 @@ def simulate(shape: Shape, tabor: float, dx: float, path: PathSpec, boundary: st
         "jump_h": path.jump_h,
         **(extra_params or {}),
     }
+    warnings = []
     if not res.all_converged:
         n = int((~res.table["converged"].astype(bool)).sum())
-        res.params["warning"] = f"{n} equilibria did not converge to tol={tol}"
+        warnings.append(f"{n} equilibria did not converge to tol={tol}")
+    n_out = int((~res.table["in_law_range"].astype(bool)).sum())
+    if n_out:
+        warnings.append(f"{n_out} equilibria have gaps below the law's safe limit g_safe={law.g_safe} "
+                        "(compressed beyond the physical law; with the periodic kernel this happens once the "
+                        "whole cell is flattened)")
+    if warnings:
+        res.params["warning"] = "; ".join(warnings)
     return res
 
 

@@ -53,7 +53,9 @@ def load_result(path) -> tuple[str, object]:
                     table[k] = cols[k]
                 else:
                     table[k] = np.zeros(len(cols["D"]))
-            for k in ("converged", "on_grid", "jump"):
+            if "in_law_range" not in cols:
+                table["in_law_range"] = np.ones(len(cols["D"]))
+            for k in ("converged", "on_grid", "jump", "in_law_range"):
                 table[k] = table[k].astype(bool)
             dx = float(header.get("dx", 1.0))
             n = int(header.get("nx", 3))
@@ -70,7 +72,8 @@ def load_result(path) -> tuple[str, object]:
             raise TengsimError(f"cannot read {path} as NetCDF: {exc}") from None
         if "branch" in ds and "D" in ds:
             table = {k: ds[k].values for k in CURVE_COLUMNS if k in ds}
-            for k in ("converged", "on_grid", "jump"):
+            table.setdefault("in_law_range", np.ones(ds.sizes["step"]))
+            for k in ("converged", "on_grid", "jump", "in_law_range"):
                 table[k] = table[k].astype(bool)
             table["branch"] = table["branch"].astype(str)
             params = json.loads(ds.attrs.get("params", "{}"))

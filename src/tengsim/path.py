@@ -130,7 +130,10 @@ def run_path(U0, law, kernel, solver, spec: PathSpec, start: State | None = None
     def make_on_row(branch):
         def on_row(D, eq, on_grid, jump):
             s = summarize(eq.P, eq.H, grid, apex)
+            # a state whose gap enters the law's safe extension (g < g_safe) is outside the physical law
+            in_range = bool(s.min_gap + 1.0 >= getattr(law, "g_safe", -np.inf))
             rows.append(dict(branch=branch, D=D, on_grid=on_grid, jump=jump, converged=eq.converged,
+                             in_law_range=in_range,
                              residual=eq.residual, iterations=eq.iterations, n_conv=eq.n_conv,
                              seconds=eq.seconds, energy=eq.energy, **asdict(s)))
             for Dm in spec.maps_at:

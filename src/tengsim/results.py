@@ -12,7 +12,7 @@ _trapz = getattr(np, "trapezoid", None) or np.trapz
 
 CURVE_COLUMNS = ["branch", "D", "F", "contact_length", "area_repulsive", "converged", "residual",
                  "iterations", "n_conv", "on_grid", "jump", "min_gap", "max_pressure",
-                 "min_pressure", "energy", "seconds"]
+                 "min_pressure", "energy", "seconds", "in_law_range"]
 
 
 @dataclass(frozen=True)
@@ -115,7 +115,7 @@ class ContactResult:
 
         t = self.table
         data = {k: ("step", t[k].astype(str) if k == "branch" else t[k]) for k in CURVE_COLUMNS}
-        for k in ("converged", "on_grid", "jump"):
+        for k in ("converged", "on_grid", "jump", "in_law_range"):
             data[k] = ("step", t[k].astype(np.int8))
         ds = xr.Dataset(data)
         units = {"D": "ε (rigid approach, Eq. 7)", "F": "3π W ε m²/n² (Eq. 7/10)",
@@ -134,6 +134,7 @@ class ContactResult:
         ds.attrs["params"] = json.dumps(self.params, default=str)
         ds.attrs["pull_off_F"] = self.pull_off_force
         ds.attrs["n_unconverged"] = int(np.count_nonzero(~t["converged"].astype(bool)))
+        ds.attrs["n_outside_law_range"] = int(np.count_nonzero(~t["in_law_range"].astype(bool)))
         ds.attrs["jumps"] = json.dumps([j.__dict__ for j in self.jumps])
         ds.attrs["seconds"] = self.seconds
         for k, v in self.params.items():

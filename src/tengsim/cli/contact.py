@@ -76,4 +76,8 @@ def write_contact(res, out, plot=None, quiet=False) -> int:
     if n_bad:
         print(f"tengsim: warning: {n_bad} equilibria did not converge (see column 'converged')",
               file=sys.stderr)
+    n_out = int((~res.table["in_law_range"].astype(bool)).sum())
+    if n_out:
+        print(f"tengsim: warning: {n_out} equilibria are compressed beyond the interaction law's range "
+              "(see column 'in_law_range')", file=sys.stderr)
     return 0
