@@ -64,8 +64,8 @@ def plot_fig3(results: dict, path, d_values=(1.0, 3.0, 6.0, 14.0)) -> None:
     """Fig. 3: pressure maps P(X, Y) on approach, rows = groups, columns = D."""
     plt = _plt()
     groups = list(results)
-    fig, axs = plt.subplots(len(groups), len(d_values), figsize=(3.0 * len(d_values), 2.8 * len(groups)),
-                            squeeze=False)
+    fig, axs = plt.subplots(len(groups), len(d_values), figsize=(3.4 * len(d_values), 2.9 * len(groups)),
+                            squeeze=False, constrained_layout=True)
     for i, g in enumerate(groups):
         res = results[g]
         maps = {round(m["D"], 9): m for m in res.maps if m["branch"] == "approach"}
@@ -81,9 +81,10 @@ def plot_fig3(results: dict, path, d_values=(1.0, 3.0, 6.0, 14.0)) -> None:
             im = ax.imshow(P.T, origin="lower", extent=ext, cmap="RdBu_r", vmin=-lim, vmax=lim)
             ax.set_title(f"group {g}, D = {D:g}", fontsize=9)
             ax.set_xlabel("X")
-            ax.set_ylabel("Y")
-            fig.colorbar(im, ax=ax, shrink=0.8, label="P")
-    fig.suptitle("Pressure P (positive = compressive), approach")
+            if j == 0:
+                ax.set_ylabel("Y")
+            fig.colorbar(im, ax=ax, shrink=0.8)
+    fig.suptitle("Pressure P (Eq. 8; positive = compressive, colour scale symmetric), approach")
     save(fig, path)
 
 

@@ -38,10 +38,19 @@ def plot_fig7(result, path) -> None:
               ("velocity (m/s)", result.ydot), ("charge Q (nC)", result.Q * 1e9), ("current I (uA)", result.I * 1e6),
               ("voltage V (V)", result.V), ("I_SC (uA)", result.I_sc * 1e6), ("V_OC (V)", result.V_oc),
               ("power (uW)", result.power * 1e6)]
+    settled = result.t >= result.waveform.period  # the first period holds the Q(0) = 0 start spike
     for a, (label, y) in zip(ax.ravel(), panels):
         a.plot(t, y, lw=0.8)
         a.set_xlabel("t (ms)")
         a.set_ylabel(label)
+        a.grid(alpha=0.3)
+        if settled.any() and np.ptp(y[settled]) > 0:
+            lo, hi = float(np.min(y[settled])), float(np.max(y[settled]))
+            pad = 0.08 * (hi - lo)
+            if np.min(y) < lo - pad or np.max(y) > hi + pad:  # keep the start spike from hiding the cycle
+                a.set_ylim(lo - pad, hi + pad)
+                a.axvspan(t[0], result.waveform.period * 1e3, color="0.9", zorder=0)
+    fig.suptitle("Fig. 7 device (grey: first period, start transient of Q(0) = 0, clipped)", fontsize=10)
     _save(plt, fig, path)
 
 
