@@ -157,3 +157,20 @@ def test_vsr_reaches_tighter_tol():
     grid, U0, K = _group_a()
     eq = VSRSolver(1e-7, max_iter=20000).solve(Problem(U0 - 0.0 + 1.0, LJ93(), K), State.zero(grid.shape))
     assert eq.converged, eq.message
+
+
+def test_vsr_and_fast_agree_on_whole_path():
+    """Approach and retraction of group A (μ = 0.5, dx = 0.2): both solvers, same D grid and
+    step control, give the same F(D) and Λc(D) on both branches (to 1e-5 and one-hundredth of dx)."""
+    from tengsim.path import PathSpec, run_path
+
+    grid, U0, K = _group_a(0.2)
+    spec = PathSpec(-1.0, 2.5, 0.25)
+    fast = run_path(U0, LJ93(), K, FastSolver(1e-8), spec)
+    vsr = run_path(U0, LJ93(), K, VSRSolver(1e-8), spec)
+    assert fast.all_converged and vsr.all_converged
+    assert list(fast.table["branch"]) == list(vsr.table["branch"])
+    assert np.allclose(fast.table["D"], vsr.table["D"])
+    assert np.max(np.abs(fast.table["F"] - vsr.table["F"])) < 1e-5
+    assert np.max(np.abs(fast.table["contact_length"] - vsr.table["contact_length"])) < 0.01 * grid.dx
+    assert vsr.table["n_conv"].sum() > 5 * fast.table["n_conv"].sum()
