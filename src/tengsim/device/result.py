@@ -142,7 +142,10 @@ class DeviceResult:
 
     # --- output ---
     def header(self) -> dict:
-        return {"model": "tengsim.device (paper Eqs. 13-24)", "params": self.params.to_dict(),
+        from tengsim import __version__
+
+        return {"model": "tengsim.device (paper Eqs. 13-24)", "tengsim_version": __version__,
+                "params": self.params.to_dict(),
                 "waveform": self.waveform.to_dict(), "solver": self.options.to_dict(),
                 "units": {k: COLUMNS[k][0] for k in CSV_COLUMNS}}
 
