@@ -122,3 +122,18 @@ def test_bad_config(tmp_path, capsys, text, word):
 def test_missing_config_file(tmp_path, capsys):
     assert main(["run", str(tmp_path / "nope.toml")]) == 2
     assert "not found" in capsys.readouterr().err
+
+
+def test_shipped_examples_are_valid():
+    """Every example config in examples/ plans without error (the README points users to them)."""
+    from pathlib import Path
+
+    from tengsim.config import load_toml, plan_contact
+
+    files = sorted((Path(__file__).parent.parent / "examples").glob("*.toml"))
+    assert files
+    for f in files:
+        cfg = load_toml(f)
+        if "contact" in cfg:
+            plan = plan_contact(cfg["contact"])
+            assert plan.tabor > 0 and plan.path.d_max > plan.path.d_min
