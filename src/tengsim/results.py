@@ -83,7 +83,8 @@ class ContactResult:
 
     @property
     def hysteresis(self) -> float:
-        """∮ F dD between approach and retraction (energy lost per cycle, units 3π W ε ℓ²... of F·D)."""
+        """∮ F dD, approach minus retraction: the energy lost per cycle (for the paper's scaling the work
+        per cell is 3π m² W ε²/n² times this value)."""
         a, r = self.branch("approach"), self.branch("retraction")
         if len(r["D"]) < 2:
             return 0.0
