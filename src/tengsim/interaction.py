@@ -9,6 +9,7 @@ C¹; physical equilibria never reach g_safe.  States are always judged by the re
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -20,9 +21,10 @@ class Law:
 
     g_safe: float
 
-    def _raw(self, g):  # pragma: no cover - abstract
+    def _raw(self, g, need_dp=True):  # pragma: no cover - abstract
         raise NotImplementedError
 
+    @cached_property
     def _safe(self):
         gs = np.array([self.g_safe])
         phi, p, dp = self._raw(gs)
@@ -33,11 +35,11 @@ class Law:
         g = np.asarray(g, dtype=float)
         low = g < self.g_safe
         if not low.any():
-            phi, p, _ = self._raw(g)
+            phi, p, _ = self._raw(g, need_dp=False)
             return phi, p
         gg = np.where(low, self.g_safe, g)
-        phi, p, _ = self._raw(gg)
-        phs, ps, dps = self._safe()
+        phi, p, _ = self._raw(gg, need_dp=False)
+        phs, ps, dps = self._safe
         t = g - self.g_safe
         p = np.where(low, ps + dps * t, p)
         phi = np.where(low, phs - ps * t - 0.5 * dps * t * t, phi)
@@ -66,7 +68,7 @@ class LJ93(Law):
     """The paper's law, Eq. (2)/(8): P = (8/3)[g⁻⁹ − g⁻³], Φ = (1/3)g⁻⁸ − (4/3)g⁻².
 
     A 9-3 law in pressure (8-2 in energy, Derjaguin): Φ(1) = −1 (the work of adhesion W),
-    P(1) = 0, tensile peak P_min = −(16/9)·3^{-1/2}·... at g = 3^{1/6}.
+    P(1) = 0, tensile peak P_min = −16/(9√3) ≈ −1.026 at g = 3^{1/6}.
     """
 
     g_safe: float = 0.6
@@ -75,7 +77,7 @@ class LJ93(Law):
         if not 0 < self.g_safe < 1:
             raise TengsimError(f"g_safe must lie in (0, 1), got {self.g_safe!r}")
 
-    def _raw(self, g):
+    def _raw(self, g, need_dp=True):
         inv = 1.0 / g
         i2 = inv * inv
         i3 = i2 * inv
@@ -84,7 +86,7 @@ class LJ93(Law):
         i9 = i8 * inv
         phi = i8 / 3.0 - (4.0 / 3.0) * i2
         p = (8.0 / 3.0) * (i9 - i3)
-        dp = (8.0 / 3.0) * (-9.0 * i9 + 3.0 * i3) * inv
+        dp = (8.0 / 3.0) * (-9.0 * i9 + 3.0 * i3) * inv if need_dp else None
         return phi, p, dp
 
 
@@ -106,7 +108,7 @@ class Repulsive(Law):
         if not 0 < self.g_safe < 1:
             raise TengsimError(f"g_safe must lie in (0, 1), got {self.g_safe!r}")
 
-    def _raw(self, g):
+    def _raw(self, g, need_dp=True):
         k, c = self.exponent, self.scale
         gk = g ** (-k)
         p = c * gk

@@ -108,7 +108,7 @@ class FastSolver:
         n_conv = 1
         G = q - P
         E = dA * (0.5 * np.vdot(q, w) + phi.sum())
-        S, KS, Y, KY, RHO = [], [], [], [], []
+        pairs = []  # (SK, YK, rho): SK = [s; K s], YK = [y; K y] stacked, so one call updates both
 
         for it in range(self.max_iter + 1):
             rmax = float(np.max(np.abs(r)))
@@ -118,60 +118,58 @@ class FastSolver:
                 return _finish(problem, State(q, w), P, r, E, True, it, n_conv, t0, "converged")
             if it == self.max_iter:
                 break
-            # two-loop recursion in the K inner product <a, b> = dA a·K b
-            v, Kv = G.copy(), r.copy()
+            # two-loop recursion in the K inner product <a, b> = dA a·K b, on VK = [v; K v]
+            VK = np.stack((G, r))
             alphas = []
-            for s, ks, y, ky, rho in zip(reversed(S), reversed(KS), reversed(Y), reversed(KY), reversed(RHO)):
-                a = rho * dA * np.vdot(s, Kv)
-                v -= a * y
-                Kv -= a * ky
+            for SK, YK, rho in reversed(pairs):
+                a = rho * dA * np.vdot(SK[0], VK[1])
+                VK -= a * YK
                 alphas.append(a)
-            yky = np.vdot(Y[-1], KY[-1]) if S else 0.0
-            if S and yky > 0:
-                gamma = np.vdot(S[-1], KY[-1]) / yky
-                v *= gamma
-                Kv *= gamma
-            for s, ks, y, ky, rho, a in zip(S, KS, Y, KY, RHO, reversed(alphas)):
-                b = rho * dA * np.vdot(y, Kv)
-                v += (a - b) * s
-                Kv += (a - b) * ks
-            d, Kd = -v, -Kv
+            if pairs:
+                SK, YK, _ = pairs[-1]
+                yky = np.vdot(YK[0], YK[1])
+                if yky > 0:
+                    VK *= np.vdot(SK[0], YK[1]) / yky
+            for (SK, YK, rho), a in zip(pairs, reversed(alphas)):
+                b = rho * dA * np.vdot(YK[0], VK[1])
+                VK += (a - b) * SK
+            d, Kd = -VK[0], -VK[1]
             # E and E'(0) from the line function itself, so the search is self-consistent
             E = dA * (0.5 * np.vdot(q, w) + phi.sum())
             slope = dA * (np.vdot(d, w) - np.vdot(P, Kd))
             if not slope < 0:  # not a descent direction: restart from the preconditioned gradient
-                S, KS, Y, KY, RHO = [], [], [], [], []
+                pairs = []
                 d, Kd = -G, -r
                 slope = dA * (np.vdot(d, w) - np.vdot(P, Kd))
-            alpha, E_new, phi_new, P_new = _wolfe(law, g, Kd, q, w, d, E, slope, dA, first=not S)
+            alpha, E_new, phi_new, P_new = _wolfe(law, g, Kd, q, w, d, E, slope, dA, first=not pairs)
             if alpha is None:
                 return _finish(problem, State(q, w), P, r, E, False, it, n_conv, t0, "line search failed")
-            s, ks = alpha * d, alpha * Kd
-            q = q + s
+            SK = np.stack((d, Kd))
+            SK *= alpha
+            q = q + SK[0]
             phi = phi_new
             if (it + 1) % self.resync == 0:
                 # the images K d are assembled, not convolved: round-off lets w drift from K q;
                 # re-anchor w = K q (one extra convolution) so the metric stays exact
                 w_exact = K.apply(q)
                 n_conv += 1
-                ks = w_exact - w
+                SK[1] = w_exact - w
                 w = w_exact
                 g = g0 + w
                 phi, P_new = law.evaluate(g)
             else:
-                w = w + ks
+                w = w + SK[1]
                 g = g0 + w
             P = P_new
             r_new = w - K.apply(P)
             n_conv += 1
             G_new = q - P
-            y, ky = G_new - G, r_new - r
-            sy = np.vdot(s, ky)
-            if sy > 1e-14 * max(abs(np.vdot(s, ks)), 1e-300):
-                S.append(s), KS.append(ks), Y.append(y), KY.append(ky), RHO.append(1.0 / (dA * sy))
-                if len(S) > self.memory:
-                    for lst in (S, KS, Y, KY, RHO):
-                        lst.pop(0)
+            YK = np.stack((G_new - G, r_new - r))
+            sy = np.vdot(SK[0], YK[1])
+            if sy > 1e-14 * max(abs(np.vdot(SK[0], SK[1])), 1e-300):
+                pairs.append((SK, YK, 1.0 / (dA * sy)))
+                if len(pairs) > self.memory:
+                    pairs.pop(0)
             r, G = r_new, G_new
         return _finish(problem, State(q, w), P, r, E, False, self.max_iter, n_conv, t0,
                        f"not converged in {self.max_iter} iterations")
