@@ -137,3 +137,13 @@ def test_shipped_examples_are_valid():
         if "contact" in cfg:
             plan = plan_contact(cfg["contact"])
             assert plan.tabor > 0 and plan.path.d_max > plan.path.d_min
+
+
+def test_unwritable_output_fails_before_running(tmp_path, capsys):
+    blocker = tmp_path / "file"
+    blocker.write_text("x")  # a file where a folder would have to be
+    rc = main(GROUP_A + ["--out", str(blocker / "sub" / "a.csv")])
+    err = capsys.readouterr().err
+    assert rc == 2 and "cannot write" in err and "Traceback" not in err
+    assert main(["reproduce", "--quick", "--quiet", "--out", str(blocker / "paper")]) == 2
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["file"]

@@ -24,6 +24,20 @@ def atomic_path(path: str | os.PathLike):
         raise
 
 
+def check_writable(path) -> None:
+    """Fail early (before a long run) if ``path`` could not be written: one clear TengsimError."""
+    from tengsim.errors import TengsimError
+
+    path = Path(path)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".check", dir=path.parent)
+        os.close(fd)
+        os.unlink(tmp)
+    except OSError as exc:
+        raise TengsimError(f"cannot write {path}: {exc.strerror or exc}") from None
+
+
 def write_text(path, text: str) -> None:
     with atomic_path(path) as tmp:
         tmp.write_text(text)

@@ -38,7 +38,7 @@ def reproduce(out_dir, quick: bool = False, progress_factory=None, log=None,
     from tengsim.plots import plot_fig3, plot_fig4, plot_fig5
 
     out_dir = Path(out_dir)
-    out_dir.parent.mkdir(parents=True, exist_ok=True)
+    io.check_writable(out_dir)  # the staging folder goes beside it
     stage = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.", suffix=".part", dir=out_dir.parent))
     say = log or (lambda msg: None)
     t0 = time.perf_counter()

@@ -50,6 +50,11 @@ def run(args) -> int:
         raise TengsimError(f"--out {args.out}: use a .csv or .nc file")
     if args.plot and Path(args.plot).suffix.lower() not in (".png", ".pdf", ".svg"):
         raise TengsimError(f"--plot {args.plot}: use a .png, .pdf or .svg file")
+    from tengsim.io import check_writable
+
+    check_writable(out)
+    if args.plot:
+        check_writable(args.plot)
     keys = ["shape", "N", "cell", "tabor", "pitch", "base", "height", "eps", "E_star", "W", "slope",
             "radius", "half_width", "dx", "d_min", "d_max", "d_step", "boundary", "solver", "tol",
             "law", "maps_at"]

@@ -45,6 +45,10 @@ def main(argv=None) -> int:
     except TengsimError as exc:
         print(f"tengsim: error: {exc}", file=sys.stderr)
         return 2
+    except OSError as exc:  # a file that cannot be read or written: one line, no traceback
+        where = f" {exc.filename}" if getattr(exc, "filename", None) else ""
+        print(f"tengsim: error:{where}: {exc.strerror or exc}", file=sys.stderr)
+        return 2
     except KeyboardInterrupt:
         print("tengsim: interrupted; no partial output was written", file=sys.stderr)
         return 130

@@ -58,6 +58,9 @@ def _contact(section, args) -> int:
         raise TengsimError("[contact] needs out = 'FILE.csv' or 'FILE.nc'")
     if Path(out).suffix.lower() not in (".csv", ".nc"):
         raise TengsimError(f"out = {out!r}: use a .csv or .nc file")
+    from tengsim.io import check_writable
+
+    check_writable(out)
     bar = Progress(args.quiet)
     try:
         res = run_contact(section, progress=bar)
