@@ -1,8 +1,7 @@
 """cProfile of tengsim's fast solver on one pyramid curve (default group C, free kernel), and the
 share of time spent in the FFTs.
 
-    OPENBLAS_NUM_THREADS=1 TENGSIM_FFT_WORKERS=1 \\
-        python benchmarks/profile_fast.py --group C --dx 0.1 --out benchmarks/results
+    OPENBLAS_NUM_THREADS=1 python benchmarks/profile_fast.py --group C --dx 0.1 --out benchmarks/results
 
 Writes ``profile_<group>.txt`` (top functions by own time and by cumulative time) and prints the
 FFT share: own time of scipy.fft's transforms (rfft2/irfft2 and their C++ workers) over the

@@ -1,7 +1,9 @@
 """Side-by-side benchmark: tengsim fast vs tengsim VSR vs ContactMechanics/Adhesion (issue 6).
 
-    OPENBLAS_NUM_THREADS=1 TENGSIM_FFT_WORKERS=1 \\
-        python benchmarks/run_benchmarks.py --groups A C --dx 0.1 --out benchmarks/results
+    OPENBLAS_NUM_THREADS=1 python benchmarks/run_benchmarks.py --groups A C --dx 0.1 \\
+        --vsr-mode full sampled --peer-max-eq 0 50 --out benchmarks/results
+
+(tengsim's FFTs run on 1 thread at these sizes, below 512² points, like the peer's.)
 
 Every solver solves the paper's Eq. (9) (pyramid groups at μ = 0.5, free kernel) on the same grid
 (tengsim's ``Pyramid(N, cell).grid(dx)``) and the same D steps (d_min → d_max → d_min in d_step),
@@ -14,7 +16,8 @@ solver) under ``--out``.
 * tengsim VSR: by default *sampled*: every ``--vsr-every``-th step of the full path is solved by VSR
   from the very state the fast solver started that step from, and the fast solve of that step is
   timed alongside; the ratio is then per equilibrium (sum of VSR seconds / sum of fast seconds on the
-  same solves).  ``--vsr-mode full`` runs ``simulate_pyramid(solver="vsr")`` on the whole path.
+  same solves).  ``--vsr-mode full`` runs ``simulate_pyramid(solver="vsr")`` on the whole path;
+  one mode per group is accepted (``--groups A C --vsr-mode full sampled``).
 * ContactMechanics/Adhesion (``benchmarks/peer_contactmechanics.py``): skipped with a note when the
   packages are not installed (``pip install -e .[bench]``).
 
@@ -191,11 +194,12 @@ def run_group(name, args, log):
         f"max {row['conv_max']}, wall/(conv*t_conv) = {row['fft_share_ratio']:.2f}")
 
     # ---- tengsim VSR -------------------------------------------------------------------------
-    if args.vsr_mode != "none":
+    vsr_mode = args.vsr_mode[min(args.groups.index(name), len(args.vsr_mode) - 1)]
+    if vsr_mode != "none":
         law = LJ93()
         vsr = make_solver("vsr", tol=args.tol, max_iter=args.vsr_max_iter)
         fast = make_solver("fast", tol=args.tol)
-        if args.vsr_mode == "sampled":
+        if vsr_mode == "sampled":
             every = args.vsr_every
             state = State.zero(grid.shape)
             t_v = t_f = 0.0
@@ -236,10 +240,12 @@ def run_group(name, args, log):
             cntv = ConvCounter(type(kernel))
             try:
                 t0 = time.perf_counter()
+                c0 = time.process_time()
                 resv = simulate_pyramid(g["N"], g["cell"], tabor=args.mu, dx=args.dx, d_min=args.d_min,
                                         d_max=d_max, d_step=args.d_step, boundary="free",
                                         solver=vsr, tol=args.tol, refine_levels=args.refine_levels)
                 t_v = time.perf_counter() - t0
+                cpu_v = time.process_time() - c0
             finally:
                 cntv.restore()
             Tv = resv.table
@@ -249,7 +255,8 @@ def run_group(name, args, log):
             cmpv = compare(fast_ref, vsr_rows)
             nc = np.asarray(Tv["n_conv"])
             row = dict(group=name, solver="tengsim VSR", path=f"full ({n_eq} eq)", n_eq=len(nc),
-                       wall_s=t_v, ratio_vs_fast=t_v / wall_fast, conv_median=float(np.median(nc[1:])),
+                       wall_s=t_v, ratio_vs_fast=t_v / wall_fast, cpu_s=cpu_v,
+                       cpu_ratio_vs_fast=cpu_v / cpu_fast, conv_median=float(np.median(nc[1:])),
                        conv_max=int(nc.max()), conv_total=cntv.n, t_conv_ms=t_conv * 1e3,
                        fft_share_ratio=t_v / (cntv.n * t_conv), max_residual=float(np.max(Tv["residual"])),
                        all_converged=bool(np.all(Tv["converged"])),
@@ -268,11 +275,22 @@ def run_group(name, args, log):
                              note="skipped: contactmechanics/adhesion not installed (pip install -e .[bench])"))
         log("   peer: not installed, skipped")
     else:
-        pr = peer.solve_path(U0, grid.dx, args.mu, D_path, tol=args.tol, branch=br_path, dy=grid.dy,
+        k_peer = args.peer_max_eq[min(args.groups.index(name), len(args.peer_max_eq) - 1)] if args.peer_max_eq else 0
+        k_peer = n_eq if k_peer <= 0 else min(n_eq, k_peer)
+        D_peer, br_peer = D_path[:k_peer], br_path[:k_peer]
+        pr = peer.solve_path(U0, grid.dx, args.mu, D_peer, tol=args.tol, branch=br_peer, dy=grid.dy,
                              length_fn=lambda P: ts_contact_length(P, grid, apex), verbose=args.verbose)
         peer_rows = {_key(b, D): (F, L) for b, D, F, L in zip(pr.branch, pr.D, pr.F, pr.contact_length)}
         # the retraction's first row (D = d_max) is the approach's last state
-        peer_rows[_key("retraction", D_path[np.argmax(D_path)])] = peer_rows[_key("approach", D_path.max())]
+        if k_peer == n_eq:
+            peer_rows[_key("retraction", D_path[np.argmax(D_path)])] = peer_rows[_key("approach", D_path.max())]
+        # tengsim fast's own seconds on the same equilibria (the whole run's wall time on a full path)
+        if k_peer == n_eq:
+            fast_ref_s, fast_ref_cpu = wall_fast, cpu_fast
+        else:
+            keys_p = {_key(b, D) for b, D in zip(br_peer, D_peer)}
+            fast_ref_s = float(sum(s_ for b, D, s_ in zip(br, T["D"], T["seconds"]) if _key(b, D) in keys_p))
+            fast_ref_cpu = fast_ref_s * cpu_fast / wall_fast
         cmpp = compare(fast_ref, peer_rows)
         # one peer convolution on its padded grid: evaluate_force is one FFT + one inverse FFT
         from ContactMechanics import FreeFFTElasticHalfSpace
@@ -280,9 +298,12 @@ def run_group(name, args, log):
                                       physical_sizes=(grid.lx, grid.ly))
         d_typ = np.random.default_rng(0).standard_normal(sub.nb_subdomain_grid_pts)
         t_conv_p = time_call(lambda: sub.evaluate_force(d_typ))
-        row = dict(group=name, solver="ContactMechanics/Adhesion", path=f"full ({n_eq} eq)", n_eq=n_eq,
-                   wall_s=pr.wall_time, ratio_vs_fast=pr.wall_time / wall_fast,
-                   cpu_s=pr.info["cpu_s"], cpu_ratio_vs_fast=pr.info["cpu_s"] / cpu_fast,
+        path_p = (f"full ({n_eq} eq)" if k_peer == n_eq else
+                  f"cut: first {k_peer} eq (D {D_peer[0]:g} -> {D_peer[-1]:g}); ratio vs fast's seconds on them "
+                  f"({fast_ref_s:.2f} s)")
+        row = dict(group=name, solver="ContactMechanics/Adhesion", path=path_p, n_eq=k_peer,
+                   wall_s=pr.wall_time, ratio_vs_fast=pr.wall_time / fast_ref_s,
+                   cpu_s=pr.info["cpu_s"], cpu_ratio_vs_fast=pr.info["cpu_s"] / fast_ref_cpu,
                    conv_median=float(np.median(pr.n_conv[1:])), conv_max=int(pr.n_conv.max()),
                    conv_total=int(pr.n_conv.sum()), t_conv_ms=t_conv_p * 1e3,
                    fft_share_ratio=pr.wall_time / (pr.n_conv.sum() * t_conv_p),
@@ -383,10 +404,16 @@ def main(argv=None):
     ap.add_argument("--d-max", type=float, default=None, help="default: per group (A 4, B 8, C 14)")
     ap.add_argument("--d-step", type=float, default=0.1)
     ap.add_argument("--refine-levels", type=int, default=0)
-    ap.add_argument("--vsr-mode", choices=["sampled", "full", "none"], default="sampled")
+    ap.add_argument("--vsr-mode", nargs="+", choices=["sampled", "full", "none"], default=["sampled"],
+                    help="per group, in the order of --groups (the last one repeats): e.g. --groups A C "
+                         "--vsr-mode full sampled")
     ap.add_argument("--vsr-every", type=int, default=10)
     ap.add_argument("--vsr-max-iter", type=int, default=20000)
     ap.add_argument("--no-peer", action="store_true")
+    ap.add_argument("--peer-max-eq", type=int, nargs="+", default=None,
+                    help="per group like --vsr-mode (0 = full path): solve only the first K equilibria of the "
+                         "path with the peer (a cut path; its ratio is then against tengsim fast's own seconds "
+                         "on those equilibria)")
     ap.add_argument("--out", type=Path, default=HERE / "results")
     ap.add_argument("-v", "--verbose", action="store_true")
     args = ap.parse_args(argv)
