@@ -20,6 +20,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from tengsim._lbfgs import KMetricLBFGS
 from tengsim.errors import TengsimError
 
 
@@ -79,11 +80,12 @@ def _finish(problem, state, P, r, energy, converged, it, n_conv, t0, msg):
 
 @dataclass(frozen=True)
 class FastSolver:
-    """L-BFGS on E(q) in the metric of the elastic kernel (K-preconditioned), strong-Wolfe line search.
+    """L-BFGS on E(q) in the metric of the elastic kernel (K-preconditioned), Wolfe line search.
 
-    Each iteration spends exactly one convolution, K P(g) at the new state: the direction's image
-    K d is assembled from stored images (K s = Δw, K y = Δr, K G = r), and the line search along d
-    needs only element-wise work, since g(α) = g + α K d.  Converged when max|r| <= ``tol``.
+    Each iteration spends one convolution, K P(g) at the new state (plus one every ``resync``
+    iterations to re-anchor w = K q): the direction's image K d is assembled from stored images
+    (K s = Δw, K y = Δr, K G = r) by the compact L-BFGS form (tengsim._lbfgs), and the line search
+    along d needs only element-wise work, since g(α) = g + α K d.  Converged when max|r| <= ``tol``.
     """
 
     tol: float = 1e-6
@@ -108,7 +110,7 @@ class FastSolver:
         n_conv = 1
         G = q - P
         E = dA * (0.5 * np.vdot(q, w) + phi.sum())
-        pairs = []  # (SK, YK, rho): SK = [s; K s], YK = [y; K y] stacked, so one call updates both
+        mem = KMetricLBFGS(self.memory, q.size, dA)
 
         for it in range(self.max_iter + 1):
             rmax = float(np.max(np.abs(r)))
@@ -118,58 +120,42 @@ class FastSolver:
                 return _finish(problem, State(q, w), P, r, E, True, it, n_conv, t0, "converged")
             if it == self.max_iter:
                 break
-            # two-loop recursion in the K inner product <a, b> = dA a·K b, on VK = [v; K v]
-            VK = np.stack((G, r))
-            alphas = []
-            for SK, YK, rho in reversed(pairs):
-                a = rho * dA * np.vdot(SK[0], VK[1])
-                VK -= a * YK
-                alphas.append(a)
-            if pairs:
-                SK, YK, _ = pairs[-1]
-                yky = np.vdot(YK[0], YK[1])
-                if yky > 0:
-                    VK *= np.vdot(SK[0], YK[1]) / yky
-            for (SK, YK, rho), a in zip(pairs, reversed(alphas)):
-                b = rho * dA * np.vdot(YK[0], VK[1])
-                VK += (a - b) * SK
-            d, Kd = -VK[0], -VK[1]
+            HG, KHG = mem.direction(G.ravel(), r.ravel())
+            d, Kd = -HG.reshape(G.shape), -KHG.reshape(G.shape)
             # E and E'(0) from the line function itself, so the search is self-consistent
             E = dA * (0.5 * np.vdot(q, w) + phi.sum())
             slope = dA * (np.vdot(d, w) - np.vdot(P, Kd))
             if not slope < 0:  # not a descent direction: restart from the preconditioned gradient
-                pairs = []
+                mem.reset()
                 d, Kd = -G, -r
                 slope = dA * (np.vdot(d, w) - np.vdot(P, Kd))
-            alpha, E_new, phi_new, P_new = _wolfe(law, g, Kd, q, w, d, E, slope, dA, first=not pairs)
+            alpha, E_new, phi_new, P_new = _wolfe(law, g, Kd, q, w, d, E, slope, dA, first=mem.empty)
             if alpha is None:
                 return _finish(problem, State(q, w), P, r, E, False, it, n_conv, t0, "line search failed")
-            SK = np.stack((d, Kd))
-            SK *= alpha
-            q = q + SK[0]
+            s = alpha * d
+            q = q + s
             phi = phi_new
             if (it + 1) % self.resync == 0:
                 # the images K d are assembled, not convolved: round-off lets w drift from K q;
                 # re-anchor w = K q (one extra convolution) so the metric stays exact
                 w_exact = K.apply(q)
                 n_conv += 1
-                SK[1] = w_exact - w
+                ks = w_exact - w
                 w = w_exact
                 g = g0 + w
                 phi, P_new = law.evaluate(g)
             else:
-                w = w + SK[1]
+                ks = alpha * Kd
+                w = w + ks
                 g = g0 + w
             P = P_new
             r_new = w - K.apply(P)
             n_conv += 1
             G_new = q - P
-            YK = np.stack((G_new - G, r_new - r))
-            sy = np.vdot(SK[0], YK[1])
-            if sy > 1e-14 * max(abs(np.vdot(SK[0], SK[1])), 1e-300):
-                pairs.append((SK, YK, 1.0 / (dA * sy)))
-                if len(pairs) > self.memory:
-                    pairs.pop(0)
+            y, ky = G_new - G, r_new - r
+            sy = np.vdot(s, ky)
+            if sy > 1e-14 * max(abs(np.vdot(s, ks)), 1e-300):
+                mem.push(s.ravel(), ks.ravel(), y.ravel(), ky.ravel())
             r, G = r_new, G_new
         return _finish(problem, State(q, w), P, r, E, False, self.max_iter, n_conv, t0,
                        f"not converged in {self.max_iter} iterations")
