@@ -59,7 +59,8 @@ class KMetricLBFGS:
             return v.copy(), Kv.copy()
         k, dA, act = self._k(), self.dA, self.order
         new = act[-1]
-        gamma = self.SY[new, new] / self.YY[new, new]
+        yy = self.YY[new, new]
+        gamma = self.SY[new, new] / yy if yy > 0 else 1.0
         pS = dA * (self.S[:k] @ Kv)   # <s_i, v>, by slot
         pY = dA * (self.Y[:k] @ Kv)   # <y_i, v>
         ix = np.ix_(act, act)

@@ -154,7 +154,7 @@ class FastSolver:
             G_new = q - P
             y, ky = G_new - G, r_new - r
             sy = np.vdot(s, ky)
-            if sy > 1e-14 * max(abs(np.vdot(s, ks)), 1e-300):
+            if sy > 1e-14 * max(abs(np.vdot(s, ks)), 1e-300) and np.vdot(y, ky) > 0:
                 mem.push(s.ravel(), ks.ravel(), y.ravel(), ky.ravel())
             r, G = r_new, G_new
         return _finish(problem, State(q, w), P, r, E, False, self.max_iter, n_conv, t0,
