@@ -68,8 +68,14 @@ def reproduce(out_dir, quick: bool = False, progress_factory=None, log=None,
             tables[g] = tab
             v = voc_polymer(tab.area_fraction, FIG5_SIGMA, FIG5_EPS_R, FIG5_T)
             curves[g] = (tab.pressure_Pa, v)
-            summary["contact"][g]["voc_saturation_V"] = float(v[-1])
-            summary["contact"][g]["area_fraction_final"] = float(tab.area_fraction[-1])
+            c = summary["contact"][g]
+            c["voc_saturation_V"] = float(v[-1])  # at the highest pressure reached (D = d_max)
+            c["voc_saturation_pressure_Pa"] = float(tab.pressure_Pa[-1])
+            c["area_fraction_final"] = float(tab.area_fraction[-1])
+            for kpa in (10, 150):  # V_OC at the pressures of the paper's Fig. 8 range
+                P = kpa * 1e3
+                c[f"voc_at_{kpa}kPa_V"] = float(np.interp(P, tab.pressure_Pa, v)) \
+                    if tab.pressure_Pa[0] <= P <= tab.pressure_Pa[-1] else float("nan")
         n = max(len(c[0]) for c in curves.values())
         for g, (p, v) in curves.items():
             cols[f"pressure_Pa_{g}"] = np.pad(p, (0, n - len(p)), constant_values=np.nan)
