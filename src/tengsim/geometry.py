@@ -196,8 +196,7 @@ class Sinusoid1D(Shape):
         return self.wavelength
 
     def gap(self, grid: Grid) -> np.ndarray:
-        X, _ = grid.mesh()
-        # grid is cell-centred on [−λ/2, λ/2]: shift so that the apex sits on the centre pixel
+        X, _ = grid.mesh()  # an odd, cell-centred grid puts the crest (U0 = 0) on the centre pixel
         return self.amplitude * (1 - np.cos(2 * np.pi * X / self.wavelength))
 
 
