@@ -28,6 +28,20 @@ def irfft2(a, s):
     return _sfft.irfft2(a, s=s, workers=_workers(s))
 
 
+def convolve_periodic(a, spectrum):
+    """irfft2(rfft2(a) · spectrum), one axis at a time, transforming in place where possible.
+
+    (scipy's irfft2 copies its input; the axis-by-axis form measured ~25 % faster at 1024²–2048².)
+    """
+    s = a.shape
+    w = _workers(s)
+    b = _sfft.rfft(a, axis=1, workers=w)
+    b = _sfft.fft(b, axis=0, workers=w, overwrite_x=True)
+    b *= spectrum
+    b = _sfft.ifft(b, axis=0, workers=w, overwrite_x=True)
+    return _sfft.irfft(b, n=s[1], axis=1, workers=w)
+
+
 def fast_len(n: int) -> int:
     """Smallest size >= n whose prime factors are 2, 3, 5 (and 7, 11, as scipy allows)."""
     return _sfft.next_fast_len(int(n), real=True)

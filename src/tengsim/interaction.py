@@ -45,6 +45,12 @@ class Law:
         phi = np.where(low, phs - ps * t - 0.5 * dps * t * t, phi)
         return phi, p
 
+    def energy_pressure(self, g: np.ndarray, out: np.ndarray, work) -> float:
+        """ΣΦ(g), writing P(g) into ``out``: the solvers' hot path (``work``: two scratch arrays)."""
+        phi, p = self.evaluate(g)
+        out[...] = p
+        return float(phi.sum())
+
     def pressure(self, g):
         return self.evaluate(g)[1]
 
@@ -88,6 +94,23 @@ class LJ93(Law):
         p = (8.0 / 3.0) * (i9 - i3)
         dp = (8.0 / 3.0) * (-9.0 * i9 + 3.0 * i3) * inv if need_dp else None
         return phi, p, dp
+
+    def energy_pressure(self, g, out, work):
+        """In place, no temporaries (same values as ``evaluate``); falls back below g_safe."""
+        if float(g.min()) < self.g_safe:
+            return super().energy_pressure(g, out, work)
+        a, b = work
+        np.reciprocal(g, out=a)      # g⁻¹
+        np.multiply(a, a, out=b)     # g⁻²
+        s2 = float(b.sum())
+        np.multiply(b, b, out=out)   # g⁻⁴
+        out *= out                   # g⁻⁸
+        s8 = float(out.sum())
+        out *= a                     # g⁻⁹
+        b *= a                       # g⁻³
+        out -= b
+        out *= 8.0 / 3.0
+        return s8 / 3.0 - (4.0 / 3.0) * s2
 
 
 @dataclass(frozen=True)

@@ -89,9 +89,8 @@ class PeriodicKernel:
         self.periodic = True
 
     def apply(self, p: np.ndarray) -> np.ndarray:
-        spec = _fft.rfft2(p)
-        spec *= self._spectrum
-        return _fft.irfft2(spec, s=self.grid.shape)
+        """w = K p (one convolution)."""
+        return _fft.convolve_periodic(p, self._spectrum)
 
     def params(self) -> dict:
         return {"boundary": "periodic", "coupling": self.coupling}

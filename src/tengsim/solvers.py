@@ -102,104 +102,137 @@ class FastSolver:
 
     def solve(self, problem: Problem, start: State) -> Equilibrium:
         t0 = time.perf_counter()
-        K, law, g0, dA = problem.kernel, problem.law, problem.g0, problem.dA
-        q, w = start.q.copy(), start.w.copy()
-        g = g0 + w
-        phi, P = law.evaluate(g)
-        r = w - K.apply(P)
+        K, law, dA = problem.kernel, problem.law, problem.dA
+        shape = problem.g0.shape
+        g0 = np.ascontiguousarray(problem.g0, dtype=float).ravel()
+        n = g0.size
+        q = np.array(start.q, dtype=float).ravel()
+        w = np.array(start.w, dtype=float).ravel()
+        # every per-iteration array is preallocated: the loop is memory-bound, not FFT-bound
+        g, gt, P, Pt, d, Kd, r, rn, G, Gn, y, ky, wa, wb = (np.empty(n) for _ in range(14))
+        work = (wa, wb)
+        axpy = _axpy(n)
+
+        def conv(x):
+            return K.apply(x.reshape(shape)).ravel()
+
+        np.add(g0, w, out=g)
+        phis = law.energy_pressure(g, P, work)
+        np.subtract(w, conv(P), out=r)
         n_conv = 1
-        G = q - P
-        E = dA * (0.5 * np.vdot(q, w) + phi.sum())
-        mem = KMetricLBFGS(self.memory, q.size, dA)
+        np.subtract(q, P, out=G)
+        qw = float(np.vdot(q, w))
+        E = dA * (0.5 * qw + phis)
+        mem = KMetricLBFGS(self.memory, n, dA)
+
+        def done(ok, it, msg):
+            st = State(q.reshape(shape), w.reshape(shape))
+            return _finish(problem, st, P.reshape(shape).copy(), r, E, ok, it, n_conv, t0, msg)
 
         for it in range(self.max_iter + 1):
-            rmax = float(np.max(np.abs(r)))
+            rmax = max(float(r.max()), -float(r.min()))
             if not math.isfinite(rmax):
-                return _finish(problem, State(q, w), P, r, E, False, it, n_conv, t0, "non-finite residual")
+                return done(False, it, "non-finite residual")
             if rmax <= self.tol:
-                return _finish(problem, State(q, w), P, r, E, True, it, n_conv, t0, "converged")
+                return done(True, it, "converged")
             if it == self.max_iter:
                 break
-            HG, KHG = mem.direction(G.ravel(), r.ravel())
-            d, Kd = -HG.reshape(G.shape), -KHG.reshape(G.shape)
-            # E and E'(0) from the line function itself, so the search is self-consistent
-            E = dA * (0.5 * np.vdot(q, w) + phi.sum())
-            slope = dA * (np.vdot(d, w) - np.vdot(P, Kd))
-            if not slope < 0:  # not a descent direction: restart from the preconditioned gradient
+            mem.direction(G, r, d, Kd)
+            a0, a1, b = float(np.vdot(d, w)), float(np.vdot(d, Kd)), float(np.vdot(P, Kd))
+            if not a0 - b < 0:  # not a descent direction: restart from the preconditioned gradient
                 mem.reset()
-                d, Kd = -G, -r
-                slope = dA * (np.vdot(d, w) - np.vdot(P, Kd))
-            alpha, E_new, phi_new, P_new = _wolfe(law, g, Kd, q, w, d, E, slope, dA, first=mem.empty)
+                mem.direction(G, r, d, Kd)
+                a0, a1, b = float(np.vdot(d, w)), float(np.vdot(d, Kd)), float(np.vdot(P, Kd))
+            slope = dA * (a0 - b)
+            alpha, E_new, phis_t = _wolfe(law, g, Kd, gt, Pt, work, qw, a0, a1, E, slope, dA, first=mem.empty)
             if alpha is None:
-                return _finish(problem, State(q, w), P, r, E, False, it, n_conv, t0, "line search failed")
-            s = alpha * d
-            q = q + s
-            phi = phi_new
+                return done(False, it, "line search failed")
+            axpy(d, q, alpha)
             if (it + 1) % self.resync == 0:
                 # the images K d are assembled, not convolved: round-off lets w drift from K q;
                 # re-anchor w = K q (one extra convolution) so the metric stays exact
-                w_exact = K.apply(q)
+                w_exact = conv(q)
                 n_conv += 1
-                ks = w_exact - w
-                w = w_exact
-                g = g0 + w
-                phi, P_new = law.evaluate(g)
+                ks_factor, ks_base = 1.0, w_exact - w
+                w[:] = w_exact
+                np.add(g0, w, out=g)
+                phis = law.energy_pressure(g, P, work)
+                qw = float(np.vdot(q, w))
+                resynced = True
             else:
-                ks = alpha * Kd
-                w = w + ks
-                g = g0 + w
-            P = P_new
-            r_new = w - K.apply(P)
+                axpy(Kd, w, alpha)
+                g, gt = gt, g
+                P, Pt = Pt, P
+                phis = phis_t
+                qw += alpha * (2.0 * a0 + alpha * a1)
+                ks_factor, ks_base = alpha, Kd
+                resynced = False
+            E = dA * (0.5 * qw + phis)
+            np.subtract(w, conv(P), out=rn)
             n_conv += 1
-            G_new = q - P
-            y, ky = G_new - G, r_new - r
-            sy = np.vdot(s, ky)
-            if sy > 1e-14 * max(abs(np.vdot(s, ks)), 1e-300) and np.vdot(y, ky) > 0:
-                mem.push(s.ravel(), ks.ravel(), y.ravel(), ky.ravel())
-            r, G = r_new, G_new
-        return _finish(problem, State(q, w), P, r, E, False, self.max_iter, n_conv, t0,
-                       f"not converged in {self.max_iter} iterations")
+            np.subtract(rn, r, out=ky)
+            np.subtract(q, P, out=Gn)
+            np.subtract(Gn, G, out=y)
+            sy = dA * alpha * float(np.vdot(d, ky))
+            yy = dA * float(np.vdot(y, ky))
+            sks = dA * alpha * alpha * abs(a1)
+            store = sy > 1e-14 * max(sks, 1e-300) and yy > 0
+            mem.update(alpha, d, ks_factor, ks_base, y, ky, rn, sy, yy, store)
+            r, rn = rn, r
+            G, Gn = Gn, G
+            if resynced:
+                mem.refresh(r)
+        return done(False, self.max_iter, f"not converged in {self.max_iter} iterations")
 
 
-def _wolfe(law, g, Kd, q, w, d, E0, slope0, dA, first, c1=1e-4, c2=0.9, max_eval=40):
+def _axpy(n):
+    """y ← y + a x in place (BLAS daxpy: one pass, no temporary)."""
+    from scipy.linalg.blas import daxpy
+
+    def f(x, y, a):
+        daxpy(x, y, n=n, a=a)
+    return f
+
+
+def _wolfe(law, g, Kd, gt, Pt, work, qw, a0, a1, E0, slope0, dA, first, c1=1e-4, c2=0.9, max_eval=40):
     """Line search along d; element-wise only (no convolution).
 
     E(α) = dA[½ q·w + α d·w + ½ α² d·K d + Σ Φ(g + α K d)],
-    E'(α) = dA[d·w + α d·K d − P(g + α K d)·K d].
+    E'(α) = dA[d·w + α d·K d − P(g + α K d)·K d]   (qw = q·w, a0 = d·w, a1 = d·K d).
     Accepts the strong Wolfe conditions, or near round-off the approximate Wolfe conditions of
     Hager & Zhang (2005): E(α) <= E(0) + 1e-11|E(0)| and 0.9 E'(0) <= E'(α) <= −0.8 E'(0).
-    The bracket is narrowed by safeguarded secant steps on E'.
+    The bracket is narrowed by safeguarded secant steps on E'.  On return the buffers gt, Pt hold
+    the gap and pressure at the accepted α; returns (α, E(α), ΣΦ) or (None, None, None).
     """
-    qw = 0.5 * np.vdot(q, w)
-    a0 = np.vdot(d, w)
-    a1 = np.vdot(d, Kd)
     eps_E = 1e-11 * max(1.0, abs(E0))
 
     def f(alpha):
-        phi, P = law.evaluate(g + alpha * Kd)
-        e = dA * (qw + alpha * a0 + 0.5 * alpha * alpha * a1 + phi.sum())
-        de = dA * (a0 + alpha * a1 - np.vdot(P, Kd))
-        return e, de, phi, P
+        np.multiply(Kd, alpha, out=gt)
+        np.add(gt, g, out=gt)
+        phis = law.energy_pressure(gt, Pt, work)
+        e = dA * (0.5 * qw + alpha * a0 + 0.5 * alpha * alpha * a1 + phis)
+        de = dA * (a0 + alpha * a1 - float(np.vdot(Pt, Kd)))
+        return e, de, phis
 
     alpha = 1.0
     if first:  # scale the first trial step so that the gap moves by at most 0.25 ε
-        m = float(np.max(np.abs(Kd)))
+        m = max(float(Kd.max()), -float(Kd.min()))
         if m > 0.25:
             alpha = 0.25 / m
     lo, de_lo = 0.0, slope0
     hi, de_hi = None, None
     best = None
     for _ in range(max_eval):
-        e, de, phi, P = f(alpha)
+        e, de, phis = f(alpha)
         if not np.isfinite(e):
             hi, de_hi = alpha, None
         else:
             wolfe = e <= E0 + c1 * alpha * slope0 and abs(de) <= -c2 * slope0
             approx = e <= E0 + eps_E and c2 * slope0 <= de <= -0.8 * slope0
             if wolfe or approx:
-                return alpha, e, phi, P
+                return alpha, e, phis
             if e <= E0 + eps_E and (best is None or abs(de) < best[0]):
-                best = (abs(de), alpha, e, phi, P)
+                best = (abs(de), alpha)
             if e > E0 + c1 * alpha * slope0 + eps_E or de > 0:
                 hi, de_hi = alpha, (de if e <= E0 + eps_E or de > 0 else None)
             else:
@@ -214,8 +247,9 @@ def _wolfe(law, g, Kd, q, w, d, E0, slope0, dA, first, c1=1e-4, c2=0.9, max_eval
             cand = lo + 0.5 * width
         alpha = min(max(cand, lo + 0.1 * width), hi - 0.1 * width)
     if best is not None:
-        return best[1], best[2], best[3], best[4]
-    return None, None, None, None
+        e, _, phis = f(best[1])  # the buffers must hold the accepted point
+        return best[1], e, phis
+    return None, None, None
 
 
 @dataclass(frozen=True)

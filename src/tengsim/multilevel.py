@@ -1,0 +1,125 @@
+"""Nested-grid start for large periodic problems (rough surfaces, arrays of cells).
+
+On a periodic cell the fast solver converges slowest on the long wavelengths, where the kernel
+2κ/|q| is largest, and a larger cell has longer ones: its iterations per equilibrium grow with the
+cell.  Those wavelengths are already resolved by a coarser grid over the same cell, at a quarter of
+the cost per convolution.  :func:`nested_solve` therefore solves the coarsest level (pixel 2^L times
+larger, heights Fourier-truncated) from the undeformed state, then each finer level from the
+Fourier-interpolated elastic pressure q of the level below (w = K q: one convolution), up to the
+given grid.
+
+Only the finest level's answer is returned, and it is judged like any other: by the Eq. (9) residual
+on the given grid, so it is a stable equilibrium of the fine problem.  With adhesion a problem can
+have several; the nested start may settle in a different one from a cold start (both are local
+minima of the same energy; measured on the benchmark surface in docs/benchmarks.md).
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from tengsim.errors import TengsimError
+from tengsim.grid import Grid
+from tengsim.kernels import PeriodicKernel
+from tengsim.solvers import Equilibrium, Problem, State
+
+
+def fourier_resample(a: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
+    """Resample a periodic real field to ``shape`` by truncating or zero-padding its spectrum.
+
+    Keeps the wavenumbers |k| below both grids' Nyquist limits (the Nyquist row/column is dropped),
+    so the mean and every resolved harmonic are preserved exactly.
+    """
+    n0, n1 = a.shape
+    m0, m1 = shape
+    A = np.fft.rfft2(a)
+    B = np.zeros((m0, m1 // 2 + 1), complex)
+    k0 = min(n0, m0) // 2
+    k1 = min(n1, m1) // 2
+    B[:k0, :k1] = A[:k0, :k1]
+    if k0 > 1:
+        B[-(k0 - 1):, :k1] = A[-(k0 - 1):, :k1]
+    return np.fft.irfft2(B, s=shape) * (m0 * m1 / (n0 * n1))
+
+
+@dataclass
+class LevelStat:
+    """One level of a nested solve: grid size, convolutions, seconds."""
+
+    shape: tuple
+    n_conv: int
+    iterations: int
+    seconds: float
+    residual: float
+
+
+@dataclass
+class NestedSolve:
+    """The finest level's equilibrium and the cost of every level (coarsest first)."""
+
+    equilibrium: Equilibrium
+    levels: list = field(default_factory=list)
+
+    @property
+    def seconds(self) -> float:
+        return sum(s.seconds for s in self.levels)
+
+    @property
+    def n_conv(self) -> int:
+        return sum(s.n_conv for s in self.levels)
+
+    @property
+    def fine_equivalent_conv(self) -> float:
+        """Convolutions weighted by their grid size relative to the finest grid."""
+        nf = np.prod(self.levels[-1].shape)
+        return float(sum(s.n_conv * np.prod(s.shape) / nf for s in self.levels))
+
+
+def coarse_levels(shape: tuple[int, int], min_size: int = 128, levels: int | None = None) -> list:
+    """Grid shapes from the coarsest to ``shape``, halving while both sides stay even and >= min_size."""
+    out = [tuple(shape)]
+    while (levels is None or len(out) <= levels) and all(k % 2 == 0 and k // 2 >= min_size for k in out[-1]):
+        out.append((out[-1][0] // 2, out[-1][1] // 2))
+    return out[::-1]
+
+
+def nested_solve(solver, g0: np.ndarray, law, kernel: PeriodicKernel, min_size: int = 128,
+                 levels: int | None = None) -> NestedSolve:
+    """Solve the periodic problem (g0 = U0 − D + 1, law, kernel) by nested grids; see the module doc.
+
+    ``levels`` caps the number of coarser levels (default: halve down to ``min_size`` pixels).
+    """
+    if not isinstance(kernel, PeriodicKernel):
+        raise TengsimError("nested_solve needs a periodic kernel (the coarse grids resample the cell "
+                           "by Fourier series)")
+    g0 = np.asarray(g0, dtype=float)
+    grid = kernel.grid
+    if g0.shape != grid.shape:
+        raise TengsimError(f"g0 has shape {g0.shape}, the kernel's grid {grid.shape}")
+    shapes = coarse_levels(grid.shape, min_size, levels)
+    stats = []
+    q = None
+    eq = None
+    for shape in shapes:
+        t0 = time.perf_counter()
+        if shape == grid.shape:
+            k, g = kernel, g0
+        else:
+            cg = Grid(shape[0], shape[1], grid.lx / shape[0], grid.ly / shape[1])
+            k = PeriodicKernel(cg, kernel.coupling)
+            g = fourier_resample(g0, shape)
+        n_conv = 0
+        if q is None:
+            start = State.zero(shape)
+        else:
+            qf = fourier_resample(q, shape)
+            start = State(qf, k.apply(qf))
+            n_conv = 1
+        eq = solver.solve(Problem(g, law, k), start)
+        n_conv += eq.n_conv
+        stats.append(LevelStat(shape, n_conv, eq.iterations, time.perf_counter() - t0, eq.residual))
+        q = eq.state.q
+    eq.n_conv = stats[-1].n_conv
+    return NestedSolve(eq, stats)
