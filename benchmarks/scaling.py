@@ -13,7 +13,9 @@ U0 = max(h) − h, periodic kernel (μ^{3/2} · 2/|q|), LJ 8-2 law, μ = 0.5.  D
 fraction of the surface overlaps rigidly (U0 < D): the contact state is comparable across sizes.
 
 Per size, in a fresh subprocess (so peak memory is that size's alone):
-* a cold equilibrium at D0 from the undeformed state, then a warm one at D0 + ΔD (the
+* a nested-grid solve (``tengsim.multilevel.nested_solve``: coarse grids over the same cell first,
+  down to ``--min-size``), its convolutions on the finest grid and in fine-grid equivalents;
+* for n <= ``--cold-max``: a cold equilibrium at D0 from the undeformed state, then a warm one at D0 + ΔD (the
   per-step cost on a path);
 * convolutions per equilibrium, time of one convolution, peak RSS (resource.getrusage).
 The growth exponent is the least-squares slope of log(time) against log(n²) (n² log n gives a
@@ -52,7 +54,7 @@ def rough_surface(n, dx, hurst=0.8, lam_r=16.0, lam_s=2.0, h_rms=1.0, seed=0):
     return h, L
 
 
-def one_size(n, dx, mu, tol, overlap, dD, seed):
+def one_size(n, dx, mu, tol, overlap, dD, seed, cold=True, nested=True, min_size=128):
     from tengsim.grid import Grid
     from tengsim.interaction import LJ93
     from tengsim.kernels import make_kernel
@@ -81,19 +83,41 @@ def one_size(n, dx, mu, tol, overlap, dD, seed):
     del p
     out = dict(n=n, N=n * n, dx=dx, L=L, mu=mu, tol=tol, rms_slope=slope, D0=D0, dD=dD, t_conv=t_conv,
                t_setup=t_setup)
-    t0 = time.perf_counter()
-    eq = solver.solve(Problem(U0 - D0 + 1.0, law, kernel), State.zero(grid.shape))
-    out.update(cold_s=time.perf_counter() - t0, cold_conv=eq.n_conv, cold_ok=bool(eq.converged),
-               cold_res=eq.residual, cold_area=float(np.mean(eq.P > 0)))
-    state = eq.state
-    del eq
-    t0 = time.perf_counter()
-    eq = solver.solve(Problem(U0 - (D0 + dD) + 1.0, law, kernel), state)
-    out.update(warm_s=time.perf_counter() - t0, warm_conv=eq.n_conv, warm_ok=bool(eq.converged),
-               warm_res=eq.residual, warm_area=float(np.mean(eq.P > 0)))
-    out["peak_rss_MiB"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
-    out["array_MiB"] = n * n * 8 / 2 ** 20
+    if nested:
+        from tengsim.multilevel import nested_solve
+
+        t0 = time.perf_counter()
+        ns = nested_solve(solver, U0 - D0 + 1.0, law, kernel, min_size=min_size)
+        eq = ns.equilibrium
+        out.update(nested_s=time.perf_counter() - t0, nested_conv=ns.n_conv,
+                   nested_fine_conv=eq.n_conv, nested_fine_equiv=ns.fine_equivalent_conv,
+                   nested_fine_s=ns.levels[-1].seconds, nested_ok=bool(eq.converged), nested_res=eq.residual,
+                   nested_area=float(np.mean(eq.P > 0)), nested_energy=eq.energy,
+                   nested_levels=[[lv.shape[0], lv.n_conv, lv.seconds] for lv in ns.levels])
+        del ns, eq
+        _emit(out)
+    if cold:
+        t0 = time.perf_counter()
+        eq = solver.solve(Problem(U0 - D0 + 1.0, law, kernel), State.zero(grid.shape))
+        out.update(cold_s=time.perf_counter() - t0, cold_conv=eq.n_conv, cold_ok=bool(eq.converged),
+                   cold_res=eq.residual, cold_area=float(np.mean(eq.P > 0)), cold_energy=eq.energy)
+        state = eq.state
+        del eq
+        out["peak_rss_MiB"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+        _emit(out)
+        t0 = time.perf_counter()
+        eq = solver.solve(Problem(U0 - (D0 + dD) + 1.0, law, kernel), state)
+        out.update(warm_s=time.perf_counter() - t0, warm_conv=eq.n_conv, warm_ok=bool(eq.converged),
+                   warm_res=eq.residual, warm_area=float(np.mean(eq.P > 0)))
+    _emit(out)
     return out
+
+
+def _emit(out):
+    """One JSON line per finished phase, so a size cut by the timeout keeps what it finished."""
+    out["peak_rss_MiB"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+    out["array_MiB"] = out["N"] * 8 / 2 ** 20
+    print(json.dumps(out), flush=True)
 
 
 def fit(ns, ts):
@@ -115,63 +139,79 @@ def main(argv=None):
     ap.add_argument("--dD", type=float, default=0.1)
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--timeout", type=float, default=1500, help="seconds per size")
+    ap.add_argument("--cold-max", type=int, default=2048, help="largest n solved cold (and warm)")
+    ap.add_argument("--no-nested", action="store_true", help="skip the nested-grid solve")
+    ap.add_argument("--min-size", type=int, default=128, help="coarsest grid of the nested solve")
     ap.add_argument("--out", type=Path, default=HERE / "results")
     ap.add_argument("--one", type=int, help=argparse.SUPPRESS)
     a = ap.parse_args(argv)
     if a.one:
-        print(json.dumps(one_size(a.one, a.dx, a.mu, a.tol, a.overlap, a.dD, a.seed)))
+        one_size(a.one, a.dx, a.mu, a.tol, a.overlap, a.dD, a.seed, cold=a.one <= a.cold_max,
+                 nested=not a.no_nested, min_size=a.min_size)
         return
     rows = []
     for n in a.sizes:
         cmd = [sys.executable, __file__, "--one", str(n), "--dx", str(a.dx), "--mu", str(a.mu),
-               "--tol", str(a.tol), "--overlap", str(a.overlap), "--dD", str(a.dD), "--seed", str(a.seed)]
+               "--tol", str(a.tol), "--overlap", str(a.overlap), "--dD", str(a.dD), "--seed", str(a.seed),
+               "--cold-max", str(a.cold_max), "--min-size", str(a.min_size)] + (["--no-nested"] if a.no_nested else [])
         print(f"n = {n} ...", flush=True)
+        t0 = time.perf_counter()
         try:
             p = subprocess.run(cmd, capture_output=True, text=True, timeout=a.timeout, env=os.environ)
-        except subprocess.TimeoutExpired:
-            print(f"  n = {n}: timed out after {a.timeout} s", flush=True)
-            rows.append(dict(n=n, error=f"timeout {a.timeout} s"))
-            continue
-        if p.returncode != 0:
-            err = (p.stderr.strip().splitlines() or ["?"])[-1]
-            print(f"  n = {n}: failed ({err})", flush=True)
-            rows.append(dict(n=n, error=err))
-            continue
-        r = json.loads(p.stdout.strip().splitlines()[-1])
+            stdout, err = p.stdout, (None if p.returncode == 0 else
+                                     (p.stderr.strip().splitlines() or ["?"])[-1])
+        except subprocess.TimeoutExpired as e:
+            so = e.stdout or ""
+            stdout = so.decode() if isinstance(so, bytes) else so
+            err = f"cut at the {a.timeout:g} s cap"
+        lines = [ln for ln in stdout.splitlines() if ln.startswith("{")]
+        r = json.loads(lines[-1]) if lines else dict(n=n)
+        r["wall_total_s"] = time.perf_counter() - t0
+        if err:
+            r["error"] = err
         rows.append(r)
-        print(f"  cold {r['cold_s']:.2f} s ({r['cold_conv']} conv), warm {r['warm_s']:.2f} s ({r['warm_conv']} conv), "
-              f"t_conv {r['t_conv'] * 1e3:.1f} ms, peak RSS {r['peak_rss_MiB']:.0f} MiB, "
-              f"repulsive area {r['warm_area']:.3f}", flush=True)
-    ok = [r for r in rows if "error" not in r]
+        print("  " + ", ".join(f"{k} {r[k]:.4g}" if isinstance(r[k], float) else f"{k} {r[k]}"
+                               for k in ("nested_s", "nested_fine_conv", "cold_s", "cold_conv", "warm_s",
+                                         "warm_conv", "peak_rss_MiB", "error") if k in r), flush=True)
+
+    def cell(r, k, spec):
+        return format(r[k], spec) if k in r else "–"
+
     lines = ["# Scaling of tengsim's fast solver (one equilibrium, periodic random rough surface)", "",
              f"Command: `python benchmarks/scaling.py {' '.join(sys.argv[1:])}`", "",
              f"Surface: self-affine, Hurst 0.8, λr = 16 ε, λs = 2 ε, h_rms = 1 ε, pixel dx = {a.dx} ε "
              f"(cell grows with n), seed {a.seed}; μ = {a.mu}, LJ 8-2, periodic kernel, tol = {a.tol:g}; "
-             f"D0 such that {100 * a.overlap:g} % overlaps rigidly, warm step ΔD = {a.dD}.", "",
+             f"D0 such that {100 * a.overlap:g} % overlaps rigidly, warm step ΔD = {a.dD}; nested: "
+             f"coarsest grid {a.min_size}².", "",
              f"Machine: {os.cpu_count()} cores; OPENBLAS_NUM_THREADS={os.environ.get('OPENBLAS_NUM_THREADS')}, "
              f"TENGSIM_FFT_WORKERS={os.environ.get('TENGSIM_FFT_WORKERS')} (unset: 1 thread below 512² "
              f"points, all cores above).", "",
-             "| n | cold [s] | cold conv | warm [s] | warm conv | t_conv [ms] | warm/(conv·t_conv) | "
-             "peak RSS [MiB] | RSS / array | repulsive area | rms slope |",
-             "|---|---|---|---|---|---|---|---|---|---|---|"]
+             "| n | cold [s] | cold conv | warm [s] | warm conv | nested [s] | nested: fine-grid conv "
+             "(fine-equivalent, all levels) | nested = cold state? | t_conv [ms] | cold/(conv·t_conv) | "
+             "warm/(conv·t_conv) | peak RSS [MiB] | repulsive area | note |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
-        if "error" in r:
-            lines.append(f"| {r['n']} | {r['error']} |" + " |" * 9)
+        if "t_conv" not in r:
+            lines.append(f"| {r['n']} |" + " – |" * 12 + f" {r.get('error', '')} |")
             continue
+        tc = r["t_conv"]
+        same = "–"
+        if "nested_energy" in r and "cold_energy" in r:
+            de = abs(r["nested_energy"] - r["cold_energy"]) / abs(r["cold_energy"])
+            same = f"yes (ΔE/E {de:.0e})" if de < 1e-8 else f"no (ΔE/E {de:.1e})"
+        nested = (f"{r['nested_fine_conv']} ({r['nested_fine_equiv']:.0f})" if "nested_fine_conv" in r else "–")
         lines.append(
-            f"| {r['n']} | {r['cold_s']:.2f} | {r['cold_conv']} | {r['warm_s']:.3f} | {r['warm_conv']} | "
-            f"{r['t_conv'] * 1e3:.2f} | {r['warm_s'] / (r['warm_conv'] * r['t_conv']):.2f} | "
-            f"{r['peak_rss_MiB']:.0f} | {r['peak_rss_MiB'] / r['array_MiB']:.0f} | {r['warm_area']:.3f} | "
-            f"{r['rms_slope']:.2f} |")
-    if len(ok) >= 2:
-        ns = [r["n"] for r in ok]
-        for key in ("cold_s", "warm_s", "t_conv"):
-            s, _ = fit(ns, [r[key] for r in ok])
-            lines.append("")
-            lines.append(f"Fitted growth of {key}: time ∝ N^{s:.2f} (N = n²).")
-        sm = float(np.polyfit(np.log(np.asarray(ns, float) ** 2), np.log([r["peak_rss_MiB"] for r in ok]), 1)[0])
-        lines.append("")
-        lines.append(f"Fitted growth of peak memory: ∝ N^{sm:.2f}.")
+            f"| {r['n']} | {cell(r, 'cold_s', '.1f')} | {cell(r, 'cold_conv', 'd')} | {cell(r, 'warm_s', '.1f')} | "
+            f"{cell(r, 'warm_conv', 'd')} | {cell(r, 'nested_s', '.1f')} | {nested} | {same} | {tc * 1e3:.1f} | "
+            + (f"{r['cold_s'] / (r['cold_conv'] * tc):.2f}" if "cold_s" in r else "–") + " | "
+            + (f"{r['warm_s'] / (r['warm_conv'] * tc):.2f}" if "warm_s" in r else "–") + " | "
+            f"{r['peak_rss_MiB']:.0f} | {r.get('cold_area', r.get('nested_area', float('nan'))):.3f} | "
+            f"{r.get('error', '')} |")
+    for key in ("cold_s", "warm_s", "nested_s", "t_conv", "peak_rss_MiB"):
+        ok = [r for r in rows if key in r]
+        if len(ok) >= 2:
+            sl, _ = fit([r["n"] for r in ok], [r[key] for r in ok])
+            lines += ["", f"Fitted growth of {key} over n = {', '.join(str(r['n']) for r in ok)}: ∝ N^{sl:.2f} (N = n²)."]
     lines.append("")
     a.out.mkdir(parents=True, exist_ok=True)
     (a.out / "scaling.md").write_text("\n".join(lines))

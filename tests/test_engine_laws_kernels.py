@@ -170,3 +170,16 @@ def test_periodic_kernel_is_sum_of_images_up_to_a_constant():
     w = wbig[m * n:(m + 1) * n, m * n:(m + 1) * n]
     diff = (w - w.mean()) - wp
     assert np.max(np.abs(diff)) < 1e-2 * np.max(np.abs(wp))
+
+
+@pytest.mark.parametrize("law", [LJ93(), Repulsive()])
+def test_energy_pressure_in_place_equals_evaluate(law):
+    """The solvers' hot path (in place, scratch buffers) gives evaluate's values, also below g_safe."""
+    rng = np.random.default_rng(5)
+    for g in (0.8 + 3 * rng.random(1000), np.linspace(-0.5, 4.0, 1001)):
+        phi, p = law.evaluate(g)
+        out = np.full_like(g, np.nan)
+        work = (np.empty_like(g), np.empty_like(g))
+        s = law.energy_pressure(g, out, work)
+        assert np.allclose(out, p, rtol=1e-13, atol=1e-13)
+        assert s == pytest.approx(phi.sum(), rel=1e-12)

@@ -174,3 +174,19 @@ def test_vsr_and_fast_agree_on_whole_path():
     assert np.max(np.abs(fast.table["F"] - vsr.table["F"])) < 1e-5
     assert np.max(np.abs(fast.table["contact_length"] - vsr.table["contact_length"])) < 0.01 * grid.dx
     assert vsr.table["n_conv"].sum() > 5 * fast.table["n_conv"].sum()
+
+
+def test_cache_blocked_line_search_gives_the_same_iterates(monkeypatch):
+    """The line search runs block by block on large grids; blocks change nothing but round-off."""
+    import tengsim.solvers as S
+
+    grid, U0, K = _group_a(dx=0.1)
+    prob = Problem(U0 - 1.5 + 1.0, LJ93(), K)
+    ref = FastSolver(1e-8).solve(prob, State.zero(grid.shape))
+    monkeypatch.setattr(S, "BLOCK", 97)  # many uneven blocks on this 39 x 39 grid
+    assert len(S._blocks(grid.nx * grid.ny)) > 10
+    blk = FastSolver(1e-8).solve(prob, State.zero(grid.shape))
+    assert ref.converged and blk.converged
+    assert abs(blk.iterations - ref.iterations) <= 2
+    assert np.max(np.abs(blk.H - ref.H)) < 1e-7
+    assert blk.energy == pytest.approx(ref.energy, rel=1e-12)

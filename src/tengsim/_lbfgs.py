@@ -75,9 +75,9 @@ class KMetricLBFGS:
         ix = np.ix_(act, act)
         SYa = self.SY[ix]
         R = np.triu(SYa)
-        u = solve_triangular(R, self.pS[act], lower=False)
+        u = solve_triangular(R, self.pS[act], lower=False, check_finite=False)
         top = solve_triangular(R, np.diag(SYa) * u + gamma * (self.YY[ix] @ u) - gamma * self.pY[act],
-                               trans="T", lower=False)
+                               trans="T", lower=False, check_finite=False)
         cS = np.zeros(k)
         cY = np.zeros(k)
         cS[act] = top

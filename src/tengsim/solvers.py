@@ -111,7 +111,6 @@ class FastSolver:
         # every per-iteration array is preallocated: the loop is memory-bound, not FFT-bound
         g, gt, P, Pt, d, Kd, r, rn, G, Gn, y, ky, wa, wb = (np.empty(n) for _ in range(14))
         work = (wa, wb)
-        axpy = _axpy(n)
 
         def conv(x):
             return K.apply(x.reshape(shape)).ravel()
@@ -147,7 +146,7 @@ class FastSolver:
             alpha, E_new, phis_t = _wolfe(law, g, Kd, gt, Pt, work, qw, a0, a1, E, slope, dA, first=mem.empty)
             if alpha is None:
                 return done(False, it, "line search failed")
-            axpy(d, q, alpha)
+            _axpy(d, q, alpha, wa)
             if (it + 1) % self.resync == 0:
                 # the images K d are assembled, not convolved: round-off lets w drift from K q;
                 # re-anchor w = K q (one extra convolution) so the metric stays exact
@@ -160,7 +159,7 @@ class FastSolver:
                 qw = float(np.vdot(q, w))
                 resynced = True
             else:
-                axpy(Kd, w, alpha)
+                _axpy(Kd, w, alpha, wa)
                 g, gt = gt, g
                 P, Pt = Pt, P
                 phis = phis_t
@@ -185,13 +184,23 @@ class FastSolver:
         return done(False, self.max_iter, f"not converged in {self.max_iter} iterations")
 
 
-def _axpy(n):
-    """y ← y + a x in place (BLAS daxpy: one pass, no temporary)."""
-    from scipy.linalg.blas import daxpy
+BLOCK = 1 << 15  # elements per cache block of the line search (8 arrays × 256 KiB)
 
-    def f(x, y, a):
-        daxpy(x, y, n=n, a=a)
-    return f
+
+def _blocks(n):
+    """(slice, length) pairs covering range(n) in cache-sized blocks (one block for small n)."""
+    if n <= 4 * BLOCK:
+        return [(slice(0, n), n)]
+    return [(slice(i, min(i + BLOCK, n)), min(i + BLOCK, n) - i) for i in range(0, n, BLOCK)]
+
+
+def _axpy(x, y, a, tmp):
+    """y ← y + a x in place, through the scratch array ``tmp`` (no allocation).
+
+    (Not BLAS daxpy: OpenBLAS threads it, and on a busy 2-core machine that cost ~1000× on small arrays.)
+    """
+    np.multiply(x, a, out=tmp)
+    np.add(y, tmp, out=y)
 
 
 def _wolfe(law, g, Kd, gt, Pt, work, qw, a0, a1, E0, slope0, dA, first, c1=1e-4, c2=0.9, max_eval=40):
@@ -206,12 +215,20 @@ def _wolfe(law, g, Kd, gt, Pt, work, qw, a0, a1, E0, slope0, dA, first, c1=1e-4,
     """
     eps_E = 1e-11 * max(1.0, abs(E0))
 
+    blocks = _blocks(g.size)
+
     def f(alpha):
-        np.multiply(Kd, alpha, out=gt)
-        np.add(gt, g, out=gt)
-        phis = law.energy_pressure(gt, Pt, work)
+        # block by block, so that the gap, the law's scratch and the pressure stay in cache
+        phis = pk = 0.0
+        for sl, m in blocks:
+            gb, pb = gt[sl], Pt[sl]
+            kb = Kd[sl]
+            np.multiply(kb, alpha, out=gb)
+            np.add(gb, g[sl], out=gb)
+            phis += law.energy_pressure(gb, pb, (work[0][:m], work[1][:m]))
+            pk += float(np.vdot(pb, kb))
         e = dA * (0.5 * qw + alpha * a0 + 0.5 * alpha * alpha * a1 + phis)
-        de = dA * (a0 + alpha * a1 - float(np.vdot(Pt, Kd)))
+        de = dA * (a0 + alpha * a1 - pk)
         return e, de, phis
 
     alpha = 1.0
