@@ -15,8 +15,8 @@ fraction of the surface overlaps rigidly (U0 < D): the contact state is comparab
 Per size, in a fresh subprocess (so peak memory is that size's alone):
 * a nested-grid solve (``tengsim.multilevel.nested_solve``: coarse grids over the same cell first,
   down to ``--min-size``), its convolutions on the finest grid and in fine-grid equivalents;
-* for n <= ``--cold-max``: a cold equilibrium at D0 from the undeformed state, then a warm one at D0 + ΔD (the
-  per-step cost on a path);
+* for n <= ``--cold-max``: a cold equilibrium at D0 from the undeformed state and, for
+  n <= ``--warm-max``, a warm one at D0 + ΔD from it (the per-step cost on a path);
 * convolutions per equilibrium, time of one convolution, peak RSS (resource.getrusage).
 The growth exponent is the least-squares slope of log(time) against log(n²) (n² log n gives a
 slope just above 1).
@@ -54,7 +54,7 @@ def rough_surface(n, dx, hurst=0.8, lam_r=16.0, lam_s=2.0, h_rms=1.0, seed=0):
     return h, L
 
 
-def one_size(n, dx, mu, tol, overlap, dD, seed, cold=True, nested=True, min_size=128):
+def one_size(n, dx, mu, tol, overlap, dD, seed, cold=True, nested=True, min_size=128, warm=True):
     from tengsim.grid import Grid
     from tengsim.interaction import LJ93
     from tengsim.kernels import make_kernel
@@ -103,8 +103,9 @@ def one_size(n, dx, mu, tol, overlap, dD, seed, cold=True, nested=True, min_size
                    cold_res=eq.residual, cold_area=float(np.mean(eq.P > 0)), cold_energy=eq.energy)
         state = eq.state
         del eq
-        out["peak_rss_MiB"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
         _emit(out)
+        if not warm:
+            return out
         t0 = time.perf_counter()
         eq = solver.solve(Problem(U0 - (D0 + dD) + 1.0, law, kernel), state)
         out.update(warm_s=time.perf_counter() - t0, warm_conv=eq.n_conv, warm_ok=bool(eq.converged),
@@ -140,6 +141,7 @@ def main(argv=None):
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--timeout", type=float, default=1500, help="seconds per size")
     ap.add_argument("--cold-max", type=int, default=2048, help="largest n solved cold (and warm)")
+    ap.add_argument("--warm-max", type=int, default=1024, help="largest n with the warm step")
     ap.add_argument("--no-nested", action="store_true", help="skip the nested-grid solve")
     ap.add_argument("--min-size", type=int, default=128, help="coarsest grid of the nested solve")
     ap.add_argument("--out", type=Path, default=HERE / "results")
@@ -147,13 +149,13 @@ def main(argv=None):
     a = ap.parse_args(argv)
     if a.one:
         one_size(a.one, a.dx, a.mu, a.tol, a.overlap, a.dD, a.seed, cold=a.one <= a.cold_max,
-                 nested=not a.no_nested, min_size=a.min_size)
+                 nested=not a.no_nested, min_size=a.min_size, warm=a.one <= a.warm_max)
         return
     rows = []
     for n in a.sizes:
         cmd = [sys.executable, __file__, "--one", str(n), "--dx", str(a.dx), "--mu", str(a.mu),
                "--tol", str(a.tol), "--overlap", str(a.overlap), "--dD", str(a.dD), "--seed", str(a.seed),
-               "--cold-max", str(a.cold_max), "--min-size", str(a.min_size)] + (["--no-nested"] if a.no_nested else [])
+               "--cold-max", str(a.cold_max), "--warm-max", str(a.warm_max), "--min-size", str(a.min_size)] + (["--no-nested"] if a.no_nested else [])
         print(f"n = {n} ...", flush=True)
         t0 = time.perf_counter()
         try:
