@@ -181,6 +181,7 @@ def run_group(name, args, log):
     nconv_rows = np.asarray(T["n_conv"])[solved]
     fast_ref = {_key(b, D): (F, L) for b, D, F, L, o in zip(br, T["D"], T["F"], T["contact_length"], on) if o}
     curves["fast"] = fast_ref
+    curves["fast_solve"] = {_key(b, D): (s_, r_) for b, D, s_, r_ in zip(br, T["D"], T["seconds"], T["residual"])}
     conv_total = cnt.n
     row = dict(group=name, solver="tengsim fast", path=f"full ({n_eq} eq)", n_eq=int(solved.sum()),
                wall_s=wall_fast, ratio_vs_fast=1.0, cpu_s=cpu_fast, cpu_ratio_vs_fast=1.0,
@@ -280,17 +281,35 @@ def run_group(name, args, log):
         D_peer, br_peer = D_path[:k_peer], br_path[:k_peer]
         pr = peer.solve_path(U0, grid.dx, args.mu, D_peer, tol=args.tol, branch=br_peer, dy=grid.dy,
                              length_fn=lambda P: ts_contact_length(P, grid, apex), verbose=args.verbose)
-        peer_rows = {_key(b, D): (F, L) for b, D, F, L in zip(pr.branch, pr.D, pr.F, pr.contact_length)}
+        ok_p = np.asarray(pr.converged, bool)
+        # only converged peer answers are compared; the failed ones are listed in the curves file
+        peer_rows = {_key(b, D): (F, L) for b, D, F, L, o in
+                     zip(pr.branch, pr.D, pr.F, pr.contact_length, ok_p) if o}
         # the retraction's first row (D = d_max) is the approach's last state
-        if k_peer == n_eq:
-            peer_rows[_key("retraction", D_path[np.argmax(D_path)])] = peer_rows[_key("approach", D_path.max())]
+        k_top = _key("approach", D_path.max())
+        if k_peer == n_eq and k_top in peer_rows:
+            peer_rows[_key("retraction", D_path[np.argmax(D_path)])] = peer_rows[k_top]
+        curves["peer_solve"] = {_key(b, D): (t_, r_) for b, D, t_, r_ in zip(pr.branch, pr.D, pr.time, pr.residual)}
+        fast_s_by_key = {_key(b, D): s_ for b, D, s_ in zip(br, T["D"], T["seconds"])}
         # tengsim fast's own seconds on the same equilibria (the whole run's wall time on a full path)
         if k_peer == n_eq:
             fast_ref_s, fast_ref_cpu = wall_fast, cpu_fast
         else:
             keys_p = {_key(b, D) for b, D in zip(br_peer, D_peer)}
-            fast_ref_s = float(sum(s_ for b, D, s_ in zip(br, T["D"], T["seconds"]) if _key(b, D) in keys_p))
+            fast_ref_s = float(sum(s_ for k_, s_ in fast_s_by_key.items() if k_ in keys_p))
             fast_ref_cpu = fast_ref_s * cpu_fast / wall_fast
+        # the same ratio on the equilibria the peer solved (both codes' own solve seconds)
+        keys_ok = [_key(b, D) for b, D, o in zip(pr.branch, pr.D, ok_p) if o]
+        t_peer_ok = float(np.sum(np.asarray(pr.time)[ok_p]))
+        t_fast_ok = float(sum(fast_s_by_key.get(k_, 0.0) for k_ in keys_ok))
+        n_fail = int((~ok_p).sum())
+        fail_note = ""
+        if n_fail:
+            first = int(np.argmax(~ok_p))
+            fail_note = (f"; NOT converged on {n_fail} of {k_peer} equilibria (first: {pr.branch[first]} "
+                         f"D = {pr.D[first]:g}, max|r| = {pr.residual[first]:.1e}: a state with g <= 0), "
+                         f"excluded from ΔF; ratio on the {len(keys_ok)} converged ones "
+                         f"{t_peer_ok / t_fast_ok:.1f}× (peer {t_peer_ok:.1f} s vs fast {t_fast_ok:.2f} s of solve time)")
         cmpp = compare(fast_ref, peer_rows)
         # one peer convolution on its padded grid: evaluate_force is one FFT + one inverse FFT
         from ContactMechanics import FreeFFTElasticHalfSpace
@@ -307,16 +326,18 @@ def run_group(name, args, log):
                    conv_median=float(np.median(pr.n_conv[1:])), conv_max=int(pr.n_conv.max()),
                    conv_total=int(pr.n_conv.sum()), t_conv_ms=t_conv_p * 1e3,
                    fft_share_ratio=pr.wall_time / (pr.n_conv.sum() * t_conv_p),
-                   max_residual=float(pr.residual.max()), all_converged=bool(pr.converged.all()),
+                   max_residual=float(pr.residual[ok_p].max()) if ok_p.any() else np.nan,
+                   all_converged=bool(pr.converged.all()),
+                   n_failed=n_fail, ratio_converged=t_peer_ok / t_fast_ok if t_fast_ok > 0 else np.nan,
                    note=(f"L-BFGS-B (maxcor {pr.info['maxcor']}), ftol=0, gtol adapted to max|r|<=tol: "
-                         f"{pr.gtol.min():.1e}..{pr.gtol.max():.1e}; FFT grid {pr.info['fft_grid']}"),
+                         f"{pr.gtol.min():.1e}..{pr.gtol.max():.1e}; FFT grid {pr.info['fft_grid']}{fail_note}"),
                    **_cmp_cols(cmpp))
         curves["peer"] = peer_rows
         rows_out.append(row)
         log(f"   peer: {pr.wall_time:.2f} s ({row['ratio_vs_fast']:.1f}x fast), median {row['conv_median']:.0f} conv/eq,"
             f" max {row['conv_max']}; max dF {row['dF_approach']:.2e}/{row['dF_retraction']:.2e}"
             f" (rel {row['dF_rel_approach']:.2e}/{row['dF_rel_retraction']:.2e}), max dLc "
-            f"{row['dLc_approach']:.3f}/{row['dLc_retraction']:.3f}")
+            f"{row['dLc_approach']:.3f}/{row['dLc_retraction']:.3f}{fail_note}")
     for r in rows_out:
         r.setdefault("grid", f"{grid.nx}x{grid.ny}")
         r.setdefault("dx", grid.dx)
@@ -356,7 +377,9 @@ def write_outputs(out, rows, curves_by_group, env, args):
         with open(out / f"curves_{gname}.csv", "w", newline="") as f:
             w = csv.writer(f)
             names = list(curves)
-            w.writerow(["branch", "D"] + [f"{n}_{q}" for n in names for q in ("F", "Lc")])
+            # "<solver>_solve" entries hold (solve seconds, Eq. 9 residual max|r|) per equilibrium
+            w.writerow(["branch", "D"] + [f"{n}_{q}" for n in names
+                                          for q in (("s", "residual") if n.endswith("_solve") else ("F", "Lc"))])
             for k in keys:
                 vals = []
                 for n in names:

@@ -54,7 +54,7 @@ def rough_surface(n, dx, hurst=0.8, lam_r=16.0, lam_s=2.0, h_rms=1.0, seed=0):
     return h, L
 
 
-def one_size(n, dx, mu, tol, overlap, dD, seed, cold=True, nested=True, min_size=128, warm=True):
+def one_size(n, dx, mu, tol, overlap, dD, seed, cold=True, nested=True, min_size=128, warm=True, max_dx=0.5):
     from tengsim.grid import Grid
     from tengsim.interaction import LJ93
     from tengsim.kernels import make_kernel
@@ -87,13 +87,13 @@ def one_size(n, dx, mu, tol, overlap, dD, seed, cold=True, nested=True, min_size
         from tengsim.multilevel import nested_solve
 
         t0 = time.perf_counter()
-        ns = nested_solve(solver, U0 - D0 + 1.0, law, kernel, min_size=min_size)
+        ns = nested_solve(solver, U0 - D0 + 1.0, law, kernel, min_size=min_size, max_dx=max_dx)
         eq = ns.equilibrium
         out.update(nested_s=time.perf_counter() - t0, nested_conv=ns.n_conv,
                    nested_fine_conv=eq.n_conv, nested_fine_equiv=ns.fine_equivalent_conv,
                    nested_fine_s=ns.levels[-1].seconds, nested_ok=bool(eq.converged), nested_res=eq.residual,
                    nested_area=float(np.mean(eq.P > 0)), nested_energy=eq.energy,
-                   nested_levels=[[lv.shape[0], lv.n_conv, lv.seconds] for lv in ns.levels])
+                   nested_levels=[[lv.shape[0], lv.n_conv, lv.seconds, lv.residual] for lv in ns.levels])
         del ns, eq
         _emit(out)
     if cold:
@@ -144,18 +144,20 @@ def main(argv=None):
     ap.add_argument("--warm-max", type=int, default=1024, help="largest n with the warm step")
     ap.add_argument("--no-nested", action="store_true", help="skip the nested-grid solve")
     ap.add_argument("--min-size", type=int, default=128, help="coarsest grid of the nested solve")
+    ap.add_argument("--max-dx", type=float, default=0.5, help="coarsest pixel of the nested solve [ε]")
     ap.add_argument("--out", type=Path, default=HERE / "results")
     ap.add_argument("--one", type=int, help=argparse.SUPPRESS)
     a = ap.parse_args(argv)
     if a.one:
         one_size(a.one, a.dx, a.mu, a.tol, a.overlap, a.dD, a.seed, cold=a.one <= a.cold_max,
-                 nested=not a.no_nested, min_size=a.min_size, warm=a.one <= a.warm_max)
+                 nested=not a.no_nested, min_size=a.min_size, warm=a.one <= a.warm_max,
+                 max_dx=a.max_dx)
         return
     rows = []
     for n in a.sizes:
         cmd = [sys.executable, __file__, "--one", str(n), "--dx", str(a.dx), "--mu", str(a.mu),
                "--tol", str(a.tol), "--overlap", str(a.overlap), "--dD", str(a.dD), "--seed", str(a.seed),
-               "--cold-max", str(a.cold_max), "--warm-max", str(a.warm_max), "--min-size", str(a.min_size)] + (["--no-nested"] if a.no_nested else [])
+               "--cold-max", str(a.cold_max), "--warm-max", str(a.warm_max), "--min-size", str(a.min_size), "--max-dx", str(a.max_dx)] + (["--no-nested"] if a.no_nested else [])
         print(f"n = {n} ...", flush=True)
         t0 = time.perf_counter()
         try:
@@ -184,7 +186,7 @@ def main(argv=None):
              f"Surface: self-affine, Hurst 0.8, λr = 16 ε, λs = 2 ε, h_rms = 1 ε, pixel dx = {a.dx} ε "
              f"(cell grows with n), seed {a.seed}; μ = {a.mu}, LJ 8-2, periodic kernel, tol = {a.tol:g}; "
              f"D0 such that {100 * a.overlap:g} % overlaps rigidly, warm step ΔD = {a.dD}; nested: "
-             f"coarsest grid {a.min_size}².", "",
+             f"coarsest grid {a.min_size}², coarsest pixel {a.max_dx} ε.", "",
              f"Machine: {os.cpu_count()} cores; OPENBLAS_NUM_THREADS={os.environ.get('OPENBLAS_NUM_THREADS')}, "
              f"TENGSIM_FFT_WORKERS={os.environ.get('TENGSIM_FFT_WORKERS')} (unset: 1 thread below 512² "
              f"points, all cores above).", "",

@@ -39,6 +39,9 @@ def test_coarse_levels():
     assert coarse_levels((512, 512), min_size=128, levels=1) == [(256, 256), (512, 512)]
     assert coarse_levels((96, 96), min_size=16) == [(24, 24), (48, 48), (96, 96)]  # 12 < 16
     assert coarse_levels((99, 99), min_size=16) == [(99, 99)]  # odd: no coarser level
+    # never coarser than max_dx: from dx = 0.25, pixels 0.5 and 1.0 are allowed, 2.0 is not
+    assert coarse_levels((512, 512), min_size=16, dx=0.25, max_dx=1.0) == [(128, 128), (256, 256), (512, 512)]
+    assert coarse_levels((512, 512), min_size=16, dx=0.25, max_dx=0.5) == [(256, 256), (512, 512)]
 
 
 def _rough_problem(n=128):
@@ -52,7 +55,7 @@ def _rough_problem(n=128):
 def test_nested_solve_is_an_equilibrium_of_the_fine_problem():
     g0, K = _rough_problem()
     solver = FastSolver(tol=1e-7)
-    ns = nested_solve(solver, g0, LJ93(), K, min_size=32)
+    ns = nested_solve(solver, g0, LJ93(), K, min_size=32, max_dx=1.0)
     eq = ns.equilibrium
     assert [lv.shape for lv in ns.levels] == [(32, 32), (64, 64), (128, 128)]
     assert eq.converged and eq.residual <= 1e-7

@@ -77,19 +77,29 @@ class NestedSolve:
         return float(sum(s.n_conv * np.prod(s.shape) / nf for s in self.levels))
 
 
-def coarse_levels(shape: tuple[int, int], min_size: int = 128, levels: int | None = None) -> list:
-    """Grid shapes from the coarsest to ``shape``, halving while both sides stay even and >= min_size."""
+def coarse_levels(shape: tuple[int, int], min_size: int = 128, levels: int | None = None,
+                  dx: float | None = None, max_dx: float | None = None) -> list:
+    """Grid shapes from the coarsest to ``shape``, halving while both sides stay even and >= min_size
+    and, given the pixel ``dx``, while the coarse pixel stays <= ``max_dx``."""
     out = [tuple(shape)]
+    f = 1
     while (levels is None or len(out) <= levels) and all(k % 2 == 0 and k // 2 >= min_size for k in out[-1]):
+        if dx is not None and max_dx is not None and dx * 2 * f > max_dx * (1 + 1e-9):
+            break
+        f *= 2
         out.append((out[-1][0] // 2, out[-1][1] // 2))
     return out[::-1]
 
 
 def nested_solve(solver, g0: np.ndarray, law, kernel: PeriodicKernel, min_size: int = 128,
-                 levels: int | None = None) -> NestedSolve:
+                 levels: int | None = None, max_dx: float = 0.5) -> NestedSolve:
     """Solve the periodic problem (g0 = U0 − D + 1, law, kernel) by nested grids; see the module doc.
 
-    ``levels`` caps the number of coarser levels (default: halve down to ``min_size`` pixels).
+    Grids are halved down to ``min_size`` pixels, at most ``levels`` times, and never to a pixel
+    coarser than ``max_dx`` (in ε, the range of the surface law: on coarser pixels the adhesive
+    contact edge is trapped by the lattice and a level may not converge — measured: on a 2048² rough
+    surface with dx = 0.25 the 4 ε, 2 ε and 1 ε levels all ran to max_iter).  A coarse level that
+    does not converge still hands its state up as a start; its residual is in ``levels``.
     """
     if not isinstance(kernel, PeriodicKernel):
         raise TengsimError("nested_solve needs a periodic kernel (the coarse grids resample the cell "
@@ -98,7 +108,7 @@ def nested_solve(solver, g0: np.ndarray, law, kernel: PeriodicKernel, min_size: 
     grid = kernel.grid
     if g0.shape != grid.shape:
         raise TengsimError(f"g0 has shape {g0.shape}, the kernel's grid {grid.shape}")
-    shapes = coarse_levels(grid.shape, min_size, levels)
+    shapes = coarse_levels(grid.shape, min_size, levels, dx=max(grid.dx, grid.dy), max_dx=max_dx)
     stats = []
     q = None
     eq = None
