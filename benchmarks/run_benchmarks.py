@@ -306,8 +306,10 @@ def run_group(name, args, log):
         fail_note = ""
         if n_fail:
             first = int(np.argmax(~ok_p))
+            n_inf = int(np.isinf(np.asarray(pr.residual)[~ok_p]).sum())
             fail_note = (f"; NOT converged on {n_fail} of {k_peer} equilibria (first: {pr.branch[first]} "
-                         f"D = {pr.D[first]:g}, max|r| = {pr.residual[first]:.1e}: a state with g <= 0), "
+                         f"D = {pr.D[first]:g}, max|r| = {pr.residual[first]:.1e}; {n_inf} of them with "
+                         f"min g <= 0, i.e. interpenetrated, the others above tol after 8 gtol refinements), "
                          f"excluded from ΔF; ratio on the {len(keys_ok)} converged ones "
                          f"{t_peer_ok / t_fast_ok:.1f}× (peer {t_peer_ok:.1f} s vs fast {t_fast_ok:.2f} s of solve time)")
         cmpp = compare(fast_ref, peer_rows)
