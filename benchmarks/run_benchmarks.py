@@ -1,7 +1,7 @@
 """Side-by-side benchmark: tengsim fast vs tengsim VSR vs ContactMechanics/Adhesion (issue 6).
 
     OPENBLAS_NUM_THREADS=1 python benchmarks/run_benchmarks.py --groups A C --dx 0.1 \\
-        --vsr-mode full sampled --peer-max-eq 0 50 --out benchmarks/results
+        --vsr-mode full full --out benchmarks/results          (full paths, ~27 min on 2 cores)
 
 (tengsim's FFTs run on 1 thread at these sizes, below 512² points, like the peer's.)
 
