@@ -111,6 +111,7 @@ class FastSolver:
         # every per-iteration array is preallocated: the loop is memory-bound, not FFT-bound
         g, gt, P, Pt, d, Kd, r, rn, G, Gn, y, ky, wa, wb = (np.empty(n) for _ in range(14))
         work = (wa, wb)
+        blocks = _blocks(n)  # the line search's cache blocks, once per solve
 
         def conv(x):
             return K.apply(x.reshape(shape)).ravel()
@@ -143,7 +144,8 @@ class FastSolver:
                 mem.direction(G, r, d, Kd)
                 a0, a1, b = float(np.vdot(d, w)), float(np.vdot(d, Kd)), float(np.vdot(P, Kd))
             slope = dA * (a0 - b)
-            alpha, E_new, phis_t = _wolfe(law, g, Kd, gt, Pt, work, qw, a0, a1, E, slope, dA, first=mem.empty)
+            alpha, E_new, phis_t = _wolfe(law, g, Kd, gt, Pt, work, qw, a0, a1, E, slope, dA,
+                                          first=mem.empty, blocks=blocks)
             if alpha is None:
                 return done(False, it, "line search failed")
             _axpy(d, q, alpha, wa)
@@ -203,7 +205,8 @@ def _axpy(x, y, a, tmp):
     np.add(y, tmp, out=y)
 
 
-def _wolfe(law, g, Kd, gt, Pt, work, qw, a0, a1, E0, slope0, dA, first, c1=1e-4, c2=0.9, max_eval=40):
+def _wolfe(law, g, Kd, gt, Pt, work, qw, a0, a1, E0, slope0, dA, first, blocks=None,
+           c1=1e-4, c2=0.9, max_eval=40):
     """Line search along d; element-wise only (no convolution).
 
     E(α) = dA[½ q·w + α d·w + ½ α² d·K d + Σ Φ(g + α K d)],
@@ -215,7 +218,7 @@ def _wolfe(law, g, Kd, gt, Pt, work, qw, a0, a1, E0, slope0, dA, first, c1=1e-4,
     """
     eps_E = 1e-11 * max(1.0, abs(E0))
 
-    blocks = _blocks(g.size)
+    blocks = blocks or _blocks(g.size)
 
     def f(alpha):
         # block by block, so that the gap, the law's scratch and the pressure stay in cache
