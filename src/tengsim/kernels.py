@@ -57,13 +57,12 @@ class FreeKernel:
         X, Y = np.meshgrid(ox, oy, indexing="ij")
         coeff = pixel_influence(X, Y, g.dx, g.dy) * (self.coupling / np.pi)
         self._spectrum = _fft.rfft2(coeff)
+        self._conv = _fft.PaddedConvolver(g.shape, self.padded_shape, self._spectrum)
         self.periodic = False
 
     def apply(self, p: np.ndarray) -> np.ndarray:
         """w = K p on the cell (one convolution)."""
-        spec = _fft.rfft2_padded(p, self.padded_shape)
-        spec *= self._spectrum
-        return _fft.irfft2_cropped(spec, self.padded_shape, self.grid.shape)
+        return self._conv(np.asarray(p, dtype=float))
 
     def params(self) -> dict:
         return {"boundary": "free", "coupling": self.coupling}

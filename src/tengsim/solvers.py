@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from tengsim._lbfgs import KMetricLBFGS
+from tengsim._sweep import Sweeper
 from tengsim.errors import TengsimError
 
 
@@ -108,92 +109,139 @@ class FastSolver:
         n = g0.size
         q = np.array(start.q, dtype=float).ravel()
         w = np.array(start.w, dtype=float).ravel()
-        # every per-iteration array is preallocated: the loop is memory-bound, not FFT-bound
-        g, gt, P, Pt, d, Kd, r, rn, G, Gn, y, ky, wa, wb = (np.empty(n) for _ in range(14))
-        work = (wa, wb)
-        blocks = _blocks(n)  # the line search's cache blocks, once per solve
+        # every per-iteration array is preallocated, and the element-wise work runs in fused,
+        # cache-blocked (on large grids threaded) sweeps: the loop is memory-bound, not FFT-bound
+        g, gt, P, Pt, d, Kd, r, rn, G, Gn, y, ky = (np.empty(n) for _ in range(12))
+        sw = Sweeper(n)
+        buf = sw.buf
+        mem = KMetricLBFGS(self.memory, n, dA)
+        B, KB = mem.B, mem.KB
 
         def conv(x):
             return K.apply(x.reshape(shape)).ravel()
 
+        def law_sweep(gg, PP):
+            def fn(sl, m, sc, acc):
+                acc[0] += law.energy_pressure(gg[sl], PP[sl], (buf(sc, "a", m), buf(sc, "b", m)))
+            return sw.sum(fn, [0.0])[0]
+
         np.add(g0, w, out=g)
-        phis = law.energy_pressure(g, P, work)
+        phis = law_sweep(g, P)
         np.subtract(w, conv(P), out=r)
         n_conv = 1
         np.subtract(q, P, out=G)
         qw = float(np.vdot(q, w))
         E = dA * (0.5 * qw + phis)
-        mem = KMetricLBFGS(self.memory, n, dA)
+        rmax = max(float(r.max()), -float(r.min()))
 
         def done(ok, it, msg):
             st = State(q.reshape(shape), w.reshape(shape))
             return _finish(problem, st, P.reshape(shape).copy(), r, E, ok, it, n_conv, t0, msg)
 
+        def direction(gamma, c):
+            """d = −H G, K d = −K H G, and the products d·w, d·K d, P·K d, in one sweep."""
+            k2 = 0 if c is None else c.size
+
+            def fn(sl, m, sc, acc):
+                ds, kds = d[sl], Kd[sl]
+                np.multiply(G[sl], -gamma, out=ds)
+                np.multiply(r[sl], -gamma, out=kds)
+                if k2:
+                    h = buf(sc, "h", m)
+                    np.matmul(c, B[:k2, sl], out=h)
+                    ds -= h
+                    np.matmul(c, KB[:k2, sl], out=h)
+                    kds -= h
+                acc[0] += float(np.vdot(ds, w[sl]))
+                acc[1] += float(np.vdot(ds, kds))
+                acc[2] += float(np.vdot(P[sl], kds))
+            return sw.sum(fn, [0.0, 0.0, 0.0])
+
         for it in range(self.max_iter + 1):
-            rmax = max(float(r.max()), -float(r.min()))
             if not math.isfinite(rmax):
                 return done(False, it, "non-finite residual")
             if rmax <= self.tol:
                 return done(True, it, "converged")
             if it == self.max_iter:
                 break
-            mem.direction(G, r, d, Kd)
-            a0, a1, b = float(np.vdot(d, w)), float(np.vdot(d, Kd)), float(np.vdot(P, Kd))
+            a0, a1, b = direction(*mem.coefficients())
             if not a0 - b < 0:  # not a descent direction: restart from the preconditioned gradient
                 mem.reset()
-                mem.direction(G, r, d, Kd)
-                a0, a1, b = float(np.vdot(d, w)), float(np.vdot(d, Kd)), float(np.vdot(P, Kd))
+                a0, a1, b = direction(*mem.coefficients())
             slope = dA * (a0 - b)
-            alpha, E_new, phis_t = _wolfe(law, g, Kd, gt, Pt, work, qw, a0, a1, E, slope, dA,
-                                          first=mem.empty, blocks=blocks)
+            alpha, E_new, phis_t = _wolfe(law, g, Kd, gt, Pt, sw, qw, a0, a1, E, slope, dA,
+                                          first=mem.empty)
             if alpha is None:
                 return done(False, it, "line search failed")
-            _axpy(d, q, alpha, wa)
-            if (it + 1) % self.resync == 0:
+            resynced = (it + 1) % self.resync == 0
+            if resynced:
                 # the images K d are assembled, not convolved: round-off lets w drift from K q;
                 # re-anchor w = K q (one extra convolution) so the metric stays exact
+                _axpy(d, q, alpha, gt)
                 w_exact = conv(q)
                 n_conv += 1
-                ks_factor, ks_base = 1.0, w_exact - w
+                ks_factor, ks_base = 1.0, np.subtract(w_exact, w, out=gt)
                 w[:] = w_exact
                 np.add(g0, w, out=g)
-                phis = law.energy_pressure(g, P, work)
+                phis = law_sweep(g, P)
                 qw = float(np.vdot(q, w))
-                resynced = True
             else:
-                _axpy(Kd, w, alpha, wa)
                 g, gt = gt, g
                 P, Pt = Pt, P
                 phis = phis_t
                 qw += alpha * (2.0 * a0 + alpha * a1)
                 ks_factor, ks_base = alpha, Kd
-                resynced = False
             E = dA * (0.5 * qw + phis)
-            np.subtract(w, conv(P), out=rn)
+            cP = conv(P)
             n_conv += 1
-            np.subtract(rn, r, out=ky)
-            np.subtract(q, P, out=Gn)
-            np.subtract(Gn, G, out=y)
-            sy = dA * alpha * float(np.vdot(d, ky))
-            yy = dA * float(np.vdot(y, ky))
+            k2 = 2 * len(mem.order)
+            step = not resynced
+
+            def fn(sl, m, sc, acc):
+                # q ← q + α d, w ← w + α K d; r_new = w − K P; K y = Δr; G_new = q − P; y = ΔG
+                ds = d[sl]
+                if step:
+                    tmp = buf(sc, "t", m)
+                    qs, ws = q[sl], w[sl]
+                    np.multiply(ds, alpha, out=tmp)
+                    qs += tmp
+                    np.multiply(Kd[sl], alpha, out=tmp)
+                    ws += tmp
+                rns, kys, Gns, ys = rn[sl], ky[sl], Gn[sl], y[sl]
+                np.subtract(w[sl], cP[sl], out=rns)
+                np.subtract(rns, r[sl], out=kys)
+                np.subtract(q[sl], P[sl], out=Gns)
+                np.subtract(Gns, G[sl], out=ys)
+                acc[0] += float(np.vdot(ds, kys))
+                acc[1] += float(np.vdot(ys, kys))
+                acc[2] += float(np.vdot(ds, rns))
+                acc[3] += float(np.vdot(ys, rns))
+                acc[4] = max(acc[4], float(rns.max()), -float(rns.min()))
+                if k2:
+                    acc[5] = acc[5] + B[:k2, sl] @ kys
+            accs = sw.run(fn, [0.0, 0.0, 0.0, 0.0, 0.0, 0.0])
+            if len(accs) == 1:
+                dky, yky, drn, yrn, rmax, x = accs[0]
+            else:
+                dky, yky, drn, yrn, _, x = (sum(a[j] for a in accs) for j in range(6))
+                rmax = max(a[4] for a in accs)
+            sy = dA * alpha * dky
+            yy = dA * yky
             sks = dA * alpha * alpha * abs(a1)
             store = sy > 1e-14 * max(sks, 1e-300) and yy > 0
-            mem.update(alpha, d, ks_factor, ks_base, y, ky, rn, sy, yy, store)
+            slot = mem.update(alpha, dA * x if k2 else None, sy, yy, dA * drn, dA * yrn, store)
+            if slot is not None:
+                def put(sl, m, sc, acc):
+                    np.multiply(d[sl], alpha, out=B[2 * slot, sl])
+                    B[2 * slot + 1, sl] = y[sl]
+                    np.multiply(ks_base[sl], ks_factor, out=KB[2 * slot, sl])
+                    KB[2 * slot + 1, sl] = ky[sl]
+                sw.run(put, ())
             r, rn = rn, r
             G, Gn = Gn, G
             if resynced:
                 mem.refresh(r)
         return done(False, self.max_iter, f"not converged in {self.max_iter} iterations")
-
-
-BLOCK = 1 << 15  # elements per cache block of the line search (8 arrays × 256 KiB)
-
-
-def _blocks(n):
-    """(slice, length) pairs covering range(n) in cache-sized blocks (one block for small n)."""
-    if n <= 4 * BLOCK:
-        return [(slice(0, n), n)]
-    return [(slice(i, min(i + BLOCK, n)), min(i + BLOCK, n) - i) for i in range(0, n, BLOCK)]
 
 
 def _axpy(x, y, a, tmp):
@@ -205,8 +253,7 @@ def _axpy(x, y, a, tmp):
     np.add(y, tmp, out=y)
 
 
-def _wolfe(law, g, Kd, gt, Pt, work, qw, a0, a1, E0, slope0, dA, first, blocks=None,
-           c1=1e-4, c2=0.9, max_eval=40):
+def _wolfe(law, g, Kd, gt, Pt, sw, qw, a0, a1, E0, slope0, dA, first, c1=1e-4, c2=0.9, max_eval=40):
     """Line search along d; element-wise only (no convolution).
 
     E(α) = dA[½ q·w + α d·w + ½ α² d·K d + Σ Φ(g + α K d)],
@@ -218,20 +265,19 @@ def _wolfe(law, g, Kd, gt, Pt, work, qw, a0, a1, E0, slope0, dA, first, blocks=N
     """
     eps_E = 1e-11 * max(1.0, abs(E0))
 
-    blocks = blocks or _blocks(g.size)
+    buf = sw.buf
 
-    def f(alpha):
-        # block by block, so that the gap, the law's scratch and the pressure stay in cache
-        phis = pk = 0.0
-        for sl, m in blocks:
-            gb, pb = gt[sl], Pt[sl]
-            kb = Kd[sl]
-            np.multiply(kb, alpha, out=gb)
+    def f(a):
+        def fn(sl, m, sc, acc):
+            # block by block (a sweep): the gap, the law's scratch and the pressure stay in cache
+            gb, pb, kb = gt[sl], Pt[sl], Kd[sl]
+            np.multiply(kb, a, out=gb)
             np.add(gb, g[sl], out=gb)
-            phis += law.energy_pressure(gb, pb, (work[0][:m], work[1][:m]))
-            pk += float(np.vdot(pb, kb))
-        e = dA * (0.5 * qw + alpha * a0 + 0.5 * alpha * alpha * a1 + phis)
-        de = dA * (a0 + alpha * a1 - pk)
+            acc[0] += law.energy_pressure(gb, pb, (buf(sc, "a", m), buf(sc, "b", m)))
+            acc[1] += float(np.vdot(pb, kb))
+        phis, pk = sw.sum(fn, [0.0, 0.0])
+        e = dA * (0.5 * qw + a * a0 + 0.5 * a * a * a1 + phis)
+        de = dA * (a0 + a * a1 - pk)
         return e, de, phis
 
     alpha = 1.0
