@@ -86,6 +86,26 @@ def irfft2_cropped(spec, s, out):
     return _sfft.irfft(b, n=s[1], axis=1, workers=w)[:, : out[1]]
 
 
+def _getstate(self):
+    st = dict(self.__dict__)
+    del st["_tls"]  # per-thread buffers are not pickled; they are made again on first use
+    return st
+
+
+def _setstate(self, st):
+    self.__dict__.update(st)
+    self._tls = threading.local()
+
+
+def _checked(conv, shape) -> bool:
+    """Does the direct pocketfft path of ``conv`` agree with the public scipy.fft one?"""
+    try:
+        x = np.random.default_rng(0).standard_normal(shape)
+        return bool(np.allclose(conv._apply_direct(x), conv._apply_public(x), rtol=1e-12, atol=1e-12))
+    except Exception:  # pragma: no cover - an incompatible private binding
+        return False
+
+
 class PaddedConvolver:
     """w = crop(irfft2(rfft2(pad(p)) · spectrum)): the free kernel's convolution, one object per grid.
 
@@ -102,28 +122,15 @@ class PaddedConvolver:
         nx, _ = self.shape
         px, py = self.padded
         self._tls = threading.local()  # buffers per thread: one kernel may serve several threads
-        self._direct = _pp is not None
-        if self._direct:
-            try:
-                x = np.random.default_rng(0).standard_normal(self.shape)
-                ok = np.allclose(self._apply_direct(x), self._apply_public(x), rtol=1e-12, atol=1e-12)
-            except Exception:  # pragma: no cover - an incompatible private binding
-                ok = False
-            self._direct = ok
+        self._direct = _pp is not None and _checked(self, self.shape)
 
     def _apply_public(self, p):
         spec = rfft2_padded(p, self.padded)
         spec *= self.spectrum
         return np.ascontiguousarray(irfft2_cropped(spec, self.padded, self.shape))
 
-    def __getstate__(self):
-        st = dict(self.__dict__)
-        del st["_tls"]
-        return st
-
-    def __setstate__(self, st):
-        self.__dict__.update(st)
-        self._tls = threading.local()
+    __getstate__ = _getstate
+    __setstate__ = _setstate
 
     def _buffers(self):
         b = getattr(self._tls, "b", None)
@@ -145,7 +152,58 @@ class PaddedConvolver:
         cb *= self.spectrum
         _pp.c2c(cb, (0,), False, 2, cb, t)
         _pp.c2r(cb[:nx], (1,), py, False, 2, out, t)
-        return out[:, :ny].copy()
+        return out[:, :ny]
 
-    def __call__(self, p):
-        return self._apply_direct(p) if self._direct else self._apply_public(p)
+    def __call__(self, p, out=None):
+        """K p into ``out`` (a new array when None)."""
+        w = self._apply_direct(p) if self._direct else self._apply_public(p)
+        if out is None:
+            return w.copy() if self._direct else w
+        np.copyto(out, w)
+        return out
+
+
+class PeriodicConvolver:
+    """w = irfft2(rfft2(p) · spectrum) on a periodic cell, one object per grid.
+
+    On scipy's pocketfft binding where available (checked against :func:`convolve_periodic` once):
+    transforms in place in a per-thread spectrum buffer, the result written straight into ``out``
+    (measured on 2 cores: 0.84 → 0.56 ms at 256², 14.7 → 9.7 ms at 1024², equal at 2048²).
+    """
+
+    def __init__(self, shape, spectrum):
+        self.shape = tuple(shape)
+        self.spectrum = spectrum
+        self.threads = _threads(self.shape)
+        self._tls = threading.local()
+        self._direct = _pp is not None and _checked(self, self.shape)
+
+    __getstate__ = _getstate
+    __setstate__ = _setstate
+
+    def _apply_public(self, p):
+        return convolve_periodic(p, self.spectrum)
+
+    def _apply_direct(self, p, out=None):
+        cb = getattr(self._tls, "cb", None)
+        if cb is None:
+            cb = self._tls.cb = np.empty(self.spectrum.shape, complex)
+        t = self.threads
+        _pp.r2c(np.ascontiguousarray(p, dtype=float), (1,), True, 0, cb, t)
+        _pp.c2c(cb, (0,), True, 0, cb, t)
+        cb *= self.spectrum
+        _pp.c2c(cb, (0,), False, 2, cb, t)
+        if out is None:
+            out = np.empty(self.shape)
+        _pp.c2r(cb, (1,), self.shape[1], False, 2, out, t)
+        return out
+
+    def __call__(self, p, out=None):
+        """K p into ``out`` (a new array when None)."""
+        if self._direct:
+            return self._apply_direct(p, out)
+        w = self._apply_public(p)
+        if out is None:
+            return w
+        np.copyto(out, w)
+        return out

@@ -60,9 +60,9 @@ class FreeKernel:
         self._conv = _fft.PaddedConvolver(g.shape, self.padded_shape, self._spectrum)
         self.periodic = False
 
-    def apply(self, p: np.ndarray) -> np.ndarray:
-        """w = K p on the cell (one convolution)."""
-        return self._conv(np.asarray(p, dtype=float))
+    def apply(self, p: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+        """w = K p on the cell (one convolution), into ``out`` if given."""
+        return self._conv(np.asarray(p, dtype=float), out)
 
     def params(self) -> dict:
         return {"boundary": "free", "coupling": self.coupling}
@@ -84,12 +84,13 @@ class PeriodicKernel:
         with np.errstate(divide="ignore"):
             mult = np.where(q > 0, 2 * self.coupling / np.where(q > 0, q, 1.0), 0.0)
         self._spectrum = mult
+        self._conv = _fft.PeriodicConvolver(g.shape, mult)
         self.padded_shape = g.shape
         self.periodic = True
 
-    def apply(self, p: np.ndarray) -> np.ndarray:
-        """w = K p (one convolution)."""
-        return _fft.convolve_periodic(p, self._spectrum)
+    def apply(self, p: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+        """w = K p (one convolution), into ``out`` if given."""
+        return self._conv(p, out)
 
     def params(self) -> dict:
         return {"boundary": "periodic", "coupling": self.coupling}

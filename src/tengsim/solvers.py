@@ -117,8 +117,11 @@ class FastSolver:
         mem = KMetricLBFGS(self.memory, n, dA)
         B, KB = mem.B, mem.KB
 
-        def conv(x):
-            return K.apply(x.reshape(shape)).ravel()
+        cP = np.empty(n)
+
+        def conv(x, out=cP):
+            K.apply(x.reshape(shape), out=out.reshape(shape))
+            return out
 
         def law_sweep(gg, PP):
             def fn(sl, m, sc, acc):
@@ -192,7 +195,7 @@ class FastSolver:
                 qw += alpha * (2.0 * a0 + alpha * a1)
                 ks_factor, ks_base = alpha, Kd
             E = dA * (0.5 * qw + phis)
-            cP = conv(P)
+            conv(P)
             n_conv += 1
             k2 = 2 * len(mem.order)
             step = not resynced
