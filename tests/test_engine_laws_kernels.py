@@ -183,3 +183,31 @@ def test_energy_pressure_in_place_equals_evaluate(law):
         s = law.energy_pressure(g, out, work)
         assert np.allclose(out, p, rtol=1e-13, atol=1e-13)
         assert s == pytest.approx(phi.sum(), rel=1e-12)
+
+
+@pytest.mark.parametrize("boundary", ["free", "periodic"])
+def test_direct_fft_path_equals_public_scipy_fft(boundary):
+    """The kernels run on scipy's pocketfft binding with preallocated buffers where it exists; it
+    must agree with the public scipy.fft path to round-off, with and without ``out``, and the
+    public fallback must give the same numbers (an old or new scipy may lack the binding)."""
+    import pickle
+
+    from tengsim.kernels import make_kernel
+
+    grid = Grid(23, 17, 0.2, 0.3)
+    p = np.random.default_rng(3).standard_normal(grid.shape)
+    K = make_kernel(boundary, grid, 0.8)
+    conv = K._conv
+    w_pub = np.asarray(conv._apply_public(p))
+    w = K.apply(p)
+    assert w.shape == grid.shape and w.flags["C_CONTIGUOUS"]
+    assert np.allclose(w, w_pub, rtol=0, atol=1e-13 * np.abs(w_pub).max())
+    out = np.full(grid.shape, np.nan)
+    assert K.apply(p, out=out) is out and np.array_equal(out, w)
+    w2 = K.apply(2 * p)  # a second call must not change the first result (no shared buffer returned)
+    assert np.array_equal(out, w) and np.allclose(w2, 2 * w, rtol=1e-13, atol=1e-15)
+    K2 = pickle.loads(pickle.dumps(K))
+    assert np.array_equal(K2.apply(p), w)
+    conv._direct = False  # the public fallback
+    assert np.allclose(K.apply(p), w, rtol=0, atol=1e-13 * np.abs(w).max())
+    assert np.allclose(K.apply(p, out=out), w, rtol=0, atol=1e-13 * np.abs(w).max())
