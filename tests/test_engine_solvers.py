@@ -207,3 +207,30 @@ def test_threaded_sweeps_give_the_same_iterates(monkeypatch):
     assert abs(thr.iterations - ref.iterations) <= 2
     assert np.max(np.abs(thr.H - ref.H)) < 1e-7
     assert thr.energy == pytest.approx(ref.energy, rel=1e-12)
+
+
+def test_sweep_pool_survives_fork(monkeypatch):
+    """A forked child (multiprocessing, Dask processes) gets a fresh sweep pool, not the parent's dead one."""
+    import multiprocessing as mp
+
+    import tengsim._sweep as S
+
+    monkeypatch.setenv("TENGSIM_THREADS", "2")
+    sw = S.Sweeper(4 * S.BLOCK + 10)
+    assert sw.threads == 2
+
+    def count(sl, m, sc, acc):
+        acc[0] += m
+    assert sw.sum(count, [0])[0] == sw.n  # the parent's pool now exists
+    ctx = mp.get_context("fork")
+    with ctx.Pool(1) as pool:
+        r = pool.apply_async(_sweep_in_child, (sw.n,))
+        assert r.get(timeout=60) == sw.n
+
+
+def _sweep_in_child(n):
+    import tengsim._sweep as S
+
+    def count(sl, m, sc, acc):
+        acc[0] += m
+    return S.Sweeper(n, threads=2).sum(count, [0])[0]

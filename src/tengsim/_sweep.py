@@ -18,6 +18,7 @@ import numpy as np
 BLOCK = 1 << 15          # elements per block: 8 float64 arrays × 256 KiB fit a 2 MiB cache
 THREAD_MIN_SIZE = 512 * 512
 _POOL: ThreadPoolExecutor | None = None
+_POOL_PID = None
 
 
 def blocks(n: int, block: int | None = None):
@@ -36,9 +37,11 @@ def thread_count(n: int) -> int:
 
 
 def _pool(workers: int) -> ThreadPoolExecutor:
-    global _POOL
-    if _POOL is None or _POOL._max_workers < workers:
+    """The shared worker pool; made again in a forked child (its threads do not survive a fork)."""
+    global _POOL, _POOL_PID
+    if _POOL is None or _POOL_PID != os.getpid() or _POOL._max_workers < workers:
         _POOL = ThreadPoolExecutor(max_workers=workers, thread_name_prefix="tengsim-sweep")
+        _POOL_PID = os.getpid()
     return _POOL
 
 
