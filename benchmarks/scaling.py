@@ -87,7 +87,12 @@ def one_size(n, dx, mu, tol, overlap, dD, seed, cold=True, nested=True, min_size
         from tengsim.multilevel import nested_solve
 
         t0 = time.perf_counter()
-        ns = nested_solve(solver, U0 - D0 + 1.0, law, kernel, min_size=min_size, max_dx=max_dx)
+        def progress(lv):  # one line per finished level, on stderr (kept if the size is cut)
+            print(f"  level {lv.shape[0]}²: {lv.n_conv} conv, {lv.seconds:.1f} s, max|r| {lv.residual:.1e}",
+                  file=sys.stderr, flush=True)
+
+        ns = nested_solve(solver, U0 - D0 + 1.0, law, kernel, min_size=min_size, max_dx=max_dx,
+                          on_level=progress)
         eq = ns.equilibrium
         out.update(nested_s=time.perf_counter() - t0, nested_conv=ns.n_conv,
                    nested_fine_conv=eq.n_conv, nested_fine_equiv=ns.fine_equivalent_conv,
