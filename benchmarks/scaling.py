@@ -3,6 +3,11 @@ surface at n² = 256² … 4096², time and peak memory, and the fitted growth.
 
     OPENBLAS_NUM_THREADS=1 python benchmarks/scaling.py --sizes 256 512 1024 2048 --out benchmarks/results
 
+A size too long for the per-size ``--timeout`` can be run alone and joined to the table:
+
+    OPENBLAS_NUM_THREADS=1 python benchmarks/scaling.py --one 4096 --cold-max 0 > one4096.out
+    OPENBLAS_NUM_THREADS=1 python benchmarks/scaling.py --sizes 256 512 1024 2048 --rows one4096.out ...
+
 tengsim's FFT threading rule applies (1 thread below 512² points, all cores from 512² up);
 TENGSIM_FFT_WORKERS forces a count and is recorded in ``scaling.md``.
 
@@ -150,6 +155,8 @@ def main(argv=None):
     ap.add_argument("--no-nested", action="store_true", help="skip the nested-grid solve")
     ap.add_argument("--min-size", type=int, default=128, help="coarsest grid of the nested solve")
     ap.add_argument("--max-dx", type=float, default=0.5, help="coarsest pixel of the nested solve [ε]")
+    ap.add_argument("--rows", type=Path, nargs="*", default=[],
+                    help="stdout files of earlier '--one N' runs whose rows join the table (a size run alone)")
     ap.add_argument("--out", type=Path, default=HERE / "results")
     ap.add_argument("--one", type=int, help=argparse.SUPPRESS)
     a = ap.parse_args(argv)
@@ -183,6 +190,14 @@ def main(argv=None):
                                for k in ("nested_s", "nested_fine_conv", "cold_s", "cold_conv", "warm_s",
                                          "warm_conv", "peak_rss_MiB", "error") if k in r), flush=True)
 
+    for f in a.rows:  # sizes run alone (``--one N > file``): their last JSON line
+        got = [ln for ln in f.read_text().splitlines() if ln.startswith("{")]
+        if got:
+            r = json.loads(got[-1])
+            r["note"] = f"run alone ({f.name})"
+            rows.append(r)
+    rows.sort(key=lambda r: r["n"])
+
     def cell(r, k, spec):
         return format(r[k], spec) if k in r else "–"
 
@@ -196,12 +211,13 @@ def main(argv=None):
              f"TENGSIM_FFT_WORKERS={os.environ.get('TENGSIM_FFT_WORKERS')} (unset: 1 thread below 512² "
              f"points, all cores above).", "",
              "| n | cold [s] | cold conv | warm [s] | warm conv | nested [s] | nested: fine-grid conv "
-             "(fine-equivalent, all levels) | nested = cold state? | t_conv [ms] | cold/(conv·t_conv) | "
-             "warm/(conv·t_conv) | peak RSS [MiB] | repulsive area | note |",
-             "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+             "(fine-equivalent, all levels) | nested levels (n: conv, s) | nested = cold state? | t_conv [ms] | "
+             "cold/(conv·t_conv) | warm/(conv·t_conv) | nested fine level/(conv·t_conv) | peak RSS [MiB] | "
+             "repulsive area | note |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         if "t_conv" not in r:
-            lines.append(f"| {r['n']} |" + " – |" * 12 + f" {r.get('error', '')} |")
+            lines.append(f"| {r['n']} |" + " – |" * 14 + f" {r.get('error', '')} |")
             continue
         tc = r["t_conv"]
         same = "–"
@@ -209,13 +225,17 @@ def main(argv=None):
             de = abs(r["nested_energy"] - r["cold_energy"]) / abs(r["cold_energy"])
             same = f"yes (ΔE/E {de:.0e})" if de < 1e-8 else f"no (ΔE/E {de:.1e})"
         nested = (f"{r['nested_fine_conv']} ({r['nested_fine_equiv']:.0f})" if "nested_fine_conv" in r else "–")
+        lv = ("; ".join(f"{x[0]}: {x[1]}, {x[2]:.1f}" for x in r["nested_levels"]) if "nested_levels" in r else "–")
+        nfr = (f"{r['nested_fine_s'] / (r['nested_fine_conv'] * tc):.2f}" if "nested_fine_s" in r else "–")
+        note = "; ".join(x for x in (r.get("note", ""), r.get("error", "")) if x)
         lines.append(
             f"| {r['n']} | {cell(r, 'cold_s', '.1f')} | {cell(r, 'cold_conv', 'd')} | {cell(r, 'warm_s', '.1f')} | "
-            f"{cell(r, 'warm_conv', 'd')} | {cell(r, 'nested_s', '.1f')} | {nested} | {same} | {tc * 1e3:.1f} | "
+            f"{cell(r, 'warm_conv', 'd')} | {cell(r, 'nested_s', '.1f')} | {nested} | {lv} | {same} | "
+            f"{tc * 1e3:.1f} | "
             + (f"{r['cold_s'] / (r['cold_conv'] * tc):.2f}" if "cold_s" in r else "–") + " | "
-            + (f"{r['warm_s'] / (r['warm_conv'] * tc):.2f}" if "warm_s" in r else "–") + " | "
+            + (f"{r['warm_s'] / (r['warm_conv'] * tc):.2f}" if "warm_s" in r else "–") + f" | {nfr} | "
             f"{r['peak_rss_MiB']:.0f} | {r.get('cold_area', r.get('nested_area', float('nan'))):.3f} | "
-            f"{r.get('error', '')} |")
+            f"{note} |")
     for key in ("cold_s", "warm_s", "nested_s", "t_conv", "peak_rss_MiB"):
         ok = [r for r in rows if key in r]
         if len(ok) >= 2:

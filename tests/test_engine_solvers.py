@@ -234,3 +234,21 @@ def _sweep_in_child(n):
     def count(sl, m, sc, acc):
         acc[0] += m
     return S.Sweeper(n, threads=2).sum(count, [0])[0]
+
+
+def test_fast_solver_takes_a_kernel_without_out():
+    """A caller's own kernel object with a plain ``apply(p)`` works (same iterates as the package's)."""
+    grid, U0, K = _group_a(dx=0.2)
+
+    class Plain:
+        def __init__(self, k):
+            self.grid, self._k = k.grid, k
+
+        def apply(self, p):
+            return self._k.apply(p)
+
+    prob = Problem(U0 - 1.0 + 1.0, LJ93(), K)
+    a = FastSolver(1e-8).solve(prob, State.zero(grid.shape))
+    b = FastSolver(1e-8).solve(Problem(prob.g0, LJ93(), Plain(K)), State.zero(grid.shape))
+    assert a.converged and b.converged and a.iterations == b.iterations
+    assert np.array_equal(a.H, b.H)

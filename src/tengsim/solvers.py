@@ -14,6 +14,7 @@ Both solvers descend E, so from a warm start they settle in a local minimum: a s
 """
 from __future__ import annotations
 
+import inspect
 import math
 import time
 from dataclasses import dataclass, field
@@ -118,9 +119,13 @@ class FastSolver:
         B, KB = mem.B, mem.KB
 
         cP = np.empty(n)
+        takes_out = _takes_out(K.apply)
 
         def conv(x, out=cP):
-            K.apply(x.reshape(shape), out=out.reshape(shape))
+            if takes_out:
+                K.apply(x.reshape(shape), out=out.reshape(shape))
+            else:  # a kernel of the caller's own without ``out=``
+                out[:] = K.apply(x.reshape(shape)).ravel()
             return out
 
         def law_sweep(gg, PP):
@@ -245,6 +250,15 @@ class FastSolver:
             if resynced:
                 mem.refresh(r)
         return done(False, self.max_iter, f"not converged in {self.max_iter} iterations")
+
+
+def _takes_out(fn) -> bool:
+    """Does ``fn`` accept an ``out=`` keyword (the package's kernels do)?"""
+    try:
+        params = inspect.signature(fn).parameters.values()
+    except (TypeError, ValueError):
+        return False
+    return any(p.name == "out" or p.kind is p.VAR_KEYWORD for p in params)
 
 
 def _axpy(x, y, a, tmp):
