@@ -176,37 +176,25 @@ def test_vsr_and_fast_agree_on_whole_path():
     assert vsr.table["n_conv"].sum() > 5 * fast.table["n_conv"].sum()
 
 
-def test_cache_blocked_line_search_gives_the_same_iterates(monkeypatch):
-    """Element-wise work runs block by block on large grids; blocks change nothing but round-off."""
+@pytest.mark.parametrize("block,threads", [(97, None), (101, "3")], ids=["blocks", "threads"])
+def test_sweeps_give_the_same_iterates(monkeypatch, block, threads):
+    """Element-wise work runs block by block on large grids, and the blocks split over threads;
+    forced here on a small grid (many uneven blocks): that changes nothing but round-off."""
     import tengsim._sweep as S
 
     grid, U0, K = _group_a(dx=0.1)
     prob = Problem(U0 - 1.5 + 1.0, LJ93(), K)
     ref = FastSolver(1e-8).solve(prob, State.zero(grid.shape))
-    monkeypatch.setattr(S, "BLOCK", 97)  # many uneven blocks on this 39 x 39 grid
-    assert len(S.blocks(grid.nx * grid.ny)) > 10
-    blk = FastSolver(1e-8).solve(prob, State.zero(grid.shape))
-    assert ref.converged and blk.converged
-    assert abs(blk.iterations - ref.iterations) <= 2
-    assert np.max(np.abs(blk.H - ref.H)) < 1e-7
-    assert blk.energy == pytest.approx(ref.energy, rel=1e-12)
-
-
-def test_threaded_sweeps_give_the_same_iterates(monkeypatch):
-    """Blocks split over threads (forced on a small grid) change nothing but round-off."""
-    import tengsim._sweep as S
-
-    grid, U0, K = _group_a(dx=0.1)
-    prob = Problem(U0 - 1.5 + 1.0, LJ93(), K)
-    ref = FastSolver(1e-8).solve(prob, State.zero(grid.shape))
-    monkeypatch.setattr(S, "BLOCK", 101)
-    monkeypatch.setenv("TENGSIM_THREADS", "3")
-    assert S.Sweeper(grid.nx * grid.ny).threads == 3
-    thr = FastSolver(1e-8).solve(prob, State.zero(grid.shape))
-    assert ref.converged and thr.converged
-    assert abs(thr.iterations - ref.iterations) <= 2
-    assert np.max(np.abs(thr.H - ref.H)) < 1e-7
-    assert thr.energy == pytest.approx(ref.energy, rel=1e-12)
+    monkeypatch.setattr(S, "BLOCK", block)
+    if threads:
+        monkeypatch.setenv("TENGSIM_THREADS", threads)
+    sw = S.Sweeper(grid.nx * grid.ny)
+    assert sum(len(g) for g in sw.groups) > 10 and sw.threads == (int(threads) if threads else 1)
+    other = FastSolver(1e-8).solve(prob, State.zero(grid.shape))
+    assert ref.converged and other.converged
+    assert abs(other.iterations - ref.iterations) <= 2
+    assert np.max(np.abs(other.H - ref.H)) < 1e-7
+    assert other.energy == pytest.approx(ref.energy, rel=1e-12)
 
 
 def test_sweep_pool_survives_fork(monkeypatch):
