@@ -86,16 +86,6 @@ class KMetricLBFGS:
         self._last = (gamma, cS, cY)
         return gamma, c
 
-    def direction(self, G, r, d, Kd) -> None:
-        """Write d = −H G and Kd = K d (whole arrays; the solver does this block by block)."""
-        gamma, c = self.coefficients()
-        np.multiply(G, -gamma, out=d)
-        np.multiply(r, -gamma, out=Kd)
-        if c is not None:
-            k2 = c.size
-            d -= c @ self.B[:k2]
-            Kd -= c @ self.KB[:k2]
-
     def update(self, alpha, x, sy, yy, d_rn, y_rn, store: bool):
         """After the step s = α d, G ← G + y.  ``x`` = ΔA·B[:2k] @ K y (the rows' products with the
         new y), ``d_rn`` = ΔA d·r_new, ``y_rn`` = ΔA y·r_new.

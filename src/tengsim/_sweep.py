@@ -94,10 +94,6 @@ class Sweeper:
 
     def sum(self, fn, init):
         """:meth:`run`, accumulators summed element-wise."""
-        if self._single is not None:
-            acc = list(init)
-            fn(self._single[0], self.n, self._scratch[0], acc)
-            return acc
         accs = self.run(fn, init)
         if len(accs) == 1:
             return accs[0]
