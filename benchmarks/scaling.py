@@ -59,7 +59,8 @@ def rough_surface(n, dx, hurst=0.8, lam_r=16.0, lam_s=2.0, h_rms=1.0, seed=0):
     return h, L
 
 
-def one_size(n, dx, mu, tol, overlap, dD, seed, cold=True, nested=True, min_size=128, warm=True, max_dx=0.5):
+def one_size(n, dx, mu, tol, overlap, dD, seed, cold=True, nested=True, min_size=128, warm=True, max_dx=0.5,
+             max_iter=3000, coarse_max_iter=1000):
     from tengsim.grid import Grid
     from tengsim.interaction import LJ93
     from tengsim.kernels import make_kernel
@@ -74,7 +75,10 @@ def one_size(n, dx, mu, tol, overlap, dD, seed, cold=True, nested=True, min_size
     D0 = float(np.quantile(U0, overlap))
     kernel = make_kernel("periodic", grid, mu ** 1.5)
     law = LJ93()
-    solver = make_solver("fast", tol=tol)
+    def monitor(it, rmax, E):  # progress of long solves, on stderr
+        print(f"    it {it}: max|r| {rmax:.2e}, E {E:.10g}", file=sys.stderr, flush=True)
+
+    solver = make_solver("fast", tol=tol, max_iter=max_iter, monitor=monitor if n >= 2048 else None)
     t_setup = time.perf_counter() - t_setup
     # one convolution
     p = np.random.default_rng(1).standard_normal((n, n))
@@ -97,7 +101,7 @@ def one_size(n, dx, mu, tol, overlap, dD, seed, cold=True, nested=True, min_size
                   file=sys.stderr, flush=True)
 
         ns = nested_solve(solver, U0 - D0 + 1.0, law, kernel, min_size=min_size, max_dx=max_dx,
-                          on_level=progress)
+                          coarse_max_iter=coarse_max_iter, on_level=progress)
         eq = ns.equilibrium
         out.update(nested_s=time.perf_counter() - t0, nested_conv=ns.n_conv,
                    nested_fine_conv=eq.n_conv, nested_fine_equiv=ns.fine_equivalent_conv,
@@ -155,6 +159,8 @@ def main(argv=None):
     ap.add_argument("--no-nested", action="store_true", help="skip the nested-grid solve")
     ap.add_argument("--min-size", type=int, default=128, help="coarsest grid of the nested solve")
     ap.add_argument("--max-dx", type=float, default=0.5, help="coarsest pixel of the nested solve [ε]")
+    ap.add_argument("--max-iter", type=int, default=3000, help="iteration cap of a solve (the finest level)")
+    ap.add_argument("--coarse-max-iter", type=int, default=1000, help="iteration cap of the coarse levels")
     ap.add_argument("--rows", type=Path, nargs="*", default=[],
                     help="stdout files of earlier '--one N' runs whose rows join the table (a size run alone)")
     ap.add_argument("--out", type=Path, default=HERE / "results")
@@ -163,13 +169,14 @@ def main(argv=None):
     if a.one:
         one_size(a.one, a.dx, a.mu, a.tol, a.overlap, a.dD, a.seed, cold=a.one <= a.cold_max,
                  nested=not a.no_nested, min_size=a.min_size, warm=a.one <= a.warm_max,
-                 max_dx=a.max_dx)
+                 max_dx=a.max_dx, max_iter=a.max_iter, coarse_max_iter=a.coarse_max_iter)
         return
     rows = []
     for n in a.sizes:
         cmd = [sys.executable, __file__, "--one", str(n), "--dx", str(a.dx), "--mu", str(a.mu),
                "--tol", str(a.tol), "--overlap", str(a.overlap), "--dD", str(a.dD), "--seed", str(a.seed),
-               "--cold-max", str(a.cold_max), "--warm-max", str(a.warm_max), "--min-size", str(a.min_size), "--max-dx", str(a.max_dx)] + (["--no-nested"] if a.no_nested else [])
+               "--cold-max", str(a.cold_max), "--warm-max", str(a.warm_max), "--min-size", str(a.min_size), "--max-dx", str(a.max_dx),
+               "--max-iter", str(a.max_iter), "--coarse-max-iter", str(a.coarse_max_iter)] + (["--no-nested"] if a.no_nested else [])
         print(f"n = {n} ...", flush=True)
         t0 = time.perf_counter()
         try:

@@ -240,3 +240,18 @@ def test_fast_solver_takes_a_kernel_without_out():
     b = FastSolver(1e-8).solve(Problem(prob.g0, LJ93(), Plain(K)), State.zero(grid.shape))
     assert a.converged and b.converged and a.iterations == b.iterations
     assert np.array_equal(a.H, b.H)
+
+
+def test_fast_solver_monitor_reports_progress():
+    """``monitor`` sees every ``monitor_every``-th iteration, a falling residual, and changes no iterate."""
+    grid, U0, K = _group_a(dx=0.2)
+    prob = Problem(U0 - 1.0 + 1.0, LJ93(), K)
+    seen = []
+    a = FastSolver(1e-8, monitor=lambda it, r, e: seen.append((it, r, e)), monitor_every=5).solve(
+        prob, State.zero(grid.shape))
+    b = FastSolver(1e-8).solve(prob, State.zero(grid.shape))
+    assert a.converged and np.array_equal(a.H, b.H)
+    assert [s[0] for s in seen] == list(range(0, a.iterations, 5))
+    assert seen[-1][1] < seen[0][1] and all(np.isfinite(s[2]) for s in seen)
+    with pytest.raises(Exception, match="monitor_every"):
+        FastSolver(monitor_every=0)

@@ -88,6 +88,8 @@ class FastSolver:
     iterations to re-anchor w = K q): the direction's image K d is assembled from stored images
     (K s = Δw, K y = Δr, K G = r) by the compact L-BFGS form (tengsim._lbfgs), and the line search
     along d needs only element-wise work, since g(α) = g + α K d.  Converged when max|r| <= ``tol``.
+    ``monitor(iteration, max|r|, energy)``, if given, is called every ``monitor_every`` iterations
+    (progress on long solves).
     """
 
     tol: float = 1e-6
@@ -95,12 +97,16 @@ class FastSolver:
     memory: int = 10
     resync: int = 25
     name: str = "fast"
+    monitor: object = None
+    monitor_every: int = 100
 
     def __post_init__(self):
         if not self.tol > 0:
             raise TengsimError(f"tol must be > 0, got {self.tol!r}")
         if int(self.memory) < 1:
             raise TengsimError(f"memory must be >= 1, got {self.memory!r}")
+        if int(self.monitor_every) < 1:
+            raise TengsimError(f"monitor_every must be >= 1, got {self.monitor_every!r}")
 
     def solve(self, problem: Problem, start: State) -> Equilibrium:
         t0 = time.perf_counter()
@@ -172,6 +178,8 @@ class FastSolver:
                 return done(True, it, "converged")
             if it == self.max_iter:
                 break
+            if self.monitor is not None and it % self.monitor_every == 0:
+                self.monitor(it, rmax, E)
             a0, a1, b = direction(*mem.coefficients())
             if not a0 - b < 0:  # not a descent direction: restart from the preconditioned gradient
                 mem.reset()
