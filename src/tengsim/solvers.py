@@ -135,25 +135,41 @@ class FastSolver:
             return out
 
         def law_sweep(gg, PP):
+            """ΣΦ(gg) and ΣP, with P(gg) written into PP."""
             def fn(sl, m, sc, acc):
                 acc[0] += law.energy_pressure(gg[sl], PP[sl], (buf(sc, "a", m), buf(sc, "b", m)))
-            return sw.sum(fn, [0.0])[0]
+                acc[1] += float(PP[sl].sum())
+            return sw.sum(fn, [0.0, 0.0])
 
+        # A periodic kernel has K(0) = 0: the mean of q is a gauge (E and w do not see it), and the
+        # K metric cannot control it.  Left alone, a near-flat line search (near round-off) can push a
+        # huge mean into q, which then spoils q·w and G in floating point and throws the iterate
+        # away from the minimum it had reached.  So the mean of q is held fixed and G = q − P is used
+        # without its mean (the K-metric gradient is the same); ΣP comes with the law's sweeps and
+        # Σd with the direction's, so this costs no extra pass.
+        proj = bool(getattr(K, "periodic", False))
         np.add(g0, w, out=g)
-        phis = law_sweep(g, P)
+        phis, sum_p = law_sweep(g, P)
         np.subtract(w, conv(P), out=r)
         n_conv = 1
+        mean_q = float(q.mean())
         np.subtract(q, P, out=G)
+        if proj:
+            G -= mean_q - sum_p / n
         qw = float(np.vdot(q, w))
         E = dA * (0.5 * qw + phis)
         rmax = max(float(r.max()), -float(r.min()))
+        E_best = E
 
         def done(ok, it, msg):
             st = State(q.reshape(shape), w.reshape(shape))
             return _finish(problem, st, P.reshape(shape).copy(), r, E, ok, it, n_conv, t0, msg)
 
         def direction(gamma, c):
-            """d = −H G, K d = −K H G, and the products d·w, d·K d, P·K d, in one sweep."""
+            """d = −H G, K d = −K H G, and the products d·w, d·K d, d·r (and Σd), in one sweep.
+
+            The slope E'(0) = ΔA (d·w − P·K d) is taken as ΔA d·r (equal, since r = w − K P and K is
+            symmetric): near convergence d·w and P·K d nearly cancel, and their difference is noise."""
             k2 = 0 if c is None else c.size
 
             def fn(sl, m, sc, acc):
@@ -168,8 +184,10 @@ class FastSolver:
                     kds -= h
                 acc[0] += float(np.vdot(ds, w[sl]))
                 acc[1] += float(np.vdot(ds, kds))
-                acc[2] += float(np.vdot(P[sl], kds))
-            return sw.sum(fn, [0.0, 0.0, 0.0])
+                acc[2] += float(np.vdot(ds, r[sl]))
+                if proj:
+                    acc[3] += float(ds.sum())
+            return sw.sum(fn, [0.0, 0.0, 0.0, 0.0])
 
         for it in range(self.max_iter + 1):
             if not math.isfinite(rmax):
@@ -180,13 +198,16 @@ class FastSolver:
                 break
             if self.monitor is not None and it % self.monitor_every == 0:
                 self.monitor(it, rmax, E)
-            a0, a1, b = direction(*mem.coefficients())
-            if not a0 - b < 0:  # not a descent direction: restart from the preconditioned gradient
+            a0, a1, dr, sum_d = direction(*mem.coefficients())
+            if not dr < 0:  # not a descent direction: restart from the preconditioned gradient
                 mem.reset()
-                a0, a1, b = direction(*mem.coefficients())
-            slope = dA * (a0 - b)
-            alpha, E_new, phis_t = _wolfe(law, g, Kd, gt, Pt, sw, qw, a0, a1, E, slope, dA,
-                                          first=mem.empty)
+                a0, a1, dr, sum_d = direction(*mem.coefficients())
+            slope = dA * dr
+            # E may rise by round-off in an accepted step (approximate Wolfe); measured from the
+            # lowest E so far, such rises cannot add up over many steps near convergence
+            E_best = min(E_best, E)
+            alpha, E_new, phis_t, sum_pt = _wolfe(law, g, P, Kd, gt, Pt, sw, qw, a0, a1, E, slope, dA,
+                                                  first=mem.empty, sum_p=proj, E_ref=E_best)
             if alpha is None:
                 return done(False, it, "line search failed")
             resynced = (it + 1) % self.resync == 0
@@ -196,18 +217,24 @@ class FastSolver:
                 _axpy(d, q, alpha, gt)
                 w_exact = conv(q)
                 n_conv += 1
-                ks_factor, ks_base = 1.0, np.subtract(w_exact, w, out=gt)
+                # the correction (w = K q exactly, minus the assembled step α K d) goes to w and r
+                # only: the stored pair keeps the assembled images K s = α K d, K y = K s − Δ(K P),
+                # as every other pair does, so the drift is not fed back into later directions
+                corr = np.subtract(w_exact, w, out=gt)
+                _axpy(Kd, corr, -alpha, Pt)
                 w[:] = w_exact
                 np.add(g0, w, out=g)
-                phis = law_sweep(g, P)
+                phis, sum_p = law_sweep(g, P)
                 qw = float(np.vdot(q, w))
+                E_best = math.inf  # E is recomputed exactly: the bookkeeping restarts from it
             else:
                 g, gt = gt, g
                 P, Pt = Pt, P
-                phis = phis_t
+                phis, sum_p = phis_t, sum_pt
                 qw += alpha * (2.0 * a0 + alpha * a1)
-                ks_factor, ks_base = alpha, Kd
             E = dA * (0.5 * qw + phis)
+            mean_q += alpha * sum_d / n
+            mu = mean_q - sum_p / n if proj else 0.0
             conv(P)
             n_conv += 1
             k2 = 2 * len(mem.order)
@@ -226,7 +253,11 @@ class FastSolver:
                 rns, kys, Gns, ys = rn[sl], ky[sl], Gn[sl], y[sl]
                 np.subtract(w[sl], cP[sl], out=rns)
                 np.subtract(rns, r[sl], out=kys)
+                if resynced:
+                    kys -= corr[sl]
                 np.subtract(q[sl], P[sl], out=Gns)
+                if proj:
+                    Gns -= mu
                 np.subtract(Gns, G[sl], out=ys)
                 acc[0] += float(np.vdot(ds, kys))
                 acc[1] += float(np.vdot(ys, kys))
@@ -250,7 +281,7 @@ class FastSolver:
                 def put(sl, m, sc, acc):
                     np.multiply(d[sl], alpha, out=B[2 * slot, sl])
                     B[2 * slot + 1, sl] = y[sl]
-                    np.multiply(ks_base[sl], ks_factor, out=KB[2 * slot, sl])
+                    np.multiply(Kd[sl], alpha, out=KB[2 * slot, sl])
                     KB[2 * slot + 1, sl] = ky[sl]
                 sw.run(put, ())
             r, rn = rn, r
@@ -278,17 +309,22 @@ def _axpy(x, y, a, tmp):
     np.add(y, tmp, out=y)
 
 
-def _wolfe(law, g, Kd, gt, Pt, sw, qw, a0, a1, E0, slope0, dA, first, c1=1e-4, c2=0.9, max_eval=40):
+def _wolfe(law, g, P, Kd, gt, Pt, sw, qw, a0, a1, E0, slope0, dA, first, c1=1e-4, c2=0.9, max_eval=40,
+           sum_p=False, E_ref=None):
     """Line search along d; element-wise only (no convolution).
 
     E(α) = dA[½ q·w + α d·w + ½ α² d·K d + Σ Φ(g + α K d)],
-    E'(α) = dA[d·w + α d·K d − P(g + α K d)·K d]   (qw = q·w, a0 = d·w, a1 = d·K d).
+    E'(α) = E'(0) + dA[α d·K d − (P(g + α K d) − P(g))·K d]   (qw = q·w, a0 = d·w, a1 = d·K d;
+    the pressure change is summed point by point, so E' keeps its precision near convergence).
     Accepts the strong Wolfe conditions, or near round-off the approximate Wolfe conditions of
-    Hager & Zhang (2005): E(α) <= E(0) + 1e-11|E(0)| and 0.9 E'(0) <= E'(α) <= −0.8 E'(0).
+    Hager & Zhang (2005): E(α) <= E_ref + 1e-11|E(0)| and 0.9 E'(0) <= E'(α) <= −0.8 E'(0), with
+    E_ref = min(E(0), ``E_ref``) (the caller's lowest energy, so round-off rises cannot accumulate).
     The bracket is narrowed by safeguarded secant steps on E'.  On return the buffers gt, Pt hold
-    the gap and pressure at the accepted α; returns (α, E(α), ΣΦ) or (None, None, None).
+    the gap and pressure at the accepted α; returns (α, E(α), ΣΦ, ΣP) (ΣP only if ``sum_p``, else 0)
+    or (None, None, None, None).
     """
     eps_E = 1e-11 * max(1.0, abs(E0))
+    E_lo = E0 if E_ref is None else min(E0, E_ref)
 
     buf = sw.buf
 
@@ -299,11 +335,15 @@ def _wolfe(law, g, Kd, gt, Pt, sw, qw, a0, a1, E0, slope0, dA, first, c1=1e-4, c
             np.multiply(kb, a, out=gb)
             np.add(gb, g[sl], out=gb)
             acc[0] += law.energy_pressure(gb, pb, (buf(sc, "a", m), buf(sc, "b", m)))
-            acc[1] += float(np.vdot(pb, kb))
-        phis, pk = sw.sum(fn, [0.0, 0.0])
+            dp = buf(sc, "c", m)
+            np.subtract(pb, P[sl], out=dp)
+            acc[1] += float(np.vdot(dp, kb))
+            if sum_p:
+                acc[2] += float(pb.sum())
+        phis, dpk, sp = sw.sum(fn, [0.0, 0.0, 0.0])
         e = dA * (0.5 * qw + a * a0 + 0.5 * a * a * a1 + phis)
-        de = dA * (a0 + a * a1 - pk)
-        return e, de, phis
+        de = slope0 + dA * (a * a1 - dpk)
+        return e, de, phis, sp
 
     alpha = 1.0
     if first:  # scale the first trial step so that the gap moves by at most 0.25 ε
@@ -314,15 +354,15 @@ def _wolfe(law, g, Kd, gt, Pt, sw, qw, a0, a1, E0, slope0, dA, first, c1=1e-4, c
     hi, de_hi = None, None
     best = None
     for _ in range(max_eval):
-        e, de, phis = f(alpha)
+        e, de, phis, sp = f(alpha)
         if not np.isfinite(e):
             hi, de_hi = alpha, None
         else:
             wolfe = e <= E0 + c1 * alpha * slope0 and abs(de) <= -c2 * slope0
-            approx = e <= E0 + eps_E and c2 * slope0 <= de <= -0.8 * slope0
+            approx = e <= E_lo + eps_E and c2 * slope0 <= de <= -0.8 * slope0
             if wolfe or approx:
-                return alpha, e, phis
-            if e <= E0 + eps_E and (best is None or abs(de) < best[0]):
+                return alpha, e, phis, sp
+            if e <= E_lo + eps_E and (best is None or abs(de) < best[0]):
                 best = (abs(de), alpha)
             if e > E0 + c1 * alpha * slope0 + eps_E or de > 0:
                 hi, de_hi = alpha, (de if e <= E0 + eps_E or de > 0 else None)
@@ -338,9 +378,9 @@ def _wolfe(law, g, Kd, gt, Pt, sw, qw, a0, a1, E0, slope0, dA, first, c1=1e-4, c
             cand = lo + 0.5 * width
         alpha = min(max(cand, lo + 0.1 * width), hi - 0.1 * width)
     if best is not None:
-        e, _, phis = f(best[1])  # the buffers must hold the accepted point
-        return best[1], e, phis
-    return None, None, None
+        e, _, phis, sp = f(best[1])  # the buffers must hold the accepted point
+        return best[1], e, phis, sp
+    return None, None, None, None
 
 
 @dataclass(frozen=True)
