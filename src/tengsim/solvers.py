@@ -134,13 +134,6 @@ class FastSolver:
                 out[:] = K.apply(x.reshape(shape)).ravel()
             return out
 
-        def law_sweep(gg, PP):
-            """ΣΦ(gg) and ΣP, with P(gg) written into PP."""
-            def fn(sl, m, sc, acc):
-                acc[0] += law.energy_pressure(gg[sl], PP[sl], (buf(sc, "a", m), buf(sc, "b", m)))
-                acc[1] += float(PP[sl].sum())
-            return sw.sum(fn, [0.0, 0.0])
-
         # A periodic kernel has K(0) = 0: the mean of q is a gauge (E and w do not see it), and the
         # K metric cannot control it.  Left alone, a near-flat line search (near round-off) can push a
         # huge mean into q, which then spoils q·w and G in floating point and throws the iterate
@@ -148,6 +141,15 @@ class FastSolver:
         # without its mean (the K-metric gradient is the same); ΣP comes with the law's sweeps and
         # Σd with the direction's, so this costs no extra pass.
         proj = bool(getattr(K, "periodic", False))
+
+        def law_sweep(gg, PP):
+            """ΣΦ(gg) and ΣP (periodic kernels only, else 0), with P(gg) written into PP."""
+            def fn(sl, m, sc, acc):
+                acc[0] += law.energy_pressure(gg[sl], PP[sl], (buf(sc, "a", m), buf(sc, "b", m)))
+                if proj:
+                    acc[1] += float(PP[sl].sum())
+            return sw.sum(fn, [0.0, 0.0])
+
         np.add(g0, w, out=g)
         phis, sum_p = law_sweep(g, P)
         np.subtract(w, conv(P), out=r)
