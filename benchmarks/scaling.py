@@ -59,20 +59,44 @@ def rough_surface(n, dx, hurst=0.8, lam_r=16.0, lam_s=2.0, h_rms=1.0, seed=0):
     return h, L
 
 
+def pyramid_array(n, px=128, group="C", jitter=0.02, seed=0):
+    """Periodic square array of the paper's pyramids (group ``group``, Eq. 7 scaling), ``px`` pixels
+    per pyramid cell, (n/px)² pyramids; each pyramid's height scaled by 1 + ``jitter``·ξ (ξ standard
+    normal, fixed seed: fabrication scatter, so that no two cells are the same problem).
+    Returns U0 (the undeformed gap, 0 at the highest tip), the pixel dx and μ."""
+    from tengsim.units import paper_scaling
+
+    if n % px:
+        raise ValueError(f"n = {n} is not a multiple of the pixels per pyramid cell ({px})")
+    sc = paper_scaling(group)
+    dx = sc.cell / px
+    m = n // px
+    x = (np.arange(px) - (px - 1) / 2) * dx
+    depth = 2 * np.maximum(np.abs(x[:, None]), np.abs(x[None, :]))   # below the tip, one cell
+    tips = 2 * sc.N * (1 + jitter * np.random.default_rng(seed).standard_normal((m, m)))
+    # height above the base, cell by cell: max(tip − depth, 0), tiled over the m × m cells
+    z = np.maximum(np.repeat(np.repeat(tips, px, 0), px, 1) - np.tile(depth, (m, m)), 0.0)
+    return z.max() - z, dx, sc.mu
+
+
 def one_size(n, dx, mu, tol, overlap, dD, seed, cold=True, nested=True, min_size=128, warm=True, max_dx=0.5,
-             max_iter=3000, coarse_max_iter=1000):
+             max_iter=3000, coarse_max_iter=1000, surface="rough", px=128, jitter=0.02, D=6.0):
     from tengsim.grid import Grid
     from tengsim.interaction import LJ93
     from tengsim.kernels import make_kernel
     from tengsim.solvers import Problem, State, make_solver
 
     t_setup = time.perf_counter()
-    h, L = rough_surface(n, dx, seed=seed)
+    if surface == "rough":
+        h, L = rough_surface(n, dx, seed=seed)
+        slope = float(np.sqrt(np.mean(np.gradient(h, dx, axis=0) ** 2 + np.gradient(h, dx, axis=1) ** 2)))
+        U0 = h.max() - h
+        del h
+        D0 = float(np.quantile(U0, overlap))
+    else:  # the paper's pyramids (group C), a periodic array of (n/px)² with scattered heights
+        U0, dx, mu = pyramid_array(n, px=px, jitter=jitter, seed=seed)
+        L, slope, D0 = n * dx, 2.0, float(D)
     grid = Grid(n, n, dx, dx)
-    slope = float(np.sqrt(np.mean(np.gradient(h, dx, axis=0) ** 2 + np.gradient(h, dx, axis=1) ** 2)))
-    U0 = h.max() - h
-    del h
-    D0 = float(np.quantile(U0, overlap))
     kernel = make_kernel("periodic", grid, mu ** 1.5)
     law = LJ93()
     def monitor(it, rmax, E):  # progress of long solves, on stderr
@@ -91,7 +115,7 @@ def one_size(n, dx, mu, tol, overlap, dD, seed, cold=True, nested=True, min_size
     t_conv = float(np.median(ts))
     del p
     out = dict(n=n, N=n * n, dx=dx, L=L, mu=mu, tol=tol, rms_slope=slope, D0=D0, dD=dD, t_conv=t_conv,
-               t_setup=t_setup)
+               t_setup=t_setup, surface=surface)
     if nested:
         from tengsim.multilevel import nested_solve
 
@@ -153,6 +177,11 @@ def main(argv=None):
     ap.add_argument("--overlap", type=float, default=0.05, help="fraction with U0 < D0")
     ap.add_argument("--dD", type=float, default=0.1)
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--surface", choices=("rough", "pyramids"), default="rough",
+                    help="random rough surface (default) or a periodic array of the paper's group-C pyramids")
+    ap.add_argument("--px", type=int, default=128, help="pyramids: pixels per pyramid cell (n must be a multiple)")
+    ap.add_argument("--jitter", type=float, default=0.02, help="pyramids: relative rms scatter of the heights")
+    ap.add_argument("--D", type=float, default=6.0, help="pyramids: the rigid approach D [ε]")
     ap.add_argument("--timeout", type=float, default=1500, help="seconds per size")
     ap.add_argument("--cold-max", type=int, default=2048, help="largest n solved cold (and warm)")
     ap.add_argument("--warm-max", type=int, default=1024, help="largest n with the warm step")
@@ -169,14 +198,20 @@ def main(argv=None):
     if a.one:
         one_size(a.one, a.dx, a.mu, a.tol, a.overlap, a.dD, a.seed, cold=a.one <= a.cold_max,
                  nested=not a.no_nested, min_size=a.min_size, warm=a.one <= a.warm_max,
-                 max_dx=a.max_dx, max_iter=a.max_iter, coarse_max_iter=a.coarse_max_iter)
+                 max_dx=a.max_dx, max_iter=a.max_iter, coarse_max_iter=a.coarse_max_iter,
+                 surface=a.surface, px=a.px, jitter=a.jitter, D=a.D)
         return
+    if a.surface == "pyramids":
+        bad = [n for n in a.sizes if n % a.px]
+        if bad:
+            ap.error(f"--sizes {bad} are not multiples of --px {a.px} (whole pyramid cells only)")
     rows = []
     for n in a.sizes:
         cmd = [sys.executable, __file__, "--one", str(n), "--dx", str(a.dx), "--mu", str(a.mu),
                "--tol", str(a.tol), "--overlap", str(a.overlap), "--dD", str(a.dD), "--seed", str(a.seed),
                "--cold-max", str(a.cold_max), "--warm-max", str(a.warm_max), "--min-size", str(a.min_size), "--max-dx", str(a.max_dx),
-               "--max-iter", str(a.max_iter), "--coarse-max-iter", str(a.coarse_max_iter)] + (["--no-nested"] if a.no_nested else [])
+               "--max-iter", str(a.max_iter), "--coarse-max-iter", str(a.coarse_max_iter),
+               "--surface", a.surface, "--px", str(a.px), "--jitter", str(a.jitter), "--D", str(a.D)] + (["--no-nested"] if a.no_nested else [])
         print(f"n = {n} ...", flush=True)
         t0 = time.perf_counter()
         try:
@@ -208,12 +243,20 @@ def main(argv=None):
     def cell(r, k, spec):
         return format(r[k], spec) if k in r else "–"
 
-    lines = ["# Scaling of tengsim's fast solver (one equilibrium, periodic random rough surface)", "",
+    if a.surface == "rough":
+        title = "periodic random rough surface"
+        what = (f"Surface: self-affine, Hurst 0.8, λr = 16 ε, λs = 2 ε, h_rms = 1 ε, pixel dx = {a.dx} ε "
+                f"(cell grows with n), seed {a.seed}; μ = {a.mu}, LJ 8-2, periodic kernel, tol = {a.tol:g}; "
+                f"D0 such that {100 * a.overlap:g} % overlaps rigidly")
+    else:
+        title = "periodic array of the paper's group-C pyramids"
+        what = (f"Surface: the paper's group-C pyramids (Eq. 7: N = 4.73, cell 18.93 ε), {a.px} pixels per "
+                f"pyramid cell (dx = {18.928200966762 / a.px:.4f} ε; the array grows with n: (n/{a.px})² "
+                f"pyramids), heights scattered by {100 * a.jitter:g} % rms (seed {a.seed}); μ = 0.5, LJ 8-2, "
+                f"periodic kernel, tol = {a.tol:g}; D0 = {a.D:g}")
+    lines = [f"# Scaling of tengsim's fast solver (one equilibrium, {title})", "",
              f"Command: `python benchmarks/scaling.py {' '.join(sys.argv[1:])}`", "",
-             f"Surface: self-affine, Hurst 0.8, λr = 16 ε, λs = 2 ε, h_rms = 1 ε, pixel dx = {a.dx} ε "
-             f"(cell grows with n), seed {a.seed}; μ = {a.mu}, LJ 8-2, periodic kernel, tol = {a.tol:g}; "
-             f"D0 such that {100 * a.overlap:g} % overlaps rigidly, warm step ΔD = {a.dD}; nested: "
-             f"coarsest grid {a.min_size}², coarsest pixel {a.max_dx} ε.", "",
+             what + f", warm step ΔD = {a.dD}; nested: coarsest grid {a.min_size}², coarsest pixel {a.max_dx} ε.", "",
              f"Machine: {os.cpu_count()} cores; OPENBLAS_NUM_THREADS={os.environ.get('OPENBLAS_NUM_THREADS')}, "
              f"TENGSIM_FFT_WORKERS={os.environ.get('TENGSIM_FFT_WORKERS')} (unset: 1 thread below 512² "
              f"points, all cores above).", "",
@@ -250,8 +293,9 @@ def main(argv=None):
             lines += ["", f"Fitted growth of {key} over n = {', '.join(str(r['n']) for r in ok)}: ∝ N^{sl:.2f} (N = n²)."]
     lines.append("")
     a.out.mkdir(parents=True, exist_ok=True)
-    (a.out / "scaling.md").write_text("\n".join(lines))
-    (a.out / "scaling.json").write_text(json.dumps(rows, indent=1))
+    stem = "scaling" if a.surface == "rough" else "scaling_pyramids"
+    (a.out / f"{stem}.md").write_text("\n".join(lines))
+    (a.out / f"{stem}.json").write_text(json.dumps(rows, indent=1))
     print("\n".join(lines))
 
 
