@@ -70,3 +70,30 @@ def test_groups_b_c_grid_convergence(group, d_max):
         _, Ff, _ = _on_grid(fine, branch)
         assert np.max(np.abs(Fc - Ff)) < 0.01 * max(1.0, np.max(np.abs(Ff)))
     assert abs(coarse.transition_D(2 * N) - fine.transition_D(2 * N)) <= coarse.grid.dx
+
+
+def test_periodic_array_of_identical_cells_is_its_one_cell():
+    """A 2 × 2 periodic array of the same group-A cell solves as the cell itself: the periodic kernel
+    is 2κ/|q| at the physical wavenumber, so the array's state stays 2 × 2-periodic and every cell
+    carries the single cell's pressure and force (the scaling study's pyramid array rests on this)."""
+    from tengsim.geometry import Pyramid
+    from tengsim.grid import Grid
+    from tengsim.interaction import LJ93
+    from tengsim.kernels import PeriodicKernel
+    from tengsim.solvers import FastSolver, Problem, State
+
+    N, cell = GROUPS["A"]
+    n, D, tol = 32, 1.5, 1e-9
+    one = Grid(n, n, cell / n, cell / n)
+    U0 = Pyramid(N, cell).gap(one)
+    arr = Grid(2 * n, 2 * n, cell / n, cell / n)
+    solver = FastSolver(tol)
+    e1 = solver.solve(Problem(U0 - D + 1.0, LJ93(), PeriodicKernel(one, 0.5 ** 1.5)), State.zero(one.shape))
+    e4 = solver.solve(Problem(np.tile(U0, (2, 2)) - D + 1.0, LJ93(), PeriodicKernel(arr, 0.5 ** 1.5)),
+                      State.zero(arr.shape))
+    assert e1.converged and e4.converged
+    assert e1.P.max() > 1.0 and e1.P.min() < -0.5  # a loaded contact with an adhesive rim
+    # the Eq. (9) tolerance moves the gap by ~tol and P by ~Φ''·tol (Φ''(1) = 16)
+    assert np.max(np.abs(e4.P - np.tile(e1.P, (2, 2)))) < 1e-6
+    assert e4.P.sum() / 4 == pytest.approx(e1.P.sum(), rel=1e-8)
+    assert e4.energy / 4 == pytest.approx(e1.energy, rel=1e-10)
