@@ -11,7 +11,11 @@ A size too long for the per-size ``--timeout`` can be run alone and joined to th
 tengsim's FFT threading rule applies (1 thread below 512² points, all cores from 512² up);
 TENGSIM_FFT_WORKERS forces a count and is recorded in ``scaling.md``.
 
-The surface is statistically the same at every size: fixed pixel dx (in ε), so the cell grows
+``--surface pyramids`` solves a periodic array of the paper's group-C pyramids instead (``--px`` pixels
+per pyramid cell, heights scattered by ``--jitter``, approach ``--D``; see :func:`pyramid_array`) and
+writes ``scaling_pyramids.md`` / ``.json``.
+
+The rough surface is statistically the same at every size: fixed pixel dx (in ε), so the cell grows
 with n (L = n·dx); a self-affine power spectrum C(q) ∝ q^{-2(1+H)} between a roll-off wavelength
 λr and a short cutoff λs (both fixed in ε), random phases from a fixed seed, rms height h_rms.
 U0 = max(h) − h, periodic kernel (μ^{3/2} · 2/|q|), LJ 8-2 law, μ = 0.5.  D is set so that a fixed
