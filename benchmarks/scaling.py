@@ -68,6 +68,7 @@ def pyramid_array(n, px=128, group="C", jitter=0.02, seed=0):
     per pyramid cell, (n/px)² pyramids; each pyramid's height scaled by 1 + ``jitter``·ξ (ξ standard
     normal, fixed seed: fabrication scatter, so that no two cells are the same problem).
     Returns U0 (the undeformed gap, 0 at the highest tip), the pixel dx and μ."""
+    from tengsim.grid import Grid
     from tengsim.units import paper_scaling
 
     if n % px:
@@ -75,8 +76,9 @@ def pyramid_array(n, px=128, group="C", jitter=0.02, seed=0):
     sc = paper_scaling(group)
     dx = sc.cell / px
     m = n // px
-    x = (np.arange(px) - (px - 1) / 2) * dx
-    depth = 2 * np.maximum(np.abs(x[:, None]), np.abs(x[None, :]))   # below the tip, one cell
+    X, Y = Grid(px, px, dx, dx).mesh()                  # the package's cell-centred pixel coordinates
+    # below the tip, one cell: Pyramid.gap without its clip at 2N (a scattered tip may stand higher)
+    depth = 2 * np.maximum(np.abs(X), np.abs(Y))
     tips = 2 * sc.N * (1 + jitter * np.random.default_rng(seed).standard_normal((m, m)))
     # height above the base, cell by cell: max(tip − depth, 0), tiled over the m × m cells
     z = np.maximum(np.repeat(np.repeat(tips, px, 0), px, 1) - np.tile(depth, (m, m)), 0.0)
@@ -99,7 +101,7 @@ def one_size(n, dx, mu, tol, overlap, dD, seed, cold=True, nested=True, min_size
         D0 = float(np.quantile(U0, overlap))
     else:  # the paper's pyramids (group C), a periodic array of (n/px)² with scattered heights
         U0, dx, mu = pyramid_array(n, px=px, jitter=jitter, seed=seed)
-        L, slope, D0 = n * dx, 2.0, float(D)
+        L, slope, D0 = n * dx, 2.0, float(D)   # |∇U0| = 2 on every face (Eq. 7 scaling)
     grid = Grid(n, n, dx, dx)
     kernel = make_kernel("periodic", grid, mu ** 1.5)
     law = LJ93()
@@ -253,11 +255,14 @@ def main(argv=None):
                 f"(cell grows with n), seed {a.seed}; μ = {a.mu}, LJ 8-2, periodic kernel, tol = {a.tol:g}; "
                 f"D0 such that {100 * a.overlap:g} % overlaps rigidly")
     else:
+        from tengsim.units import paper_scaling
+
+        sc = paper_scaling("C")
         title = "periodic array of the paper's group-C pyramids"
-        what = (f"Surface: the paper's group-C pyramids (Eq. 7: N = 4.73, cell 18.93 ε), {a.px} pixels per "
-                f"pyramid cell (dx = {18.928200966762 / a.px:.4f} ε; the array grows with n: (n/{a.px})² "
-                f"pyramids), heights scattered by {100 * a.jitter:g} % rms (seed {a.seed}); μ = 0.5, LJ 8-2, "
-                f"periodic kernel, tol = {a.tol:g}; D0 = {a.D:g}")
+        what = (f"Surface: the paper's group-C pyramids (Eq. 7: N = {sc.N:.2f}, cell {sc.cell:.2f} ε), {a.px} "
+                f"pixels per pyramid cell (dx = {sc.cell / a.px:.4f} ε; the array grows with n: (n/{a.px})² "
+                f"pyramids), heights scattered by {100 * a.jitter:g} % rms (seed {a.seed}); μ = {sc.mu:g}, "
+                f"LJ 8-2, periodic kernel, tol = {a.tol:g}; D0 = {a.D:g}")
     lines = [f"# Scaling of tengsim's fast solver (one equilibrium, {title})", "",
              f"Command: `python benchmarks/scaling.py {' '.join(sys.argv[1:])}`", "",
              what + f", warm step ΔD = {a.dD}; nested: coarsest grid {a.min_size}², coarsest pixel {a.max_dx} ε.", "",
