@@ -1,0 +1,209 @@
+"""Extension points: one protocol and one registry each for shapes, laws, kernels, solvers and observers.
+
+Everything that lists names (config validation, CLI choices and help, result metadata, docs) reads
+them from here; no other module keeps its own list.  A user extends tengsim from their own module::
+
+    from tengsim.registry import LAWS
+
+    @LAWS.register("mylaw", summary="my interaction law")
+    class MyLaw(tengsim.interaction.Law): ...
+
+and ``law = "mylaw"`` then works in :func:`tengsim.simulate`, TOML runs and ``tengsim contact --law``.
+Plugins named in the environment variable ``TENGSIM_PLUGINS`` (comma-separated module names) or under
+the ``tengsim.plugins`` entry-point group are imported before the command line is built.
+"""
+from __future__ import annotations
+
+import importlib
+import os
+from typing import Any, Callable, Generic, Iterator, Protocol, TypeVar, runtime_checkable
+
+import numpy as np
+
+from tengsim.errors import TengsimError
+
+T = TypeVar("T")
+
+
+# ---- protocols: what a piece must offer -------------------------------------------------------
+
+@runtime_checkable
+class ShapeLike(Protocol):
+    """Initial gap U0 >= 0 (in ε) of the elastic surface over a grid of its cell (paper Eq. 11)."""
+
+    cell: float
+
+    def gap(self, grid) -> np.ndarray: ...
+
+    def grid(self, dx: float): ...
+
+    def params(self) -> dict: ...
+
+
+@runtime_checkable
+class LawLike(Protocol):
+    """Surface interaction: energy Φ(g) and pressure P(g) = −dΦ/dg of the gap g = h/ε (paper Eq. 2/8)."""
+
+    g_safe: float
+
+    def evaluate(self, g: np.ndarray) -> tuple[np.ndarray, np.ndarray]: ...
+
+    def energy_pressure(self, g: np.ndarray, out: np.ndarray, work) -> float: ...
+
+    def params(self) -> dict: ...
+
+
+@runtime_checkable
+class KernelLike(Protocol):
+    """Elastic operator w = K p on a grid (one convolution per ``apply``, paper Eq. 9)."""
+
+    grid: Any
+    periodic: bool
+
+    def apply(self, p: np.ndarray, out: np.ndarray | None = None) -> np.ndarray: ...
+
+    def params(self) -> dict: ...
+
+
+@runtime_checkable
+class SolverLike(Protocol):
+    """Finds one stable equilibrium of a :class:`tengsim.solvers.Problem` from a start state."""
+
+    tol: float
+    name: str
+
+    def solve(self, problem, start): ...
+
+
+@runtime_checkable
+class ObserverLike(Protocol):
+    """Scalar observables of one equilibrium, added as columns of the result table.
+
+    ``columns`` names what ``__call__(eq, ctx)`` returns (a dict of floats); ``ctx`` has the grid, the
+    apex index and the initial gap U0.  ``units`` maps a column to its unit text (optional).
+    """
+
+    columns: tuple
+
+    def __call__(self, eq, ctx) -> dict: ...
+
+
+# ---- the registry ------------------------------------------------------------------------------
+
+class Registry(Generic[T]):
+    """Names → objects of one kind, with aliases and a one-line summary each."""
+
+    def __init__(self, kind: str, protocol: type | None = None):
+        self.kind = kind
+        self.protocol = protocol
+        self._items: dict[str, T] = {}
+        self._aliases: dict[str, str] = {}
+        self._summary: dict[str, str] = {}
+
+    @staticmethod
+    def _key(name: str) -> str:
+        return str(name).strip().lower().replace("-", "_")
+
+    def register(self, name: str, obj: T | None = None, *, aliases=(), summary: str | None = None,
+                 replace: bool = False):
+        """Register ``obj`` under ``name`` (usable as a decorator); returns ``obj``."""
+        def add(o: T) -> T:
+            key = self._key(name)
+            if not replace and (key in self._items or key in self._aliases):
+                raise TengsimError(f"{self.kind} {name!r} is already registered")
+            self._items[key] = o
+            doc = (getattr(o, "__doc__", None) or "").strip().splitlines()
+            self._summary[key] = summary or (doc[0].rstrip(".") if doc else "")
+            for a in aliases:
+                self._aliases[self._key(a)] = key
+            return o
+        return add if obj is None else add(obj)
+
+    def unregister(self, name: str) -> None:
+        key = self.canonical(name)
+        self._items.pop(key)
+        self._summary.pop(key, None)
+        for a in [a for a, k in self._aliases.items() if k == key]:
+            del self._aliases[a]
+
+    def canonical(self, name: str) -> str:
+        """The registered name for ``name`` or an alias of it; a TengsimError naming the choices."""
+        key = self._key(name)
+        key = self._aliases.get(key, key)
+        if key not in self._items:
+            raise TengsimError(f"unknown {self.kind} {name!r} (choose from {', '.join(self.names())})")
+        return key
+
+    def get(self, name: str) -> T:
+        return self._items[self.canonical(name)]
+
+    def name_of(self, obj) -> str:
+        """The registered name of ``obj`` (a registered object, or an instance of a registered class)."""
+        for k, v in self._items.items():
+            if v is obj or (isinstance(v, type) and type(obj) is v):
+                return k
+        return type(obj).__name__
+
+    def names(self) -> tuple[str, ...]:
+        return tuple(self._items)
+
+    def summary(self, name: str) -> str:
+        return self._summary[self.canonical(name)]
+
+    def help(self) -> str:
+        """'name (summary), ...' for --help texts and docs."""
+        return "; ".join(f"{k}: {s}" if s else k for k, s in self._summary.items())
+
+    def __contains__(self, name) -> bool:
+        key = self._key(name)
+        return self._aliases.get(key, key) in self._items
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._items)
+
+    def __len__(self) -> int:
+        return len(self._items)
+
+    def __repr__(self) -> str:
+        return f"Registry({self.kind!r}, {list(self._items)})"
+
+
+SHAPES: Registry = Registry("shape", ShapeLike)
+LAWS: Registry = Registry("law", LawLike)
+KERNELS: Registry = Registry("boundary", KernelLike)
+SOLVERS: Registry = Registry("solver", SolverLike)
+OBSERVERS: Registry = Registry("observer", ObserverLike)
+
+_PLUGINS_LOADED = False
+
+
+def load_plugins() -> None:
+    """Import the modules named in ``TENGSIM_PLUGINS`` and the ``tengsim.plugins`` entry points (once)."""
+    global _PLUGINS_LOADED
+    if _PLUGINS_LOADED:
+        return
+    _PLUGINS_LOADED = True
+    for mod in filter(None, (m.strip() for m in os.environ.get("TENGSIM_PLUGINS", "").split(","))):
+        try:
+            importlib.import_module(mod)
+        except ImportError as exc:
+            raise TengsimError(f"TENGSIM_PLUGINS: cannot import {mod!r}: {exc}") from None
+    try:
+        from importlib.metadata import entry_points
+
+        for ep in entry_points(group="tengsim.plugins"):
+            ep.load()
+    except Exception as exc:  # noqa: BLE001 - a broken plugin is reported, not a traceback
+        raise TengsimError(f"tengsim.plugins entry point failed: {exc}") from None
+
+
+def ensure_builtins() -> None:
+    """Import the modules that register the built-in pieces."""
+    import tengsim.geometry  # noqa: F401
+    import tengsim.interaction  # noqa: F401
+    import tengsim.kernels  # noqa: F401
+    import tengsim.observers  # noqa: F401
+    import tengsim.solvers  # noqa: F401
+
+
+Factory = Callable[..., Any]

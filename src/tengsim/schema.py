@@ -1,0 +1,220 @@
+"""The one config schema: typed fields, tables that refuse unknown keys, units only on dimensional keys.
+
+Every config file (``tengsim run``, ``tengsim device --config``, ``tengsim sweep``) and every CLI option
+set is validated through :class:`Table`: a key not in the table is refused with its name, a number is
+typed, and a unit string ('2um', '0.59MPa') is accepted only where the field has a dimension.
+"""
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Callable
+
+from tengsim.errors import TengsimError
+
+REQUIRED = object()
+"""Marker default of a field that must be given."""
+
+
+@dataclass(frozen=True)
+class Field:
+    """One config key.
+
+    ``kind``: 'float', 'int', 'bool', 'str', 'floats' (list or comma-separated), 'any'.
+    ``dim``: the dimension of a quantity ('length', 'pressure', 'energy/area', ...; see
+    :func:`tengsim.units.parse_quantity`); a field with a dimension takes a number (SI) or a unit string,
+    one without refuses unit strings.  ``choices``: a tuple of names, or a callable returning them (a
+    registry's ``names``), checked case-insensitively.  ``check``: an extra validator ``value -> value``.
+    """
+
+    name: str
+    kind: str = "float"
+    default: Any = None
+    dim: str | None = None
+    choices: Any = None
+    help: str = ""
+    check: Callable | None = None
+
+    @property
+    def required(self) -> bool:
+        return self.default is REQUIRED
+
+    def _choices(self):
+        c = self.choices
+        return tuple(c()) if callable(c) else tuple(c or ())
+
+    def parse(self, value, where: str = ""):
+        """Typed value of ``value`` for this field; a TengsimError naming ``where.name`` if it is bad."""
+        label = f"{where}{self.name}"
+        k = self.kind
+        if k == "any":
+            v = value
+        elif k == "bool":
+            if isinstance(value, bool):
+                v = value
+            elif isinstance(value, str) and value.lower() in ("true", "false", "1", "0", "yes", "no"):
+                v = value.lower() in ("true", "1", "yes")
+            else:
+                raise TengsimError(f"{label} must be true or false, got {value!r}")
+        elif k == "str":
+            if not isinstance(value, str):
+                raise TengsimError(f"{label} must be a string, got {value!r}")
+            v = value
+            ch = self._choices()
+            if ch:
+                key = value.strip().lower().replace("-", "_")
+                norm = {c.lower().replace("-", "_"): c for c in ch}
+                if key not in norm:
+                    raise TengsimError(f"{label} = {value!r} is not one of {', '.join(ch)}")
+                v = norm[key]
+        elif k == "int":
+            if isinstance(value, bool) or not isinstance(value, (int, float, str)):
+                raise TengsimError(f"{label} must be an integer, got {value!r}")
+            try:
+                f = float(value)
+            except ValueError:
+                raise TengsimError(f"{label} must be an integer, got {value!r}") from None
+            if not math.isfinite(f) or f != int(f):
+                raise TengsimError(f"{label} must be an integer, got {value!r}")
+            v = int(f)
+        elif k == "float":
+            v = self._number(value, label)
+        elif k == "floats":
+            items = value
+            if isinstance(value, str):
+                items = [s for s in value.split(",") if s.strip()]
+            elif isinstance(value, (int, float)) and not isinstance(value, bool):
+                items = [value]
+            if not isinstance(items, (list, tuple)):
+                raise TengsimError(f"{label} must be a list of numbers, got {value!r}")
+            v = tuple(self._number(x, label) for x in items)
+        else:  # pragma: no cover - a schema bug
+            raise TypeError(f"unknown field kind {k!r}")
+        if self.check is not None:
+            v = self.check(v, label) if _arity(self.check) == 2 else self.check(v)
+        return v
+
+    def _number(self, value, label):
+        from tengsim.units import parse_quantity
+
+        if isinstance(value, bool):
+            raise TengsimError(f"{label} must be a number, got {value!r}")
+        if isinstance(value, str):
+            s = value.strip()
+            try:
+                x = float(s)
+            except ValueError:
+                if self.dim is None:
+                    raise TengsimError(f"{label} is dimensionless: give a plain number, got {value!r}") from None
+                x = parse_quantity(s, self.dim, name=label)
+        elif isinstance(value, (int, float)):
+            x = float(value)
+        else:
+            raise TengsimError(f"{label} must be a number, got {value!r}")
+        if not math.isfinite(x):
+            raise TengsimError(f"{label} must be finite, got {value!r}")
+        return x
+
+    def describe(self) -> str:
+        """One line for --help and the docs."""
+        bits = [self.kind if self.dim is None else f"{self.dim} (number in SI or with a unit)"]
+        ch = self._choices()
+        if ch:
+            bits.append("one of " + ", ".join(ch))
+        if self.required:
+            bits.append("required")
+        elif self.default is not None:
+            bits.append(f"default {self.default!r}")
+        return f"{self.name}: {self.help}" + (f" [{'; '.join(bits)}]" if bits else "")
+
+
+def _arity(fn) -> int:
+    import inspect
+
+    try:
+        return len(inspect.signature(fn).parameters)
+    except (TypeError, ValueError):  # pragma: no cover
+        return 1
+
+
+class Table:
+    """A named set of fields; :meth:`parse` types a mapping and refuses keys it does not know."""
+
+    def __init__(self, name: str, fields, doc: str = ""):
+        self.name = name
+        self.fields = {f.name: f for f in fields}
+        self.doc = doc
+
+    def __contains__(self, key) -> bool:
+        return key in self.fields
+
+    def keys(self):
+        return tuple(self.fields)
+
+    def parse(self, mapping: dict, *, defaults: bool = True, where: str | None = None) -> dict:
+        """Typed values of ``mapping``; unknown keys and missing required ones are errors.
+
+        With ``defaults`` the result holds every field (defaults filled in), else only the given keys.
+        """
+        where = f"[{self.name}] " if where is None else where
+        if not isinstance(mapping, dict):
+            raise TengsimError(f"{where.strip() or self.name} must be a table, got {mapping!r}")
+        unknown = [k for k in mapping if k not in self.fields]
+        if unknown:
+            raise TengsimError(f"{where}unknown key(s) {', '.join(map(repr, unknown))} "
+                               f"(known: {', '.join(self.fields)})")
+        out = {}
+        for name, f in self.fields.items():
+            if name in mapping and mapping[name] is not None:
+                out[name] = f.parse(mapping[name], where)
+            elif f.required:
+                raise TengsimError(f"{where}missing required key {name!r}")
+            elif defaults:
+                out[name] = f.default
+        return out
+
+    def help(self) -> str:
+        lines = [f"[{self.name}]" + (f"  {self.doc}" if self.doc else "")]
+        lines += ["  " + f.describe() for f in self.fields.values()]
+        return "\n".join(lines)
+
+
+def read_config(path) -> dict:
+    """Read a TOML (or .json) config file into a dict; any failure is one clear TengsimError."""
+    path = Path(path)
+    if not path.is_file():
+        raise TengsimError(f"config file {str(path)!r} not found")
+    try:
+        raw = path.read_bytes()
+    except OSError as exc:
+        raise TengsimError(f"cannot read config file {str(path)!r}: {exc.strerror}") from None
+    if path.suffix.lower() == ".json":
+        try:
+            cfg = json.loads(raw.decode())
+        except (ValueError, UnicodeDecodeError) as exc:
+            raise TengsimError(f"config file {str(path)!r} is not valid JSON: {exc}") from None
+    else:
+        try:
+            import tomllib
+        except ModuleNotFoundError:  # Python 3.10
+            import tomli as tomllib
+        try:
+            cfg = tomllib.loads(raw.decode())
+        except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+            raise TengsimError(f"config file {str(path)!r} is not valid TOML: {exc}") from None
+    if not isinstance(cfg, dict):
+        raise TengsimError(f"config file {str(path)!r} must hold tables")
+    return cfg
+
+
+def check_tables(cfg: dict, allowed, where: str = "config") -> None:
+    """Refuse top-level tables not in ``allowed`` and top-level values that are not tables."""
+    unknown = [k for k in cfg if k not in allowed]
+    if unknown:
+        raise TengsimError(f"{where}: unknown table(s) {', '.join(map(repr, unknown))} "
+                           f"(known: {', '.join(allowed)})")
+    for k, v in cfg.items():
+        if not isinstance(v, dict):
+            raise TengsimError(f"{where}: [{k}] must be a table, got {v!r}")
