@@ -60,7 +60,9 @@ def common_fields() -> list:
         Field("tol", default=1e-6, help="max residual of Eq. (9) in ε"),
         Field("law", "str", "lj93", check=lambda v: LAWS.canonical(v), help="interaction law: " + LAWS.help()),
         Field("observers", "any", (), check=_observer_names,
-              help="extra observers adding columns (registered: " + ", ".join(OBSERVERS.names()) + ")"),
+              help="extra observers adding columns: "
+              + ("; ".join(f"{n}: {OBSERVERS.summary(n)}" for n in OBSERVERS.names() if n != "summary")
+                 or "none registered (F, Λc, areas, gaps, pressures are always there)")),
         Field("out", "str", None, help="output file, .csv or .nc"),
         Field("plot", "str", None, help="figure of F(D), Λc(D), Λc(F), .png/.pdf/.svg"),
     ]
@@ -116,8 +118,8 @@ def contact_table(shape: str = "pyramid", mode: str | None = None) -> Table:
             if d is None:
                 merged[f.name] = dataclasses.replace(f, default=None)
             else:  # same name in both: a plain number, or a quantity in a physical run
-                merged[f.name] = Field(f.name, "float", None, dim=f.dim,
-                                       help=f"{d.help} (dimensionless) / {f.help} (physical)")
+                h = d.help if d.help == f.help or not f.dim else f"{d.help} (dimensionless) / {f.help} (physical)"
+                merged[f.name] = Field(f.name, "float", None, dim=f.dim, help=h)
         fields = [*common, *merged.values()]
     else:
         raise TengsimError(f"mode must be 'dimensionless', 'physical' or None, got {mode!r}")

@@ -290,6 +290,7 @@ class FlatPunch(Shape):
 
     physical_fields = (_length("radius", "punch radius"), _length("step", "height of the step (default 50 ε)", None),
                        _length("pitch", "cell side"))
+    field_help = {"radius": "punch radius a", "cell": "cell side", "step": "height of the step in ε"}
     si_map = {"pitch": "cell"}
     lateral_unit = "ε"
 

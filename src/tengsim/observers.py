@@ -49,7 +49,8 @@ def resolve(observers) -> list:
     """Observer objects for ``observers``: registered names (or aliases), classes, or instances.
 
     A registered class is instantiated without arguments.  An observer needs ``columns`` and to be
-    callable; a TengsimError names the one that is not.
+    callable; a TengsimError names the one that is not.  The built-in :class:`Summary` always runs,
+    so naming it adds nothing.
     """
     if observers is None:
         return []
@@ -60,6 +61,8 @@ def resolve(observers) -> list:
         obj = OBSERVERS.get(o) if isinstance(o, str) else o
         if isinstance(obj, type):
             obj = obj()
+        if type(obj) is Summary:
+            continue
         cols = getattr(obj, "columns", None)
         if not callable(obj) or not cols or isinstance(cols, str):
             raise TengsimError(f"observer {o!r} must be callable and name its columns (a tuple of names)")

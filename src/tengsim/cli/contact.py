@@ -12,7 +12,7 @@ _ALIASES = {"maps_at": ("--maps",)}
 
 
 def _option_help():
-    """Per key: (help, shapes using it) across the registered shapes, from the [contact] schema."""
+    """Common keys, and per shape key its help text(s) and the shapes using it, from the [contact] schema."""
     from tengsim.config import common_fields, contact_table
     from tengsim.registry import SHAPES
 
@@ -21,9 +21,15 @@ def _option_help():
     for s in SHAPES.names():
         for k, f in contact_table(s).fields.items():
             if k not in common:
-                h, users = per_key.setdefault(k, (f.help, []))
-                users.append(s)
-    return common, per_key
+                per_key.setdefault(k, {}).setdefault(f.help or k, []).append(s)
+    helps = {}
+    for k, groups in per_key.items():
+        if len(groups) == 1:
+            (h, users), = groups.items()
+            helps[k] = f"{h} [{', '.join(users)}]"
+        else:
+            helps[k] = "; ".join(f"{', '.join(users)}: {h}" for h, users in groups.items())
+    return common, helps
 
 
 def register(sub):
@@ -43,11 +49,11 @@ def register(sub):
         if k == "shape" or k in _CLI_ONLY:
             continue
         p.add_argument("--" + k.replace("_", "-"), *_ALIASES.get(k, ()), dest=k,
-                       help=f.describe().split(": ", 1)[1])
-    for k, (h, users) in per_key.items():
+                       help=f.describe().split(": ", 1)[1].replace("%", "%%"))
+    for k, h in per_key.items():
         if k in _CLI_ONLY:
             continue
-        p.add_argument("--" + k.replace("_", "-"), dest=k, help=f"{h} [{', '.join(users)}]")
+        p.add_argument("--" + k.replace("_", "-"), dest=k, help=h.replace("%", "%%"))
     p.add_argument("--out", required=True, help="output file: .csv (curves) or .nc (everything)")
     p.add_argument("--plot", help="also draw F(D), Λc(D), Λc(F) to this .png/.pdf")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
