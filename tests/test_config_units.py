@@ -279,3 +279,12 @@ def test_cone_and_cube_dimensionless_defaults():
     assert plan_contact(dict(shape="cone")).shape == Cone(1.0, 10.0)
     assert plan_contact(dict(shape="cube")).shape == Cube(1.0, 5.0, 6.0)
     assert plan_contact(dict(shape="cone")).tabor == 0.5
+
+
+def test_eps_for_tabor_root_and_no_root():
+    """Brent in log ε reproduces a closed form (ℓ = sqrt(Rε)) and names a μ no ε in range can give."""
+    R = 3e-6
+    eps = eps_for_tabor(lambda e: math.sqrt(R * e), E, W, 2.0)
+    assert eps == pytest.approx((math.sqrt(R) * W / (E * 2.0**1.5)) ** (2 / 3), rel=1e-12)
+    with pytest.raises(TengsimError, match="tabor = 2"):
+        eps_for_tabor(lambda e: e * e, E, W, 2.0)  # κ = W/E* whatever ε is

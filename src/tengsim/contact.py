@@ -52,6 +52,8 @@ def simulate(shape: Shape, tabor: float, dx: float, path: PathSpec, boundary: st
         **(extra_params or {}),
     }
     if scaling is not None:
+        for k, v in scaling.params().items():
+            res.params.setdefault(k, v)
         res.add_physical(scaling)
     warnings = []
     if not res.all_converged:

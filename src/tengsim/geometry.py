@@ -99,6 +99,9 @@ class Shape:
         (shapes with a closed form override this)."""
         from tengsim.units import eps_for_tabor
 
+        if cls.si_map and cls.lateral_scale.__func__ is Shape.lateral_scale.__func__:
+            # ℓ = ε: κ = W/(E* ε), so ε = W/(E* μ^{3/2})
+            return positive("W", W) / (positive("E_star", E_star) * positive("tabor", mu) ** 1.5)
         return eps_for_tabor(lambda e: cls.lateral_scale(values, e), E_star, W, mu)
 
 
@@ -230,6 +233,11 @@ class Hemisphere(Shape):
         lat = cls.lateral_scale(values, eps)
         return cls(radius=values["radius"] / lat, cell=positive("pitch", values["pitch"]) / lat, k=lat / eps)
 
+    @classmethod
+    def eps_from_tabor(cls, values, E_star, W, mu):
+        """Closed form (as the sphere's): ε = (sqrt(R) W/(E* μ^{3/2}))^{2/3}."""
+        return Paraboloid.eps_from_tabor(values, E_star, W, mu)
+
     def gap(self, grid: Grid) -> np.ndarray:
         X, Y = grid.mesh()
         r2 = np.minimum(X**2 + Y**2, self.radius**2)
@@ -265,6 +273,12 @@ class Cone(Shape):
         h = values.get("height")
         return cls(slope=1.0, cell=positive("pitch", values["pitch"]) / lat,
                    height=np.inf if h is None else positive("height", h) / eps)
+
+    @classmethod
+    def eps_from_tabor(cls, values, E_star, W, mu):
+        """Closed form: κ = W/(E* slope ε), so ε = W/(E* slope μ^{3/2})."""
+        return positive("W", W) / (positive("E_star", E_star) * positive("slope", values["slope"])
+                                   * positive("tabor", mu) ** 1.5)
 
     def __post_init__(self):
         positive("slope", self.slope)

@@ -94,7 +94,8 @@ def write_contact(res, out, plot=None, quiet=False) -> int:
     n_bad = int((~res.table["converged"].astype(bool)).sum())
     if not quiet:
         j = res.jumps
-        print(f"wrote {out}: {len(res.table['D'])} equilibria, pull-off F = {res.pull_off_force:.4g}, "
+        si = f" ({res.scaling.force(res.pull_off_force):.4g} N per cell)" if res.scaling is not None else ""
+        print(f"wrote {out}: {len(res.table['D'])} equilibria, pull-off F = {res.pull_off_force:.4g}{si}, "
               f"{len(j)} jump(s), {res.seconds:.1f} s", file=sys.stderr)
     if n_bad:
         print(f"tengsim: warning: {n_bad} equilibria did not converge (see column 'converged')",
