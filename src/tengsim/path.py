@@ -114,7 +114,7 @@ def run_path(U0, law, kernel, solver, spec: PathSpec, start: State | None = None
     (registered names or objects, see :mod:`tengsim.observers`) add their columns to every row.
     """
     from tengsim import observers as obs
-    from tengsim.results import CURVE_COLUMNS, ContactResult
+    from tengsim.results import CURVE_COLUMNS, PHYSICAL_COLUMNS, ContactResult
 
     grid = kernel.grid
     U0 = np.asarray(U0, dtype=float)
@@ -125,7 +125,7 @@ def run_path(U0, law, kernel, solver, spec: PathSpec, start: State | None = None
     apex = apex_index(U0)
     summary = obs.Summary()
     extra = obs.resolve(observers)
-    extra_cols = obs.check_columns(extra, CURVE_COLUMNS)
+    extra_cols = obs.check_columns(extra, CURVE_COLUMNS + PHYSICAL_COLUMNS)
     ctx = obs.Context(grid, apex, U0, law, kernel)
     targets = spec.targets()
     total = len(targets) * (2 if spec.retract else 1)
