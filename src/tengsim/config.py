@@ -189,7 +189,8 @@ def plan_contact(cfg: dict) -> ContactPlan:
         if others:
             raise TengsimError(f"shape {name} has no key {', '.join(map(repr, others))} "
                                f"(its keys: {', '.join(k for k in full.keys() if k not in _common_names())})")
-        raise TengsimError(f"[contact] unknown key(s) {', '.join(map(repr, unknown))} (known: {', '.join(full.keys())})")
+        raise TengsimError(f"[contact] unknown key(s) {', '.join(map(repr, unknown))} "
+                           f"(known: {', '.join(full.keys())})")
     dims, phys = dimensionless_fields(cls), physical_fields(cls)
     dim_names, phys_names = [f.name for f in dims], [f.name for f in phys]
     given = {k for k, v in cfg.items() if v is not None and v != ""}

@@ -182,7 +182,8 @@ class Paraboloid(Shape):
         lat = cls.lateral_scale(values, eps)
         pitch = values.get("pitch")
         # U0 = r²/(2Rε) = X² ℓ²/(2Rε) = X²/2: the dimensionless radius is Rε/ℓ² = 1
-        return cls(radius=values["radius"] * eps / lat**2, **({} if pitch is None else {"cell": positive("pitch", pitch) / lat}))
+        cell = {} if pitch is None else {"cell": positive("pitch", pitch) / lat}
+        return cls(radius=values["radius"] * eps / lat**2, **cell)
 
     @classmethod
     def eps_from_tabor(cls, values, E_star, W, mu):
