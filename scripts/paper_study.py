@@ -20,8 +20,8 @@ Contact-size measures recorded at every equilibrium (all as a length comparable 
   L_rep    √(area where P > 0)
   L_gap0   √(area where H < 0),  L_gap02  √(area where H < 0.2)
   floor    fraction of the valley floor (U0 = 2N, outside the pyramid base) with H < 0.2
-The engine is used as is; the extra measures come from a wrapper around tengsim.path.summarize
-that sees the same (P, H) as the engine's own summary.
+The engine is used as is; the extra measures come from an observer (tengsim.observers) passed to
+simulate, which sees the same (P, H) as the engine's own summary and adds its columns to the table.
 """
 from __future__ import annotations
 
@@ -39,8 +39,7 @@ os.environ.setdefault("TENGSIM_FFT_WORKERS", "1")
 
 import numpy as np  # noqa: E402
 
-import tengsim.path as _tpath  # noqa: E402
-from tengsim.analysis import summarize as _summarize, tensile_peak_offset  # noqa: E402
+from tengsim.analysis import tensile_peak_offset  # noqa: E402
 from tengsim.contact import simulate  # noqa: E402
 from tengsim.geometry import HeightMap, Pyramid  # noqa: E402
 from tengsim.path import PathSpec  # noqa: E402
@@ -49,12 +48,9 @@ from tengsim.units import paper_scaling  # noqa: E402
 PAPER = {"A": 1.75, "B": 5.20, "C": 10.95}
 GROUPS = ("A", "B", "C")
 
+
 # ---------------------------------------------------------------------------------------------
-# extra per-state measures (wrapping the engine's summarize; one call per recorded row)
-_EXTRA: list = []
-_CTX: dict = {}
-
-
+# extra per-state measures: an observer, one call per recorded row
 def _diag_length(P, dx, i0, j0):
     """Λc = 2·Xc from the tensile peak along the four half-diagonals from the apex (averaged)."""
     n = P.shape[0]
@@ -69,21 +65,25 @@ def _diag_length(P, dx, i0, j0):
     return 2.0 * float(np.mean(offs)) * dx
 
 
-def _summarize_plus(P, H, grid, apex):
-    s = _summarize(P, H, grid, apex)
-    a = grid.area
-    floor = _CTX.get("floor_mask")
-    _EXTRA.append(dict(
-        L_diag=_diag_length(P, grid.dx, *apex),
-        L_rep=float(np.sqrt(np.count_nonzero(P > 0) * a)),
-        L_gap0=float(np.sqrt(np.count_nonzero(H < 0) * a)),
-        L_gap02=float(np.sqrt(np.count_nonzero(H < 0.2) * a)),
-        floor=float(np.mean(H[floor] < 0.2)) if floor is not None and floor.any() else float("nan"),
-    ))
-    return s
+class ContactSizes:
+    """Observer: the contact-size measures of the module docstring; ``floor`` masks the valley floor."""
 
+    columns = ("L_diag", "L_rep", "L_gap0", "L_gap02", "floor")
 
-_tpath.summarize = _summarize_plus
+    def __init__(self, floor=None):
+        self.floor = floor
+
+    def __call__(self, eq, ctx):
+        P, H, grid = eq.P, eq.H, ctx.grid
+        a = grid.area
+        floor = self.floor
+        return dict(
+            L_diag=_diag_length(P, grid.dx, *ctx.apex),
+            L_rep=float(np.sqrt(np.count_nonzero(P > 0) * a)),
+            L_gap0=float(np.sqrt(np.count_nonzero(H < 0) * a)),
+            L_gap02=float(np.sqrt(np.count_nonzero(H < 0.2) * a)),
+            floor=float(np.mean(H[floor] < 0.2)) if floor is not None and floor.any() else float("nan"),
+        )
 
 
 # ---------------------------------------------------------------------------------------------
@@ -107,18 +107,16 @@ def run_case(case):
     """One approach–retraction run; returns (case, rows dict, seconds)."""
     t0 = time.perf_counter()
     shape, grid, N, floor = make_shape(case["group"], case.get("variant", ""), case["dx"])
-    _EXTRA.clear()
-    _CTX["floor_mask"] = floor
     spec = PathSpec(case["d_min"], case["d_max"], case["d_step"])
+    sizes = ContactSizes(floor)
     res = simulate(shape, case["mu"], case["dx"], spec, boundary=case["boundary"], tol=case["tol"],
-                   grid=grid)
+                   grid=grid, observers=[sizes])
     t = res.table
-    assert len(_EXTRA) == len(t["D"]), "summary wrapper out of step with the engine"
     rows = {k: np.asarray(t[k]) for k in ("branch", "D", "F", "contact_length", "on_grid", "jump",
                                           "converged", "min_gap")}
     rows["L_axis"] = rows.pop("contact_length")
-    for k in _EXTRA[0]:
-        rows[k] = np.array([e[k] for e in _EXTRA])
+    for k in sizes.columns:
+        rows[k] = np.asarray(t[k])
     jumps = [dict(kind=j.kind, branch=j.branch, D_before=j.D_before, D_after=j.D_after,
                   F_before=j.F_before, F_after=j.F_after, L_before=j.length_before,
                   L_after=j.length_after) for j in res.jumps]

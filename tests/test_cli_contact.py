@@ -110,6 +110,11 @@ out = "{out}"
     ("[contact\nN = 1", "not valid TOML"),
     ("[contact]\nN = 0.9\ncell = 3.78\nbogus = 1\nout = 'x.csv'", "bogus"),
     ("[nothing]\n", "nothing"),
+    ("[contact]\nN = 0.9\ncell = 3.78\nrefine_levels = 1.5\nout = 'x.csv'", "refine_levels"),
+    ("[contact]\nshape = 'cube'\nhalf_width = '0.7um'\nout = 'x.csv'", "half_width"),
+    ("[contact]\nshape = 'cone'\nradius = 2\nout = 'x.csv'", "radius"),
+    ("[contact]\nN = 0.9\ncell = 3.78\nout = 'x.csv'\nplot = 'x.txt'", "plot"),
+    ("[reproduce]\nquick = 'maybe'", "quick"),
 ])
 def test_bad_config(tmp_path, capsys, text, word):
     cfg = tmp_path / "bad.toml"
@@ -132,11 +137,15 @@ def test_shipped_examples_are_valid():
 
     files = sorted((Path(__file__).parent.parent / "examples").glob("*.toml"))
     assert files
+    shapes = set()
     for f in files:
         cfg = load_toml(f)
         if "contact" in cfg:
             plan = plan_contact(cfg["contact"])
             assert plan.tabor > 0 and plan.path.d_max > plan.path.d_min
+            shapes.add((cfg["contact"].get("shape", "pyramid"), plan.scaling is not None))
+    # examples show physical input for more than the paper's pyramid, and a dimensionless run
+    assert {("sphere", True), ("cone", True)} <= shapes and any(not phys for _, phys in shapes)
 
 
 def test_unwritable_output_fails_before_running(tmp_path, capsys):

@@ -1,7 +1,8 @@
 """tengsim: adhesive contact of micro-structured TENG interfaces and the device output.
 
 Public API (re-exported by hand; internals may move):
-shapes (geometry), laws (interaction), kernels, solvers, the continuation path, results, units.
+shapes (geometry), laws (interaction), kernels, solvers, observers, the continuation path, results,
+units, and the registries through which each of those is extended (tengsim.registry).
 """
 __version__ = "0.1.0"
 
@@ -13,12 +14,15 @@ from tengsim.geometry import (Cone, Cube, FlatPunch, HeightMap, Hemisphere, Line
 from tengsim.grid import Grid  # noqa: E402
 from tengsim.interaction import LJ93, Repulsive  # noqa: E402
 from tengsim.kernels import FreeKernel, PeriodicKernel  # noqa: E402
+from tengsim.observers import Summary  # noqa: E402
 from tengsim.path import PathSpec, run_path  # noqa: E402
+from tengsim.registry import KERNELS, LAWS, OBSERVERS, SHAPES, SOLVERS  # noqa: E402
 from tengsim.results import ContactResult, Jump  # noqa: E402
 from tengsim.solvers import Equilibrium, FastSolver, Problem, State, VSRSolver  # noqa: E402
-from tengsim.units import PaperScaling, paper_scaling, parse_quantity  # noqa: E402
+from tengsim.units import PaperScaling, Scaling, paper_scaling, parse_quantity  # noqa: E402
 
 __all__ = [
+    "KERNELS", "LAWS", "OBSERVERS", "SHAPES", "SOLVERS", "Scaling", "Summary",
     "Cone", "ContactResult", "Cube", "Equilibrium", "FastSolver", "FlatPunch", "FreeKernel", "Grid",
     "HeightMap", "Hemisphere", "Jump", "LJ93", "Line", "PaperScaling", "Paraboloid", "PathSpec",
     "PeriodicKernel", "Problem", "Pyramid", "Repulsive", "Sinusoid1D", "State", "TengsimError",

@@ -1,51 +1,140 @@
-"""Run descriptions: one dict (from CLI options or a TOML file) → the API objects of a contact run.
+"""Run descriptions: one [contact] table (CLI options or a TOML file) → the API objects of a contact run.
 
-Physical inputs carry units ('0.59MPa', '54mJ/m2', '2um'); the core stays dimensionless.
+The table's keys come from the registries and the schema, never from a list kept here: the shape's
+dimensionless fields (its dataclass fields, plain numbers) *or* its physical fields (numbers in SI
+or unit strings such as '2um') with ``E_star``, ``W`` and ``eps`` or ``tabor``; then the grid, the
+path, and the boundary, solver, law and observers by registered name.  A physical run builds the
+shape's :class:`tengsim.units.Scaling`; the core stays dimensionless.
 """
 from __future__ import annotations
 
-import math
+import dataclasses
+import inspect
 from dataclasses import dataclass, field
 
 from tengsim.errors import TengsimError, positive
-from tengsim.geometry import Cone, Cube, Hemisphere, Line, Paraboloid, Pyramid
 from tengsim.interaction import make_law
 from tengsim.path import PathSpec
-from tengsim.units import PaperScaling, parse_quantity
+from tengsim.registry import KERNELS, LAWS, OBSERVERS, SHAPES, SOLVERS, ensure_builtins
+from tengsim.schema import REQUIRED, Field, Table, read_config
+from tengsim.units import PaperScaling, Scaling, parse_quantity
 
-SHAPES = ("pyramid", "sphere", "cone", "hemisphere", "cube", "line")
-CONTACT_KEYS = {
-    "shape", "N", "cell", "tabor", "pitch", "base", "height", "E_star", "W", "eps", "dx",
-    "d_min", "d_max", "d_step", "boundary", "solver", "tol", "maps_at", "law", "slope",
-    "radius", "half_width", "out", "plot", "refine_levels",
-}
+PHYSICAL_KEYS = ("E_star", "W", "eps")
+"""Keys that make a [contact] table a physical run (with any physical-only key of the shape)."""
+
+_SUFFIX = {"length": "_m", "pressure": "_Pa", "energy/area": "_J_m2"}
 
 
 def load_toml(path) -> dict:
-    """Read a TOML file; any failure becomes one clear TengsimError."""
-    try:
-        import tomllib
-    except ModuleNotFoundError:  # Python 3.10
-        import tomli as tomllib
-    try:
-        with open(path, "rb") as fh:
-            return tomllib.load(fh)
-    except FileNotFoundError:
-        raise TengsimError(f"config file {path} not found") from None
-    except OSError as exc:
-        raise TengsimError(f"cannot read config file {path}: {exc.strerror}") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise TengsimError(f"config file {path} is not valid TOML: {exc}") from None
+    """Read a config file (TOML or JSON) through :func:`tengsim.schema.read_config`."""
+    return read_config(path)
 
 
-def _num(cfg, key, default=None, kind=None):
-    v = cfg.get(key, default)
-    if v is None:
-        return None
-    x = parse_quantity(v, kind, name=key)
-    if math.isnan(x):
-        raise TengsimError(f"{key} must be a number, got {v!r}")
-    return x
+def _observer_names(v):
+    if isinstance(v, str):
+        v = [s for s in (x.strip() for x in v.split(",")) if s]
+    if not isinstance(v, (list, tuple)) or not all(isinstance(x, str) for x in v):
+        raise TengsimError(f"observers must be a list of names, got {v!r}")
+    return tuple(OBSERVERS.canonical(x) for x in v)
+
+
+def common_fields() -> list:
+    """The [contact] keys every shape has (choices and help read from the registries)."""
+    ensure_builtins()
+    return [
+        Field("shape", "str", "pyramid", check=lambda v: SHAPES.canonical(v),
+              help="registered shape: " + SHAPES.help()),
+        Field("tabor", help="Tabor parameter μ (coupling μ^{3/2}); dimensionless runs: default 0.5; "
+              "physical runs: no default, give tabor or eps"),
+        Field("E_star", dim="pressure", help="effective modulus E* (physical run)"),
+        Field("W", dim="energy/area", help="work of adhesion W (physical run)"),
+        Field("eps", dim="length", help="interaction range ε (physical run; or give tabor)"),
+        Field("dx", "any", 0.1, help="grid spacing in X units; in a physical run also a length, e.g. '20nm'"),
+        Field("d_min", default=-1.0, help="first rigid approach D of the path, in ε"),
+        Field("d_max", default=4.0, help="last rigid approach D, in ε"),
+        Field("d_step", default=0.05, help="step in D, in ε"),
+        Field("refine_levels", "int", 4, help="step bisections before a change is called a jump"),
+        Field("maps_at", "floats", (), help="D values whose pressure and gap maps are kept (.nc)"),
+        Field("boundary", "str", "free", choices=KERNELS.names, help="elastic kernel: " + KERNELS.help()),
+        Field("solver", "str", "fast", choices=SOLVERS.names, help="solver: " + SOLVERS.help()),
+        Field("tol", default=1e-6, help="max residual of Eq. (9) in ε"),
+        Field("law", "str", "lj93", check=lambda v: LAWS.canonical(v), help="interaction law: " + LAWS.help()),
+        Field("observers", "any", (), check=_observer_names,
+              help="extra observers adding columns: "
+              + ("; ".join(f"{n}: {OBSERVERS.summary(n)}" for n in OBSERVERS.names() if n != "summary")
+                 or "none registered (F, Λc, areas, gaps, pressures are always there)")),
+        Field("out", "str", None, help="output file, .csv or .nc"),
+        Field("plot", "str", None, help="figure of F(D), Λc(D), Λc(F), .png/.pdf/.svg"),
+    ]
+
+
+def _shape_cls(name):
+    ensure_builtins()
+    if not isinstance(name, str):
+        raise TengsimError(f"shape must be a name, got {name!r}")
+    return SHAPES.canonical(name), SHAPES.get(name)
+
+
+def dimensionless_fields(cls) -> tuple:
+    """A shape's dimensionless input fields (its dataclass fields, or its constructor's arguments)."""
+    from tengsim.geometry import Shape
+
+    if hasattr(cls, "dimensionless_fields"):
+        return tuple(cls.dimensionless_fields())
+    if dataclasses.is_dataclass(cls):
+        return tuple(Shape.dimensionless_fields.__func__(cls))
+    out = []
+    for p in inspect.signature(cls).parameters.values():
+        if p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY):
+            out.append(Field(p.name, "float", REQUIRED if p.default is p.empty else p.default))
+    return tuple(out)
+
+
+def physical_fields(cls) -> tuple:
+    return tuple(getattr(cls, "physical_fields", ()) or ())
+
+
+def contact_table(shape: str = "pyramid", mode: str | None = None) -> Table:
+    """The schema of a [contact] table for ``shape``.
+
+    ``mode`` 'dimensionless' or 'physical' gives the table a run of that kind is parsed with; None
+    (default) every key the shape accepts in either (for docs, the sweep and the CLI).
+    """
+    name, cls = _shape_cls(shape)
+    common = common_fields()
+    taken = {f.name for f in common}
+    dims, phys = dimensionless_fields(cls), physical_fields(cls)
+    for f in (*dims, *phys):
+        if f.name in taken:
+            raise TengsimError(f"shape {name} field {f.name!r} clashes with the [contact] key of that name")
+    if mode == "dimensionless":
+        fields = [*common, *dims]
+    elif mode == "physical":
+        fields = [*common, *phys]
+    elif mode is None:
+        merged = {f.name: dataclasses.replace(f, default=None) if f.required else f for f in dims}
+        for f in phys:
+            d = merged.get(f.name)
+            if d is None:
+                merged[f.name] = dataclasses.replace(f, default=None)
+            else:  # same name in both: a plain number, or a quantity in a physical run
+                h = d.help if d.help == f.help or not f.dim else f"{d.help} (dimensionless) / {f.help} (physical)"
+                merged[f.name] = Field(f.name, "float", None, dim=f.dim, help=h)
+        fields = [*common, *merged.values()]
+    else:
+        raise TengsimError(f"mode must be 'dimensionless', 'physical' or None, got {mode!r}")
+    return Table("contact", fields, doc=f"shape {name}")
+
+
+def contact_keys() -> tuple:
+    """Every key a [contact] table may hold for some registered shape (the CLI's option set)."""
+    ensure_builtins()
+    keys = [f.name for f in common_fields()]
+    for s in SHAPES.names():
+        for k in contact_table(s).keys():
+            if k not in keys:
+                keys.append(k)
+    return tuple(keys)
 
 
 @dataclass
@@ -61,88 +150,120 @@ class ContactPlan:
     tol: float
     law: object
     extra: dict = field(default_factory=dict)
-    scaling: PaperScaling | None = None
+    scaling: Scaling | PaperScaling | None = None
+    observers: tuple = ()
+
+
+def _dx(raw, lateral):
+    """dx in X units: a number, or (physical runs only) a length with a unit."""
+    if isinstance(raw, str):
+        try:
+            return positive("dx", float(raw))
+        except ValueError:
+            pass
+        if lateral is None:
+            raise TengsimError(f"dx = {raw!r} has a unit, but this run is dimensionless: give dx in X units "
+                               "(or the shape's physical sizes with E_star and W)")
+        return positive("dx", parse_quantity(raw, "length", name="dx") / lateral)
+    if isinstance(raw, bool) or not isinstance(raw, (int, float)):
+        raise TengsimError(f"dx must be a number, got {raw!r}")
+    return positive("dx", raw)
+
+
+def _build(cls, name, kw):
+    try:
+        return cls(**kw)
+    except TypeError as exc:
+        raise TengsimError(f"shape {name}: {exc}") from None
 
 
 def plan_contact(cfg: dict) -> ContactPlan:
-    """Validate a contact description and build its pieces (no solving)."""
-    unknown = set(cfg) - CONTACT_KEYS
+    """Validate a [contact] table and build its pieces (no solving)."""
+    if not isinstance(cfg, dict):
+        raise TengsimError(f"[contact] must be a table, got {cfg!r}")
+    name, cls = _shape_cls(cfg.get("shape") or "pyramid")
+    full = contact_table(name)
+    unknown = [k for k in cfg if k not in full]
     if unknown:
-        raise TengsimError(f"unknown contact option(s): {', '.join(sorted(unknown))}")
-    shape_name = str(cfg.get("shape", "pyramid")).lower()
-    if shape_name not in SHAPES:
-        raise TengsimError(f"unknown shape {shape_name!r} (choose from {', '.join(SHAPES)})")
-    extra, scaling = {}, None
-    physical = any(cfg.get(k) is not None for k in ("pitch", "base", "height", "E_star", "W", "eps"))
-    tabor = _num(cfg, "tabor")
-    if shape_name == "pyramid" and physical:
-        need = ["pitch", "base", "height", "E_star", "W"]
-        miss = [k for k in need if cfg.get(k) is None]
-        if miss:
-            raise TengsimError(f"physical pyramid input needs {', '.join(miss)}")
-        L = positive("pitch", _num(cfg, "pitch", kind="length"))
-        m = positive("base", _num(cfg, "base", kind="length"))
-        n = positive("height", _num(cfg, "height", kind="length"))
-        E = positive("E_star", _num(cfg, "E_star", kind="pressure"))
-        W = positive("W", _num(cfg, "W", kind="energy/area"))
-        if cfg.get("eps") is not None and tabor is not None:
+        others = [k for k in unknown if k in contact_keys()]
+        if others:
+            raise TengsimError(f"shape {name} has no key {', '.join(map(repr, others))} "
+                               f"(its keys: {', '.join(k for k in full.keys() if k not in _common_names())})")
+        raise TengsimError(f"[contact] unknown key(s) {', '.join(map(repr, unknown))} "
+                           f"(known: {', '.join(full.keys())})")
+    dims, phys = dimensionless_fields(cls), physical_fields(cls)
+    dim_names, phys_names = [f.name for f in dims], [f.name for f in phys]
+    given = {k for k, v in cfg.items() if v is not None and v != ""}
+    triggers = sorted(given & (set(PHYSICAL_KEYS) | (set(phys_names) - set(dim_names))))
+    extra, scaling, lateral = {}, None, None
+    if triggers:
+        if not phys:
+            raise TengsimError(f"shape {name} has no physical input ({', '.join(triggers)} given): "
+                               f"give its dimensionless keys {', '.join(dim_names)}")
+        mixed = sorted(given & (set(dim_names) - set(phys_names)))
+        if mixed:
+            raise TengsimError(f"{name}: {', '.join(mixed)} {'is' if len(mixed) == 1 else 'are'} dimensionless but "
+                               f"{', '.join(triggers)} make this a physical run; give {', '.join(phys_names)} "
+                               "with units instead (do not mix the two)")
+        missing = [k for k in ("E_star", "W") if k not in given]
+        missing += [f.name for f in phys if f.required and f.name not in given]
+        if missing:
+            raise TengsimError(f"physical {name} input needs {', '.join(missing)}")
+        vals = contact_table(name, "physical").parse(cfg)
+        E, W = positive("E_star", vals["E_star"]), positive("W", vals["W"])
+        p = {f.name: vals[f.name] for f in phys}
+        if vals["eps"] is not None and vals["tabor"] is not None:
             raise TengsimError("give either eps or tabor, not both")
-        if cfg.get("eps") is not None:
-            scaling = PaperScaling(E, W, m, n, L, positive("eps", _num(cfg, "eps", kind="length")))
-        elif tabor is not None:
-            scaling = PaperScaling.from_tabor(E, W, m, n, L, tabor)
+        if vals["eps"] is not None:
+            eps = positive("eps", vals["eps"])
+        elif vals["tabor"] is not None:
+            eps = cls.eps_from_tabor(p, E, W, positive("tabor", vals["tabor"]))
         else:
-            raise TengsimError("physical pyramid input needs eps or tabor")
+            raise TengsimError(f"physical {name} input needs eps or tabor (tabor has no default in a physical run)")
+        lateral = positive("lateral scale", cls.lateral_scale(p, eps))
+        shape = cls.from_si(p, eps)
+        if name == "pyramid" and cls.__name__ == "Pyramid":
+            scaling = PaperScaling(E, W, p["base"], p["height"], p["pitch"], eps)
+        else:
+            scaling = Scaling(E, W, eps, lateral, (shape.cell * lateral) ** 2)
         tabor = scaling.mu
-        shape = Pyramid(scaling.N, scaling.cell)
+        if vals["tabor"] is not None and abs(tabor - vals["tabor"]) > 1e-8 * vals["tabor"]:
+            raise TengsimError(f"could not solve eps for tabor = {vals['tabor']:g} (got μ = {tabor:g})")
+        extra.update({f"{f.name}{_SUFFIX.get(f.dim, '_input')}": p[f.name] for f in phys if p[f.name] is not None})
         extra.update(scaling.params())
+        extra["lateral_m"] = lateral
     else:
-        tabor = positive("tabor", 0.5 if tabor is None else tabor)
-        if shape_name == "pyramid":
-            N, cell = cfg.get("N"), cfg.get("cell")
-            if N is None or cell is None:
-                raise TengsimError("pyramid needs --N and --cell (dimensionless) or pitch/base/height/E_star/W")
-            shape = Pyramid(_num(cfg, "N"), _num(cfg, "cell"))
-        elif shape_name == "sphere":
-            shape = Paraboloid(1.0, _num(cfg, "cell", 10.0))
-        elif shape_name == "cone":
-            shape = Cone(_num(cfg, "slope", 1.0), _num(cfg, "cell", 10.0))
-        elif shape_name == "hemisphere":
-            shape = Hemisphere(_num(cfg, "radius", 3.0), _num(cfg, "cell", 10.0))
-        elif shape_name == "cube":
-            shape = Cube(_num(cfg, "half_width", 1.0), _num(cfg, "height", 5.0), _num(cfg, "cell", 6.0))
-        else:
-            shape = Line(_num(cfg, "half_width", 1.0), _num(cfg, "height", 5.0), _num(cfg, "cell", 6.0))
-    dx = positive("dx", _num(cfg, "dx", 0.1))
-    maps = cfg.get("maps_at") or ()
-    if isinstance(maps, str):
-        try:
-            maps = tuple(float(v) for v in maps.split(",") if v.strip())
-        except ValueError:
-            raise TengsimError(f"maps_at must be comma-separated numbers, got {maps!r}") from None
-    path = PathSpec(_num(cfg, "d_min", -1.0), _num(cfg, "d_max", 4.0), _num(cfg, "d_step", 0.05),
-                    maps_at=tuple(maps), refine_levels=int(cfg.get("refine_levels", 4)))
-    boundary = str(cfg.get("boundary", "free"))
-    if boundary not in ("free", "periodic"):
-        raise TengsimError(f"unknown boundary {boundary!r} (choose 'free' or 'periodic')")
-    solver = str(cfg.get("solver", "fast"))
-    if solver not in ("fast", "vsr"):
-        raise TengsimError(f"unknown solver {solver!r} (choose 'fast' or 'vsr')")
-    tol = positive("tol", _num(cfg, "tol", 1e-6))
-    law = make_law(str(cfg.get("law", "lj93")))
+        missing = [f.name for f in dims if f.required and f.name not in given]
+        if missing:
+            raise TengsimError(f"{name} needs {', '.join(missing)} (dimensionless)"
+                               + (f" or {', '.join(phys_names)} with E_star, W and eps or tabor (physical)"
+                                  if phys_names else ""))
+        vals = contact_table(name, "dimensionless").parse(cfg)
+        tabor = positive("tabor", 0.5 if vals["tabor"] is None else vals["tabor"])
+        shape = _build(cls, name, {f.name: vals[f.name] for f in dims if vals[f.name] is not None})
+    dx = _dx(cfg.get("dx", 0.1) if cfg.get("dx") not in (None, "") else 0.1, lateral)
+    path = PathSpec(vals["d_min"], vals["d_max"], vals["d_step"], maps_at=tuple(vals["maps_at"]),
+                    refine_levels=vals["refine_levels"])
+    tol = positive("tol", vals["tol"])
+    law = make_law(vals["law"])
     grid = shape.grid(dx)  # validates dx against the cell
     if grid.nx * grid.ny > 4096 * 4096:
-        raise TengsimError(f"dx={dx} gives a {grid.nx}×{grid.ny} grid; too large")
-    return ContactPlan(shape, tabor, dx, path, boundary, solver, tol, law, extra, scaling)
+        raise TengsimError(f"dx={dx:g} gives a {grid.nx}×{grid.ny} grid; too large")
+    return ContactPlan(shape, tabor, dx, path, vals["boundary"], vals["solver"], tol, law, extra, scaling,
+                       tuple(vals["observers"]))
+
+
+def _common_names():
+    return {f.name for f in common_fields()}
 
 
 def run_contact(cfg: dict, progress=None):
-    """Plan and run a contact description; returns a ContactResult with the config in params."""
+    """Plan and run a [contact] table; returns a ContactResult with the config in params."""
     from tengsim.contact import simulate
 
     plan = plan_contact(cfg)
     res = simulate(plan.shape, plan.tabor, plan.dx, plan.path, boundary=plan.boundary,
                    solver=plan.solver, tol=plan.tol, law=plan.law, progress=progress,
-                   extra_params=plan.extra)
+                   extra_params=plan.extra, observers=plan.observers, scaling=plan.scaling)
     res.params["config"] = {k: v for k, v in cfg.items() if k not in ("out", "plot")}
     return res

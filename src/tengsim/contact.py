@@ -4,29 +4,38 @@ from __future__ import annotations
 from tengsim import __version__
 from tengsim.errors import TengsimError, positive
 from tengsim.geometry import Pyramid, Shape
-from tengsim.interaction import LJ93, Law
+from tengsim.interaction import LJ93, Law, make_law
 from tengsim.kernels import make_kernel
 from tengsim.path import PathSpec, run_path
+from tengsim.registry import KERNELS
 from tengsim.solvers import make_solver
 
 
 def simulate(shape: Shape, tabor: float, dx: float, path: PathSpec, boundary: str = "free",
-             solver="fast", tol: float = 1e-6, law: Law | None = None, progress=None,
-             grid=None, extra_params: dict | None = None):
+             solver="fast", tol: float = 1e-6, law: Law | str | None = None, progress=None,
+             grid=None, extra_params: dict | None = None, observers=(), scaling=None):
     """Approach–retraction run of ``shape`` against a rigid flat plate (paper Eq. 9).
 
     ``tabor`` is μ (the elastic coupling is μ^{3/2}); ``dx`` the grid spacing in X units;
-    ``solver`` a name ('fast', 'vsr') or a solver object.  Returns a ContactResult.
+    ``boundary`` a registered kernel name ('free', 'periodic'); ``solver`` a registered name
+    ('fast', 'vsr') or a solver object; ``law`` a law object or registered name (default the
+    paper's LJ93).  ``observers`` (registered names or objects) add columns to the table; with a
+    ``scaling`` (:class:`tengsim.units.Scaling`) the table also gets F_N, pressure_Pa and
+    contact_length_m and the units metadata of that scaling.  Returns a ContactResult.
     """
     tabor = positive("tabor", tabor)
-    law = law or LJ93()
+    if scaling is not None and abs(scaling.mu - tabor) > 1e-9 * tabor:
+        raise TengsimError(f"tabor = {tabor:g} does not match the scaling's μ = {scaling.mu:g}")
+    law = make_law(law) if isinstance(law, str) else (law or LJ93())
+    boundary = KERNELS.canonical(boundary)
     grid = grid or shape.grid(dx)
     kernel = make_kernel(boundary, grid, tabor**1.5)
     solver_obj = make_solver(solver, tol=tol) if isinstance(solver, str) else solver
-    res = run_path(shape.gap(grid), law, kernel, solver_obj, path, progress=progress)
+    res = run_path(shape.gap(grid), law, kernel, solver_obj, path, progress=progress, observers=observers)
     res.params = {
         "tengsim_version": __version__,
         **shape.params(),
+        "lateral_unit": getattr(shape, "lateral_unit", "ℓ"),
         "tabor": tabor,
         "boundary": boundary,
         "solver": solver_obj.name,
@@ -42,6 +51,10 @@ def simulate(shape: Shape, tabor: float, dx: float, path: PathSpec, boundary: st
         "jump_h": path.jump_h,
         **(extra_params or {}),
     }
+    if scaling is not None:
+        for k, v in scaling.params().items():
+            res.params.setdefault(k, v)
+        res.add_physical(scaling)
     warnings = []
     if not res.all_converged:
         n = int((~res.table["converged"].astype(bool)).sum())

@@ -1,23 +1,47 @@
 """Initial gap U0(X, Y) >= 0 of the elastic surface, in units of the interaction range ε.
 
-All shapes are dimensionless (paper Eq. 7): lengths in the plane are X = x n/(ε m) for the paper's
-pyramid (or any lateral scale ℓ for other shapes), heights are U0 = h0/ε.  The apex is at the origin,
-where U0 = 0.  Every shape has ``gap(grid)`` and ``params()``.
+All shapes are dimensionless (paper Eq. 7): heights are U0 = h0/ε, lengths in the plane X = x/ℓ with
+a lateral scale ℓ each shape chooses so that its dimensionless form is simplest (the paper's pyramid:
+ℓ = ε m/n).  The apex is at the origin, where U0 = 0.  Every shape has ``gap(grid)``, ``grid(dx)``
+and ``params()``.
+
+A registered shape also declares its input: its dimensionless fields are its dataclass fields, its
+physical fields (with dimensions) are ``physical_fields``, and ``from_si(values, eps)`` builds it
+from SI input with the lateral scale ``lateral_scale(values, eps)`` (then κ = W ℓ/(E* ε²) = μ^{3/2}).
 """
 from __future__ import annotations
 
+import dataclasses
+import math
 from dataclasses import asdict, dataclass
 
 import numpy as np
 
 from tengsim.errors import TengsimError, positive
 from tengsim.grid import Grid
+from tengsim.registry import SHAPES
+from tengsim.schema import REQUIRED, Field
+
+
+def _length(name, help, default=REQUIRED):
+    return Field(name, "float", default, dim="length", help=help)
 
 
 class Shape:
-    """Base of all shapes: ``gap(grid)`` gives U0 on the grid, ``cell`` a natural cell side."""
+    """Base of all shapes: ``gap(grid)`` gives U0 on the grid, ``cell`` a natural cell side.
+
+    Class attributes a shape may set: ``physical_fields`` (schema Fields with dimensions: the
+    physical input), ``field_help`` (help text of the dimensionless fields), ``lateral_unit`` (the
+    text of ℓ for result metadata).  With physical fields, a shape overrides ``lateral_scale`` and
+    ``from_si``; shapes with ℓ = ε can instead set ``si_map`` (physical name → dimensionless name,
+    each length divided by ε).
+    """
 
     cell: float
+    physical_fields: tuple = ()
+    field_help: dict = {}
+    lateral_unit: str = "ℓ"
+    si_map: dict = {}
 
     def gap(self, grid: Grid) -> np.ndarray:  # pragma: no cover - abstract
         raise NotImplementedError
@@ -31,6 +55,55 @@ class Shape:
         """A square grid over the shape's cell with spacing about ``dx``."""
         return Grid.square(self.cell, dx)
 
+    # ---- declared input -----------------------------------------------------------------------
+    @classmethod
+    def dimensionless_fields(cls) -> tuple:
+        """Schema fields of the dimensionless input: the dataclass fields (plain numbers, no units)."""
+        out = []
+        for f in dataclasses.fields(cls):
+            if not f.init:
+                continue
+            if f.default is not dataclasses.MISSING:
+                default = f.default
+            elif f.default_factory is not dataclasses.MISSING:  # pragma: no cover
+                default = f.default_factory()
+            else:
+                default = REQUIRED
+            kind = "int" if f.type in ("int", int) else "float"
+            out.append(Field(f.name, kind, default, help=cls.field_help.get(f.name, "")))
+        return tuple(out)
+
+    @classmethod
+    def lateral_scale(cls, values: dict, eps: float) -> float:
+        """ℓ (m per unit of X) for physical ``values`` (SI) and interaction range ``eps`` (m)."""
+        if cls.si_map:
+            return eps
+        raise TengsimError(f"shape {SHAPES.name_of(cls)} has no physical input")
+
+    @classmethod
+    def from_si(cls, values: dict, eps: float) -> "Shape":
+        """The dimensionless shape for physical ``values`` (SI, the keys of ``physical_fields``)."""
+        if not cls.si_map:
+            raise TengsimError(f"shape {SHAPES.name_of(cls)} has no physical input")
+        kw = {}
+        for k, v in values.items():
+            if v is None:
+                continue
+            f = next(f for f in cls.physical_fields if f.name == k)
+            kw[cls.si_map.get(k, k)] = v / eps if f.dim == "length" else v
+        return cls(**kw)
+
+    @classmethod
+    def eps_from_tabor(cls, values: dict, E_star: float, W: float, mu: float) -> float:
+        """ε (m) giving the Tabor parameter ``mu``: κ(ε) = W ℓ(ε)/(E* ε²) = μ^{3/2}, solved numerically
+        (shapes with a closed form override this)."""
+        from tengsim.units import eps_for_tabor
+
+        if cls.si_map and cls.lateral_scale.__func__ is Shape.lateral_scale.__func__:
+            # ℓ = ε: κ = W/(E* ε), so ε = W/(E* μ^{3/2})
+            return positive("W", W) / (positive("E_star", E_star) * positive("tabor", mu) ** 1.5)
+        return eps_for_tabor(lambda e: cls.lateral_scale(values, e), E_star, W, mu)
+
 
 @dataclass(frozen=True)
 class Pyramid(Shape):
@@ -42,6 +115,11 @@ class Pyramid(Shape):
 
     N: float
     cell: float
+
+    physical_fields = (_length("pitch", "pitch L (cell side)"), _length("base", "base width m"),
+                       _length("height", "height n"))
+    field_help = {"N": "n/(2ε): half the base in X, the height in ε over 2", "cell": "cell side L̄ = L n/(ε m)"}
+    lateral_unit = "ε m/n"
 
     def __post_init__(self):
         positive("pyramid N", self.N)
@@ -60,6 +138,20 @@ class Pyramid(Shape):
             raise TengsimError(f"pyramid base {base:g} is wider than its pitch {pitch:g}")
         return cls(N=height / (2 * eps), cell=pitch * height / (eps * base))
 
+    @classmethod
+    def lateral_scale(cls, values, eps):
+        """ℓ = ε m/n (paper Eq. 7)."""
+        return eps * positive("base", values["base"]) / positive("height", values["height"])
+
+    @classmethod
+    def from_si(cls, values, eps):
+        return cls.from_physical(values["pitch"], values["base"], values["height"], eps)
+
+    @classmethod
+    def eps_from_tabor(cls, values, E_star, W, mu):
+        """Closed form: ε = m W/(n E* μ^{3/2})."""
+        return values["base"] * W / (values["height"] * positive("E_star", E_star) * positive("tabor", mu) ** 1.5)
+
     def gap(self, grid: Grid) -> np.ndarray:
         X, Y = grid.mesh()
         return np.minimum(2 * np.maximum(np.abs(X), np.abs(Y)), 2 * self.N)
@@ -69,12 +161,35 @@ class Pyramid(Shape):
 class Paraboloid(Shape):
     """Sphere in the Hertz (paraboloid) approximation, U0 = (X² + Y²)/(2R).
 
-    With lateral scale ℓ = sqrt(R_phys ε) the radius is R = 1 and the coupling is μ^{3/2} with
-    Tabor's μ = (R W²/(E*² ε³))^{1/3}.
+    Physical input (radius R, pitch): ℓ = sqrt(R ε), so the dimensionless radius is 1, the cell
+    pitch/ℓ, and the coupling μ^{3/2} with Tabor's μ = (R W²/(E*² ε³))^{1/3}.
     """
 
     radius: float = 1.0
     cell: float = 10.0
+
+    physical_fields = (_length("radius", "sphere radius R"), _length("pitch", "cell side (default 10 ℓ)", None))
+    field_help = {"radius": "radius in X units (1 with ℓ = sqrt(Rε))", "cell": "cell side"}
+    lateral_unit = "sqrt(R ε)"
+
+    @classmethod
+    def lateral_scale(cls, values, eps):
+        """ℓ = sqrt(R ε)."""
+        return math.sqrt(positive("radius", values["radius"]) * eps)
+
+    @classmethod
+    def from_si(cls, values, eps):
+        lat = cls.lateral_scale(values, eps)
+        pitch = values.get("pitch")
+        # U0 = r²/(2Rε) = X² ℓ²/(2Rε) = X²/2: the dimensionless radius is Rε/ℓ² = 1
+        cell = {} if pitch is None else {"cell": positive("pitch", pitch) / lat}
+        return cls(radius=values["radius"] * eps / lat**2, **cell)
+
+    @classmethod
+    def eps_from_tabor(cls, values, E_star, W, mu):
+        """Closed form: ε = (sqrt(R) W/(E* μ^{3/2}))^{2/3}."""
+        R = positive("radius", values["radius"])
+        return (math.sqrt(R) * W / (positive("E_star", E_star) * positive("tabor", mu) ** 1.5)) ** (2 / 3)
 
     def __post_init__(self):
         positive("radius", self.radius)
@@ -87,30 +202,84 @@ class Paraboloid(Shape):
 
 @dataclass(frozen=True)
 class Hemisphere(Shape):
-    """Exact hemisphere of radius R on a flat base, U0 = R − sqrt(R² − r²) for r < R, R outside."""
+    """Exact hemisphere of radius ρ on a flat base, U0 = k(ρ − sqrt(ρ² − r²)) for r < ρ, kρ outside.
 
-    radius: float
-    cell: float
+    ``k`` = ℓ/ε is the ratio of the lateral to the vertical unit (k = 1: both ε).  Physical input
+    (radius R, pitch): ℓ = sqrt(R ε), ρ = R/ℓ, k = ℓ/ε, cell = pitch/ℓ, so U0 = h0/ε exactly.
+    """
+
+    radius: float = 3.0
+    cell: float = 10.0
+    k: float = 1.0
+
+    physical_fields = (_length("radius", "hemisphere radius R"), _length("pitch", "cell side"))
+    field_help = {"radius": "radius ρ in X units", "cell": "cell side",
+                  "k": "lateral/vertical unit ratio ℓ/ε (1: X and U0 both in ε)"}
+    lateral_unit = "sqrt(R ε)"
 
     def __post_init__(self):
         positive("radius", self.radius)
         positive("cell", self.cell)
+        positive("k", self.k)
         if 2 * self.radius > self.cell:
             raise TengsimError(f"hemisphere diameter {2 * self.radius:g} exceeds its cell {self.cell:g}")
+
+    @classmethod
+    def lateral_scale(cls, values, eps):
+        """ℓ = sqrt(R ε)."""
+        return math.sqrt(positive("radius", values["radius"]) * eps)
+
+    @classmethod
+    def from_si(cls, values, eps):
+        lat = cls.lateral_scale(values, eps)
+        return cls(radius=values["radius"] / lat, cell=positive("pitch", values["pitch"]) / lat, k=lat / eps)
+
+    @classmethod
+    def eps_from_tabor(cls, values, E_star, W, mu):
+        """Closed form (as the sphere's): ε = (sqrt(R) W/(E* μ^{3/2}))^{2/3}."""
+        return Paraboloid.eps_from_tabor(values, E_star, W, mu)
 
     def gap(self, grid: Grid) -> np.ndarray:
         X, Y = grid.mesh()
         r2 = np.minimum(X**2 + Y**2, self.radius**2)
-        return self.radius - np.sqrt(self.radius**2 - r2)
+        return self.k * (self.radius - np.sqrt(self.radius**2 - r2))
 
 
 @dataclass(frozen=True)
 class Cone(Shape):
-    """Axisymmetric cone U0 = slope · r (slope = tan of the surface inclination), capped at ``height``."""
+    """Axisymmetric cone U0 = slope · r (slope = tan of the surface inclination), capped at ``height``.
 
-    slope: float
-    cell: float
+    Physical input (slope, pitch, optional height): ℓ = ε/slope, so the dimensionless slope is 1, the
+    cell pitch/ℓ and the cap height/ε.
+    """
+
+    slope: float = 1.0
+    cell: float = 10.0
     height: float = np.inf
+
+    physical_fields = (Field("slope", "float", REQUIRED, help="tan of the surface inclination"),
+                       _length("pitch", "cell side"), _length("height", "cap height (default: none)", None))
+    field_help = {"slope": "tan of the surface inclination", "cell": "cell side",
+                  "height": "cap height in ε (default: none)"}
+    lateral_unit = "ε/slope"
+
+    @classmethod
+    def lateral_scale(cls, values, eps):
+        """ℓ = ε/slope."""
+        return eps / positive("slope", values["slope"])
+
+    @classmethod
+    def from_si(cls, values, eps):
+        lat = cls.lateral_scale(values, eps)
+        h = values.get("height")
+        return cls(slope=1.0, cell=positive("pitch", values["pitch"]) / lat,
+                   height=np.inf if h is None else positive("height", h) / eps)
+
+    @classmethod
+    def eps_from_tabor(cls, values, E_star, W, mu):
+        """Closed form: κ = W/(E* slope ε), so ε = W/(E* slope μ^{3/2})."""
+        return positive("W", W) / (positive("E_star", E_star) * positive("slope", values["slope"])
+                                   * positive("tabor", mu) ** 1.5)
 
     def __post_init__(self):
         positive("slope", self.slope)
@@ -125,11 +294,20 @@ class Cone(Shape):
 
 @dataclass(frozen=True)
 class FlatPunch(Shape):
-    """Circular flat-ended punch of radius a: U0 = 0 for r <= a, ``step`` outside."""
+    """Circular flat-ended punch of radius a: U0 = 0 for r <= a, ``step`` outside.
 
-    radius: float
-    cell: float
+    Physical input (radius, step, pitch): ℓ = ε, every length divided by ε.
+    """
+
+    radius: float = 1.0
+    cell: float = 6.0
     step: float = 50.0
+
+    physical_fields = (_length("radius", "punch radius"), _length("step", "height of the step (default 50 ε)", None),
+                       _length("pitch", "cell side"))
+    field_help = {"radius": "punch radius a", "cell": "cell side", "step": "height of the step in ε"}
+    si_map = {"pitch": "cell"}
+    lateral_unit = "ε"
 
     def __post_init__(self):
         positive("radius", self.radius)
@@ -143,11 +321,20 @@ class FlatPunch(Shape):
 
 @dataclass(frozen=True)
 class Cube(Shape):
-    """Square flat-topped pillar (cube pattern): U0 = 0 on [−a, a]², ``height`` outside."""
+    """Square flat-topped pillar (cube pattern): U0 = 0 on [−a, a]², ``height`` outside.
 
-    half_width: float
-    height: float
-    cell: float
+    Physical input (half_width, height, pitch): ℓ = ε, every length divided by ε.
+    """
+
+    half_width: float = 1.0
+    height: float = 5.0
+    cell: float = 6.0
+
+    physical_fields = (_length("half_width", "half the pillar width"), _length("height", "pillar height"),
+                       _length("pitch", "cell side"))
+    field_help = {"half_width": "half the pillar width a", "height": "pillar height in ε", "cell": "cell side"}
+    si_map = {"pitch": "cell"}
+    lateral_unit = "ε"
 
     def __post_init__(self):
         positive("half_width", self.half_width)
@@ -164,11 +351,20 @@ class Cube(Shape):
 
 @dataclass(frozen=True)
 class Line(Shape):
-    """Ridge along Y (line pattern): flat top |X| <= a at U0 = 0, ``height`` elsewhere."""
+    """Ridge along Y (line pattern): flat top |X| <= a at U0 = 0, ``height`` elsewhere.
 
-    half_width: float
-    height: float
-    cell: float
+    Physical input (half_width, height, pitch): ℓ = ε, every length divided by ε.
+    """
+
+    half_width: float = 1.0
+    height: float = 5.0
+    cell: float = 6.0
+
+    physical_fields = (_length("half_width", "half the ridge width"), _length("height", "ridge height"),
+                       _length("pitch", "cell side"))
+    field_help = {"half_width": "half the ridge width a", "height": "ridge height in ε", "cell": "cell side"}
+    si_map = {"pitch": "cell"}
+    lateral_unit = "ε"
 
     def __post_init__(self):
         positive("half_width", self.half_width)
@@ -182,10 +378,18 @@ class Line(Shape):
 
 @dataclass(frozen=True)
 class Sinusoid1D(Shape):
-    """1-D sinusoid U0 = Δ (1 − cos(2πX/λ)) (peak-to-valley 2Δ); use the periodic kernel."""
+    """1-D sinusoid U0 = Δ (1 − cos(2πX/λ)) (peak-to-valley 2Δ); use the periodic kernel.
 
-    wavelength: float
-    amplitude: float
+    Physical input (wavelength, amplitude): ℓ = ε, every length divided by ε.
+    """
+
+    wavelength: float = 10.0
+    amplitude: float = 1.0
+
+    physical_fields = (_length("wavelength", "wavelength λ (the cell side)"), _length("amplitude", "amplitude Δ"))
+    field_help = {"wavelength": "wavelength λ (the cell side)", "amplitude": "amplitude Δ in ε"}
+    si_map = {"wavelength": "wavelength"}
+    lateral_unit = "ε"
 
     def __post_init__(self):
         positive("wavelength", self.wavelength)
@@ -217,8 +421,13 @@ class HeightMap(Shape):
         object.__setattr__(self, "heights", z)
 
     def grid(self, dx: float | None = None) -> Grid:
+        """The map's own grid (pixel cell/nx); a ``dx`` that differs from that pixel is refused."""
         nx, ny = self.heights.shape
-        return Grid(nx, ny, self.cell / nx, self.cell / nx)
+        h = self.cell / nx
+        if dx is not None and abs(positive("dx", dx) - h) > 1e-9 * h:
+            raise TengsimError(f"dx={dx:g} does not match the height map's pixel {h:g} (cell {self.cell:g} / "
+                               f"{nx} pixels); resample the map or give dx={h:g}")
+        return Grid(nx, ny, h, h)
 
     def gap(self, grid: Grid) -> np.ndarray:
         if grid.shape != self.heights.shape:
@@ -239,3 +448,13 @@ def random_rough(n: int, cell: float, hurst: float = 0.8, rms_height: float = 1.
     z = np.fft.ifft2(spec).real
     z *= rms_height / z.std()
     return HeightMap(z, cell)
+
+
+SHAPES.register("pyramid", Pyramid, summary="the paper's square pyramid, Eq. (11)")
+SHAPES.register("sphere", Paraboloid, aliases=("paraboloid",), summary="sphere, Hertz paraboloid")
+SHAPES.register("cone", Cone, summary="axisymmetric cone")
+SHAPES.register("hemisphere", Hemisphere, summary="exact hemisphere on a flat base")
+SHAPES.register("cube", Cube, summary="square flat-topped pillar")
+SHAPES.register("line", Line, summary="flat-topped ridge along Y")
+SHAPES.register("flat_punch", FlatPunch, summary="circular flat punch")
+SHAPES.register("sinusoid", Sinusoid1D, summary="1-D sinusoid (periodic kernel)")

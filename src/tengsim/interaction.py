@@ -8,12 +8,14 @@ C¹; physical equilibria never reach g_safe.  States are always judged by the re
 """
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
 
 from tengsim.errors import TengsimError, positive
+from tengsim.registry import LAWS
 
 
 class Law:
@@ -64,7 +66,11 @@ class Law:
         return -self._raw(gg)[2]
 
     def params(self) -> dict:
-        d = dict(self.__dict__)
+        """The law's parameters (its dataclass fields; public attributes otherwise) and its class name."""
+        if dataclasses.is_dataclass(self):
+            d = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
+        else:
+            d = {k: v for k, v in vars(self).items() if not k.startswith("_")}
         d["law"] = type(self).__name__
         return d
 
@@ -140,11 +146,10 @@ class Repulsive(Law):
         return phi, p, dp
 
 
-def make_law(name: str) -> Law:
-    """Law by name: 'lj93' (the paper's, default) or 'repulsive'."""
-    key = name.lower().replace("-", "").replace("_", "")
-    if key in ("lj93", "lj", "paper", "lj82"):
-        return LJ93()
-    if key in ("repulsive", "hertz", "nonadhesive"):
-        return Repulsive()
-    raise TengsimError(f"unknown interaction law {name!r} (choose 'lj93' or 'repulsive')")
+def make_law(name: str, **params) -> Law:
+    """Law by registered name or alias (see ``tengsim.registry.LAWS``): 'lj93' (the paper's) or 'repulsive'."""
+    return LAWS.get(name)(**params)
+
+
+LAWS.register("lj93", LJ93, aliases=("lj", "paper", "lj82"), summary="the paper's 9-3 law, Eq. (2)/(8)")
+LAWS.register("repulsive", Repulsive, aliases=("hertz", "nonadhesive"), summary="non-adhesive wall")

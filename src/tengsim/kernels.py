@@ -18,6 +18,7 @@ import numpy as np
 from tengsim import _fft
 from tengsim.errors import positive
 from tengsim.grid import Grid
+from tengsim.registry import KERNELS
 
 
 def _F(x, y):
@@ -96,12 +97,12 @@ class PeriodicKernel:
         return {"boundary": "periodic", "coupling": self.coupling}
 
 
-def make_kernel(boundary: str, grid: Grid, coupling: float):
-    """Kernel by name: 'free' (isolated cell, Eq. 9 as printed) or 'periodic' (array of cells)."""
-    from tengsim.errors import TengsimError
+def make_kernel(boundary: str, grid: Grid, coupling: float, **params):
+    """Kernel by registered name (see ``tengsim.registry.KERNELS``): 'free' (isolated cell, Eq. 9 as
+    printed) or 'periodic' (array of cells).  A registered kernel is a factory
+    ``(grid, coupling, **params) -> kernel``."""
+    return KERNELS.get(boundary)(grid, coupling, **params)
 
-    if boundary == "free":
-        return FreeKernel(grid, coupling)
-    if boundary == "periodic":
-        return PeriodicKernel(grid, coupling)
-    raise TengsimError(f"unknown boundary {boundary!r} (choose 'free' or 'periodic')")
+
+KERNELS.register("free", FreeKernel, summary="isolated cell on a half-space, Eq. (9)")
+KERNELS.register("periodic", PeriodicKernel, summary="periodic array of cells")

@@ -9,11 +9,11 @@ survives the finest step is recorded as a jump.
 from __future__ import annotations
 
 import time
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field
 
 import numpy as np
 
-from tengsim.analysis import apex_index, summarize
+from tengsim.analysis import apex_index
 from tengsim.errors import TengsimError, finite, positive
 from tengsim.solvers import Problem, State
 
@@ -107,12 +107,14 @@ class _Branch:
 
 
 def run_path(U0, law, kernel, solver, spec: PathSpec, start: State | None = None,
-             progress=None, keep_states: bool = False):
+             progress=None, keep_states: bool = False, observers=()):
     """Solve the approach–retraction path; returns a :class:`tengsim.results.ContactResult`.
 
-    ``progress(branch, D, done, total)`` is called after each row on the D grid.
+    ``progress(branch, D, done, total)`` is called after each row on the D grid.  ``observers``
+    (registered names or objects, see :mod:`tengsim.observers`) add their columns to every row.
     """
-    from tengsim.results import ContactResult
+    from tengsim import observers as obs
+    from tengsim.results import CURVE_COLUMNS, PHYSICAL_COLUMNS, ContactResult
 
     grid = kernel.grid
     U0 = np.asarray(U0, dtype=float)
@@ -121,6 +123,10 @@ def run_path(U0, law, kernel, solver, spec: PathSpec, start: State | None = None
     if not np.all(np.isfinite(U0)):
         raise TengsimError("the initial gap U0 contains NaN or infinite values")
     apex = apex_index(U0)
+    summary = obs.Summary()
+    extra = obs.resolve(observers)
+    extra_cols = obs.check_columns(extra, CURVE_COLUMNS + PHYSICAL_COLUMNS)
+    ctx = obs.Context(grid, apex, U0, law, kernel)
     targets = spec.targets()
     total = len(targets) * (2 if spec.retract else 1)
     rows, maps, done = [], [], [0]
@@ -129,13 +135,16 @@ def run_path(U0, law, kernel, solver, spec: PathSpec, start: State | None = None
 
     def make_on_row(branch):
         def on_row(D, eq, on_grid, jump):
-            s = summarize(eq.P, eq.H, grid, apex)
+            s = summary(eq, ctx)
             # a state whose gap enters the law's safe extension (g < g_safe) is outside the physical law
-            in_range = bool(s.min_gap + 1.0 >= getattr(law, "g_safe", -np.inf))
+            in_range = bool(s["min_gap"] + 1.0 >= getattr(law, "g_safe", -np.inf))
+            more = {}
+            for o in extra:
+                more.update(obs.observe(o, eq, ctx))
             rows.append(dict(branch=branch, D=D, on_grid=on_grid, jump=jump, converged=eq.converged,
                              in_law_range=in_range,
                              residual=eq.residual, iterations=eq.iterations, n_conv=eq.n_conv,
-                             seconds=eq.seconds, energy=eq.energy, **asdict(s)))
+                             seconds=eq.seconds, energy=eq.energy, **s, **more))
             for Dm in spec.maps_at:
                 if on_grid and abs(D - Dm) < 1e-9 * max(1.0, abs(Dm)) + 1e-9 and (branch, Dm) not in map_keys:
                     map_keys.add((branch, Dm))
@@ -160,5 +169,8 @@ def run_path(U0, law, kernel, solver, spec: PathSpec, start: State | None = None
         rev = targets[::-1]
         for Da, Db in zip(rev[:-1], rev[1:]):
             eq = back.advance(Da, eq, Db, 0, True)
-    return ContactResult.from_rows(rows, maps, grid, seconds=time.perf_counter() - t_start,
-                                   final_state=eq.state if keep_states else None)
+    res = ContactResult.from_rows(rows, maps, grid, seconds=time.perf_counter() - t_start,
+                                  final_state=eq.state if keep_states else None, extra_columns=extra_cols)
+    for o in extra:
+        res.units.update(getattr(o, "units", None) or {})
+    return res

@@ -44,13 +44,28 @@ def _branches(ax, res, x, y, color, label, jumps=True):
 
 
 def plot_curves(res, path, title: str = "") -> None:
-    """F(D), Λc(D) and Λc(F) of one run, approach solid and retraction dashed, jumps as dots."""
+    """F(D), Λc(D) and Λc(F) of one run, approach solid and retraction dashed, jumps as dots.
+
+    A physical run (columns F_N and contact_length_m, D in ε from its scaling) is drawn in
+    µN, µm and nm; a dimensionless one in the units of Eq. (7).
+    """
     plt = _plt()
+    t = res.table
+    eps = (res.params or {}).get("eps_m")
+    physical = "F_N" in t and "contact_length_m" in t and eps
+    if physical:
+        view = type(res)(table={**t, "D": t["D"] * eps * 1e9, "F": t["F_N"] * 1e6,
+                                "contact_length": t["contact_length_m"] * 1e6}, grid=res.grid)
+        labels = [("approach α (nm)", "force per cell f (µN)"), ("approach α (nm)", r"contact length $\lambda_c$ (µm)"),
+                  ("force per cell f (µN)", r"contact length $\lambda_c$ (µm)")]
+    else:
+        view = res
+        labels = [("D", "F"), ("D", r"$\Lambda_c$"), ("F", r"$\Lambda_c$")]
     fig, axs = plt.subplots(1, 3, figsize=(12, 3.6))
-    _branches(axs[0], res, "D", "F", "k", "")
-    _branches(axs[1], res, "D", "contact_length", "k", "")
-    _branches(axs[2], res, "F", "contact_length", "k", "")
-    for ax, (xl, yl) in zip(axs, [("D", "F"), ("D", r"$\Lambda_c$"), ("F", r"$\Lambda_c$")]):
+    _branches(axs[0], view, "D", "F", "k", "")
+    _branches(axs[1], view, "D", "contact_length", "k", "")
+    _branches(axs[2], view, "F", "contact_length", "k", "")
+    for ax, (xl, yl) in zip(axs, labels):
         ax.set_xlabel(xl)
         ax.set_ylabel(yl)
         ax.grid(alpha=0.3)

@@ -8,11 +8,21 @@ import numpy as np
 
 from tengsim.grid import Grid
 
-_trapz = getattr(np, "trapezoid", None) or np.trapz
+
+
+def trapezoid(y, x) -> float:
+    """∫ y dx by the trapezoidal rule (numpy >= 1.24: ``np.trapezoid`` is numpy 2's name for ``np.trapz``)."""
+    y, x = np.asarray(y, dtype=float), np.asarray(x, dtype=float)
+    if len(y) < 2:
+        return 0.0
+    return float(np.sum(0.5 * (y[1:] + y[:-1]) * np.diff(x)))
+
 
 CURVE_COLUMNS = ["branch", "D", "F", "contact_length", "area_repulsive", "converged", "residual",
                  "iterations", "n_conv", "on_grid", "jump", "min_gap", "max_pressure",
                  "min_pressure", "energy", "seconds", "in_law_range"]
+PHYSICAL_COLUMNS = ["F_N", "pressure_Pa", "contact_length_m"]
+_FLAGS = ("converged", "on_grid", "jump", "in_law_range")
 
 
 @dataclass(frozen=True)
@@ -36,7 +46,12 @@ class Jump:
 
 @dataclass
 class ContactResult:
-    """Curves (one entry per equilibrium, in path order), maps at chosen D, and parameters."""
+    """Curves (one entry per equilibrium, in path order), maps at chosen D, and parameters.
+
+    ``table`` holds the columns of :data:`CURVE_COLUMNS`, then any observer columns, then (for a
+    physical run, see :meth:`add_physical`) ``F_N``, ``pressure_Pa`` and ``contact_length_m``.
+    ``units`` maps a column to its unit text; ``scaling`` is the run's physical scaling or None.
+    """
 
     table: dict
     grid: Grid
@@ -44,11 +59,39 @@ class ContactResult:
     params: dict = field(default_factory=dict)
     seconds: float = 0.0
     final_state: object = None
+    units: dict = field(default_factory=dict)
+    scaling: object = None
 
     @classmethod
-    def from_rows(cls, rows, maps, grid, seconds=0.0, final_state=None):
-        table = {k: np.array([r[k] for r in rows]) for k in CURVE_COLUMNS}
+    def from_rows(cls, rows, maps, grid, seconds=0.0, final_state=None, extra_columns=()):
+        table = {k: np.array([r[k] for r in rows]) for k in [*CURVE_COLUMNS, *extra_columns]}
         return cls(table=table, grid=grid, maps=maps, seconds=seconds, final_state=final_state)
+
+    def add_physical(self, scaling) -> None:
+        """Append F_N (force per cell, N), pressure_Pa (F_N / cell area, if known) and contact_length_m
+        from the dimensionless F and Λc, with ``scaling`` (a :class:`tengsim.units.Scaling`)."""
+        t = self.table
+        t["F_N"] = np.asarray(scaling.force(t["F"]), dtype=float)
+        if getattr(scaling, "cell_area", None):
+            t["pressure_Pa"] = t["F_N"] / scaling.cell_area
+        t["contact_length_m"] = np.asarray(scaling.length(t["contact_length"]), dtype=float)
+        self.scaling = scaling
+        self.units.update(scaling.units())
+
+    def column_units(self) -> dict:
+        """Unit text of every column that has one: the shape's own scaling, then observers' units."""
+        lat = self.params.get("lateral_unit", "ℓ")
+        u = {"D": "ε (rigid approach, Eq. 7)", "F": f"3π W ℓ²/ε with ℓ = {lat} (per cell, Eq. 10)",
+             "contact_length": f"ℓ = {lat} (Λc, Eq. 7)", "residual": "ε (max |r| of Eq. 9)",
+             "area_repulsive": f"ℓ² with ℓ = {lat}", "min_gap": "ε",
+             "max_pressure": "W/ε (Eq. 8)", "min_pressure": "W/ε (Eq. 8)"}
+        u.update(self.units)
+        return {k: v for k, v in u.items() if k in self.table}
+
+    @property
+    def columns(self) -> list:
+        """Table columns in output order."""
+        return [*CURVE_COLUMNS, *[k for k in self.table if k not in CURVE_COLUMNS]]
 
     # ---- selections -------------------------------------------------------------------------
     def branch(self, name: str) -> dict:
@@ -90,7 +133,7 @@ class ContactResult:
             return 0.0
         ia = np.argsort(a["D"])
         ir = np.argsort(r["D"])
-        return float(_trapz(a["F"][ia], a["D"][ia]) - _trapz(r["F"][ir], r["D"][ir]))
+        return trapezoid(a["F"][ia], a["D"][ia]) - trapezoid(r["F"][ir], r["D"][ir])
 
     def transition_D(self, full_length: float, fraction: float = 0.95) -> float:
         """First approach D at which Λc reaches ``fraction`` × ``full_length`` (linear interpolation):
@@ -115,14 +158,11 @@ class ContactResult:
         import xarray as xr
 
         t = self.table
-        data = {k: ("step", t[k].astype(str) if k == "branch" else t[k]) for k in CURVE_COLUMNS}
-        for k in ("converged", "on_grid", "jump", "in_law_range"):
+        data = {k: ("step", t[k].astype(str) if k == "branch" else t[k]) for k in self.columns if k in t}
+        for k in _FLAGS:
             data[k] = ("step", t[k].astype(np.int8))
         ds = xr.Dataset(data)
-        units = {"D": "ε (rigid approach, Eq. 7)", "F": "3π W ε m²/n² (Eq. 7/10)",
-                 "contact_length": "ε m/n (Λc, Eq. 7)", "residual": "ε (max |r| of Eq. 9)",
-                 "area_repulsive": "(ε m/n)²"}
-        for k, u in units.items():
+        for k, u in self.column_units().items():
             ds[k].attrs["units"] = u
         if self.maps:
             ds = ds.assign(
@@ -145,7 +185,7 @@ class ContactResult:
 
     def csv_columns(self) -> dict:
         t = self.table
-        return {k: t[k] for k in CURVE_COLUMNS}
+        return {k: t[k] for k in self.columns if k in t}
 
     def save(self, path) -> None:
         """Write ``.csv`` (curves, parameters in '#' header lines) or ``.nc`` (everything), atomically."""
@@ -156,7 +196,7 @@ class ContactResult:
 
         suffix = Path(path).suffix.lower()
         if suffix == ".csv":
-            io.write_csv(path, self.csv_columns(), header=self.params)
+            io.write_csv(path, self.csv_columns(), header={**self.params, "units": self.column_units()})
         elif suffix in (".nc", ".netcdf", ".nc4"):
             io.write_dataset(self.to_dataset(), path)
         else:

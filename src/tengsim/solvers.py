@@ -24,6 +24,7 @@ import numpy as np
 from tengsim._lbfgs import KMetricLBFGS
 from tengsim._sweep import Sweeper
 from tengsim.errors import TengsimError
+from tengsim.registry import SOLVERS
 
 
 @dataclass
@@ -453,13 +454,11 @@ class VSRSolver:
         return _finish(problem, State(q, w), P, r, E, msg == "converged", it, n_conv, t0, msg)
 
 
-SOLVERS = {"fast": FastSolver, "vsr": VSRSolver}
-
-
 def make_solver(name: str, tol: float = 1e-6, **kw):
-    """Solver by name: 'fast' (L-BFGS) or 'vsr' (the paper's relaxation)."""
-    try:
-        cls = SOLVERS[name]
-    except KeyError:
-        raise TengsimError(f"unknown solver {name!r} (choose 'fast' or 'vsr')") from None
-    return cls(tol=tol, **kw)
+    """Solver by registered name (see ``tengsim.registry.SOLVERS``): 'fast' (L-BFGS) or 'vsr' (the paper's
+    relaxation).  A registered solver is a factory ``(tol=..., **kw) -> solver``."""
+    return SOLVERS.get(name)(tol=tol, **kw)
+
+
+SOLVERS.register("fast", FastSolver, summary="L-BFGS in the kernel metric")
+SOLVERS.register("vsr", VSRSolver, summary="the paper's relaxation")

@@ -1,4 +1,4 @@
-"""Physical units at the edges: quantity parsing and the paper's scaling (Eq. 7)."""
+"""Physical units at the edges: quantity parsing and the scaling of Eq. (7) for any shape."""
 from __future__ import annotations
 
 import math
@@ -60,11 +60,117 @@ def parse_quantity(text, kind: str | None = None, name: str = "value") -> float:
     return v
 
 
+class _Units:
+    """Conversions shared by :class:`Scaling` and :class:`PaperScaling` (paper Eqs. 7, 9, 10).
+
+    Needs ``E_star`` (Pa), ``W`` (J/m²), ``eps`` (m), ``lateral`` ℓ (m per unit of X) and
+    ``cell_area`` (m², or None).
+    """
+
+    @property
+    def coupling(self) -> float:
+        """κ = W ℓ/(E* ε²), the factor of Eq. (9); κ = μ^{3/2}."""
+        return self.W * self.lateral / (self.E_star * self.eps**2)
+
+    @property
+    def mu(self) -> float:
+        """The Tabor-like parameter μ = κ^{2/3}."""
+        return self.coupling ** (2.0 / 3.0)
+
+    def length(self, X):
+        """In-plane X (e.g. Λc) → metres: X ℓ."""
+        return X * self.lateral
+
+    def force(self, F):
+        """Dimensionless F (Eq. 10) → newtons per cell: 3π W ℓ²/ε · F."""
+        return F * 3 * math.pi * self.W * self.lateral**2 / self.eps
+
+    def pressure(self, F):
+        """Nominal pressure on the array: force per cell / cell area (Pa)."""
+        if not self.cell_area:
+            raise TengsimError("this scaling has no cell area: pressure is undefined")
+        return self.force(F) / self.cell_area
+
+    def displacement(self, D):
+        """D → metres: D ε."""
+        return D * self.eps
+
+    def work(self, E):
+        """∮ F dD → joules per cell: 3π W ℓ² · E."""
+        return E * 3 * math.pi * self.W * self.lateral**2
+
+    def units(self) -> dict:
+        """Unit text of the dimensionless result columns, with their SI values."""
+        return {
+            "D": f"ε = {self.eps:.6g} m (rigid approach, Eq. 7)",
+            "F": f"3π W ℓ²/ε = {self.force(1.0):.6g} N per cell (Eq. 10)",
+            "contact_length": f"ℓ = {self.lateral:.6g} m (Λc)",
+            "area_repulsive": f"ℓ² = {self.lateral**2:.6g} m²",
+            "residual": "ε (max |r| of Eq. 9)",
+            "min_gap": f"ε = {self.eps:.6g} m",
+            "F_N": "N (force per cell)",
+            "pressure_Pa": "Pa (force per cell / cell area)",
+            "contact_length_m": "m",
+        }
+
+
 @dataclass(frozen=True)
-class PaperScaling:
+class Scaling(_Units):
+    """Physical units of a dimensionless run, for any shape (paper Eq. 7 generalised).
+
+    Heights are in ε, in-plane lengths in ℓ = ``lateral`` (metres per unit of X), pressures in W/ε.
+    Eq. (9) then has the coupling κ = W ℓ/(E* ε²) = μ^{3/2}; the force of Eq. (10) is per cell in
+    units of 3π W ℓ²/ε.  ``cell_area`` (m²) turns the force into a nominal pressure.
+    """
+
+    E_star: float
+    W: float
+    eps: float
+    lateral: float
+    cell_area: float | None = None
+
+    def __post_init__(self):
+        for k in ("E_star", "W", "eps", "lateral"):
+            positive(k, getattr(self, k))
+        if self.cell_area is not None:
+            positive("cell_area", self.cell_area)
+
+    def params(self) -> dict:
+        d = {"E_star_Pa": self.E_star, "W_J_m2": self.W, "eps_m": self.eps, "lateral_m": self.lateral,
+             "tabor": self.mu}
+        if self.cell_area is not None:
+            d["cell_area_m2"] = self.cell_area
+        return d
+
+
+def eps_for_tabor(lateral, E_star: float, W: float, mu: float) -> float:
+    """ε (m) with κ(ε) = W ℓ(ε)/(E* ε²) = μ^{3/2}, for a lateral scale ``lateral(eps) -> ℓ``.
+
+    Solved by Brent's method in log ε between 1e-15 m and 1 m; a TengsimError if no root lies there.
+    """
+    from scipy.optimize import brentq
+
+    mu, E_star, W = positive("tabor", mu), positive("E_star", E_star), positive("W", W)
+    target = 1.5 * math.log(mu)
+
+    def f(t):
+        e = math.exp(t)
+        return math.log(W * lateral(e) / (E_star * e * e)) - target
+
+    a, b = math.log(1e-15), math.log(1.0)
+    fa, fb = f(a), f(b)
+    if fa * fb > 0:
+        raise TengsimError(f"no interaction range ε in [1e-15 m, 1 m] gives tabor = {mu:g}")
+    t = brentq(f, a, b, xtol=1e-14, rtol=1e-15, maxiter=200)
+    return math.exp(t)
+
+
+@dataclass(frozen=True)
+class PaperScaling(_Units):
     """The paper's dimensionless variables (Eq. 7) for a pyramid of base m, height n in pitch L.
 
     Give ε directly or the Tabor parameter μ = (m W / (n E* ε))^{2/3}; SI units throughout.
+    A :class:`Scaling` with ℓ = ε m/n and cell area L².
     """
 
     E_star: float
@@ -104,6 +210,11 @@ class PaperScaling:
         """Length of one unit of X: ε m/n (m)."""
         return self.eps * self.m / self.n
 
+    @property
+    def cell_area(self) -> float:
+        """L² (m²)."""
+        return self.L**2
+
     def length(self, X):
         """Dimensionless in-plane length (e.g. Λc) → metres: λc = Λc ε m/n."""
         return X * self.lateral
@@ -116,9 +227,8 @@ class PaperScaling:
         """Nominal pressure on the array f/L² (Pa)."""
         return self.force(F) / self.L**2
 
-    def displacement(self, D):
-        """D → α = D ε (m)."""
-        return D * self.eps
+    def to_scaling(self) -> Scaling:
+        return Scaling(self.E_star, self.W, self.eps, self.lateral, self.cell_area)
 
     def params(self) -> dict:
         return {"E_star_Pa": self.E_star, "W_J_m2": self.W, "base_m": self.m, "height_m": self.n,

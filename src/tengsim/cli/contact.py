@@ -7,34 +7,53 @@ from pathlib import Path
 from tengsim.errors import TengsimError
 
 
+_CLI_ONLY = ("out", "plot", "quiet")
+_ALIASES = {"maps_at": ("--maps",)}
+
+
+def _option_help():
+    """Common keys, and per shape key its help text(s) and the shapes using it, from the [contact] schema."""
+    from tengsim.config import common_fields, contact_table
+    from tengsim.registry import SHAPES
+
+    common = {f.name: f for f in common_fields()}
+    per_key = {}
+    for s in SHAPES.names():
+        for k, f in contact_table(s).fields.items():
+            if k not in common:
+                per_key.setdefault(k, {}).setdefault(f.help or k, []).append(s)
+    helps = {}
+    for k, groups in per_key.items():
+        if len(groups) == 1:
+            (h, users), = groups.items()
+            helps[k] = f"{h} [{', '.join(users)}]"
+        else:
+            helps[k] = "; ".join(f"{', '.join(users)}: {h}" for h, users in groups.items())
+    return common, helps
+
+
 def register(sub):
+    from tengsim.registry import SHAPES
+
     p = sub.add_parser(
         "contact",
         help="one approach–retraction run of a micro-structure against a flat plate",
         description="Solve the adhesive contact (paper Eq. 9) along an approach from --d-min to --d-max "
-        "and a retraction back. Dimensionless input (--N, --cell, --tabor) or physical input with "
-        "units (--pitch 2um --base 1um --height 0.7um --E-star 0.59MPa --W 54mJ/m2 --tabor 0.5 or --eps).",
+        "and a retraction back. Dimensionless input (the shape's own numbers, e.g. --N 0.946 --cell 3.78 "
+        "--tabor 0.5) or physical input with units (e.g. pyramid --pitch 2um --base 1um --height 0.7um "
+        "--E-star 0.59MPa --W 54mJ/m2 --tabor 0.5, or --eps instead of --tabor). Shapes: " + SHAPES.help(),
     )
-    p.add_argument("shape", choices=["pyramid", "sphere", "cone", "hemisphere", "cube", "line"])
-    p.add_argument("--N", help="pyramid N = n/(2ε)")
-    p.add_argument("--cell", help="cell side L̄ (dimensionless)")
-    p.add_argument("--tabor", help="Tabor parameter μ (default 0.5)")
-    for k in ("pitch", "base", "height", "eps"):
-        p.add_argument(f"--{k}", help=f"physical {k} with unit, e.g. 2um")
-    p.add_argument("--E-star", dest="E_star", help="effective modulus, e.g. 0.59MPa")
-    p.add_argument("--W", help="work of adhesion, e.g. 54mJ/m2")
-    p.add_argument("--slope", help="cone slope")
-    p.add_argument("--radius", help="hemisphere radius")
-    p.add_argument("--half-width", dest="half_width", help="cube/line half width")
-    p.add_argument("--dx", default="0.1", help="grid spacing in X units (default 0.1)")
-    p.add_argument("--d-min", dest="d_min", default="-1")
-    p.add_argument("--d-max", dest="d_max", default="4")
-    p.add_argument("--d-step", dest="d_step", default="0.05")
-    p.add_argument("--boundary", default="free", help="free (isolated cell, Eq. 9) or periodic")
-    p.add_argument("--solver", default="fast", help="fast (L-BFGS) or vsr (the paper's relaxation)")
-    p.add_argument("--tol", default="1e-6", help="max residual of Eq. (9) in ε (default 1e-6)")
-    p.add_argument("--law", default="lj93", help="lj93 (paper) or repulsive")
-    p.add_argument("--maps", dest="maps_at", default="", help="comma-separated D values whose maps go in the .nc")
+    p.add_argument("shape", choices=SHAPES.names(), help="registered shape")
+    common, per_key = _option_help()
+    for k, f in common.items():
+        if k == "shape" or k in _CLI_ONLY:
+            continue
+        p.add_argument("--" + k.replace("_", "-"), *_ALIASES.get(k, ()), dest=k,
+                       help=f.describe().split(": ", 1)[1].replace("%", "%%"))
+    for k, h in per_key.items():
+        if k in _CLI_ONLY:
+            continue
+        p.add_argument("--" + k.replace("_", "-"), dest=k, help=h.replace("%", "%%"))
     p.add_argument("--out", required=True, help="output file: .csv (curves) or .nc (everything)")
     p.add_argument("--plot", help="also draw F(D), Λc(D), Λc(F) to this .png/.pdf")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
@@ -42,9 +61,12 @@ def register(sub):
 
 
 def run(args) -> int:
-    from tengsim.config import run_contact
+    from tengsim.config import contact_keys, plan_contact, run_contact
     from tengsim.progress import Progress
 
+    keys = [k for k in contact_keys() if k not in _CLI_ONLY]
+    cfg = {k: getattr(args, k) for k in keys if getattr(args, k, None) not in (None, "")}
+    plan_contact(cfg)  # every option checked before anything is written
     out = Path(args.out)
     if out.suffix.lower() not in (".csv", ".nc"):
         raise TengsimError(f"--out {args.out}: use a .csv or .nc file")
@@ -55,10 +77,6 @@ def run(args) -> int:
     check_writable(out)
     if args.plot:
         check_writable(args.plot)
-    keys = ["shape", "N", "cell", "tabor", "pitch", "base", "height", "eps", "E_star", "W", "slope",
-            "radius", "half_width", "dx", "d_min", "d_max", "d_step", "boundary", "solver", "tol",
-            "law", "maps_at"]
-    cfg = {k: getattr(args, k) for k in keys if getattr(args, k) not in (None, "")}
     bar = Progress(args.quiet)
     try:
         res = run_contact(cfg, progress=bar)
@@ -76,7 +94,8 @@ def write_contact(res, out, plot=None, quiet=False) -> int:
     n_bad = int((~res.table["converged"].astype(bool)).sum())
     if not quiet:
         j = res.jumps
-        print(f"wrote {out}: {len(res.table['D'])} equilibria, pull-off F = {res.pull_off_force:.4g}, "
+        si = f" ({res.scaling.force(res.pull_off_force):.4g} N per cell)" if res.scaling is not None else ""
+        print(f"wrote {out}: {len(res.table['D'])} equilibria, pull-off F = {res.pull_off_force:.4g}{si}, "
               f"{len(j)} jump(s), {res.seconds:.1f} s", file=sys.stderr)
     if n_bad:
         print(f"tengsim: warning: {n_bad} equilibria did not converge (see column 'converged')",

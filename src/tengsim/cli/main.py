@@ -35,6 +35,14 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv=None) -> int:
+    from tengsim.registry import ensure_builtins, load_plugins
+
+    try:
+        ensure_builtins()
+        load_plugins()  # user shapes, laws, kernels, solvers, observers: before the parser lists them
+    except TengsimError as exc:
+        print(f"tengsim: error: {exc}", file=sys.stderr)
+        return 2
     parser = build_parser()
     args = parser.parse_args(argv)
     if not getattr(args, "func", None):

@@ -21,13 +21,11 @@ def register(sub):
 
 
 def run(args) -> int:
-    from tengsim.config import load_toml
+    from tengsim.schema import check_tables, read_config
 
-    cfg = load_toml(args.config)
+    cfg = read_config(args.config)
+    check_tables(cfg, ("contact", "device", "reproduce"), where=str(args.config))
     kinds = [k for k in ("contact", "device", "reproduce") if k in cfg]
-    extra = set(cfg) - {"contact", "device", "reproduce"}
-    if extra:
-        raise TengsimError(f"{args.config}: unknown table(s) {', '.join(sorted(extra))}")
     if len(kinds) != 1:
         raise TengsimError(f"{args.config}: needs exactly one of [contact], [device], [reproduce]")
     kind = kinds[0]
@@ -36,11 +34,11 @@ def run(args) -> int:
         return _contact(section, args)
     if kind == "reproduce":
         from tengsim.reproduce import reproduce
+        from tengsim.schema import Field, Table
 
-        out = section.pop("out", "tengsim-paper")
-        quick = bool(section.pop("quick", False))
-        if section:
-            raise TengsimError(f"unknown reproduce option(s): {', '.join(sorted(section))}")
+        vals = Table("reproduce", [Field("out", "str", "tengsim-paper", help="output folder"),
+                                   Field("quick", "bool", False, help="coarse grids (minutes)")]).parse(section)
+        out, quick = vals["out"], vals["quick"]
         reproduce(out, quick=quick, log=None if args.quiet else (lambda m: print(m, file=sys.stderr)))
         return 0
     from tengsim.cli import device as device_cli
@@ -50,21 +48,29 @@ def run(args) -> int:
 
 def _contact(section, args) -> int:
     from tengsim.cli.contact import write_contact
-    from tengsim.config import run_contact
+    from tengsim.config import plan_contact, run_contact
     from tengsim.progress import Progress
 
+    plan_contact(section)  # every key checked before anything is written
     out = section.get("out")
     if not out:
         raise TengsimError("[contact] needs out = 'FILE.csv' or 'FILE.nc'")
+    if not isinstance(out, str):
+        raise TengsimError(f"[contact] out must be a file name, got {out!r}")
     if Path(out).suffix.lower() not in (".csv", ".nc"):
         raise TengsimError(f"out = {out!r}: use a .csv or .nc file")
+    plot = section.get("plot")
+    if plot and (not isinstance(plot, str) or Path(plot).suffix.lower() not in (".png", ".pdf", ".svg")):
+        raise TengsimError(f"plot = {plot!r}: use a .png, .pdf or .svg file")
     from tengsim.io import check_writable
 
     check_writable(out)
+    if plot:
+        check_writable(plot)
     bar = Progress(args.quiet)
     try:
         res = run_contact(section, progress=bar)
     finally:
         bar.close()
     res.params["config_file"] = str(args.config)
-    return write_contact(res, out, section.get("plot"), args.quiet)
+    return write_contact(res, out, plot, args.quiet)
