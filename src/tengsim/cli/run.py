@@ -24,6 +24,10 @@ def run(args) -> int:
     from tengsim.config import load_toml
 
     cfg = load_toml(args.config)
+    if "device" in cfg:  # a device file: [device], [waveform], [run], [solver], [sweep] (tengsim device fields)
+        from tengsim.cli import device as device_cli
+
+        return device_cli.run_config(cfg, args)
     kinds = [k for k in ("contact", "device", "reproduce") if k in cfg]
     extra = set(cfg) - {"contact", "device", "reproduce"}
     if extra:
@@ -43,9 +47,6 @@ def run(args) -> int:
             raise TengsimError(f"unknown reproduce option(s): {', '.join(sorted(section))}")
         reproduce(out, quick=quick, log=None if args.quiet else (lambda m: print(m, file=sys.stderr)))
         return 0
-    from tengsim.cli import device as device_cli
-
-    return device_cli.run_config(section, args)
 
 
 def _contact(section, args) -> int:

@@ -1,6 +1,7 @@
 """The paper's contact cases: pyramid groups A, B, C (Section 3) and the A(P) tables they give.
 
 Physical scaling (Eq. 7) with E* = 0.59 MPa, W = 54 mJ/m², μ = 0.5 (so ε ≈ 0.37 µm for all groups).
+Built on the core: :func:`tengsim.contact.simulate` for the runs, :class:`tengsim.device.AreaTable` for A(P).
 """
 from __future__ import annotations
 
@@ -8,7 +9,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from tengsim.cases._json import json_safe
 from tengsim.contact import simulate
+from tengsim.device.params import AreaTable
 from tengsim.errors import TengsimError
 from tengsim.geometry import Pyramid
 from tengsim.path import PathSpec
@@ -53,18 +56,12 @@ def run_group(group: str, settings: RunSettings = RunSettings(), progress=None):
     return res
 
 
-@dataclass(frozen=True)
-class AreaTable:
-    """Charged-area fraction A/S = λc²/L² against applied pressure f/L² (Pa), approach branch."""
-
-    pressure_Pa: np.ndarray
-    area_fraction: np.ndarray
-    group: str = ""
-
-
 def area_table_from_result(res, group: str) -> AreaTable:
     """A(P) under load control from a displacement-controlled approach: keep the states whose force
-    exceeds every earlier one (where F(D) falls back, a pressed device jumps ahead), F > 0 only."""
+    exceeds every earlier one (where F(D) falls back, a pressed device jumps ahead), F > 0 only.
+
+    A/S = λc²/L² against the pressure f/L² (Pa) on the array (Eq. 12's area; the device's area model).
+    """
     sc = paper_scaling(group)
     a = res.branch("approach")
     F, L = a["F"], a["contact_length"]
@@ -78,11 +75,11 @@ def area_table_from_result(res, group: str) -> AreaTable:
         raise TengsimError(f"group {group}: the approach never reached a positive load; raise d_max")
     p = sc.pressure(F[keep])
     frac = np.clip((sc.length(L[keep]) / sc.L) ** 2, 0.0, 1.0)
-    return AreaTable(p, frac, group)
+    return AreaTable(p, frac)
 
 
 def area_table(group: str = "A", quick: bool = False, progress=None) -> AreaTable:
-    """Run the group and return its A(P) table (used by the Fig. 8 device run)."""
+    """Run the group and return its A(P) table (the area model of the Fig. 8 device run)."""
     return area_table_from_result(run_group(group, RunSettings.preset(quick), progress), group)
 
 
@@ -92,7 +89,7 @@ def contact_summary(res, group: str) -> dict:
     full = 2 * sc.N
     tD = res.transition_D(full)
     pull = res.pull_off_force
-    return {
+    return json_safe({
         "N": sc.N,
         "cell": sc.cell,
         "transition_D": tD,
@@ -106,7 +103,8 @@ def contact_summary(res, group: str) -> dict:
         "all_converged": res.all_converged,
         "median_conv_per_equilibrium": float(np.median(res.table["n_conv"])),
         "seconds": res.seconds,
-    }
+    })
 
 
 GROUPS = tuple(PAPER_GROUPS)
+

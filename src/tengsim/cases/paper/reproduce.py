@@ -1,7 +1,8 @@
 """Reproduce the paper end to end: Figs. 3, 4, 5 (contact) and 7, 8 (device), data and summary.
 
 Everything is written into a staging folder first and moved into place only when the whole run
-has succeeded, so an interrupted or failed run leaves no partial output behind.
+has succeeded, so an interrupted or failed run leaves no partial output behind. summary.json is
+strict JSON: a value that could not be measured is null, never NaN.
 """
 from __future__ import annotations
 
@@ -16,9 +17,10 @@ from pathlib import Path
 import numpy as np
 
 from tengsim import __version__, io
-from tengsim.paper import (FIG3_D, GROUPS, PAPER_TRANSITION_D, RunSettings, area_table_from_result,
-                           contact_summary, run_group)
-from tengsim.units import paper_scaling
+from tengsim.cases._json import json_safe
+from tengsim.cases.paper.contact import (FIG3_D, GROUPS, PAPER_TRANSITION_D, RunSettings, area_table_from_result,
+                                         contact_summary, run_group)
+from tengsim.cases.paper.device import fig7_summary, fig8_summary, run_fig7, run_fig8
 
 # Section 4 (Fig. 5) constants: σ = 5.84 µC/m², ε_r = 2.40, T = 400 µm.
 FIG5_SIGMA = 5.84e-6
@@ -33,8 +35,8 @@ def reproduce(out_dir, quick: bool = False, progress_factory=None, log=None,
     ``progress_factory(label)`` returns a progress callable for one long stage (or None).
     Returns the summary dict.
     """
-    from tengsim.device import fig7_summary, fig8_summary, run_fig7, run_fig8, voc_polymer
     from tengsim.device import plots as dplots
+    from tengsim.device.formulas import voc_polymer
     from tengsim.plots import plot_fig3, plot_fig4, plot_fig5
 
     out_dir = Path(out_dir)
@@ -75,7 +77,7 @@ def reproduce(out_dir, quick: bool = False, progress_factory=None, log=None,
             for kpa in (10, 150):  # V_OC at the pressures of the paper's Fig. 8 range
                 P = kpa * 1e3
                 c[f"voc_at_{kpa}kPa_V"] = float(np.interp(P, tab.pressure_Pa, v)) \
-                    if tab.pressure_Pa[0] <= P <= tab.pressure_Pa[-1] else float("nan")
+                    if tab.pressure_Pa[0] <= P <= tab.pressure_Pa[-1] else None  # outside the table
         n = max(len(c[0]) for c in curves.values())
         for g, (p, v) in curves.items():
             cols[f"pressure_Pa_{g}"] = np.pad(p, (0, n - len(p)), constant_values=np.nan)
@@ -102,6 +104,7 @@ def reproduce(out_dir, quick: bool = False, progress_factory=None, log=None,
             dplots.plot_fig8(r8, stage / "fig8.pdf")
             summary["fig8"] = fig8_summary(r8)
         summary["seconds"] = time.perf_counter() - t0
+        summary = json_safe(summary)
         io.write_json(stage / "summary.json", summary)
         out_dir.mkdir(parents=True, exist_ok=True)
         for f in sorted(stage.iterdir()):
@@ -109,3 +112,14 @@ def reproduce(out_dir, quick: bool = False, progress_factory=None, log=None,
         return summary
     finally:
         shutil.rmtree(stage, ignore_errors=True)
+
+
+def _num(x, fmt: str = ".4g") -> str:
+    return "n/a" if x is None else format(x, fmt)
+
+
+def summary_text(summary: dict) -> list:
+    """One line per contact group (transition D, pull-off F, saturated V_OC); missing values read 'n/a'."""
+    return [f"group {g}: transition D = {_num(s.get('transition_D'), '.3g')} (paper {s.get('transition_D_paper')}), "
+            f"pull-off F = {_num(s.get('pull_off_F'))}, V_OC sat = {_num(s.get('voc_saturation_V'))} V"
+            for g, s in summary.get("contact", {}).items()]
