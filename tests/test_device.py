@@ -224,7 +224,7 @@ def test_run_fig8_with_table_and_area_memory():
 
 def test_resistance_sweep_has_interior_optimum():
     sw = resistance_sweep(P7, WF7, [1e5, 5e6, 1e9], cycles=2)
-    assert sw.optimum_ohm == 5e6
+    assert sw.optimum_ohm == 5e6 and not sw.optimum_at_edge
     assert np.all(sw.energy_per_cycle_J > 0)
     assert sw.energy_per_cycle_J.max() < figure_of_merit(P7).energy_max_J
 

@@ -141,15 +141,16 @@ def parse_waveform(mapping: dict, base=None):
     if not isinstance(mapping, dict):
         raise TengsimError(f"[waveform] must be a table, got {mapping!r}")
     d = dict(mapping)
+    kind_field = Field("kind", "str", choices=WAVEFORMS.names)
     if base is not None:
         bd = base.to_dict()
-        if "kind" not in d or WAVEFORMS.canonical(str(d["kind"])) == WAVEFORMS.canonical(bd["kind"]):
+        if "kind" not in d or kind_field.parse(d["kind"], "[waveform] ") == WAVEFORMS.canonical(bd["kind"]):
             d = {**{k: v for k, v in bd.items() if not (bd["kind"] == "table" and k == "interp")}, **d}
             if bd["kind"] == "table" and "interp" not in d:
                 d["interp"] = bd["interp"]
     if "kind" not in d:
         raise TengsimError(f"[waveform] missing required key 'kind' (one of {', '.join(WAVEFORMS.names())})")
-    kind = Field("kind", "str", choices=WAVEFORMS.names).parse(d["kind"], "[waveform] ")
+    kind = WAVEFORMS.canonical(kind_field.parse(d["kind"], "[waveform] "))
     v = waveform_table(kind).parse(d, defaults=False)
     v.pop("kind")
     cls = WAVEFORMS.get(kind)
