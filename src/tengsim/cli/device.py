@@ -41,10 +41,11 @@ def register(subparsers) -> None:
     p.set_defaults(func=lambda args: (p.print_help(), 2)[1])
 
     def common(sp, default_cycles, sweep=False):
-        sp.add_argument("--out", help="output file: .csv (one row per time, .json sidecar) or .nc"
-                        + (" (sweep: .csv)" if sweep else "") + "; else [run] out")
-        sp.add_argument("--cycles", help=f"periods to run (default {default_cycles}; else [run] cycles)")
-        sp.add_argument("--dt", help="output time step in s or with a unit, e.g. 0.1ms (else [run] dt_out)")
+        sp.add_argument("--out", help=("output .csv (one row per load, .json sidecar)" if sweep else
+                                        "output file: .csv (one row per time, .json sidecar) or .nc")
+                        + "; overrides [run] out")
+        sp.add_argument("--cycles", help=f"periods to run (overrides [run] cycles; default {default_cycles})")
+        sp.add_argument("--dt", help="output time step in s or with a unit, e.g. 0.1ms (overrides [run] dt_out)")
         sp.add_argument("--config", default=None, help=CONFIG_HELP)
         sp.add_argument("--quiet", action="store_true", help="no progress or summary output")
         if sweep:
@@ -57,23 +58,24 @@ def register(subparsers) -> None:
 
     f7 = sub.add_parser("fig7", help="flat device, 10 N 5 Hz square wave (Fig. 7)", description=CONFIG_HELP)
     common(f7, 5)
-    f7.add_argument("--t-end", help="run length in s (else [run] t_end, else cycles x period)")
-    f7.set_defaults(func=lambda a: execute("fig7", _read(a.config), _cli(a), a.quiet))
+    f7.add_argument("--t-end", help="run length in s or with a unit (overrides [run] t_end; default cycles x period)")
+    f7.set_defaults(func=lambda a: execute("fig7", _read(a.config), _cli(a), a.quiet, a.config))
     f8 = sub.add_parser("fig8", help="group-A device, 10-150 kPa staircase at 2 Hz (Fig. 8)", description=CONFIG_HELP)
     common(f8, "all 15 steps")
-    f8.add_argument("--quick", action="store_true", default=None, help="quick (coarse) contact-engine area table")
-    f8.set_defaults(func=lambda a: execute("fig8", _read(a.config), _cli(a), a.quiet))
+    f8.add_argument("--quick", action="store_true", default=None,
+                    help="quick (coarse) contact-engine area table (overrides [run] quick)")
+    f8.set_defaults(func=lambda a: execute("fig8", _read(a.config), _cli(a), a.quiet, a.config))
     rn = sub.add_parser("run", help="any device and waveform from --config", description=CONFIG_HELP)
     common(rn, 5)
-    rn.add_argument("--t-end", help="run length in s (else [run] t_end, else cycles x period)")
-    rn.set_defaults(func=lambda a: execute("run", _read(a.config), _cli(a), a.quiet))
+    rn.add_argument("--t-end", help="run length in s or with a unit (overrides [run] t_end; default cycles x period)")
+    rn.set_defaults(func=lambda a: execute("run", _read(a.config), _cli(a), a.quiet, a.config))
     sw = sub.add_parser("sweep", help="load-resistance sweep of the Fig. 7 device (or --config)",
                         description=CONFIG_HELP)
     common(sw, 3, sweep=True)
-    sw.add_argument("--r-min", help="smallest load in ohm (default 1e3; else [sweep] r_min_ohm)")
-    sw.add_argument("--r-max", help="largest load in ohm (default 1e10; else [sweep] r_max_ohm)")
-    sw.add_argument("--points", help="loads, log-spaced (default 15; else [sweep] points)")
-    sw.set_defaults(func=lambda a: execute("sweep", _read(a.config), _cli(a), a.quiet))
+    sw.add_argument("--r-min", help="smallest load in ohm or with a unit (overrides [sweep] r_min_ohm; default 1e3)")
+    sw.add_argument("--r-max", help="largest load in ohm or with a unit (overrides [sweep] r_max_ohm; default 1e10)")
+    sw.add_argument("--points", help="loads, log-spaced (overrides [sweep] points; default 15)")
+    sw.set_defaults(func=lambda a: execute("sweep", _read(a.config), _cli(a), a.quiet, a.config))
     fl = sub.add_parser("fields", help="list every config table and key (from the dataclasses)")
     fl.set_defaults(func=_cmd_fields)
 
@@ -109,14 +111,12 @@ def _typed_cli(table, values: dict) -> dict:
 
 
 def _out_path(run: dict, case: str) -> Path:
+    """The output path (checked by suffix only: nothing is created before every input has been checked)."""
     out = run.get("out")
     require(out, "give --out FILE (or [run] out = 'FILE' in the config)")
     out = Path(out)
     allowed = (".csv",) if case == "sweep" else (".csv", ".nc")
     require(out.suffix.lower() in allowed, f"out must end in {' or '.join(allowed)}, got {str(out)!r}")
-    from tengsim.io import check_writable
-
-    check_writable(out)
     return out
 
 
@@ -138,6 +138,7 @@ def execute(case: str, cfg: dict, cli: dict | None = None, quiet: bool = False, 
         return _sweep(cfg, cli, run, dev_cli, solver, out, quiet, source)
     params, wf = _device_and_waveform(case, cfg, dev_cli)
     from tengsim.device import simulate
+    from tengsim.io import check_writable
 
     if case == "fig8":
         from tengsim.cases.paper import fig8_area_table, fig8_summary
@@ -146,6 +147,7 @@ def execute(case: str, cfg: dict, cli: dict | None = None, quiet: bool = False, 
         cycles = run.get("cycles", n)
         require(cycles <= n, f"cycles = {cycles} but the staircase has {n} steps (give at most {n})")
         wf = dataclasses.replace(wf, amplitudes_Pa=wf.amplitudes_Pa[:cycles])
+        check_writable(out)
         if "area" not in cfg.get("device", {}):  # the slow contact engine runs only after every check
             params = params.replace(area=fig8_area_table(bool(run.get("quick", False))))
         res = simulate(params, wf, wf.duration, dt_out=run.get("dt_out", 1e-4), options=solver, progress=not quiet)
@@ -156,6 +158,7 @@ def execute(case: str, cfg: dict, cli: dict | None = None, quiet: bool = False, 
             per = wf.period or wf.duration
             require(per is not None, "give --t-end (or [run] t_end) for a waveform with no period")
             t_end = run.get("cycles", DEFAULT_CYCLES[case]) * per
+        check_writable(out)
         res = simulate(params, wf, t_end, dt_out=run.get("dt_out"), options=solver, progress=not quiet)
         skip = 1 if (wf.period and t_end >= 2 * wf.period - 1e-12) else 0
         if case == "fig7":
@@ -186,8 +189,9 @@ def _device_and_waveform(case, cfg, dev_cli):
         params = dc.parse_device(cfg.get("device", {}), fig8_params(ConstantArea(1.0)), dev_cli)
         base_wf = fig8_waveform()
     else:
-        require("device" in cfg and "waveform" in cfg, "device run needs --config with [device] and [waveform]")
+        require("device" in cfg, "device run needs a config with [device] and [waveform] (--config FILE)")
         params = dc.parse_device(cfg["device"], None, dev_cli)
+        require("waveform" in cfg, "device run needs a [waveform] table in its config (kind = square, ...)")
     wf = dc.parse_waveform(cfg["waveform"], base_wf) if "waveform" in cfg else base_wf
     if case == "fig8":
         from tengsim.device import Staircase
@@ -234,6 +238,9 @@ def _sweep(cfg, cli, run, dev_cli, solver, out, quiet, source) -> int:
     require(cycles >= 2, f"cycles must be >= 2 for a sweep (the first is dropped), got {cycles!r}")
     params, wf = _device_and_waveform("sweep", cfg, {k: v for k, v in dev_cli.items() if k != "load_ohm"})
     loads = np.logspace(np.log10(r_min), np.log10(r_max), points)
+    from tengsim.io import check_writable
+
+    check_writable(out)
     sw = resistance_sweep(params, wf, loads, cycles=cycles, steady=sw_cfg["steady"], dt_out=run.get("dt_out"),
                           options=solver, progress=not quiet)
     from tengsim.cases._json import json_safe

@@ -70,6 +70,7 @@ def plot_fig8(result, path, table=None) -> None:
     ax[0, 0].plot(p / 1e3, area(p), "-", label="A(P) model")
     ax[0, 0].plot(steps / 1e3, s["area_fraction_steps"], "o", ms=3, label="staircase steps")
     ax[0, 0].set_xlim(0.0, p_hi / 1e3)
+    ax[0, 0].set_ylim(0.0, max(1.1 * float(np.max(area(p))), 1e-3))  # a fraction: from 0, not zoomed
     ax[0, 0].set_xlabel("applied pressure (kPa)")
     ax[0, 0].set_ylabel("charged area A/S")
     ax[0, 0].legend()
