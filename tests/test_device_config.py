@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from tengsim.cli.main import main
-from tengsim.device import DeviceParams, SolverOptions, WAVEFORMS, Sine, Staircase, simulate, waveform_from_dict
+from tengsim.device import WAVEFORMS, DeviceParams, SolverOptions, Staircase, simulate, waveform_from_dict
 from tengsim.device.config import (DEVICE_TABLE, RUN_TABLE, SOLVER_TABLE, SWEEP_TABLE, fields_help, parse_waveform,
                                    waveform_table)
 from tengsim.errors import TengsimError

@@ -206,5 +206,5 @@ def staircase_summary(result: DeviceResult) -> dict:
             "area_fraction_steps": [float(result.params.area(p)) for p in steps]}
 
 
-__all__ = ["staircase_summary", "StaticVoltageCurve", "voc_from_area", "ResistanceSweep", "resistance_sweep", "steady_charge", "VQCycle", "vq_cycle",
-           "FigureOfMerit", "figure_of_merit"]
+__all__ = ["StaticVoltageCurve", "voc_from_area", "ResistanceSweep", "resistance_sweep", "steady_charge", "VQCycle",
+           "vq_cycle", "FigureOfMerit", "figure_of_merit", "staircase_summary"]

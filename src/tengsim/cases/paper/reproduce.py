@@ -6,10 +6,8 @@ strict JSON: a value that could not be measured is null, never NaN.
 """
 from __future__ import annotations
 
-import json
 import os
 import shutil
-import sys
 import tempfile
 import time
 from pathlib import Path
