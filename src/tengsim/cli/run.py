@@ -1,8 +1,10 @@
 """``tengsim run CONFIG.toml``: repeat any run described in a TOML file.
 
 The file holds one table naming the run: ``[contact]`` (the options of ``tengsim contact``, plus
-``out`` and optional ``plot``), ``[reproduce]`` (``out``, ``quick``) or ``[device]`` (see
-``tengsim device --help``).  Results carry the configuration and the package version.
+``out`` and optional ``plot``), ``[reproduce]`` (``out``, ``quick``) or ``[device]``: a device file may
+also hold ``[waveform]``, ``[run]`` (``case`` = fig7/fig8/run/sweep, ``out``, ...), ``[solver]`` and
+``[sweep]`` (``tengsim device fields`` lists every key).  Results carry the configuration and the
+package version.
 """
 from __future__ import annotations
 
