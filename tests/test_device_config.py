@@ -301,6 +301,13 @@ def test_sweep_cli_warns_and_flags_edge(tmp_path, capsys):
     assert _strict(out.with_suffix(".json").read_text())["optimum_at_edge"] is True
 
 
+def test_sweep_refuses_a_load_it_would_ignore(tmp_path, capsys):
+    cfg = tmp_path / "c.toml"
+    cfg.write_text("[device]\nload_ohm = 1e6\n")
+    assert main(["device", "sweep", "--out", str(tmp_path / "s.csv"), "--config", str(cfg), "--quiet"]) == 2
+    assert "load_ohm" in capsys.readouterr().err
+
+
 def test_device_run_says_where_it_wrote(tmp_path, capsys):
     out = tmp_path / "f7.csv"
     assert main(["device", "fig7", "--out", str(out), "--cycles", "1", "--dt", "1e-3"]) == 0

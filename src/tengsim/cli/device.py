@@ -230,13 +230,15 @@ def _sweep(cfg, cli, run, dev_cli, solver, out, quiet, source) -> int:
     from tengsim.device import resistance_sweep
     from tengsim.io import write_csv, write_json
 
+    require("load_ohm" not in cfg.get("device", {}),
+            "[device] load_ohm is not used by a sweep: the loads come from [sweep] r_min_ohm, r_max_ohm, points")
     sw_cfg = {**dc.SWEEP_TABLE.parse(cfg.get("sweep", {})), **_typed_cli(dc.SWEEP_TABLE, cli.get("sweep", {}))}
     r_min, r_max, points = sw_cfg["r_min_ohm"], sw_cfg["r_max_ohm"], sw_cfg["points"]
     require(0 < r_min < r_max, f"need 0 < r_min < r_max, got {r_min!r}, {r_max!r}")
     require(points >= 2, f"points must be >= 2, got {points!r}")
     cycles = run.get("cycles", DEFAULT_CYCLES["sweep"])
     require(cycles >= 2, f"cycles must be >= 2 for a sweep (the first is dropped), got {cycles!r}")
-    params, wf = _device_and_waveform("sweep", cfg, {k: v for k, v in dev_cli.items() if k != "load_ohm"})
+    params, wf = _device_and_waveform("sweep", cfg, dev_cli)
     loads = np.logspace(np.log10(r_min), np.log10(r_max), points)
     from tengsim.io import check_writable
 
