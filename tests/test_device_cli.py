@@ -86,7 +86,8 @@ def test_run_without_config_is_error(tmp_path):
 
 
 def test_plots(tmp_path):
-    from tengsim.device import fig8_params, resistance_sweep, run_fig7, simulate, Staircase, AreaTable
+    from tengsim.cases.paper import fig8_params, run_fig7
+    from tengsim.device import resistance_sweep, simulate, Staircase, AreaTable
     from tengsim.device.plots import plot_fig7, plot_fig8, plot_resistance_sweep, plot_vq_cycle
 
     r = run_fig7(2, dt_out=1e-4)

@@ -1,222 +1,288 @@
-"""``tengsim device``: the paper's dynamic cases (fig7, fig8), any configured device (run), load sweep."""
+"""``tengsim device``: the paper's dynamic cases (fig7, fig8), any configured device (run), load sweep.
+
+A thin shell: the config tables are read by :func:`tengsim.schema.read_config` and typed by the schema
+of :mod:`tengsim.device.config`; the paper's devices come from :mod:`tengsim.cases.paper`.
+``tengsim run FILE.toml`` with a [device] table calls :func:`run_config` with the whole file.
+"""
 from __future__ import annotations
 
+import dataclasses
 import json
-import math
 import sys
 from pathlib import Path
 
 from tengsim.errors import TengsimError, require
 
-CONFIG_HELP = ("TOML or JSON file with optional tables [device] (DeviceParams fields, SI), [waveform] "
-               "(kind = square|staircase|sine|table, ...), [run] (cycles, t_end, dt_out) and [solver] "
-               "(method, rtol, atol)")
+PRECEDENCE = "A value given as a CLI option wins over the config file, which wins over the case's default."
+CONFIG_HELP = ("TOML or JSON file with tables [device], [waveform], [run], [solver] (and [sweep] for sweep); "
+               "`tengsim device fields` lists every key. " + PRECEDENCE)
+DESCRIPTION = (
+    "Open-circuit voltage, current and power of a contact-separation TENG (paper Section 5). "
+    "Cases: fig7 and fig8 are the paper's devices, run is the [device] of --config as given, sweep is a "
+    "load-resistance sweep. A config file (--config, or `tengsim run FILE` with [run] case = ...) may hold "
+    "[device] (DeviceParams fields, SI or with units), [waveform] (kind and its fields; without kind it "
+    "changes the case's waveform), [run] (case, out, cycles, t_end, dt_out, quick), [solver] (method, rtol, "
+    "atol, max_step) and [sweep] (r_min_ohm, r_max_ohm, points, steady). Every table given is used or "
+    "refused by name; `tengsim device fields` lists every key with its unit and default. " + PRECEDENCE)
+DEFAULT_CYCLES = {"fig7": 5, "run": 5, "sweep": 3}
+
+# CLI option -> (table, key)
+_OPTIONS = {"out": ("run", "out"), "cycles": ("run", "cycles"), "t_end": ("run", "t_end"), "dt": ("run", "dt_out"),
+            "quick": ("run", "quick"), "load_ohm": ("device", "load_ohm"), "damping": ("device", "damping_ratio"),
+            "force_model": ("device", "force_model"), "initial_charge": ("device", "initial_charge"),
+            "r_min": ("sweep", "r_min_ohm"), "r_max": ("sweep", "r_max_ohm"), "points": ("sweep", "points")}
 
 
 def register(subparsers) -> None:
-    p = subparsers.add_parser("device", help="dynamic TENG output (paper Section 5)",
-                              description="Open-circuit voltage, current and power of a contact-separation TENG.")
+    from tengsim.device.params import FORCE_MODELS, INITIAL_CHARGES
+
+    p = subparsers.add_parser("device", help="dynamic TENG output (paper Section 5)", description=DESCRIPTION)
     sub = p.add_subparsers(dest="device_command", metavar="CASE")
     p.set_defaults(func=lambda args: (p.print_help(), 2)[1])
 
-    def common(sp, default_cycles):
-        sp.add_argument("--out", required=True, help="output file: .csv (one row per time, JSON sidecar) or .nc")
-        sp.add_argument("--cycles", type=int, default=default_cycles, help="periods to run (default %(default)s)")
-        sp.add_argument("--load-ohm", type=float, default=None, help="load R in ohm (0 = short, inf = open)")
-        sp.add_argument("--damping", type=float, default=None, help="damping ratio zeta (default 0.7)")
-        sp.add_argument("--force-model", choices=["field", "eq20", "none"], default=None,
-                        help="electrostatic force (default field)")
-        sp.add_argument("--initial-charge", choices=["zero", "rest"], default=None,
-                        help="Q(0): zero (paper) or rest (V = 0, no start spike)")
-        sp.add_argument("--dt", type=float, default=None, help="output time step in s")
+    def common(sp, default_cycles, sweep=False):
+        sp.add_argument("--out", help=("output .csv (one row per load, .json sidecar)" if sweep else
+                                        "output file: .csv (one row per time, .json sidecar) or .nc")
+                        + "; overrides [run] out")
+        sp.add_argument("--cycles", help=f"periods to run (overrides [run] cycles; default {default_cycles})")
+        sp.add_argument("--dt", help="output time step in s or with a unit, e.g. 0.1ms (overrides [run] dt_out)")
         sp.add_argument("--config", default=None, help=CONFIG_HELP)
         sp.add_argument("--quiet", action="store_true", help="no progress or summary output")
+        if sweep:
+            return
+        sp.add_argument("--load-ohm", help="load R in ohm or with a unit, e.g. 10MOhm (0 = short, inf = open)")
+        sp.add_argument("--damping", help="damping ratio zeta (default 0.7)")
+        sp.add_argument("--force-model", choices=FORCE_MODELS, default=None, help="electrostatic force (default field)")
+        sp.add_argument("--initial-charge", choices=INITIAL_CHARGES, default=None,
+                        help="Q(0): zero (paper) or rest (V = 0, no start spike)")
 
-    f7 = sub.add_parser("fig7", help="flat device, 10 N 5 Hz square wave (Fig. 7)")
+    f7 = sub.add_parser("fig7", help="flat device, 10 N 5 Hz square wave (Fig. 7)", description=CONFIG_HELP)
     common(f7, 5)
-    f7.set_defaults(func=_cmd_fig7)
-    f8 = sub.add_parser("fig8", help="group-A device, 10-150 kPa staircase at 2 Hz (Fig. 8)")
-    common(f8, 15)
-    f8.add_argument("--quick", action="store_true", help="quick (coarse) contact-engine area table")
-    f8.set_defaults(func=_cmd_fig8)
-    rn = sub.add_parser("run", help="any device and waveform from --config")
+    f7.add_argument("--t-end", help="run length in s or with a unit (overrides [run] t_end; default cycles x period)")
+    f7.set_defaults(func=lambda a: execute("fig7", _read(a.config), _cli(a), a.quiet, a.config))
+    f8 = sub.add_parser("fig8", help="group-A device, 10-150 kPa staircase at 2 Hz (Fig. 8)", description=CONFIG_HELP)
+    common(f8, "all 15 steps")
+    f8.add_argument("--quick", action="store_true", default=None,
+                    help="quick (coarse) contact-engine area table (overrides [run] quick)")
+    f8.set_defaults(func=lambda a: execute("fig8", _read(a.config), _cli(a), a.quiet, a.config))
+    rn = sub.add_parser("run", help="any device and waveform from --config", description=CONFIG_HELP)
     common(rn, 5)
-    rn.add_argument("--t-end", type=float, default=None, help="run length in s (else cycles x period)")
-    rn.set_defaults(func=_cmd_run)
-    sw = sub.add_parser("sweep", help="load-resistance sweep of the Fig. 7 device (or --config)")
-    sw.add_argument("--out", required=True, help="output .csv (one row per load)")
-    sw.add_argument("--r-min", type=float, default=1e3)
-    sw.add_argument("--r-max", type=float, default=1e10)
-    sw.add_argument("--points", type=int, default=15)
-    sw.add_argument("--cycles", type=int, default=3)
-    sw.add_argument("--config", default=None, help=CONFIG_HELP)
-    sw.add_argument("--quiet", action="store_true")
-    sw.set_defaults(func=_cmd_sweep)
+    rn.add_argument("--t-end", help="run length in s or with a unit (overrides [run] t_end; default cycles x period)")
+    rn.set_defaults(func=lambda a: execute("run", _read(a.config), _cli(a), a.quiet, a.config))
+    sw = sub.add_parser("sweep", help="load-resistance sweep of the Fig. 7 device (or --config)",
+                        description=CONFIG_HELP)
+    common(sw, 3, sweep=True)
+    sw.add_argument("--r-min", help="smallest load in ohm or with a unit (overrides [sweep] r_min_ohm; default 1e3)")
+    sw.add_argument("--r-max", help="largest load in ohm or with a unit (overrides [sweep] r_max_ohm; default 1e10)")
+    sw.add_argument("--points", help="loads, log-spaced (overrides [sweep] points; default 15)")
+    sw.set_defaults(func=lambda a: execute("sweep", _read(a.config), _cli(a), a.quiet, a.config))
+    fl = sub.add_parser("fields", help="list every config table and key (from the dataclasses)")
+    fl.set_defaults(func=_cmd_fields)
 
 
-# --- config ---
+# --- config and options ---
 
-def _read_config(path) -> dict:
+def _read(path) -> dict:
     if path is None:
         return {}
-    path = Path(path)
-    require(path.is_file(), f"config file not found: {str(path)!r}")
-    text = path.read_text()
-    try:
-        if path.suffix.lower() == ".json":
-            cfg = json.loads(text)
-        else:
-            import tomllib
+    from tengsim.schema import read_config
 
-            cfg = tomllib.loads(text)
-    except Exception as exc:  # noqa: BLE001 - any parse error is bad input
-        raise TengsimError(f"malformed config {str(path)!r}: {exc}") from None
-    require(isinstance(cfg, dict), f"config {str(path)!r} must be a mapping")
-    unknown = sorted(set(cfg) - {"device", "waveform", "run", "solver"})
-    require(not unknown, f"config {str(path)!r}: unknown table(s) {unknown}")
-    for key in cfg:
-        require(isinstance(cfg[key], dict), f"config {str(path)!r}: [{key}] must be a table")
-    return cfg
+    return read_config(path)
 
 
-def _params(base, cfg, args):
-    from tengsim.device import DeviceParams
-
-    d = base.to_dict() if base is not None else {}
-    d.update(cfg.get("device", {}))
-    if args.load_ohm is not None:
-        d["load_ohm"] = args.load_ohm
-    if getattr(args, "damping", None) is not None:
-        d["damping_ratio"] = args.damping
-    if getattr(args, "force_model", None) is not None:
-        d["force_model"] = args.force_model
-    if getattr(args, "initial_charge", None) is not None:
-        d["initial_charge"] = args.initial_charge
-    return DeviceParams.from_dict(d)
-
-
-def _solver(cfg):
-    from tengsim.device import SolverOptions
-
-    try:
-        return SolverOptions(**cfg.get("solver", {}))
-    except TypeError as exc:
-        raise TengsimError(f"[solver]: {exc}") from None
-
-
-def _check_out(path) -> Path:
-    out = Path(path)
-    require(out.suffix.lower() in (".csv", ".nc"), f"--out must end in .csv or .nc, got {str(path)!r}")
+def _cli(args) -> dict:
+    """Options given on the command line, as {table: {key: raw value}}."""
+    out = {}
+    for opt, (table, key) in _OPTIONS.items():
+        v = getattr(args, opt, None)
+        if v is not None and v != "":
+            out.setdefault(table, {})[key] = v
     return out
 
 
-def _check_run_args(args):
-    require(args.cycles is not None and args.cycles >= 1, f"--cycles must be >= 1, got {args.cycles!r}")
-    if args.dt is not None:
-        require(math.isfinite(args.dt) and args.dt > 0, f"--dt must be > 0, got {args.dt!r}")
-    if args.load_ohm is not None:
-        require(args.load_ohm >= 0, f"--load-ohm must be >= 0, got {args.load_ohm!r}")
+def _typed_cli(table, values: dict) -> dict:
+    """CLI values typed by the table's own fields; an error names the option (--load-ohm, not load_ohm)."""
+    names = {key: "--" + opt.replace("_", "-") for opt, (_, key) in _OPTIONS.items()}
+    out = {}
+    for key, raw in values.items():
+        f = dataclasses.replace(table.fields[key], name=names[key])
+        out[key] = f.parse(raw)
+    return out
 
 
-def _write(result, out: Path, summary: dict, quiet: bool) -> int:
+def _out_path(run: dict, case: str) -> Path:
+    """The output path (checked by suffix only: nothing is created before every input has been checked)."""
+    out = run.get("out")
+    require(out, "give --out FILE (or [run] out = 'FILE' in the config)")
+    out = Path(out)
+    allowed = (".csv",) if case == "sweep" else (".csv", ".nc")
+    require(out.suffix.lower() in allowed, f"out must end in {' or '.join(allowed)}, got {str(out)!r}")
+    return out
+
+
+# --- the one path every device run takes ---
+
+def execute(case: str, cfg: dict, cli: dict | None = None, quiet: bool = False, source: str | None = None) -> int:
+    """Run device ``case`` (fig7, fig8, run, sweep) from config tables ``cfg`` and CLI values ``cli``."""
+    from tengsim.device import config as dc
+
+    cli = cli or {}
+    dc.check_device_tables(cfg, source or "config")
+    if "sweep" in cfg and case != "sweep":
+        raise TengsimError(f"[sweep] is used only by the sweep case, not {case}")
+    run = {**dc.parse_run(cfg.get("run", {}), case), **_typed_cli(dc.RUN_TABLE, cli.get("run", {}))}
+    dev_cli = _typed_cli(dc.DEVICE_TABLE, cli.get("device", {}))
+    solver = dc.parse_solver(cfg.get("solver", {}))
+    out = _out_path(run, case)
+    if case == "sweep":
+        return _sweep(cfg, cli, run, dev_cli, solver, out, quiet, source)
+    params, wf = _device_and_waveform(case, cfg, dev_cli)
+    from tengsim.device import simulate
+    from tengsim.io import check_writable
+
+    if case == "fig8":
+        from tengsim.cases.paper import fig8_area_table, fig8_summary
+
+        n = len(wf.amplitudes_Pa)
+        cycles = run.get("cycles", n)
+        require(cycles <= n, f"cycles = {cycles} but the staircase has {n} steps (give at most {n})")
+        wf = dataclasses.replace(wf, amplitudes_Pa=wf.amplitudes_Pa[:cycles])
+        check_writable(out)
+        if "area" not in cfg.get("device", {}):  # the slow contact engine runs only after every check
+            params = params.replace(area=fig8_area_table(bool(run.get("quick", False))))
+        res = simulate(params, wf, wf.duration, dt_out=run.get("dt_out", 1e-4), options=solver, progress=not quiet)
+        summary = fig8_summary(res)
+    else:
+        t_end = run.get("t_end")
+        if t_end is None:
+            per = wf.period or wf.duration
+            require(per is not None, "give --t-end (or [run] t_end) for a waveform with no period")
+            t_end = run.get("cycles", DEFAULT_CYCLES[case]) * per
+        check_writable(out)
+        res = simulate(params, wf, t_end, dt_out=run.get("dt_out"), options=solver, progress=not quiet)
+        skip = 1 if (wf.period and t_end >= 2 * wf.period - 1e-12) else 0
+        if case == "fig7":
+            from tengsim.cases.paper import fig7_summary
+
+            summary = fig7_summary(res, skip)
+        else:
+            from tengsim.cases._json import json_safe
+
+            summary = json_safe(res.summary(skip))
+    return _write(res, out, summary, quiet, {"case": case, "config": cfg, "config_file": source})
+
+
+def _device_and_waveform(case, cfg, dev_cli):
+    """The case's device and waveform with the [device] and [waveform] tables and CLI values applied."""
+    from tengsim.device import config as dc
+
+    base_wf = None
+    if case in ("fig7", "sweep"):
+        from tengsim.cases.paper import fig7_params, fig7_waveform
+
+        params = dc.parse_device(cfg.get("device", {}), fig7_params(), dev_cli)
+        base_wf = fig7_waveform(area_m2=params.area_m2)
+    elif case == "fig8":
+        from tengsim.cases.paper import fig8_params, fig8_waveform
+        from tengsim.device import ConstantArea
+
+        params = dc.parse_device(cfg.get("device", {}), fig8_params(ConstantArea(1.0)), dev_cli)
+        base_wf = fig8_waveform()
+    else:
+        require("device" in cfg, "device run needs a config with [device] and [waveform] (--config FILE)")
+        params = dc.parse_device(cfg["device"], None, dev_cli)
+        require("waveform" in cfg, "device run needs a [waveform] table in its config (kind = square, ...)")
+    wf = dc.parse_waveform(cfg["waveform"], base_wf) if "waveform" in cfg else base_wf
+    if case == "fig8":
+        from tengsim.device import Staircase
+
+        require(isinstance(wf, Staircase), f"fig8 needs [waveform] kind = 'staircase', got {wf.to_dict()['kind']!r} "
+                "(use `tengsim device run` for other waveforms)")
+    if case == "sweep":
+        require(getattr(wf, "period", None) is not None, "a load sweep needs a periodic waveform")
+    return params, wf
+
+
+def _write(result, out: Path, summary: dict, quiet: bool, provenance: dict) -> int:
     from tengsim.io import write_dataset, write_json
 
     if out.suffix.lower() == ".nc":
-        write_dataset(result.to_dataset(), out)
+        ds = result.to_dataset()
+        ds.attrs["summary"] = json.dumps(summary)
+        ds.attrs["run"] = json.dumps(provenance, default=str)
+        write_dataset(ds, out)
+        where = f"{out}"
     else:
         result.write_csv(out)
-        write_json(out.with_suffix(".json"), {**result.header(), "summary": summary})
+        side = out.with_suffix(".json")
+        write_json(side, {**result.header(), "summary": summary, "run": provenance})
+        where = f"{out} (+ {side.name})"
     if not quiet:
-        print(json.dumps(summary, indent=1, default=str))
+        print(json.dumps(summary, indent=1))
+        print(f"wrote {where}", file=sys.stderr)
     return 0
 
 
-# --- commands ---
-
-def _cmd_fig7(args) -> int:
-    from tengsim.device import fig7_params, fig7_summary, fig7_waveform, simulate
-
-    out = _check_out(args.out)
-    _check_run_args(args)
-    cfg = _read_config(args.config)
-    params = _params(fig7_params(), cfg, args)
-    wf = fig7_waveform(area_m2=params.area_m2)
-    run = cfg.get("run", {})
-    res = simulate(params, wf, args.cycles * wf.period, dt_out=args.dt or run.get("dt_out"),
-                   options=_solver(cfg), progress=not args.quiet)
-    skip = 1 if args.cycles > 1 else 0
-    return _write(res, out, fig7_summary(res, skip), args.quiet)
-
-
-def _cmd_fig8(args) -> int:
-    from tengsim.device import ConstantArea, fig8_params, fig8_summary, fig8_waveform, simulate
-
-    out = _check_out(args.out)
-    _check_run_args(args)
-    cfg = _read_config(args.config)
-    dev = cfg.get("device", {})
-    flat = fig8_params(ConstantArea(1.0))
-    if "area" in dev:  # the config's own A(P) replaces the contact engine's
-        params = _params(None if "mass_kg" in dev else flat, cfg, args)
-    else:
-        _params(flat, cfg, args)  # validate the overrides before the (slow) contact engine runs
-        from tengsim.paper import area_table
-
-        params = _params(fig8_params(area_table("A", quick=args.quick)), cfg, args)
-    amps = fig8_waveform().amplitudes_Pa[: args.cycles]
-    wf = fig8_waveform(amps)
-    res = simulate(params, wf, wf.duration, dt_out=args.dt or cfg.get("run", {}).get("dt_out", 1e-4),
-                   options=_solver(cfg), progress=not args.quiet)
-    return _write(res, out, fig8_summary(res), args.quiet)
-
-
-def _cmd_run(args) -> int:
-    from tengsim.device import simulate, waveform_from_dict
-
-    out = _check_out(args.out)
-    _check_run_args(args)
-    cfg = _read_config(args.config)
-    require("device" in cfg and "waveform" in cfg, "device run needs --config with [device] and [waveform]")
-    params = _params(None, cfg, args)
-    wf = waveform_from_dict(cfg["waveform"])
-    run = cfg.get("run", {})
-    t_end = args.t_end or run.get("t_end")
-    if t_end is None:
-        per = wf.period or wf.duration
-        require(per is not None, "give --t-end (or [run] t_end) for this waveform")
-        t_end = int(run.get("cycles", args.cycles)) * per
-    res = simulate(params, wf, t_end, dt_out=args.dt or run.get("dt_out"), options=_solver(cfg),
-                   progress=not args.quiet)
-    skip = 1 if (wf.period and t_end >= 2 * wf.period) else 0
-    return _write(res, out, res.summary(skip), args.quiet)
-
-
-def _cmd_sweep(args) -> int:
+def _sweep(cfg, cli, run, dev_cli, solver, out, quiet, source) -> int:
     import numpy as np
 
-    from tengsim.device import fig7_params, fig7_waveform, resistance_sweep, waveform_from_dict
+    from tengsim.device import config as dc
+    from tengsim.device import resistance_sweep
     from tengsim.io import write_csv, write_json
 
-    out = Path(args.out)
-    require(out.suffix.lower() == ".csv", f"--out must end in .csv, got {args.out!r}")
-    require(0 < args.r_min < args.r_max and math.isfinite(args.r_max),
-            f"need 0 < --r-min < --r-max, got {args.r_min!r}, {args.r_max!r}")
-    require(args.points >= 2, f"--points must be >= 2, got {args.points!r}")
-    require(args.cycles >= 2, f"--cycles must be >= 2, got {args.cycles!r}")
-    cfg = _read_config(args.config)
-    args.load_ohm = None
-    params = _params(fig7_params(), cfg, args)
-    wf = waveform_from_dict(cfg["waveform"]) if "waveform" in cfg else fig7_waveform(area_m2=params.area_m2)
-    sw = resistance_sweep(params, wf, np.logspace(np.log10(args.r_min), np.log10(args.r_max), args.points),
-                          cycles=args.cycles, options=_solver(cfg), progress=not args.quiet)
-    head = {"params": params.to_dict(), "waveform": wf.to_dict(), "optimum_ohm": sw.optimum_ohm,
-            "optimum_power_W": sw.optimum_power_W}
+    require("load_ohm" not in cfg.get("device", {}),
+            "[device] load_ohm is not used by a sweep: the loads come from [sweep] r_min_ohm, r_max_ohm, points")
+    sw_cfg = {**dc.SWEEP_TABLE.parse(cfg.get("sweep", {})), **_typed_cli(dc.SWEEP_TABLE, cli.get("sweep", {}))}
+    r_min, r_max, points = sw_cfg["r_min_ohm"], sw_cfg["r_max_ohm"], sw_cfg["points"]
+    require(0 < r_min < r_max, f"need 0 < r_min < r_max, got {r_min!r}, {r_max!r}")
+    require(points >= 2, f"points must be >= 2, got {points!r}")
+    cycles = run.get("cycles", DEFAULT_CYCLES["sweep"])
+    require(cycles >= 2, f"cycles must be >= 2 for a sweep (the first is dropped), got {cycles!r}")
+    params, wf = _device_and_waveform("sweep", cfg, dev_cli)
+    loads = np.logspace(np.log10(r_min), np.log10(r_max), points)
+    from tengsim.io import check_writable
+
+    check_writable(out)
+    sw = resistance_sweep(params, wf, loads, cycles=cycles, steady=sw_cfg["steady"], dt_out=run.get("dt_out"),
+                          options=solver, progress=not quiet)
+    from tengsim.cases._json import json_safe
+
+    head = json_safe({"params": params.to_dict(), "waveform": wf.to_dict(), "optimum_ohm": sw.optimum_ohm,
+                      "optimum_power_W": sw.optimum_power_W, "optimum_at_edge": sw.optimum_at_edge,
+                      "run": {"case": "sweep", "cycles": cycles, "config": cfg, "config_file": source}})
     write_csv(out, {"R": sw.load_ohm, "energy_per_cycle": sw.energy_per_cycle_J, "average_power": sw.average_power_W,
                     "peak_voltage": sw.peak_voltage_V, "peak_current": sw.peak_current_A}, head)
-    write_json(out.with_suffix(".json"), head)
-    if not args.quiet:
-        print(f"optimum load {sw.optimum_ohm:.4g} ohm, mean power {sw.optimum_power_W:.4g} W", file=sys.stdout)
+    side = out.with_suffix(".json")
+    write_json(side, head)
+    if sw.optimum_at_edge:
+        print(f"tengsim: warning: the mean power is largest at the edge of the swept range (R = "
+              f"{sw.optimum_ohm:.4g} ohm): no optimum inside {r_min:.3g}..{r_max:.3g} ohm; widen the range",
+              file=sys.stderr)
+    if not quiet:
+        what = "largest mean power in the range (at its edge)" if sw.optimum_at_edge else "optimum load"
+        print(f"{what}: R = {sw.optimum_ohm:.4g} ohm, mean power {sw.optimum_power_W:.4g} W")
+        print(f"wrote {out} (+ {side.name})", file=sys.stderr)
     return 0
 
 
-__all__ = ["register"]
+def _cmd_fields(args) -> int:
+    from tengsim.device.config import fields_help
+
+    print(fields_help())
+    return 0
+
+
+def run_config(cfg_tables: dict, args) -> int:
+    """``tengsim run FILE.toml`` with a [device] table: the file is a device config whose [run] names the
+    case (fig7, fig8, run, sweep; default run) and the output (``out``); ``args.quiet`` is honoured."""
+    from tengsim.device import config as dc
+
+    source = str(getattr(args, "config", "") or "") or None
+    dc.check_device_tables(cfg_tables, source or "config")
+    run = cfg_tables.get("run", {})
+    case = dc.RUN_TABLE.fields["case"].parse(run["case"], "[run] ") if isinstance(run, dict) and "case" in run \
+        else "run"
+    return execute(case, cfg_tables, {}, bool(getattr(args, "quiet", False)), source)
+
+
+__all__ = ["register", "execute", "run_config", "PRECEDENCE"]

@@ -1,7 +1,6 @@
 """``tengsim reproduce``: the paper's Figs. 3, 4, 5, 7, 8 with data and summary.json."""
 from __future__ import annotations
 
-import json
 import sys
 
 
@@ -16,17 +15,14 @@ def register(sub):
 
 
 def run(args) -> int:
+    from tengsim.cases.paper.reproduce import reproduce, summary_text
     from tengsim.progress import Progress
-    from tengsim.reproduce import reproduce
 
     log = None if args.quiet else (lambda m: print(m, file=sys.stderr, flush=True))
     summary = reproduce(args.out, quick=args.quick, log=log,
                         progress_factory=lambda label: Progress(args.quiet))
     if not args.quiet:
-        c = summary["contact"]
-        for g, s in c.items():
-            print(f"group {g}: transition D = {s['transition_D']:.3g} (paper {s['transition_D_paper']}), "
-                  f"pull-off F = {s['pull_off_F']:.4g}, V_OC sat = {s.get('voc_saturation_V', float('nan')):.4g} V",
-                  file=sys.stderr)
+        for line in summary_text(summary):
+            print(line, file=sys.stderr)
         print(f"wrote {args.out}/ (summary.json, fig3..fig8) in {summary['seconds']:.0f} s", file=sys.stderr)
     return 0

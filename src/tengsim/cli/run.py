@@ -1,8 +1,10 @@
 """``tengsim run CONFIG.toml``: repeat any run described in a TOML file.
 
 The file holds one table naming the run: ``[contact]`` (the options of ``tengsim contact``, plus
-``out`` and optional ``plot``), ``[reproduce]`` (``out``, ``quick``) or ``[device]`` (see
-``tengsim device --help``).  Results carry the configuration and the package version.
+``out`` and optional ``plot``), ``[reproduce]`` (``out``, ``quick``) or ``[device]``: a device file may
+also hold ``[waveform]``, ``[run]`` (``case`` = fig7/fig8/run/sweep, ``out``, ...), ``[solver]`` and
+``[sweep]`` (``tengsim device fields`` lists every key).  Results carry the configuration and the
+package version.
 """
 from __future__ import annotations
 
@@ -24,8 +26,12 @@ def run(args) -> int:
     from tengsim.schema import check_tables, read_config
 
     cfg = read_config(args.config)
-    check_tables(cfg, ("contact", "device", "reproduce"), where=str(args.config))
-    kinds = [k for k in ("contact", "device", "reproduce") if k in cfg]
+    if "device" in cfg:  # a device file: [device], [waveform], [run], [solver], [sweep] (tengsim device fields)
+        from tengsim.cli import device as device_cli
+
+        return device_cli.run_config(cfg, args)
+    check_tables(cfg, ("contact", "reproduce"), where=str(args.config))
+    kinds = [k for k in ("contact", "reproduce") if k in cfg]
     if len(kinds) != 1:
         raise TengsimError(f"{args.config}: needs exactly one of [contact], [device], [reproduce]")
     kind = kinds[0]
@@ -41,9 +47,6 @@ def run(args) -> int:
         out, quick = vals["out"], vals["quick"]
         reproduce(out, quick=quick, log=None if args.quiet else (lambda m: print(m, file=sys.stderr)))
         return 0
-    from tengsim.cli import device as device_cli
-
-    return device_cli.run_config(section, args)
 
 
 def _contact(section, args) -> int:

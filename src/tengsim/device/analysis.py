@@ -1,6 +1,7 @@
 """What TENG users expect beyond the paper: static V_OC(pressure) (Eq. 12), load sweep, V-Q cycles, FOM_S."""
 from __future__ import annotations
 
+import math
 import sys
 from dataclasses import dataclass
 
@@ -73,6 +74,8 @@ class ResistanceSweep:
     peak_current_A: np.ndarray
     optimum_ohm: float
     optimum_power_W: float
+    optimum_at_edge: bool = False
+    """True when the largest power is at the first or last load: the optimum may lie outside the range."""
 
     def to_dataset(self):
         import xarray as xr
@@ -82,7 +85,8 @@ class ResistanceSweep:
              "peak_voltage": ("R", self.peak_voltage_V, {"units": "V"}),
              "peak_current": ("R", self.peak_current_A, {"units": "A"})}
         return xr.Dataset(v, coords={"R": ("R", self.load_ohm, {"units": "ohm"})},
-                          attrs={"optimum_ohm": self.optimum_ohm, "optimum_power_W": self.optimum_power_W})
+                          attrs={"optimum_ohm": self.optimum_ohm, "optimum_power_W": self.optimum_power_W,
+                                 "optimum_at_edge": int(self.optimum_at_edge)})
 
 
 def steady_charge(params: DeviceParams, waveform, options: SolverOptions | None = None) -> float:
@@ -107,7 +111,8 @@ def resistance_sweep(params: DeviceParams, waveform, loads_ohm, *, cycles: int =
     """Run ``cycles`` periods per load; energy per cycle = heat in R over the settled cycles.
 
     With ``steady`` each run starts from :func:`steady_charge`, so the numbers are periodic-steady-state
-    values even where R C exceeds the run.
+    values even where R C exceeds the run. ``optimum_at_edge`` is set when the largest power is at the
+    smallest or largest load (then it is the best of the range, not an optimum).
     """
     loads = np.asarray(loads_ohm, dtype=float).ravel()
     require(loads.size >= 1, "loads_ohm is empty")
@@ -121,13 +126,16 @@ def resistance_sweep(params: DeviceParams, waveform, loads_ohm, *, cycles: int =
         q0 = steady_charge(pr, waveform, options) if steady else None
         res = simulate(pr, waveform, int(cycles) * per, dt_out=dt_out, options=options, q0_C=q0)
         s = res.summary(skip_cycles)
-        rows.append((s["energy_per_cycle_J"], s["average_power_W"], s["peak_voltage_V"], s["peak_current_A"]))
+        rows.append(tuple(math.nan if s[k] is None else s[k]
+                          for k in ("energy_per_cycle_J", "average_power_W", "peak_voltage_V", "peak_current_A")))
         if progress:
             print(f"tengsim device: R = {r:.3g} ohm ({i + 1}/{loads.size}), P = {s['average_power_W']:.3g} W",
                   file=sys.stderr, flush=True)
-    e, p, v, c = (np.array(col) for col in zip(*rows))
+    e, p, v, c = (np.array(col, dtype=float) for col in zip(*rows))
+    require(bool(np.any(np.isfinite(p))), "no load gave a settled cycle: raise cycles")
     k = int(np.nanargmax(p))
-    return ResistanceSweep(loads, e, p, v, c, float(loads[k]), float(p[k]))
+    edge = loads.size > 1 and k in (int(np.argmin(loads)), int(np.argmax(loads)))
+    return ResistanceSweep(loads, e, p, v, c, float(loads[k]), float(p[k]), bool(edge))
 
 
 # --- V-Q cycle and the structural figure of merit (Zi et al. 2015) ---
@@ -157,7 +165,7 @@ def vq_cycle(result: DeviceResult, cycle: int = -1) -> VQCycle:
     x_max = float(np.max(result.gap[m]))
     area = float(np.max(result.area[m]))
     cm = fm.cmeo_cycle(p.sigma_C_per_m2, p.area_m2, p.thickness_m, p.eps_r, x_max, area=area)
-    return VQCycle(q, v, float(np.trapezoid(v, q)), x_max, cm)
+    return VQCycle(q, v, fm.trapezoid(v, q), x_max, cm)
 
 
 @dataclass(frozen=True)
@@ -179,5 +187,24 @@ def figure_of_merit(params: DeviceParams, x_max: float | None = None) -> FigureO
                          cm.energy_J, float(x))
 
 
-__all__ = ["StaticVoltageCurve", "voc_from_area", "ResistanceSweep", "resistance_sweep", "steady_charge", "VQCycle", "vq_cycle",
-           "FigureOfMerit", "figure_of_merit"]
+# --- staircase (one pressure per pulse) ---
+
+def staircase_summary(result: DeviceResult) -> dict:
+    """V_OC per pressure step of a :class:`Staircase` run: the largest Eq. (17) voltage after that step's
+    release, the peak |V| during the step, and the area fraction A(P_k). A step with no rows is None."""
+    wf = result.waveform
+    require(hasattr(wf, "amplitudes_Pa"), "a staircase summary needs a Staircase run")
+    per = wf.period
+    steps, vocs, peak_v = [], [], []
+    for k, amp in enumerate(wf.amplitudes_Pa):
+        after = (result.t >= (k + wf.duty) * per) & (result.t < (k + 1) * per)
+        step = (result.t >= k * per) & (result.t < (k + 1) * per)
+        vocs.append(float(np.max(result.V_oc[after])) if np.any(after) else None)
+        peak_v.append(float(np.max(np.abs(result.V[step]))) if np.any(step) else None)
+        steps.append(float(amp))
+    return {"pressure_steps_Pa": steps, "voc_steps_V": vocs, "peak_voltage_steps_V": peak_v,
+            "area_fraction_steps": [float(result.params.area(p)) for p in steps]}
+
+
+__all__ = ["StaticVoltageCurve", "voc_from_area", "ResistanceSweep", "resistance_sweep", "steady_charge", "VQCycle",
+           "vq_cycle", "FigureOfMerit", "figure_of_merit", "staircase_summary"]

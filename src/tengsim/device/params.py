@@ -22,6 +22,19 @@ AREA_MEMORIES = ("max", "release")
 INITIAL_CHARGES = ("zero", "rest")
 
 
+_NO_DEFAULT = object()
+
+
+def _f(help_text: str, default=_NO_DEFAULT, **meta):
+    """A dataclass field whose help (and optional ``dim``, ``choices``) the config schema reads."""
+    meta = {"help": help_text, **meta}
+    if default is _NO_DEFAULT:
+        return field(metadata=meta)
+    if callable(default) and not isinstance(default, (int, float, str)):
+        return field(default_factory=default, metadata=meta)
+    return field(default=default, metadata=meta)
+
+
 @dataclass(frozen=True)
 class ConstantArea:
     """Charged area A = fraction * S, independent of pressure (flat interface, Fig. 7)."""
@@ -89,6 +102,53 @@ class AreaTable:
                 "area_fraction": self.area_fraction.tolist()}
 
 
+@dataclass(frozen=True, eq=False)
+class AreaFunction:
+    """Any callable pressure (Pa) -> charged-area fraction A/S in [0, 1], e.g. a user's model.
+
+    ``initial_fraction`` is the charged fraction before the first contact (0: a patterned polymer).
+    """
+
+    function: object
+    initial_fraction: float = 0.0
+    name: str = ""
+
+    def __post_init__(self):
+        require(callable(self.function), f"area model must be callable, got {type(self.function).__name__}")
+        f = finite("initial_fraction", self.initial_fraction)
+        require(0.0 <= f <= 1.0, f"initial_fraction must be in [0, 1], got {self.initial_fraction!r}")
+        object.__setattr__(self, "initial_fraction", f)
+        if not self.name:
+            object.__setattr__(self, "name", getattr(self.function, "__qualname__", type(self.function).__name__))
+
+    def __call__(self, pressure_Pa):
+        p = np.asarray(pressure_Pa, dtype=float)
+        a = np.asarray(self.function(p), dtype=float)
+        if a.shape != p.shape:
+            a = np.broadcast_to(a, p.shape).astype(float)
+        require(bool(np.all((a >= 0) & (a <= 1))),
+                f"area model {self.name!r} returned a fraction outside [0, 1]: {np.ravel(a)[:3].tolist()}")
+        return a
+
+    def to_dict(self) -> dict:
+        return {"kind": "function", "name": self.name, "initial_fraction": self.initial_fraction}
+
+
+def area_model(area):
+    """The charged-area model for ``area``: a number (constant fraction), an area model, or any callable
+    pressure (Pa) -> A/S (wrapped in :class:`AreaFunction`)."""
+    if isinstance(area, (ConstantArea, AreaTable, AreaFunction)):
+        return area
+    if isinstance(area, (int, float)) and not isinstance(area, bool):
+        return ConstantArea(area)
+    if hasattr(area, "pressure_Pa") and hasattr(area, "area_fraction"):
+        return AreaTable.from_table(area)
+    if callable(area):
+        return AreaFunction(area)
+    raise TengsimError(f"area must be a fraction, an AreaTable or a callable pressure -> A/S, "
+                       f"got {type(area).__name__}")
+
+
 def _choice(name, value, allowed):
     require(value in allowed, f"{name} must be one of {list(allowed)}, got {value!r}")
     return value
@@ -104,21 +164,26 @@ class DeviceParams:
     corrected, 1/d regularised by ``eq20_reg`` d0) or "none".
     """
 
-    mass_kg: float
-    stiffness_N_per_m: float
-    area_m2: float
-    thickness_m: float
-    gap_m: float
-    eps_r: float
-    sigma_C_per_m2: float
-    load_ohm: float = 1.0e6
-    damping_ratio: float = 0.7
-    area: ConstantArea | AreaTable = field(default_factory=ConstantArea)
-    force_model: str = "field"
-    eq20_reg: float = 1.0e-3
-    area_pressure: str = "applied"
-    area_memory: str = "max"
-    initial_charge: str = "zero"
+    mass_kg: float = _f("moving plate mass M")
+    stiffness_N_per_m: float = _f("spring stiffness k_e (N/m; a unit such as '5.12kN/m' is read)",
+                                  dim="energy/area")
+    area_m2: float = _f("electrode area S (m2, plain number)")
+    thickness_m: float = _f("dielectric thickness T")
+    gap_m: float = _f("rest air gap d0")
+    eps_r: float = _f("relative permittivity of the dielectric")
+    sigma_C_per_m2: float = _f("tribo-charge density sigma")
+    load_ohm: float = _f("load R; 0 = short circuit, 'inf' = open circuit", 1.0e6)
+    damping_ratio: float = _f("damping ratio zeta, c = 2 zeta sqrt(M k_e)", 0.7)
+    area: ConstantArea | AreaTable | AreaFunction = _f(
+        "charged-area model: a fraction, or a table {pressure_Pa = [...], area_fraction = [...]}", ConstantArea)
+    force_model: str = _f("electrostatic force on the plate", "field", choices=FORCE_MODELS)
+    eq20_reg: float = _f("eq20 only: the 1/d term uses d + eq20_reg d0", 1.0e-3)
+    area_pressure: str = _f("pressure that sets A in contact: applied P_a, or contact P_a - k_e d0/S",
+                            "applied", choices=AREA_PRESSURES)
+    area_memory: str = _f("charged area in flight: largest reached, or the area at release", "max",
+                          choices=AREA_MEMORIES)
+    initial_charge: str = _f("Q(0): zero (paper), or rest (V = 0, no start spike)", "zero",
+                             choices=INITIAL_CHARGES)
 
     def __post_init__(self):
         for name in ("mass_kg", "stiffness_N_per_m", "area_m2", "thickness_m", "gap_m", "eps_r",
@@ -133,8 +198,7 @@ class DeviceParams:
         z = finite("damping_ratio", self.damping_ratio)
         require(z >= 0, f"damping_ratio must be >= 0, got {self.damping_ratio!r}")
         object.__setattr__(self, "damping_ratio", z)
-        require(isinstance(self.area, (ConstantArea, AreaTable)),
-                f"area must be ConstantArea or AreaTable, got {type(self.area).__name__}")
+        object.__setattr__(self, "area", area_model(self.area))
         _choice("force_model", self.force_model, FORCE_MODELS)
         _choice("area_pressure", self.area_pressure, AREA_PRESSURES)
         _choice("area_memory", self.area_memory, AREA_MEMORIES)
@@ -200,44 +264,22 @@ class DeviceParams:
         return d
 
     @classmethod
-    def from_dict(cls, d: dict) -> "DeviceParams":
-        """Build from a plain mapping (config file); ``area`` is a number or {pressure_Pa, area_fraction}."""
-        require(isinstance(d, dict), f"device parameters must be a mapping, got {type(d).__name__}")
-        d = dict(d)
-        allowed = {f.name for f in cls.__dataclass_fields__.values()}
-        unknown = sorted(set(d) - allowed)
-        require(not unknown, f"unknown device parameter(s): {unknown}")
-        area = d.get("area", None)
-        if area is None:
-            d.pop("area", None)
-        elif isinstance(area, dict):
-            kind = area.get("kind", "table" if "pressure_Pa" in area else "constant")
-            if kind == "constant":
-                d["area"] = ConstantArea(area.get("fraction", 1.0))
-            else:
-                require("pressure_Pa" in area and "area_fraction" in area,
-                        "area table needs 'pressure_Pa' and 'area_fraction'")
-                d["area"] = AreaTable(area["pressure_Pa"], area["area_fraction"])
-        else:
-            d["area"] = ConstantArea(area)
-        if isinstance(d.get("load_ohm"), str):
-            require(d["load_ohm"].lower() in ("inf", "open"), f"load_ohm must be a number or 'inf', got {d['load_ohm']!r}")
-            d["load_ohm"] = math.inf
-        missing = [f.name for f in dataclasses.fields(cls)
-                   if f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING
-                   and f.name not in d]
-        require(not missing, f"missing device parameter(s): {missing}")
-        return cls(**d)
+    def from_dict(cls, d: dict, base: "DeviceParams | None" = None) -> "DeviceParams":
+        """Build from a [device] mapping through the config schema; keys missing there come from ``base``."""
+        from tengsim.device.config import parse_device
+
+        return parse_device(d, base)
 
 
 @dataclass(frozen=True)
 class SolverOptions:
     """Integrator settings for the flight phases (scipy.integrate.solve_ivp)."""
 
-    method: str = "LSODA"
-    rtol: float = 1e-8
-    atol: float = 1e-10
-    max_step: float = math.inf
+    method: str = _f("scipy.integrate.solve_ivp method", "LSODA",
+                     choices=("RK45", "DOP853", "Radau", "BDF", "LSODA"))
+    rtol: float = _f("relative tolerance", 1e-8)
+    atol: float = _f("absolute tolerance (dimensionless state)", 1e-10)
+    max_step: float = _f("largest integrator step (s); default unlimited", math.inf, dim="time")
 
     def __post_init__(self):
         _choice("method", self.method, ("RK45", "DOP853", "Radau", "BDF", "LSODA"))

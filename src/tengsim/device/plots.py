@@ -55,20 +55,30 @@ def plot_fig7(result, path) -> None:
 
 
 def plot_fig8(result, path, table=None) -> None:
-    """Fig. 8: (a) A/S against pressure, (b) V_OC(t) under the staircase, with the per-step V_OC."""
-    from tengsim.device.paper import fig8_summary
+    """Staircase run as Fig. 8: (a) A/S against pressure over the staircase's range, (b) V_OC(t) with
+    the per-step V_OC. The pressure axis spans 0 to 1.1 x the largest step (not the area table's range)."""
+    from tengsim.device.analysis import staircase_summary
 
     plt, fig, ax = _figure(1, 2, (12, 4.5))
     area = result.params.area
-    p = np.asarray(getattr(area, "pressure_Pa", np.linspace(0, 1.5e5, 50)))
-    ax[0, 0].plot(p / 1e3, area(p), "-")
+    s = staircase_summary(result)
+    steps = np.asarray(s["pressure_steps_Pa"])
+    p_hi = 1.1 * float(np.max(steps))
+    p = np.linspace(0.0, p_hi, 200)
+    tab = np.asarray(getattr(area, "pressure_Pa", []), dtype=float)
+    p = np.union1d(p, tab[(tab >= 0) & (tab <= p_hi)])  # keep the table's own points inside the range
+    ax[0, 0].plot(p / 1e3, area(p), "-", label="A(P) model")
+    ax[0, 0].plot(steps / 1e3, s["area_fraction_steps"], "o", ms=3, label="staircase steps")
+    ax[0, 0].set_xlim(0.0, p_hi / 1e3)
+    ax[0, 0].set_ylim(0.0, max(1.1 * float(np.max(area(p))), 1e-3))  # a fraction: from 0, not zoomed
     ax[0, 0].set_xlabel("applied pressure (kPa)")
     ax[0, 0].set_ylabel("charged area A/S")
+    ax[0, 0].legend()
     ax[0, 1].plot(result.t, result.V_oc, lw=0.8, label="V_OC(t), Eq. 17")
-    s = fig8_summary(result)
     per = result.waveform.period
-    tk = (np.arange(len(s["voc_steps_V"])) + 0.75) * per
-    ax[0, 1].plot(tk, s["voc_steps_V"], "o", ms=3, label="per step")
+    v = np.array([np.nan if x is None else x for x in s["voc_steps_V"]], dtype=float)
+    tk = (np.arange(v.size) + 0.75) * per
+    ax[0, 1].plot(tk, v, "o", ms=3, label="per step")
     ax[0, 1].set_xlabel("t (s)")
     ax[0, 1].set_ylabel("V_OC (V)")
     ax[0, 1].legend()
@@ -94,7 +104,10 @@ def plot_resistance_sweep(sweep, path) -> None:
     """Mean power and energy per cycle against load R, optimum marked."""
     plt, fig, ax = _figure(1, 2, (11, 4.5))
     ax[0, 0].loglog(sweep.load_ohm, sweep.average_power_W, "o-")
-    ax[0, 0].axvline(sweep.optimum_ohm, color="k", ls=":")
+    ax[0, 0].axvline(sweep.optimum_ohm, color="k", ls=":",
+                     label="largest in range (at its edge)" if getattr(sweep, "optimum_at_edge", False)
+                     else "optimum")
+    ax[0, 0].legend()
     ax[0, 0].set_xlabel("load R (ohm)")
     ax[0, 0].set_ylabel("mean power (W)")
     ax[0, 1].loglog(sweep.load_ohm, sweep.peak_voltage_V, "o-", label="peak V (V)")

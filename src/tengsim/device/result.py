@@ -116,16 +116,18 @@ class DeviceResult:
         return np.interp(tb, self.t, self.series[name])
 
     def summary(self, skip_cycles: int = 1) -> dict:
-        """Headline numbers over settled cycles: peaks, energy per cycle, mean power, net charge."""
+        """Headline numbers over settled cycles: peaks, energy per cycle, mean power, net charge.
+
+        Values that need a whole settled cycle are None when the run holds none (strict JSON, no NaN).
+        """
         m = self.settled(skip_cycles)
-        require_rows = bool(np.any(m))
-        if not require_rows:
+        if not np.any(m):
             m = np.ones(self.t.size, bool)
         e = self.cycle_values("E_load", skip_cycles)
         qc = self.cycle_values("Q", skip_cycles)
         per = self.period
         n_cyc = max(e.size - 1, 0)
-        energy = float((e[-1] - e[0]) / n_cyc) if n_cyc else float("nan")
+        energy = float((e[-1] - e[0]) / n_cyc) if n_cyc else None
         return {
             "peak_voltage_V": float(np.max(np.abs(self.V[m]))),
             "peak_current_A": float(np.max(np.abs(self.I[m]))),
@@ -133,8 +135,8 @@ class DeviceResult:
             "isc_A": float(np.max(np.abs(self.I_sc[m]))),
             "qsc_C": float(np.max(self.Q_sc[m])),
             "energy_per_cycle_J": energy,
-            "average_power_W": energy / per if n_cyc else float("nan"),
-            "net_charge_per_cycle_C": float(np.max(np.abs(np.diff(qc)))) if qc.size > 1 else float("nan"),
+            "average_power_W": energy / per if n_cyc else None,
+            "net_charge_per_cycle_C": float(np.max(np.abs(np.diff(qc)))) if qc.size > 1 else None,
             "settled_cycles": n_cyc,
             "impacts": int(self.impacts_s.size),
             "wall_s": self.wall_s,

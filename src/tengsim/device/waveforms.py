@@ -6,11 +6,24 @@ jumps or kinks (``breakpoints``) so that the integrator never steps across one.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from tengsim.errors import TengsimError, finite, positive, require
+from tengsim.registry import Registry
+
+WAVEFORMS: Registry = Registry("waveform")
+"""Waveform kinds by name (``kind`` in a [waveform] table); the config fields are the dataclass fields."""
+
+
+_NO_DEFAULT = object()
+
+
+def _f(help_text: str, default=_NO_DEFAULT, **meta):
+    """A dataclass field whose help (and optional ``dim``, ``choices``) the config schema reads."""
+    meta = {"help": help_text, **meta}
+    return field(metadata=meta) if default is _NO_DEFAULT else field(default=default, metadata=meta)
 
 
 def _duty(duty):
@@ -27,14 +40,15 @@ def _grid_breaks(period, duty, t0, t1):
     return np.unique(b[(b > t0) & (b < t1)])
 
 
+@WAVEFORMS.register("square")
 @dataclass(frozen=True)
 class SquareWave:
     """P = amplitude for the first ``duty`` of each period, ``low_Pa`` otherwise (Fig. 7)."""
 
-    amplitude_Pa: float
-    frequency_Hz: float
-    duty: float = 0.5
-    low_Pa: float = 0.0
+    amplitude_Pa: float = _f("pressure while pressed")
+    frequency_Hz: float = _f("repetition frequency")
+    duty: float = _f("pressed fraction of each period, in (0, 1)", 0.5)
+    low_Pa: float = _f("pressure while released", 0.0)
 
     def __post_init__(self):
         object.__setattr__(self, "amplitude_Pa", finite("amplitude_Pa", self.amplitude_Pa))
@@ -61,13 +75,14 @@ class SquareWave:
                 "duty": self.duty, "low_Pa": self.low_Pa}
 
 
+@WAVEFORMS.register("staircase")
 @dataclass(frozen=True)
 class Staircase:
     """Square wave whose k-th pulse has amplitude ``amplitudes_Pa[k]`` (Fig. 8); zero afterwards."""
 
-    amplitudes_Pa: tuple
-    frequency_Hz: float
-    duty: float = 0.5
+    amplitudes_Pa: tuple = _f("pressure of each pulse, in order (one pulse per period)")
+    frequency_Hz: float = _f("repetition frequency")
+    duty: float = _f("pressed fraction of each period, in (0, 1)", 0.5)
 
     def __post_init__(self):
         try:
@@ -113,14 +128,15 @@ class Staircase:
                 "frequency_Hz": self.frequency_Hz, "duty": self.duty}
 
 
+@WAVEFORMS.register("sine")
 @dataclass(frozen=True)
 class Sine:
     """P = offset + amplitude sin(2 pi f t + phase); offset = amplitude, phase = -pi/2 gives 0 -> 2A."""
 
-    amplitude_Pa: float
-    frequency_Hz: float
-    offset_Pa: float = 0.0
-    phase_rad: float = 0.0
+    amplitude_Pa: float = _f("amplitude")
+    frequency_Hz: float = _f("frequency")
+    offset_Pa: float = _f("mean pressure", 0.0)
+    phase_rad: float = _f("phase at t = 0 (radians)", 0.0)
 
     def __post_init__(self):
         for name in ("amplitude_Pa", "offset_Pa", "phase_rad"):
@@ -145,17 +161,19 @@ class Sine:
                 "offset_Pa": self.offset_Pa, "phase_rad": self.phase_rad}
 
 
+@WAVEFORMS.register("table")
 @dataclass(frozen=True, eq=False)
 class TableWaveform:
-    """User table (t_s, pressure_Pa); ``kind`` "linear" or "step" (hold previous); end value held.
+    """User table (t_s, pressure_Pa); ``interp`` "linear" or "step" (hold previous); end value held.
 
     With ``periodic`` the table repeats with period t_s[-1] (t_s[0] must be 0).
     """
 
-    t_s: np.ndarray
-    pressure_Pa: np.ndarray
-    kind: str = "linear"
-    periodic: bool = False
+    t_s: np.ndarray = _f("times, strictly increasing")
+    pressure_Pa: np.ndarray = _f("pressure at each time")
+    interp: str = _f("between rows: linear, or step (hold the previous value)", "linear",
+                     choices=("linear", "step"))
+    periodic: bool = _f("repeat the table with period t_s[-1] (t_s[0] must be 0)", False)
 
     def __post_init__(self):
         try:
@@ -167,7 +185,7 @@ class TableWaveform:
                 f"waveform table needs >= 2 equal-length columns, got {t.size} times and {p.size} pressures")
         require(bool(np.all(np.isfinite(t)) and np.all(np.isfinite(p))), "waveform table holds non-finite values")
         require(bool(np.all(np.diff(t) > 0)), "waveform table times must be strictly increasing")
-        require(self.kind in ("linear", "step"), f"kind must be 'linear' or 'step', got {self.kind!r}")
+        require(self.interp in ("linear", "step"), f"interp must be 'linear' or 'step', got {self.interp!r}")
         if self.periodic:
             require(t[0] == 0.0, f"a periodic table must start at t = 0, got {t[0]!r}")
         t.setflags(write=False)
@@ -187,7 +205,7 @@ class TableWaveform:
         t = np.asarray(t, dtype=float)
         if self.periodic:
             t = np.mod(t, self.t_s[-1])
-        if self.kind == "linear":
+        if self.interp == "linear":
             return np.interp(t, self.t_s, self.pressure_Pa)
         i = np.clip(np.searchsorted(self.t_s, t, side="right") - 1, 0, self.t_s.size - 1)
         return self.pressure_Pa[i]
@@ -203,23 +221,14 @@ class TableWaveform:
 
     def to_dict(self) -> dict:
         return {"kind": "table", "t_s": self.t_s.tolist(), "pressure_Pa": self.pressure_Pa.tolist(),
-                "interp": self.kind, "periodic": self.periodic}
+                "interp": self.interp, "periodic": self.periodic}
 
 
 def waveform_from_dict(d: dict):
-    """Build a waveform from a config mapping with ``kind`` square / staircase / sine / table."""
-    require(isinstance(d, dict), f"waveform must be a mapping, got {type(d).__name__}")
-    d = dict(d)
-    kind = d.pop("kind", None)
-    makers = {"square": SquareWave, "staircase": Staircase, "sine": Sine}
-    try:
-        if kind in makers:
-            return makers[kind](**d)
-        if kind == "table":
-            interp = d.pop("interp", "linear")
-            return TableWaveform(d.pop("t_s"), d.pop("pressure_Pa"), interp, bool(d.pop("periodic", False)), **d)
-    except TypeError as exc:
-        raise TengsimError(f"waveform {kind!r}: {exc}") from None
-    except KeyError as exc:
-        raise TengsimError(f"waveform {kind!r} needs {exc}") from None
-    raise TengsimError(f"waveform kind must be square, staircase, sine or table, got {kind!r}")
+    """Build a waveform from a config mapping: ``kind`` (a :data:`WAVEFORMS` name) plus that kind's fields.
+
+    Keys, types and units are checked by the one config schema (:mod:`tengsim.device.config`).
+    """
+    from tengsim.device.config import parse_waveform
+
+    return parse_waveform(d)
