@@ -15,7 +15,14 @@ import json, resource, sys
 from tengsim.contact import simulate
 from tengsim.geometry import Pyramid
 from tengsim.path import PathSpec
-rss = lambda: resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+def rss():
+    # peak RSS of this process image: VmHWM (getrusage's ru_maxrss also counts the parent's RSS at
+    # fork time, since Linux keeps it across exec)
+    try:
+        with open("/proc/self/status") as fh:
+            return next(int(l.split()[1]) * 1024 for l in fh if l.startswith("VmHWM:"))
+    except (OSError, StopIteration):
+        return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
 boundary, solver, n = sys.argv[1], sys.argv[2], int(sys.argv[3])
 shape = Pyramid(0.946, 3.78)
 grid = shape.grid(3.78 / n)

@@ -46,12 +46,14 @@ def atomic_path(path: str | os.PathLike):
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part", dir=path.parent)
     try:
-        os.fchmod(fd, _mode_for(path))
+        with contextlib.suppress(OSError):  # a file system without modes keeps its own
+            os.fchmod(fd, _mode_for(path))
     finally:
         os.close(fd)
     try:
         yield Path(tmp)
-        os.chmod(tmp, _mode_for(path))  # the writer may have replaced the file at tmp
+        with contextlib.suppress(OSError):  # again: the writer may have made the file at tmp anew
+            os.chmod(tmp, _mode_for(path))
         os.replace(tmp, path)
     except BaseException:
         with contextlib.suppress(FileNotFoundError):
