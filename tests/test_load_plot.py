@@ -161,3 +161,17 @@ def test_loaded_result_without_grid_is_a_contact_result():
     t["branch"] = np.array(["approach", "retraction"])
     res = ContactResult(table=t, grid=None)
     assert res.branch("approach")["D"].shape == (1,)
+
+
+def test_plot_draws_the_output_of_device_sweep(tmp_path, monkeypatch):
+    src = tmp_path / "sw.csv"
+    assert main(["device", "sweep", "--out", str(src), "--points", "3", "--cycles", "2", "--quiet"]) == 0
+    kind, data = load_result(src)
+    assert kind == "sweep" and len(data["R"]) == 3
+    saved = []
+    monkeypatch.setattr(plots, "save", lambda fig, path: saved.append((fig, path)))
+    assert main(["plot", str(src)]) == 0
+    fig, path = saved[0]
+    assert path == tmp_path / "sw.png"
+    best = fig.axes[0].get_legend().get_texts()[0].get_text()
+    assert f"best load {data['header']['optimum_ohm']:.3g}" in best

@@ -93,3 +93,14 @@ def test_cli_refuses_a_run_that_does_not_fit(tmp_path, capsys, monkeypatch):
     assert rc == 2 and "165×165 grid" in err and "0.01 GiB is available" in err
     assert len(err.strip().splitlines()) == 1 and "Traceback" not in err
     assert list(tmp_path.iterdir()) == []
+
+
+def test_cgroup_limit_counts_reclaimable_cache(tmp_path):
+    assert resources.cgroup_room(str(tmp_path)) is None  # no cgroup files
+    (tmp_path / "memory.max").write_text("max\n")
+    (tmp_path / "memory.current").write_text("5000\n")
+    assert resources.cgroup_room(str(tmp_path)) is None  # no limit
+    (tmp_path / "memory.max").write_text("8000\n")
+    assert resources.cgroup_room(str(tmp_path)) == 3000
+    (tmp_path / "memory.stat").write_text("anon 3000\nfile 2000\nactive_file 500\ninactive_file 1500\n")
+    assert resources.cgroup_room(str(tmp_path)) == 4500

@@ -55,8 +55,8 @@ def estimate_bytes(nx: int, ny: int, boundary: str = "free", solver: str = "fast
 
 
 def available_bytes() -> int | None:
-    """Memory this process can still get: MemAvailable (/proc/meminfo), capped by a cgroup v2 limit;
-    else the free physical pages (os.sysconf); None if neither can be read."""
+    """Memory this process can still get: MemAvailable (/proc/meminfo), else the free physical pages
+    (os.sysconf), capped by a cgroup v2 limit (:func:`cgroup_room`); None if nothing can be read."""
     avail = None
     try:
         with open("/proc/meminfo") as fh:
@@ -71,16 +71,33 @@ def available_bytes() -> int | None:
             avail = os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
         except (ValueError, OSError, AttributeError):
             avail = None
-    try:  # a container's limit may be far below the host's free memory
-        with open("/sys/fs/cgroup/memory.max") as fh:
-            limit = fh.read().strip()
-        if limit != "max":
-            with open("/sys/fs/cgroup/memory.current") as fh:
-                room = int(limit) - int(fh.read().strip())
-            avail = room if avail is None else min(avail, room)
+    room = cgroup_room()  # a container's limit may be far below the host's free memory
+    if room is not None:
+        avail = room if avail is None else min(avail, room)
+    return avail
+
+
+def cgroup_room(root: str = "/sys/fs/cgroup") -> int | None:
+    """Bytes left under a cgroup v2 memory limit: memory.max − memory.current + the inactive file
+    cache (reclaimable); None without a limit."""
+    from pathlib import Path
+
+    try:
+        limit = (Path(root) / "memory.max").read_text().strip()
+        if limit == "max":
+            return None
+        used = int((Path(root) / "memory.current").read_text().strip())
+    except (OSError, ValueError):
+        return None
+    cache = 0
+    try:
+        for line in (Path(root) / "memory.stat").read_text().splitlines():
+            key, _, val = line.partition(" ")
+            if key == "inactive_file":
+                cache = int(val)
     except (OSError, ValueError):
         pass
-    return avail
+    return max(0, int(limit) - used + cache)
 
 
 def _gib(b: float) -> str:
