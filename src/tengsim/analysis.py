@@ -57,11 +57,6 @@ def repulsive_area(P: np.ndarray, grid: Grid) -> float:
     return float(np.count_nonzero(P > 0) * grid.area)
 
 
-def gap_area(H: np.ndarray, grid: Grid, threshold: float = 0.0) -> float:
-    """Area where the gap H = h/ε − 1 is below ``threshold`` (h below ε(1 + threshold))."""
-    return float(np.count_nonzero(H <= threshold) * grid.area)
-
-
 def apex_index(U0: np.ndarray) -> tuple[int, int]:
     """Grid index of the highest point (smallest initial gap); the centre pixel wins ties."""
     m = U0.min()

@@ -247,8 +247,9 @@ def plan_contact(cfg: dict) -> ContactPlan:
     tol = positive("tol", vals["tol"])
     law = make_law(vals["law"])
     grid = shape.grid(dx)  # validates dx against the cell
-    if grid.nx * grid.ny > 4096 * 4096:
-        raise TengsimError(f"dx={dx:g} gives a {grid.nx}×{grid.ny} grid; too large")
+    from tengsim.resources import check_memory
+
+    check_memory(grid.nx, grid.ny, vals["boundary"], vals["solver"], maps=2 * len(path.maps_at))
     return ContactPlan(shape, tabor, dx, path, vals["boundary"], vals["solver"], tol, law, extra, scaling,
                        tuple(vals["observers"]))
 

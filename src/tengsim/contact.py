@@ -1,6 +1,8 @@
 """One entry point composing shape, law, kernel, solver and path into a contact run."""
 from __future__ import annotations
 
+from dataclasses import is_dataclass, replace
+
 from tengsim import __version__
 from tengsim.errors import TengsimError, positive
 from tengsim.geometry import Pyramid, Shape
@@ -8,7 +10,10 @@ from tengsim.interaction import LJ93, Law, make_law
 from tengsim.kernels import make_kernel
 from tengsim.path import PathSpec, run_path
 from tengsim.registry import KERNELS
+from tengsim.resources import check_memory
 from tengsim.solvers import make_solver
+
+MONITOR_MIN_POINTS = 1024**2  # grids from this size on report progress inside each solve
 
 
 def simulate(shape: Shape, tabor: float, dx: float, path: PathSpec, boundary: str = "free",
@@ -29,8 +34,13 @@ def simulate(shape: Shape, tabor: float, dx: float, path: PathSpec, boundary: st
     law = make_law(law) if isinstance(law, str) else (law or LJ93())
     boundary = KERNELS.canonical(boundary)
     grid = grid or shape.grid(dx)
-    kernel = make_kernel(boundary, grid, tabor**1.5)
     solver_obj = make_solver(solver, tol=tol) if isinstance(solver, str) else solver
+    check_memory(grid.nx, grid.ny, boundary, getattr(solver_obj, "name", ""), getattr(solver_obj, "memory", 10),
+                 maps=2 * len(path.maps_at))  # before any large array: one clear error, needed vs available
+    if (hasattr(progress, "monitor") and grid.nx * grid.ny >= MONITOR_MIN_POINTS and is_dataclass(solver_obj)
+            and getattr(solver_obj, "monitor", 0) is None):  # long solves report as they go
+        solver_obj = replace(solver_obj, monitor=progress.monitor(), monitor_every=10)
+    kernel = make_kernel(boundary, grid, tabor**1.5)
     res = run_path(shape.gap(grid), law, kernel, solver_obj, path, progress=progress, observers=observers)
     res.params = {
         "tengsim_version": __version__,

@@ -1,22 +1,59 @@
-"""Atomic result writing: a file appears whole or not at all."""
+"""Atomic result writing: a file appears whole or not at all, with the permissions of an ordinary write.
+
+JSON is strict (RFC 8259): NaN and ±inf are written as ``null``.  CSV columns are written vectorised,
+floats as Python's shortest round-trip ``repr``, booleans as 0/1.
+"""
 from __future__ import annotations
 
 import contextlib
 import json
+import math
 import os
+import stat
 import tempfile
 from pathlib import Path
 
 
+def _umask() -> int:
+    """The process umask (read from /proc where it is shown, so it is never changed, even briefly)."""
+    try:
+        with open("/proc/self/status") as fh:
+            for line in fh:
+                if line.startswith("Umask:"):
+                    return int(line.split()[1], 8)
+    except (OSError, ValueError, IndexError):
+        pass
+    mask = os.umask(0o022)  # pragma: no cover - no /proc: read it by setting it back at once
+    os.umask(mask)
+    return mask
+
+
+def _mode_for(path: Path) -> int:
+    """Mode an ordinary ``open(path, 'w')`` would leave: the existing file's, else 0666 & ~umask."""
+    try:
+        return stat.S_IMODE(os.stat(path).st_mode)
+    except OSError:
+        return 0o666 & ~_umask()
+
+
 @contextlib.contextmanager
 def atomic_path(path: str | os.PathLike):
-    """Yield a temporary path beside ``path``; rename it onto ``path`` only on success."""
+    """Yield a temporary path beside ``path``; rename it onto ``path`` only on success.
+
+    The file gets the mode an ordinary write would give it (the umask for a new file, the old
+    file's mode when one is replaced), not mkstemp's 0600."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part", dir=path.parent)
-    os.close(fd)
+    try:
+        with contextlib.suppress(OSError):  # a file system without modes keeps its own
+            os.fchmod(fd, _mode_for(path))
+    finally:
+        os.close(fd)
     try:
         yield Path(tmp)
+        with contextlib.suppress(OSError):  # again: the writer may have made the file at tmp anew
+            os.chmod(tmp, _mode_for(path))
         os.replace(tmp, path)
     except BaseException:
         with contextlib.suppress(FileNotFoundError):
@@ -43,21 +80,35 @@ def write_text(path, text: str) -> None:
         tmp.write_text(text)
 
 
-def write_json(path, obj) -> None:
-    write_text(path, json.dumps(obj, indent=2, default=_jsonable) + "\n")
-
-
-def _jsonable(x):
+def jsonable(x):
+    """``x`` as plain JSON types: numpy scalars and arrays to Python, NaN and ±inf to None, tuples to
+    lists, other objects to ``str``."""
+    if isinstance(x, float):
+        return x if math.isfinite(x) else None
+    if x is None or isinstance(x, (str, bool, int)):
+        return x
+    if isinstance(x, dict):
+        return {k if isinstance(k, str) else str(k): jsonable(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [jsonable(v) for v in x]
     try:
         import numpy as np
 
-        if isinstance(x, np.generic):
-            return x.item()
-        if isinstance(x, np.ndarray):
-            return x.tolist()
+        if isinstance(x, (np.generic, np.ndarray)):
+            return jsonable(x.tolist())
     except ImportError:  # pragma: no cover
         pass
     return str(x)
+
+
+def dumps(obj, indent: int | None = None) -> str:
+    """Strict JSON text of ``obj`` (see :func:`jsonable`); never contains NaN or Infinity."""
+    return json.dumps(jsonable(obj), indent=indent, allow_nan=False)
+
+
+def write_json(path, obj) -> None:
+    """Write ``obj`` as strict JSON (NaN and ±inf become null), atomically."""
+    write_text(path, dumps(obj, indent=2) + "\n")
 
 
 def write_dataset(ds, path) -> None:
@@ -66,26 +117,42 @@ def write_dataset(ds, path) -> None:
         ds.to_netcdf(tmp, engine="h5netcdf")
 
 
-def write_csv(path, columns: dict, header: dict | None = None) -> None:
-    """Write equal-length columns as CSV; ``header`` goes in as '# key: value' lines."""
+def _column_text(a) -> list[str]:
+    """One column as strings: floats by ``repr`` (shortest exact round-trip), bools as 0/1, else str."""
     import numpy as np
 
+    kind = a.dtype.kind
+    if kind == "b":
+        return np.where(a, "1", "0").tolist()
+    if kind == "f":
+        return list(map(float.__repr__, a.astype(float, copy=False).tolist()))
+    if kind in "iuUS":
+        return list(map(str, a.tolist()))
+    out = []  # object or mixed columns: element by element
+    for x in a.tolist():
+        if isinstance(x, (bool, np.bool_)):
+            out.append(str(int(x)))
+        elif isinstance(x, (float, np.floating)):
+            out.append(repr(float(x)))
+        else:
+            out.append(str(x))
+    return out
+
+
+def write_csv(path, columns: dict, header: dict | None = None) -> None:
+    """Write equal-length columns as CSV; ``header`` goes in as '# key: json' lines (strict JSON)."""
+    import numpy as np
+
+    from tengsim.errors import TengsimError
+
     names = list(columns)
-    arrays = [np.asarray(columns[k]) for k in names]
-    lines = []
-    for k, v in (header or {}).items():
-        lines.append(f"# {k}: {json.dumps(v, default=_jsonable)}")
+    arrays = [np.asarray(columns[k]).ravel() for k in names]
+    lengths = {len(a) for a in arrays}
+    if len(lengths) > 1:
+        raise TengsimError(f"CSV columns of unequal length: "
+                           f"{', '.join(f'{k}={len(a)}' for k, a in zip(names, arrays))}")
+    lines = [f"# {k}: {dumps(v)}" for k, v in (header or {}).items()]
     lines.append(",".join(names))
-    n = len(arrays[0]) if arrays else 0
-    for i in range(n):
-        row = []
-        for a in arrays:
-            x = a[i]
-            if isinstance(x, (float, np.floating)):
-                row.append(repr(float(x)))
-            elif isinstance(x, (bool, np.bool_)):
-                row.append(str(int(x)))
-            else:
-                row.append(str(x))
-        lines.append(",".join(row))
+    if arrays and len(arrays[0]):
+        lines.append("\n".join(map(",".join, zip(*map(_column_text, arrays)))))
     write_text(path, "\n".join(lines) + "\n")

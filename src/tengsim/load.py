@@ -1,4 +1,8 @@
-"""Read results written by tengsim back in (NetCDF or CSV)."""
+"""Read results written by tengsim back in (NetCDF or CSV): contact runs, device time series, load sweeps.
+
+Nothing is invented: a file that lacks a required column is refused (the columns are named), and a
+CSV without its grid in the header gives a result with ``grid=None`` (curves need no grid).
+"""
 from __future__ import annotations
 
 import json
@@ -10,9 +14,14 @@ from tengsim.errors import TengsimError
 from tengsim.grid import Grid
 from tengsim.results import CURVE_COLUMNS, ContactResult
 
+BOOL_COLUMNS = ("converged", "on_grid", "jump", "in_law_range")
+# written by every tengsim version; later additions (in_law_range) are taken when present
+REQUIRED_CONTACT = tuple(k for k in CURVE_COLUMNS if k != "in_law_range")
+SWEEP_COLUMNS = ("R", "energy_per_cycle", "average_power")
+
 
 def _read_csv(path: Path):
-    header, rows, names = {}, [], None
+    header, lines, names = {}, [], None
     with open(path) as fh:
         for line in fh:
             line = line.rstrip("\n")
@@ -25,9 +34,13 @@ def _read_csv(path: Path):
             elif names is None:
                 names = line.split(",")
             elif line:
-                rows.append(line.split(","))
+                lines.append(line)
     if names is None:
         raise TengsimError(f"{path}: no column header found")
+    rows = [r.split(",") for r in lines]
+    bad = next((i for i, r in enumerate(rows) if len(r) != len(names)), None)
+    if bad is not None:
+        raise TengsimError(f"{path}: data row {bad + 1} has {len(rows[bad])} fields, the header has {len(names)}")
     cols = {}
     for j, n in enumerate(names):
         vals = [r[j] for r in rows]
@@ -38,31 +51,60 @@ def _read_csv(path: Path):
     return header, cols
 
 
+def _require(path, cols, required, what):
+    missing = [k for k in required if k not in cols]
+    if missing:
+        raise TengsimError(f"{path}: {what} lacks column(s) {', '.join(missing)}")
+
+
+def _contact_table(path, cols) -> dict:
+    _require(path, cols, REQUIRED_CONTACT, "contact result")
+    table = {k: np.asarray(cols[k]) for k in CURVE_COLUMNS if k in cols}
+    for k in BOOL_COLUMNS:
+        if k in table:
+            table[k] = table[k].astype(bool)
+    table["branch"] = table["branch"].astype(str)
+    return table
+
+
+def _header_grid(header: dict):
+    """Grid from the '# nx', '# ny', '# dx' (and '# dy') header lines, or None if they are absent."""
+    if not all(k in header for k in ("nx", "dx")):
+        return None
+    try:
+        nx = int(header["nx"])
+        ny = int(header.get("ny", nx))
+        dx = float(header["dx"])
+        return Grid(nx, ny, dx, float(header.get("dy", dx)))
+    except (TypeError, ValueError, TengsimError) as exc:
+        raise TengsimError(f"header grid nx={header.get('nx')!r}, dx={header.get('dx')!r} is not valid: {exc}") \
+            from None
+
+
 def load_result(path) -> tuple[str, object]:
-    """Return ('contact', ContactResult) or ('device', xarray.Dataset / columns dict)."""
+    """Return ``(kind, obj)``: ('contact', ContactResult), ('device', Dataset or columns dict) for a time
+    series, or ('sweep', dict of columns plus 'header') for a load-resistance sweep."""
     path = Path(path)
     if not path.exists():
         raise TengsimError(f"result file {path} not found")
+    if path.is_dir():
+        raise TengsimError(f"{path} is a directory, not a result file")
     suffix = path.suffix.lower()
     if suffix == ".csv":
         header, cols = _read_csv(path)
         if "branch" in cols and "D" in cols:
-            table = {}
-            for k in CURVE_COLUMNS:
-                if k in cols:
-                    table[k] = cols[k]
-                else:
-                    table[k] = np.zeros(len(cols["D"]))
-            if "in_law_range" not in cols:
-                table["in_law_range"] = np.ones(len(cols["D"]))
-            for k in ("converged", "on_grid", "jump", "in_law_range"):
-                table[k] = table[k].astype(bool)
-            dx = float(header.get("dx", 1.0))
-            n = int(header.get("nx", 3))
-            return "contact", ContactResult(table=table, grid=Grid(max(n, 3), max(n, 3), dx, dx), params=header)
+            table = _contact_table(path, cols)
+            try:
+                grid = _header_grid(header)
+            except TengsimError as exc:
+                raise TengsimError(f"{path}: {exc}") from None
+            return "contact", ContactResult(table=table, grid=grid, params=header)
         if "t" in cols:
             return "device", cols
-        raise TengsimError(f"{path}: not a tengsim result (no 'branch'/'D' or 't' columns)")
+        if "R" in cols:
+            _require(path, cols, SWEEP_COLUMNS, "load sweep")
+            return "sweep", {**cols, "header": header}
+        raise TengsimError(f"{path}: not a tengsim result (no 'branch'/'D', 't' or 'R' columns)")
     if suffix == ".nc":
         import xarray as xr
 
@@ -71,15 +113,12 @@ def load_result(path) -> tuple[str, object]:
         except Exception as exc:  # noqa: BLE001 - any reader failure is a bad input file
             raise TengsimError(f"cannot read {path} as NetCDF: {exc}") from None
         if "branch" in ds and "D" in ds:
-            table = {k: ds[k].values for k in CURVE_COLUMNS if k in ds}
-            table.setdefault("in_law_range", np.ones(ds.sizes["step"]))
-            for k in ("converged", "on_grid", "jump", "in_law_range"):
-                table[k] = table[k].astype(bool)
-            table["branch"] = table["branch"].astype(str)
+            table = _contact_table(path, {k: ds[k].values for k in ds.data_vars})
             params = json.loads(ds.attrs.get("params", "{}"))
-            x = ds["x"].values
-            dx = float(x[1] - x[0]) if len(x) > 1 else 1.0
-            grid = Grid(len(x), len(ds["y"]), dx, dx)
+            x, y = ds["x"].values, ds["y"].values
+            if len(x) < 3 or len(y) < 3:
+                raise TengsimError(f"{path}: grid coordinates x, y have {len(x)}, {len(y)} points (need >= 3)")
+            grid = Grid(len(x), len(y), float(x[1] - x[0]), float(y[1] - y[0]))
             maps = []
             if "P" in ds:
                 for i in range(ds.sizes["map"]):
@@ -88,5 +127,9 @@ def load_result(path) -> tuple[str, object]:
             return "contact", ContactResult(table=table, grid=grid, maps=maps, params=params)
         if "t" in ds:
             return "device", ds
+        if "R" in ds.coords and "average_power" in ds:
+            _require(path, set(ds.variables), SWEEP_COLUMNS, "load sweep")
+            cols = {k: ds[k].values for k in SWEEP_COLUMNS + ("peak_voltage", "peak_current") if k in ds.variables}
+            return "sweep", {**cols, "header": dict(ds.attrs)}
         raise TengsimError(f"{path}: not a tengsim result")
     raise TengsimError(f"{path}: unknown result format {suffix!r} (use .nc or .csv)")

@@ -159,3 +159,66 @@ def plot_timeseries(data, path, title: str = "") -> None:
     if title:
         fig.suptitle(title)
     save(fig, path)
+
+
+def plot_maps(res, path, title: str = "") -> None:
+    """Saved pressure and gap maps of a contact result: one row per map, P (Eq. 8) and H side by side,
+    on the cell's X, Y axes (for the pyramid in units of ε m/n, Eq. 7), equal aspect, colour bars with
+    units (P in W/ε, H in ε)."""
+    from tengsim.errors import TengsimError
+
+    if not res.maps:
+        raise TengsimError("the result holds no maps (run with --maps D1,D2,...)")
+    if res.grid is None:
+        raise TengsimError("the result has no grid, so its maps cannot be placed")
+    plt = _plt()
+    g = res.grid
+    unit = r"$\varepsilon m/n$" if res.params.get("shape") == "Pyramid" else "dimensionless"  # Eq. 7
+    ext = [g.x[0] - g.dx / 2, g.x[-1] + g.dx / 2, g.y[0] - g.dy / 2, g.y[-1] + g.dy / 2]
+    n = len(res.maps)
+    fig, axs = plt.subplots(n, 2, figsize=(9.0, 3.6 * n), squeeze=False, constrained_layout=True)
+    for i, m in enumerate(res.maps):
+        P, H = np.asarray(m["P"], float), np.asarray(m["H"], float)
+        lim = max(1e-12, float(np.nanpercentile(np.abs(P), 99.5)))
+        panels = [(P, "RdBu_r", -lim, lim, r"pressure $P$ ($W_{ad}/\varepsilon$, Eq. 7)"),
+                  (H, "viridis", float(np.nanmin(H)), float(np.nanmax(H)), r"gap $H$ ($\varepsilon$)")]
+        for ax, (field, cmap, lo, hi, label) in zip(axs[i], panels):
+            im = ax.imshow(field.T, origin="lower", extent=ext, cmap=cmap, vmin=lo, vmax=hi, interpolation="nearest")
+            ax.set_aspect("equal")
+            ax.set_xlabel(f"$X$ ({unit})")
+            ax.set_ylabel(f"$Y$ ({unit})")
+            ax.set_title(f"{m['branch']}, D = {m['D']:g}", fontsize=9)
+            fig.colorbar(im, ax=ax, shrink=0.85).set_label(label)
+    if title:
+        fig.suptitle(title)
+    save(fig, path)
+
+
+def plot_sweep(data, path, title: str = "") -> None:
+    """Load-resistance sweep read back from a file (columns R, energy_per_cycle, average_power): mean
+    power and energy per cycle against R on a log axis, the best load marked."""
+    plt = _plt()
+    R = np.asarray(data["R"], float)
+    p = np.asarray(data["average_power"], float)
+    e = np.asarray(data["energy_per_cycle"], float)
+    order = np.argsort(R)
+    R, p, e = R[order], p[order], e[order]
+    k = int(np.nanargmax(p)) if np.isfinite(p).any() else None
+    fig, axs = plt.subplots(1, 2, figsize=(10, 3.8), constrained_layout=True)
+    for ax, y, label in ((axs[0], p, "mean power (W)"), (axs[1], e, "energy per cycle (J)")):
+        ax.plot(R, y, "o-", ms=3)
+        ax.set_xscale("log")
+        if np.all(y[np.isfinite(y)] > 0):
+            ax.set_yscale("log")
+        ax.set_xlabel(r"load $R$ ($\Omega$)")
+        ax.set_ylabel(label)
+        ax.grid(alpha=0.3, which="both")
+        if k is not None:
+            ax.axvline(R[k], color="k", ls=":", lw=1)
+            ax.plot(R[k], y[k], "*", color="tab:red", ms=10,
+                    label=f"best load {R[k]:.3g} Ω: {p[k]:.3g} W, {e[k]:.3g} J/cycle")
+    if k is not None:
+        axs[0].legend(fontsize=8)
+    if title:
+        fig.suptitle(title)
+    save(fig, path)

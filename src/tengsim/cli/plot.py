@@ -1,35 +1,70 @@
-"""``tengsim plot RESULT``: redraw the figure of a saved contact result (.nc or .csv)."""
+"""``tengsim plot RESULT``: redraw the figures of a saved result.
+
+A contact result (.nc or .csv) gives F(D), Λc(D), Λc(F), and, when it holds maps (``--maps``), a
+second figure ``<out stem>_maps<suffix>`` of the pressure and gap maps; a device time series gives
+its traces; a load sweep (``tengsim device sweep``) its power and energy against R; a study folder
+is drawn by ``tengsim.study.plot``.
+"""
 from __future__ import annotations
 
+import importlib
 from pathlib import Path
 
 from tengsim.errors import TengsimError
 
+FIGURE_SUFFIXES = (".png", ".pdf", ".svg")
+
 
 def register(sub):
     p = sub.add_parser("plot", help="redraw figures from a saved result",
-                       description="Draw F(D), Λc(D), Λc(F) of a contact result (.nc or .csv written by "
-                       "tengsim), or the time series of a device result.")
-    p.add_argument("result", help="result file (.nc or .csv)")
-    p.add_argument("--out", help="figure file (.png/.pdf); default RESULT with .png")
+                       description="Draw a saved tengsim result: F(D), Λc(D), Λc(F) of a contact result "
+                       "(.nc or .csv) and its pressure/gap maps (second figure OUT_maps.png, .nc with "
+                       "--maps only), the time series of a device result, power and energy against R of a "
+                       "load sweep, or a study folder.")
+    p.add_argument("result", help="result file (.nc or .csv) or a study folder")
+    p.add_argument("--out", help="figure file (.png/.pdf/.svg); default RESULT with .png")
+    p.add_argument("--no-maps", action="store_true", help="do not draw the saved maps of a contact result")
     p.set_defaults(func=run)
+
+
+def _plot_study(src: Path, out):
+    try:
+        mod = importlib.import_module("tengsim.study.plot")
+    except ModuleNotFoundError as exc:
+        if exc.name not in ("tengsim.study", "tengsim.study.plot"):
+            raise
+        raise TengsimError(f"{src} is a folder, not a result file (this tengsim cannot plot study folders)") \
+            from None
+    return mod.plot_study(src, out)
 
 
 def run(args) -> int:
     from tengsim.load import load_result
 
     src = Path(args.result)
-    out = Path(args.out) if args.out else src.with_suffix(".png")
-    if out.suffix.lower() not in (".png", ".pdf", ".svg"):
+    out = Path(args.out) if args.out else None
+    if out is not None and out.suffix.lower() not in FIGURE_SUFFIXES:
         raise TengsimError(f"--out {out}: use a .png, .pdf or .svg file")
+    if src.is_dir():
+        written = _plot_study(src, out)
+        for w in written or ():
+            print(f"wrote {w}")
+        return 0
+    out = out or src.with_suffix(".png")
     kind, obj = load_result(src)
+    from tengsim import plots
+
+    written = [out]
     if kind == "contact":
-        from tengsim.plots import plot_curves
-
-        plot_curves(obj, out, title=src.name)
+        maps_out = out.with_name(f"{out.stem}_maps{out.suffix}")
+        plots.plot_curves(obj, out, title=src.name)
+        if obj.maps and not args.no_maps:
+            plots.plot_maps(obj, maps_out, title=src.name)
+            written.append(maps_out)
+    elif kind == "sweep":
+        plots.plot_sweep(obj, out, title=src.name)
     else:
-        from tengsim.plots import plot_timeseries
-
-        plot_timeseries(obj, out, title=src.name)
-    print(f"wrote {out}")
+        plots.plot_timeseries(obj, out, title=src.name)
+    for w in written:
+        print(f"wrote {w}")
     return 0
