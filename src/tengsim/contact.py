@@ -1,8 +1,8 @@
 """One entry point composing shape, law, kernel, solver and path into a contact run."""
 from __future__ import annotations
 
-from tengsim import __version__
-from tengsim.errors import TengsimError, positive
+from tengsim import __version__, status
+from tengsim.errors import positive
 from tengsim.geometry import Pyramid, Shape
 from tengsim.interaction import LJ93, Law
 from tengsim.kernels import make_kernel
@@ -12,11 +12,14 @@ from tengsim.solvers import make_solver
 
 def simulate(shape: Shape, tabor: float, dx: float, path: PathSpec, boundary: str = "free",
              solver="fast", tol: float = 1e-6, law: Law | None = None, progress=None,
-             grid=None, extra_params: dict | None = None):
+             grid=None, extra_params: dict | None = None, throw: bool = False):
     """Approach–retraction run of ``shape`` against a rigid flat plate (paper Eq. 9).
 
     ``tabor`` is μ (the elastic coupling is μ^{3/2}); ``dx`` the grid spacing in X units;
-    ``solver`` a name ('fast', 'vsr') or a solver object.  Returns a ContactResult.
+    ``solver`` a name ('fast', 'vsr') or a solver object.  Returns a ContactResult whose ``status``
+    (and per-row ``status`` column) says ok / not_converged / out_of_law_range / under_resolved
+    (:mod:`tengsim.status`); with ``throw=True`` a status other than 'ok' raises
+    :class:`tengsim.status.ResultStatusError`, which carries the result.
     """
     tabor = positive("tabor", tabor)
     law = law or LJ93()
@@ -42,17 +45,9 @@ def simulate(shape: Shape, tabor: float, dx: float, path: PathSpec, boundary: st
         "jump_h": path.jump_h,
         **(extra_params or {}),
     }
-    warnings = []
-    if not res.all_converged:
-        n = int((~res.table["converged"].astype(bool)).sum())
-        warnings.append(f"{n} equilibria did not converge to tol={tol}")
-    n_out = int((~res.table["in_law_range"].astype(bool)).sum())
-    if n_out:
-        warnings.append(f"{n_out} equilibria have gaps below the law's safe limit g_safe={law.g_safe} "
-                        "(compressed beyond the physical law; with the periodic kernel this happens once the "
-                        "whole cell is flattened)")
-    if warnings:
-        res.params["warning"] = "; ".join(warnings)
+    status.attach(res, law, kernel.coupling)  # per-row 'status' column, params['status'] (tengsim.status)
+    if throw:
+        res.raise_for_status()
     return res
 
 

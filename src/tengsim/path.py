@@ -16,6 +16,7 @@ import numpy as np
 from tengsim.analysis import apex_index, summarize
 from tengsim.errors import TengsimError, finite, positive
 from tengsim.solvers import Problem, State
+from tengsim.status import process_zone_width
 
 
 @dataclass(frozen=True)
@@ -134,6 +135,7 @@ def run_path(U0, law, kernel, solver, spec: PathSpec, start: State | None = None
             in_range = bool(s.min_gap + 1.0 >= getattr(law, "g_safe", -np.inf))
             rows.append(dict(branch=branch, D=D, on_grid=on_grid, jump=jump, converged=eq.converged,
                              in_law_range=in_range,
+                             process_zone=process_zone_width(eq.H, grid.dx, apex, law),
                              residual=eq.residual, iterations=eq.iterations, n_conv=eq.n_conv,
                              seconds=eq.seconds, energy=eq.energy, **asdict(s)))
             for Dm in spec.maps_at:
