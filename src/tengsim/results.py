@@ -132,7 +132,8 @@ class ContactResult:
         import xarray as xr
 
         t = self.table
-        data = {k: ("step", t[k].astype(str) if k in ("branch", "status") else t[k]) for k in CURVE_COLUMNS}
+        data = {k: ("step", t[k].astype(str) if k in ("branch", "status") else t[k])
+                for k in CURVE_COLUMNS if k in t}  # files from before a column existed lack it
         for k in ("converged", "on_grid", "jump", "in_law_range"):
             data[k] = ("step", t[k].astype(np.int8))
         ds = xr.Dataset(data)
@@ -163,7 +164,7 @@ class ContactResult:
 
     def csv_columns(self) -> dict:
         t = self.table
-        return {k: t[k] for k in CURVE_COLUMNS}
+        return {k: t[k] for k in CURVE_COLUMNS if k in t}
 
     def save(self, path) -> None:
         """Write ``.csv`` (curves, parameters in '#' header lines) or ``.nc`` (everything), atomically."""
