@@ -3,7 +3,7 @@ from __future__ import annotations
 
 from dataclasses import is_dataclass, replace
 
-from tengsim import __version__
+from tengsim import __version__, status
 from tengsim.errors import TengsimError, positive
 from tengsim.geometry import Pyramid, Shape
 from tengsim.interaction import LJ93, Law, make_law
@@ -18,7 +18,7 @@ MONITOR_MIN_POINTS = 1024**2  # grids from this size on report progress inside e
 
 def simulate(shape: Shape, tabor: float, dx: float, path: PathSpec, boundary: str = "free",
              solver="fast", tol: float = 1e-6, law: Law | str | None = None, progress=None,
-             grid=None, extra_params: dict | None = None, observers=(), scaling=None):
+             grid=None, extra_params: dict | None = None, observers=(), scaling=None, throw: bool = False):
     """Approach–retraction run of ``shape`` against a rigid flat plate (paper Eq. 9).
 
     ``tabor`` is μ (the elastic coupling is μ^{3/2}); ``dx`` the grid spacing in X units;
@@ -26,7 +26,10 @@ def simulate(shape: Shape, tabor: float, dx: float, path: PathSpec, boundary: st
     ('fast', 'vsr') or a solver object; ``law`` a law object or registered name (default the
     paper's LJ93).  ``observers`` (registered names or objects) add columns to the table; with a
     ``scaling`` (:class:`tengsim.units.Scaling`) the table also gets F_N, pressure_Pa and
-    contact_length_m and the units metadata of that scaling.  Returns a ContactResult.
+    contact_length_m and the units metadata of that scaling.  Returns a ContactResult whose ``status``
+    (and per-row ``status`` column) says ok / not_converged / out_of_law_range / under_resolved
+    (:mod:`tengsim.status`); with ``throw=True`` a status other than 'ok' raises
+    :class:`tengsim.status.ResultStatusError`, which carries the result.
     """
     tabor = positive("tabor", tabor)
     if scaling is not None and abs(scaling.mu - tabor) > 1e-9 * tabor:
@@ -65,17 +68,9 @@ def simulate(shape: Shape, tabor: float, dx: float, path: PathSpec, boundary: st
         for k, v in scaling.params().items():
             res.params.setdefault(k, v)
         res.add_physical(scaling)
-    warnings = []
-    if not res.all_converged:
-        n = int((~res.table["converged"].astype(bool)).sum())
-        warnings.append(f"{n} equilibria did not converge to tol={tol}")
-    n_out = int((~res.table["in_law_range"].astype(bool)).sum())
-    if n_out:
-        warnings.append(f"{n_out} equilibria have gaps below the law's safe limit g_safe={law.g_safe} "
-                        "(compressed beyond the physical law; with the periodic kernel this happens once the "
-                        "whole cell is flattened)")
-    if warnings:
-        res.params["warning"] = "; ".join(warnings)
+    status.attach(res, law, kernel.coupling)  # per-row 'status' column, params['status'] (tengsim.status)
+    if throw:
+        res.raise_for_status()
     return res
 
 

@@ -15,8 +15,9 @@ from tengsim.grid import Grid
 from tengsim.results import CURVE_COLUMNS, ContactResult
 
 BOOL_COLUMNS = ("converged", "on_grid", "jump", "in_law_range")
-# written by every tengsim version; later additions (in_law_range) are taken when present
-REQUIRED_CONTACT = tuple(k for k in CURVE_COLUMNS if k != "in_law_range")
+# written by every tengsim version; later additions (in_law_range, process_zone, status) are taken when present
+LATER_COLUMNS = ("in_law_range", "process_zone", "status")
+REQUIRED_CONTACT = tuple(k for k in CURVE_COLUMNS if k not in LATER_COLUMNS)
 SWEEP_COLUMNS = ("R", "energy_per_cycle", "average_power")
 
 
@@ -57,13 +58,22 @@ def _require(path, cols, required, what):
         raise TengsimError(f"{path}: {what} lacks column(s) {', '.join(missing)}")
 
 
-def _contact_table(path, cols) -> dict:
+def _contact_table(path, cols, dx=None) -> dict:
+    """Every column of the file (SI and observer columns too); a file older than the status column gets
+    its status worked out from its other columns."""
+    from tengsim import status as _status
+
     _require(path, cols, REQUIRED_CONTACT, "contact result")
-    table = {k: np.asarray(cols[k]) for k in CURVE_COLUMNS if k in cols}
+    table = {k: np.asarray(v) for k, v in cols.items() if np.ndim(v) == 1 and len(v) == len(cols["D"])}
     for k in BOOL_COLUMNS:
         if k in table:
             table[k] = table[k].astype(bool)
     table["branch"] = table["branch"].astype(str)
+    if "status" in table:
+        table["status"] = table["status"].astype(str)
+    else:
+        table.setdefault("in_law_range", np.ones(len(table["D"]), bool))
+        table["status"] = _status.classify(table, dx if dx else np.nan)
     return table
 
 
@@ -93,11 +103,11 @@ def load_result(path) -> tuple[str, object]:
     if suffix == ".csv":
         header, cols = _read_csv(path)
         if "branch" in cols and "D" in cols:
-            table = _contact_table(path, cols)
             try:
                 grid = _header_grid(header)
             except TengsimError as exc:
                 raise TengsimError(f"{path}: {exc}") from None
+            table = _contact_table(path, cols, grid.dx if grid else None)
             return "contact", ContactResult(table=table, grid=grid, params=header)
         if "t" in cols:
             return "device", cols
@@ -113,12 +123,13 @@ def load_result(path) -> tuple[str, object]:
         except Exception as exc:  # noqa: BLE001 - any reader failure is a bad input file
             raise TengsimError(f"cannot read {path} as NetCDF: {exc}") from None
         if "branch" in ds and "D" in ds:
-            table = _contact_table(path, {k: ds[k].values for k in ds.data_vars})
             params = json.loads(ds.attrs.get("params", "{}"))
             x, y = ds["x"].values, ds["y"].values
             if len(x) < 3 or len(y) < 3:
                 raise TengsimError(f"{path}: grid coordinates x, y have {len(x)}, {len(y)} points (need >= 3)")
             grid = Grid(len(x), len(y), float(x[1] - x[0]), float(y[1] - y[0]))
+            table = _contact_table(path, {k: ds[k].values for k in ds.data_vars if ds[k].dims == ("step",)},
+                                   grid.dx)
             maps = []
             if "P" in ds:
                 for i in range(ds.sizes["map"]):

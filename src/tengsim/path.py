@@ -16,6 +16,7 @@ import numpy as np
 from tengsim.analysis import apex_index
 from tengsim.errors import TengsimError, finite, positive
 from tengsim.solvers import Problem, State
+from tengsim.status import process_zone_width
 
 
 @dataclass(frozen=True)
@@ -143,6 +144,7 @@ def run_path(U0, law, kernel, solver, spec: PathSpec, start: State | None = None
                 more.update(obs.observe(o, eq, ctx))
             rows.append(dict(branch=branch, D=D, on_grid=on_grid, jump=jump, converged=eq.converged,
                              in_law_range=in_range,
+                             process_zone=process_zone_width(eq.H, grid.dx, apex, law),
                              residual=eq.residual, iterations=eq.iterations, n_conv=eq.n_conv,
                              seconds=eq.seconds, energy=eq.energy, **s, **more))
             for Dm in spec.maps_at:

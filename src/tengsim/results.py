@@ -6,6 +6,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from tengsim import status as _status
 from tengsim.grid import Grid
 
 
@@ -20,7 +21,7 @@ def trapezoid(y, x) -> float:
 
 CURVE_COLUMNS = ["branch", "D", "F", "contact_length", "area_repulsive", "converged", "residual",
                  "iterations", "n_conv", "on_grid", "jump", "min_gap", "max_pressure",
-                 "min_pressure", "energy", "seconds", "in_law_range"]
+                 "min_pressure", "energy", "seconds", "in_law_range", "process_zone", "status"]
 PHYSICAL_COLUMNS = ["F_N", "pressure_Pa", "contact_length_m"]
 _FLAGS = ("converged", "on_grid", "jump", "in_law_range")
 
@@ -64,7 +65,9 @@ class ContactResult:
 
     @classmethod
     def from_rows(cls, rows, maps, grid, seconds=0.0, final_state=None, extra_columns=()):
-        table = {k: np.array([r[k] for r in rows]) for k in [*CURVE_COLUMNS, *extra_columns]}
+        table = {k: np.array([r.get(k, np.nan) for r in rows], dtype=float if k == "process_zone" else None)
+                 for k in [*CURVE_COLUMNS, *extra_columns] if k != "status"}
+        table["status"] = _status.classify(table, grid.dx)
         return cls(table=table, grid=grid, maps=maps, seconds=seconds, final_state=final_state)
 
     def add_physical(self, scaling) -> None:
@@ -102,6 +105,20 @@ class ContactResult:
     @property
     def all_converged(self) -> bool:
         return bool(np.all(self.table["converged"]))
+
+    @property
+    def status(self) -> str:
+        """Overall status, the worst row's: 'ok', 'under_resolved', 'out_of_law_range' or 'not_converged'
+        (criteria in :mod:`tengsim.status`)."""
+        s = self.table.get("status")
+        if s is None or np.asarray(s).dtype.kind not in "US":  # older files: classify from the columns
+            s = _status.classify(self.table, self.grid.dx)
+        return _status.overall(s)
+
+    def raise_for_status(self) -> "ContactResult":
+        """Raise :class:`tengsim.status.ResultStatusError` unless :attr:`status` is 'ok'; else return self."""
+        _status.raise_for_status(self)
+        return self
 
     # ---- events -----------------------------------------------------------------------------
     @property
@@ -158,7 +175,8 @@ class ContactResult:
         import xarray as xr
 
         t = self.table
-        data = {k: ("step", t[k].astype(str) if k == "branch" else t[k]) for k in self.columns if k in t}
+        data = {k: ("step", t[k].astype(str) if k in ("branch", "status") else t[k])
+                for k in self.columns if k in t}  # files from before a column existed lack it
         for k in _FLAGS:
             data[k] = ("step", t[k].astype(np.int8))
         ds = xr.Dataset(data)
@@ -176,6 +194,7 @@ class ContactResult:
         ds.attrs["pull_off_F"] = self.pull_off_force
         ds.attrs["n_unconverged"] = int(np.count_nonzero(~t["converged"].astype(bool)))
         ds.attrs["n_outside_law_range"] = int(np.count_nonzero(~t["in_law_range"].astype(bool)))
+        ds.attrs["status"] = self.status
         ds.attrs["jumps"] = json.dumps([j.__dict__ for j in self.jumps])
         ds.attrs["seconds"] = self.seconds
         for k, v in self.params.items():

@@ -91,17 +91,13 @@ def write_contact(res, out, plot=None, quiet=False) -> int:
         from tengsim.plots import plot_curves
 
         plot_curves(res, plot)
-    n_bad = int((~res.table["converged"].astype(bool)).sum())
     if not quiet:
         j = res.jumps
         si = f" ({res.scaling.force(res.pull_off_force):.4g} N per cell)" if res.scaling is not None else ""
         print(f"wrote {out}: {len(res.table['D'])} equilibria, pull-off F = {res.pull_off_force:.4g}{si}, "
               f"{len(j)} jump(s), {res.seconds:.1f} s", file=sys.stderr)
-    if n_bad:
-        print(f"tengsim: warning: {n_bad} equilibria did not converge (see column 'converged')",
-              file=sys.stderr)
-    n_out = int((~res.table["in_law_range"].astype(bool)).sum())
-    if n_out:
-        print(f"tengsim: warning: {n_out} equilibria are compressed beyond the interaction law's range "
-              "(see column 'in_law_range')", file=sys.stderr)
+    from tengsim.status import warning_lines
+
+    for line in warning_lines(res):  # one line per problem kind; a warning, so the exit code stays 0
+        print(f"tengsim: warning: {line} (see column 'status')", file=sys.stderr)
     return 0
