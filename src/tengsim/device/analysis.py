@@ -157,7 +157,7 @@ def vq_cycle(result: DeviceResult, cycle: int = -1) -> VQCycle:
     x_max = float(np.max(result.gap[m]))
     area = float(np.max(result.area[m]))
     cm = fm.cmeo_cycle(p.sigma_C_per_m2, p.area_m2, p.thickness_m, p.eps_r, x_max, area=area)
-    return VQCycle(q, v, float(np.trapezoid(v, q)), x_max, cm)
+    return VQCycle(q, v, float(fm._trapz(v, q)), x_max, cm)
 
 
 @dataclass(frozen=True)

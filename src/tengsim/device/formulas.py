@@ -18,6 +18,8 @@ import numpy as np
 
 from tengsim.device.params import EPS0
 
+_trapz = getattr(np, "trapezoid", None) or np.trapz  # numpy < 2 has only trapz
+
 
 def voc_polymer(area_fraction, sigma, eps_r, thickness):
     """Eq. (12): V_OC = sigma (A/S) T / (eps_r eps0) (V)."""
@@ -117,5 +119,5 @@ def cmeo_cycle(sigma, plate_area, thickness, eps_r, x_max, area=None, n: int = 2
     legs_v = [v(0.0, xs), v(qs, x_max), v(qm, xs[::-1]), v(qs[::-1], 0.0)]
     q = np.concatenate(legs_q)
     vv = np.concatenate(legs_v)
-    energy = float(np.trapezoid(vv, q))  # only the two discharge legs move Q
+    energy = float(_trapz(vv, q))  # only the two discharge legs move Q
     return CMEOCycle(q, vv, energy, qm, float(v(0.0, x_max)), float(-v(qm, 0.0)), float(x_max))
