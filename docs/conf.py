@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import importlib
 import os
+import pkgutil
 import sys
 from pathlib import Path
 
@@ -66,11 +67,10 @@ def _public_api() -> dict:
     ``__init__.py`` is the reader's entry point; computed at build time, never written down twice.
     """
     out = {}
-    for pkg_name in ("tengsim", "tengsim.device"):
-        try:
-            pkg = importlib.import_module(pkg_name)
-        except ImportError:
-            continue
+    packages = ["tengsim"] + [m.name for m in pkgutil.walk_packages(tengsim.__path__, "tengsim.")
+                              if m.ispkg and not any(p.startswith("_") for p in m.name.split("."))]
+    for pkg_name in packages:
+        pkg = importlib.import_module(pkg_name)
         names = getattr(pkg, "__all__", None) or [n for n in vars(pkg) if not n.startswith("_")]
         rows = []
         for n in names:
@@ -81,7 +81,8 @@ def _public_api() -> dict:
             if not mod.startswith("tengsim") or any(p.startswith("_") for p in mod.split(".")):
                 continue
             rows.append((n, f"{mod}.{getattr(obj, '__qualname__', n)}"))
-        out[pkg_name] = sorted(rows, key=lambda r: r[0].lower())
+        if rows:
+            out[pkg_name] = sorted(rows, key=lambda r: r[0].lower())
     return out
 
 
