@@ -334,9 +334,11 @@ def maugis_dugdale_m(lam, A):
 def maugis_dugdale_curve(lam, A_max=3.0, n=400, A_min=None) -> MDCurve:
     """Maugis-Dugdale load/indentation curve (dimensionless) for A in [A_min, A_max].
 
-    Equations (Maugis 1992; Johnson & Greenwood 1997 Eqs. 3-5), s = sqrt(m^2-1):
+    Equations (Maugis 1992; Johnson & Greenwood 1997 Eqs. 3-5), s = sqrt(m^2-1)::
+
       (lam A^2/2)[s + (m^2-2) atan s] + (4 lam^2 A/3)[s atan s - m + 1] = 1,
       P = A^3 - lam A^2 [s + m^2 atan s],   D = A^2 - (4/3) A lam s.
+
     For each A (uniform grid, A_min default A_max/n) m is found by bisection,
     which is robust for all lam > 0. Dimensional values: multiply by
     :func:`md_scales`.
