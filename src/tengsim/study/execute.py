@@ -248,14 +248,14 @@ def run_study(study, out, *, workers=None, scheduler=None, client=None, resume=F
     if sd.root.exists() and not sd.root.is_dir():
         raise TengsimError(f"--out {sd.root} is a file, not a directory")
     check_resume(study, sd, resume)
-    from tengsim.io import check_writable
-
-    check_writable(sd.root / "study.json")
     own = None
     if client is None:
         client, own = connect(workers, scheduler)
         own = (client, own)
     try:
+        from tengsim.io import check_writable
+
+        check_writable(sd.root / "study.json")
         say(f"sweep: {len(study.points)} points ({len(valid) + len(invalid)} distinct computations) on "
             f"{len(client.scheduler_info().get('workers', {}))} worker(s); dashboard {client.dashboard_link}")
         sd.points.mkdir(parents=True, exist_ok=True)
@@ -280,7 +280,10 @@ def run_study(study, out, *, workers=None, scheduler=None, client=None, resume=F
             _close(*own)
     from tengsim.study.dataset import build_study
 
-    summary = build_study(sd.root)
+    import dask
+
+    with dask.config.set(scheduler="synchronous"):
+        summary = build_study(sd.root)
     summary["computed"] = computed
     say(f"sweep: wrote {sd.root / 'study.nc'} and {sd.root / 'study.csv'}: {summary['ok']} ok, "
         f"{summary['failed']} failed, {summary['unconverged']} unconverged, {summary['pending']} pending")
@@ -302,6 +305,7 @@ def _append_log(sd, entry):
 
 def _compute(client, valid, todo, sd, bar) -> list:
     """Submit ``todo``; write each result as it completes.  Returns the ids computed here."""
+    import dask
     from dask.distributed import as_completed
 
     from tengsim.io import write_dataset, write_json
@@ -322,7 +326,8 @@ def _compute(client, valid, todo, sd, bar) -> list:
                                             "message": r["message"], "contact": valid[pid],
                                             **{k: r.get(k) for k in ("seconds", "host", "pid")}})
             else:
-                write_dataset(r["data"], sd.nc(pid))
+                with dask.config.set(scheduler="synchronous"):  # a local file: no distributed write lock
+                    write_dataset(r["data"], sd.nc(pid))
                 try:
                     sd.failed(pid).unlink()
                 except FileNotFoundError:

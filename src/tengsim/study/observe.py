@@ -221,9 +221,10 @@ def observe(res, device: dict, settings: dict) -> dict:
     curves["area_fraction"] = np.where(np.isfinite(curves["V_OC"]), np.interp(grid, P, A), nan)
     curves["V_OC_at"] = at(settings["pressures"])
     lo, hi = settings["fit_range"]
-    m = (P >= lo) & (P <= hi)
-    if np.count_nonzero(m) >= 2 and np.ptp(P[m]) > 0:
-        slope, icpt = np.polyfit(P[m], V[m], 1)
+    a, b = max(lo, P[0]), min(hi, P[-1])
+    if b > a:  # least squares over the piecewise-linear V_OC(P) sampled evenly on [lo, hi] ∩ the run
+        xs = np.linspace(a, b, 41)
+        slope, icpt = np.polyfit(xs, np.interp(xs, P, V), 1)
         out["S_V_per_kPa"] = slope * 1e3
         fit = icpt + slope * P
         ok = np.abs(V - fit) <= settings["linear_tolerance"] * np.abs(fit)
