@@ -32,7 +32,7 @@ SCALARS = {
     "jump_out_D": ("ε", "D at which the retraction first lands on the jumped-out state"),
     "transition_D": ("ε", "approach D where Λc reaches transition_fraction of full contact"),
     "area_fraction_0": ("1", "charged-area fraction A/S at zero load (approach)"),
-    "adhesive_full_contact": ("1", "1 if A/S at zero load >= full_contact_fraction × its maximum"),
+    "adhesive_full_contact": ("1", "1 if Λc at zero load >= full_contact_fraction × full contact (2N)"),
     "S_V_per_kPa": ("V/kPa", "dV_OC/dP, least-squares line over fit_range"),
     "linear_range_Pa": ("Pa", "highest P with V_OC within linear_tolerance of the fit"),
     "V_sat": ("V", "largest V_OC of the run"),
@@ -57,7 +57,7 @@ def parse_observables(table: dict, where: str = "study") -> dict:
               help="top of the common pressure grid (from 0)"),
         Field("grid_num", "int", 61, help="points of the common pressure grid"),
         Field("transition_fraction", "float", 0.95, help="Λc fraction of full contact for transition_D"),
-        Field("full_contact_fraction", "float", 0.9, help="A/S fraction at zero load flagged as full contact"),
+        Field("full_contact_fraction", "float", 0.9, help="Λc fraction of full contact at zero load flagged"),
     ])
     raw = dict(table)
     labels = raw.get("pressures", OBSERVABLE_DEFAULTS["pressures"])
@@ -201,8 +201,8 @@ def observe(res, device: dict, settings: dict) -> dict:
     if len(Fk):
         A = area_fraction(res, Lk)
         out["area_fraction_0"] = float(A[0])
-        Amax = float(np.max(area_fraction(res, res.table["contact_length"])))
-        out["adhesive_full_contact"] = float(A[0] >= settings["full_contact_fraction"] * Amax) if Amax > 0 else 0.0
+        if math.isfinite(full):
+            out["adhesive_full_contact"] = float(Lk[0] >= settings["full_contact_fraction"] * full)
     scale = physical_scale(res)
     if scale is None or len(Fk) < 2:
         return {"scalars": out, "curves": curves}

@@ -297,8 +297,10 @@ def _split_unit(v, name, where):
 
 
 def _with_unit(x, unit):
-    x = float(f"{float(x):.12g}")
-    return f"{x:.12g}{unit}" if unit else x
+    """A generated axis value: a float (12 significant digits), or '<6 significant digits><unit>'."""
+    if unit:
+        return f"{float(x):.6g}{unit}"
+    return float(f"{float(x):.12g}")
 
 
 def _parse_axis(name, spec, where) -> Axis:
