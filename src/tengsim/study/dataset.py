@@ -28,12 +28,9 @@ def _read_point(sd, pid):
 
     nc = sd.nc(pid)
     if nc.exists():
-        import xarray as xr
-
-        with xr.open_dataset(nc, engine="h5netcdf") as ds:
-            attrs = dict(ds.attrs)
         _, res = load_result(nc)
-        return attrs.get("status", "ok"), str(attrs.get("message", "")), res, float(attrs.get("compute_seconds", math.nan))
+        a = res.attrs if hasattr(res, "attrs") else _attrs(nc)
+        return a.get("status", "ok"), str(a.get("message", "")), res, float(a.get("compute_seconds", math.nan))
     f = sd.failed(pid)
     if f.exists():
         try:
@@ -43,6 +40,14 @@ def _read_point(sd, pid):
         s = d.get("seconds")
         return "failed", str(d.get("message", "")), None, float(s) if s is not None else math.nan
     return "pending", "", None, math.nan
+
+
+def _attrs(nc) -> dict:
+    import h5py
+
+    with h5py.File(nc, "r") as f:
+        return {k: (v.decode() if isinstance(v, bytes) else v.item() if hasattr(v, "item") else v)
+                for k, v in f.attrs.items() if k in ("status", "message", "compute_seconds")}
 
 
 def collect(root) -> dict:

@@ -67,6 +67,17 @@ def compute_point(contact: dict, pid: str) -> dict:
             "data": ds}
 
 
+def warm_up() -> int:
+    """Import the solver stack on a worker (before the first point, so that no point pays for it)."""
+    for k, v in WORKER_ENV.items():
+        os.environ.setdefault(k, v)
+    import tengsim.config  # noqa: F401
+    import tengsim.contact  # noqa: F401
+    import xarray  # noqa: F401
+
+    return os.getpid()
+
+
 # ---- validation ---------------------------------------------------------------------------------
 
 def validate(study) -> tuple[dict, dict]:
@@ -273,7 +284,11 @@ def run_study(study, out, *, workers=None, scheduler=None, client=None, resume=F
         if len(todo) < len(valid):
             say(f"sweep: {len(valid) - len(todo)} point(s) already in {sd.points}, {len(todo)} to compute")
         _append_log(sd, {"event": "start", "time": time.time(), "todo": todo})
+        if todo:
+            client.run(warm_up)
+        t0 = time.perf_counter()
         computed = _compute(client, valid, todo, sd, bar)
+        t_compute = time.perf_counter() - t0
         bar.close()
     finally:
         if own is not None:
@@ -282,9 +297,10 @@ def run_study(study, out, *, workers=None, scheduler=None, client=None, resume=F
 
     import dask
 
+    t0 = time.perf_counter()
     with dask.config.set(scheduler="synchronous"):
         summary = build_study(sd.root)
-    summary["computed"] = computed
+    summary.update(computed=computed, compute_phase_s=t_compute, assemble_s=time.perf_counter() - t0)
     say(f"sweep: wrote {sd.root / 'study.nc'} and {sd.root / 'study.csv'}: {summary['ok']} ok, "
         f"{summary['failed']} failed, {summary['unconverged']} unconverged, {summary['pending']} pending")
     return summary

@@ -349,6 +349,8 @@ def expand(study: Study) -> list:
     axes = study.axes
     if study.sampling == "grid":
         for a in axes:
+            if not a.values and study.objective:
+                return []  # an optimisation: tengsim optimize draws the points
             if not a.values:
                 raise TengsimError(f"axis {a.name!r} is a range without num (only sampling = 'lhs' or "
                                    "'sobol' may leave num out)")
