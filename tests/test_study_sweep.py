@@ -271,3 +271,58 @@ def test_kill_and_resume_equals_uninterrupted(tmp_path, client):
     b = xr.load_dataset(tmp_path / "ref" / "study.nc").drop_vars("seconds")
     a.attrs.pop("study"), b.attrs.pop("study")  # the study's source path differs
     xr.testing.assert_identical(a, b)
+
+
+OPT = {"base": {"contact": {"shape": "pyramid", "pitch": "2um", "base": "1um", "height": "0.7um",
+                            "E_star": "0.59MPa", "W": "54mJ/m2", "eps": "0.37um", "dx": 0.45, "d_min": -1.0,
+                            "d_max": 4.0, "d_step": 0.25}},
+       "axes": {"contact.E_star": {"start": "0.5MPa", "stop": "3MPa", "scale": "log"}},
+       "objective": {"maximize": "V_sat", "maxiter": 1, "popsize": 2, "seed": 2}}
+
+
+@pytest.mark.slow
+def test_optimize_stores_points_and_resumes(tmp_path, client):
+    from tengsim.study.optimize import optimize_study
+
+    study = parse_study(OPT, source="opt")
+    assert study.points == []
+    r = optimize_study(study, tmp_path / "o", client=client, quiet=True)
+    files = {f.name: f.stat().st_mtime_ns for f in (tmp_path / "o" / "points").glob("*.nc")}
+    assert r["feasible"] and r["evaluations"] == len(files) >= 4
+    ds = xr.load_dataset(tmp_path / "o" / "study.nc")
+    assert ds.sizes["point"] == r["evaluations"]
+    assert r["value"] == pytest.approx(float(ds["V_sat"].max()))  # the best of all evaluations
+    # the optimum is a stored point whose V_sat is a direct run's
+    direct = run_contact(dict(OPT["base"]["contact"], E_star=r["x"]["contact.E_star"]))
+    from tengsim.study.observe import observe
+
+    v = observe(direct, study.base["device"], study.observables)["scalars"]["V_sat"]
+    assert v == pytest.approx(r["value"], rel=1e-12)
+    r2 = optimize_study(parse_study(OPT, source="opt"), tmp_path / "o", client=client, quiet=True, resume=True)
+    after = {f.name: f.stat().st_mtime_ns for f in (tmp_path / "o" / "points").glob("*.nc")}
+    assert after == files and r2["x"] == r["x"]  # same seed: the same points, all found on disk
+
+
+def test_optimize_objective_errors():
+    from tengsim.study.optimize import parse_objective
+
+    for obj, msg in [({"maximize": "nope"}, "not an observable"), ({}, "needs an [objective]"),
+                     ({"maximize": "V_sat", "minimize": "V_sat"}, "exactly one"),
+                     ({"maximize": "V_sat", "subject_to": {"P_sat_Pa": {"low": 1}}}, "subject_to.P_sat_Pa")]:
+        with pytest.raises(TengsimError, match=msg.replace("[", r"\[").replace("]", r"\]")):
+            parse_objective(parse_study(dict(OPT, objective=obj)) if obj else parse_study(
+                {k: v for k, v in OPT.items() if k != "objective"} | {"axes": {"contact.N": [1.0]}}))
+    with pytest.raises(TengsimError, match="range axes only"):
+        parse_objective(parse_study(dict(OPT, axes={"contact.E_star": ["1MPa", "2MPa"]})))
+
+
+def test_plot_study_maps(tmp_path, client):
+    study = tiny_study({"contact.N": [0.946, 1.2], "contact.tabor": [0.4, 0.5]})
+    run_study(study, tmp_path / "s", client=client, quiet=True)
+    rc = main(["plot", str(tmp_path / "s")])
+    assert rc == 0 and (tmp_path / "s" / "design.png").stat().st_size > 10000
+    one = tiny_study({"contact.N": [0.946, 1.2]})
+    run_study(one, tmp_path / "l", client=client, quiet=True)
+    from tengsim.study.plot import plot_study
+
+    assert plot_study(tmp_path / "l", tmp_path / "l.png")[0].stat().st_size > 10000

@@ -217,7 +217,7 @@ def _hms(s):
 
 # ---- the client ---------------------------------------------------------------------------------
 
-def connect(workers=None, scheduler=None, timeout: float = 5.0):
+def connect(workers=None, scheduler=None, timeout: float = 3.0):
     """A dask Client: on ``scheduler`` (an address) or on a new LocalCluster; returns (client, cluster)."""
     if workers is not None and scheduler is not None:
         raise TengsimError("give either --workers or --scheduler, not both")
