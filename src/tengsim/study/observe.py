@@ -34,7 +34,8 @@ SCALARS = {
     "area_fraction_0": ("1", "charged-area fraction A/S at zero load (approach)"),
     "adhesive_full_contact": ("1", "1 if Λc at zero load >= full_contact_fraction × full contact (2N)"),
     "S_V_per_kPa": ("V/kPa", "dV_OC/dP, least-squares line over fit_range"),
-    "linear_range_Pa": ("Pa", "highest P with V_OC within linear_tolerance of the fit"),
+    "linear_range_Pa": ("Pa", "highest P up to which V_OC stays within linear_tolerance of the fit "
+                        "(fit_range[0] if the first state is off)"),
     "V_sat": ("V", "largest V_OC of the run"),
     "P_sat_Pa": ("Pa", "lowest P where V_OC reaches saturation_fraction × V_sat"),
     "hysteresis": ("3π W ε² m²/n² per cell (∮F dD)", "approach minus retraction ∮ F dD"),
@@ -229,7 +230,7 @@ def observe(res, device: dict, settings: dict) -> dict:
         fit = icpt + slope * P
         ok = np.abs(V - fit) <= settings["linear_tolerance"] * np.abs(fit)
         idx = np.flatnonzero(P >= lo)
-        last = nan
+        last = float(lo) if len(idx) else nan  # the first state already off the line: no linear range
         for i in idx:
             if not ok[i]:
                 break
