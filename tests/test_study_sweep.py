@@ -161,6 +161,21 @@ def test_physical_study_has_pressure_observables(tmp_path, client):
         assert np.isfinite(float(row["S_V_per_kPa"])) and np.isfinite(float(row["hysteresis_J_m2"]))
 
 
+def test_sampled_study_indexed_by_point(tmp_path, client):
+    study = tiny_study({"contact.tabor": {"start": 0.3, "stop": 0.6},
+                        "g": {"zip": {"contact.N": [0.9, 1.1], "contact.cell": [3.6, 4.0]}, "labels": ["s", "t"]}},
+                       study={"sampling": "lhs", "n": 3, "seed": 5})
+    s = run_study(study, tmp_path / "out", client=client, quiet=True)
+    assert s["ok"] == 3
+    ds = xr.load_dataset(tmp_path / "out" / "study.nc")
+    assert ds["pull_off_F"].dims == ("point",) and ds.sizes["point"] == 3
+    np.testing.assert_array_equal(ds["contact.tabor"].values, [p.contact["tabor"] for p in study.points])
+    lines = (tmp_path / "out" / "study.csv").read_text().splitlines()
+    assert lines[0].startswith("contact.tabor,g,contact.N,contact.cell,id,status,")
+    for line, p in zip(lines[1:], study.points):
+        assert line.split(",")[1] == p.axes["g"] and line.split(",")[4] == p.id
+
+
 CLI_BAD = [
     ('"contact.bogus" = [1.0, 2.0]', "bogus"),
     ('"contact.N" = []', "axis 'contact.N' is empty"),

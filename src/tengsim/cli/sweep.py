@@ -4,6 +4,7 @@ The study file holds a ``[base.contact]`` table (exactly a ``tengsim run`` [cont
 ``[axes]`` ("contact.N" = [..], ranges {start, stop, num, scale}, zip groups); see docs/design.md.
 Every finished point is written at once to DIR/points/<id>.nc; DIR/study.nc and DIR/study.csv are
 rebuilt at the end.  A killed sweep continues with --resume and never recomputes a finished point.
+Exit code 0 when every point finished, 1 when some failed (see study.csv), 2 for a bad study file.
 """
 from __future__ import annotations
 
