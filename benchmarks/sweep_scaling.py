@@ -5,6 +5,7 @@ the ratio, and the scheduler + I/O overhead: (workers × wall − Σ point compu
 Writes benchmarks/results/sweep_scaling.md and .json.   python benchmarks/sweep_scaling.py
 """
 import json
+import os
 import logging
 import shutil
 import sys
@@ -38,7 +39,7 @@ def main(out=Path(__file__).parent / "results"):
         cluster.close()
         compute = sum(float(xr.open_dataset(f, engine="h5netcdf").attrs["compute_seconds"])
                       for f in (tmp / "s" / "points").glob("*.nc"))
-        rows.append({"workers": n, "points": s["points"], "ok": s["ok"], "startup_s": t1 - t0, "wall_s": t2 - t1,
+        rows.append({"workers": n, "load_average_1min_after": os.getloadavg()[0], "cpus": os.cpu_count(), "points": s["points"], "ok": s["ok"], "startup_s": t1 - t0, "wall_s": t2 - t1,
                      "compute_s": compute, "points_per_hour": s["points"] / (t2 - t1) * 3600,
                      "points_per_hour_with_startup": s["points"] / (t2 - t0) * 3600,
                      "overhead_fraction": (n * (t2 - t1) - compute) / compute,
@@ -65,7 +66,11 @@ def main(out=Path(__file__).parent / "results"):
               "(first submit to last point written) and the assembly of study.nc/csv. "
               "overhead = (workers × time − Σ point compute seconds) / Σ compute: scheduler round trips, "
               "result transfer and the client's NetCDF write of each point (compute phase), plus warm-up and "
-              "assembly (wall)."]
+              "assembly (wall).", "",
+              f"Machine: {os.cpu_count()} CPUs; 1-minute load average after each run: "
+              + ", ".join(f"{r['load_average_1min_after']:.1f} ({r['workers']} worker(s))" for r in rows)
+              + ". A load above the CPU count means other jobs shared the cores: a second worker then "
+              "gets no core of its own and the ratio measures the contention, not the sweep."]
     (out / "sweep_scaling.md").write_text("\n".join(lines) + "\n")
     print("\n".join(lines))
 
