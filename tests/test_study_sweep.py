@@ -14,7 +14,7 @@ import xarray as xr
 from tengsim.cli.main import main
 from tengsim.config import plan_contact, run_contact
 from tengsim.errors import TengsimError
-from tengsim.study import build_study, parse_study, run_study
+from tengsim.study import parse_study, run_study
 
 MINIMAL = """
 [base.contact]             # exactly what the [contact] table of a `tengsim run` file holds

@@ -248,7 +248,7 @@ def run_study(study, out, *, workers=None, scheduler=None, client=None, resume=F
     ``client`` (an existing dask Client) overrides ``workers``/``scheduler``.  Returns a summary dict.
     Nothing is written if validation, the directory check or the connection fails.
     """
-    from tengsim.io import write_json, write_text
+    from tengsim.io import write_json
 
     stream = stream or sys.stderr
     say = (lambda m: None) if quiet else (lambda m: print(m, file=stream, flush=True))
