@@ -11,7 +11,7 @@ import sys
 
 from tengsim.errors import TengsimError
 
-SUBCOMMANDS = ["contact", "device", "reproduce", "run", "plot"]
+SUBCOMMANDS = ["contact", "device", "reproduce", "run", "plot", "sweep", "optimize"]
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -7,7 +7,6 @@ is drawn by ``tengsim.study.plot``.
 """
 from __future__ import annotations
 
-import importlib
 from pathlib import Path
 
 from tengsim.errors import TengsimError
@@ -28,14 +27,10 @@ def register(sub):
 
 
 def _plot_study(src: Path, out):
-    try:
-        mod = importlib.import_module("tengsim.study.plot")
-    except ModuleNotFoundError as exc:
-        if exc.name not in ("tengsim.study", "tengsim.study.plot"):
-            raise
-        raise TengsimError(f"{src} is a folder, not a result file (this tengsim cannot plot study folders)") \
-            from None
-    return mod.plot_study(src, out)
+    """Design maps of a study folder written by ``tengsim sweep`` (default ``DIR/design.png``)."""
+    from tengsim.study.plot import plot_study
+
+    return plot_study(src, out or src / "design.png")
 
 
 def run(args) -> int:

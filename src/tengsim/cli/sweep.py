@@ -1,0 +1,50 @@
+"""``tengsim sweep STUDY.toml``: a design study over any contact/device parameters, on Dask, resumable.
+
+The study file holds a ``[base.contact]`` table (exactly a ``tengsim run`` [contact] table) and
+``[axes]`` ("contact.N" = [..], ranges {start, stop, num, scale}, zip groups); see docs/design.md.
+Every finished point is written at once to DIR/points/<id>.nc; DIR/study.nc and DIR/study.csv are
+rebuilt at the end.  A killed sweep continues with --resume and never recomputes a finished point.
+Exit code 0 when every point finished, 1 when some failed (see study.csv), 2 for a bad study file.
+"""
+from __future__ import annotations
+
+import sys
+
+from tengsim.errors import TengsimError
+
+
+def register(sub):
+    p = sub.add_parser("sweep", help="design study: a grid or sample of runs on Dask, resumable",
+                       description=__doc__.split("\n\n", 1)[1])
+    p.add_argument("study", help="study TOML file ([base.contact], [axes], optional [study], [observables])")
+    p.add_argument("--out", help="study directory (default: the study file's name without .toml)")
+    g = p.add_argument_group("where the points run (default: a LocalCluster with one worker per core)")
+    g.add_argument("--workers", type=int, help="number of local worker processes")
+    g.add_argument("--scheduler", help="address of a running dask scheduler, e.g. tcp://host:8786")
+    p.add_argument("--resume", action="store_true", help="continue the study in --out (skip finished points)")
+    p.add_argument("--retry-failed", dest="retry_failed", action="store_true",
+                   help="with --resume: compute failed points again")
+    p.add_argument("--quiet", action="store_true", help="no progress output")
+    p.set_defaults(func=run)
+
+
+def run(args) -> int:
+    from pathlib import Path
+
+    from tengsim.study.execute import run_study
+    from tengsim.study.spec import load_study
+
+    if args.workers is not None and args.scheduler is not None:
+        raise TengsimError("give either --workers or --scheduler, not both")
+    if args.workers is not None and args.workers < 1:
+        raise TengsimError(f"--workers must be >= 1, got {args.workers}")
+    study = load_study(args.study)
+    out = args.out or str(Path(args.study).with_suffix(""))
+    try:
+        s = run_study(study, out, workers=args.workers, scheduler=args.scheduler, resume=args.resume,
+                      retry_failed=args.retry_failed, quiet=args.quiet)
+    except KeyboardInterrupt:
+        print(f"tengsim: interrupted; finished points are kept in {out}/points; continue with --resume",
+              file=sys.stderr)
+        return 130
+    return 0 if s["failed"] == 0 else 1

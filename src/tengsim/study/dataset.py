@@ -1,0 +1,219 @@
+"""Assembling DIR/study.nc and DIR/study.csv from DIR/study.json and DIR/points/ (idempotent).
+
+study.nc is indexed by the axes for a full grid (a zip group is one dimension, its parameters
+coordinates along it) and by ``point`` for sampled studies.  study.csv has one row per point: the axis
+values in columns named as in [axes], ``id``, ``status``, the scalar observables (units in
+tengsim.study.observe.SCALARS; pull_off_F and jump_in_D as in ``tengsim contact``'s CSV), V_OC at the
+named pressures, and an empty cell wherever there is no value.
+"""
+from __future__ import annotations
+
+import csv
+import io
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+
+from tengsim.errors import TengsimError
+from tengsim.study.observe import SCALARS, observe, pressure_grid
+
+STATUSES = ("ok", "unconverged", "failed", "pending")
+
+
+def _read_point(sd, pid):
+    """(status, message, ContactResult or None, seconds) of one point id."""
+    nc = sd.nc(pid)
+    if nc.exists():
+        try:
+            res, a = _light_result(nc)
+        except (OSError, KeyError, ValueError) as exc:
+            return "failed", f"unreadable point file {nc.name}: {exc}", None, math.nan
+        return a.get("status", "ok"), str(a.get("message", "")), res, float(a.get("compute_seconds", math.nan))
+    f = sd.failed(pid)
+    if f.exists():
+        try:
+            d = json.loads(f.read_text())
+        except (OSError, ValueError):
+            d = {"message": "unreadable failure record"}
+        s = d.get("seconds")
+        return "failed", str(d.get("message", "")), None, float(s) if s is not None else math.nan
+    return "pending", "", None, math.nan
+
+
+_COLUMNS = ("branch", "D", "F", "contact_length", "jump", "converged", "pressure_Pa", "F_N", "contact_length_m")
+
+
+def _light_result(nc):
+    """The curves the observables need and the point's attrs, read with h5py (an xarray open costs ~10×)."""
+    import h5py
+
+    from tengsim.grid import Grid
+    from tengsim.results import ContactResult
+
+    def text(v):
+        return v.decode() if isinstance(v, bytes) else v
+
+    with h5py.File(nc, "r") as f:
+        attrs = {k: text(v.item() if hasattr(v, "item") and getattr(v, "size", 2) == 1 else v)
+                 for k, v in f.attrs.items() if k in ("status", "message", "compute_seconds", "params")}
+        table = {k: f[k][()] for k in _COLUMNS if k in f}
+    table["branch"] = np.array([text(b) for b in table["branch"]])
+    for k in ("jump", "converged"):
+        table[k] = table[k].astype(bool)
+    params = json.loads(attrs.get("params", "{}"))
+    return ContactResult(table=table, grid=Grid(3, 3, 1.0, 1.0), params=params), attrs
+
+
+def collect(root) -> dict:
+    """Per study point (in study.json order): axes, id, status, message, scalars, curves."""
+    from tengsim.study.execute import StudyDir
+
+    sd = StudyDir(Path(root))
+    try:
+        spec = json.loads(sd.spec.read_text())
+    except FileNotFoundError:
+        raise TengsimError(f"{root} is not a study directory (no study.json)") from None
+    except (OSError, ValueError) as exc:
+        raise TengsimError(f"cannot read {sd.spec}: {exc}") from None
+    settings = spec["observables"]
+    cache, rows = {}, []
+    for p in spec["points"]:
+        pid = p["id"]
+        if pid not in cache:
+            cache[pid] = _read_point(sd, pid)
+        status, msg, res, secs = cache[pid]
+        obs = None
+        if res is not None:
+            try:
+                obs = observe(res, p["tables"]["device"], settings)
+            except (TengsimError, ValueError, FloatingPointError) as exc:
+                msg = (msg + "; " if msg else "") + f"observables: {exc}"
+        rows.append({"axes": p["axes"], "index": p["index"], "id": pid, "status": status, "message": msg,
+                     "seconds": secs, "obs": obs})
+    return {"spec": spec, "rows": rows, "settings": settings}
+
+
+def _coord(values):
+    vals = list(values)
+    if all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in vals):
+        return np.array(vals, dtype=float)
+    return np.array([str(v) for v in vals])
+
+
+def build_study(root) -> dict:
+    """Write DIR/study.nc and DIR/study.csv from what DIR/points/ holds; returns counts by status."""
+    import xarray as xr
+
+    from tengsim.io import write_dataset, write_text
+
+    root = Path(root)
+    c = collect(root)
+    spec, rows, settings = c["spec"], c["rows"], c["settings"]
+    grid = pressure_grid(settings)
+    labels = settings["pressure_labels"]
+    nan = math.nan
+    n = len(rows)
+    scal = {k: np.full(n, nan) for k in SCALARS}
+    voc = np.full((n, len(grid)), nan)
+    area = np.full((n, len(grid)), nan)
+    vat = np.full((n, len(labels)), nan)
+    for i, r in enumerate(rows):
+        if r["obs"] is not None:
+            for k in SCALARS:
+                scal[k][i] = r["obs"]["scalars"][k]
+            voc[i] = r["obs"]["curves"]["V_OC"]
+            area[i] = r["obs"]["curves"]["area_fraction"]
+            vat[i] = r["obs"]["curves"]["V_OC_at"]
+    per_point = {
+        "id": np.array([r["id"] for r in rows]),
+        "status": np.array([r["status"] for r in rows]),
+        "message": np.array([r["message"] for r in rows]),
+        "seconds": np.array([r["seconds"] for r in rows], dtype=float),
+        **scal,
+    }
+    axes = spec["axes"]
+    is_grid = spec["sampling"] == "grid"
+    if is_grid and axes:
+        dims = [a["name"] for a in axes]
+        shape = tuple(len(a["coord"]) for a in axes)
+        order = [tuple(r["index"]) for r in rows]
+
+        def arr(v, extra=()):
+            v = np.asarray(v)
+            out = np.empty(shape + tuple(extra), dtype=v.dtype)
+            for i, ix in enumerate(order):
+                out[ix] = v[i]
+            return out
+
+        coords = {}
+        for a in axes:
+            coords[a["name"]] = _coord(a["coord"])
+            if len(a["members"]) > 1:
+                for j, m in enumerate(a["members"]):
+                    coords[m] = (a["name"], _coord([a["values"][k][j] for k in range(len(a["coord"]))]))
+        data = {k: (dims, arr(v)) for k, v in per_point.items()}
+        data["V_OC"] = (dims + ["pressure"], arr(voc, (len(grid),)))
+        data["area_fraction"] = (dims + ["pressure"], arr(area, (len(grid),)))
+        data["V_OC_at"] = (dims + ["pressure_named"], arr(vat, (len(labels),)))
+    else:
+        dims = ["point"]
+        coords = {"point": np.arange(n)}
+        members = [m for a in axes for m in a["members"]]
+        for m in members:
+            coords[m] = ("point", _coord([r["axes"][m] for r in rows]))
+        data = {k: ("point", v) for k, v in per_point.items()}
+        data["V_OC"] = (["point", "pressure"], voc)
+        data["area_fraction"] = (["point", "pressure"], area)
+        data["V_OC_at"] = (["point", "pressure_named"], vat)
+    coords["pressure"] = ("pressure", grid, {"units": "Pa"})
+    coords["pressure_named"] = ("pressure_named", np.array(labels))
+    coords["pressure_named_Pa"] = ("pressure_named", np.array(settings["pressures"], float), {"units": "Pa"})
+    ds = xr.Dataset(data, coords=coords)
+    for k, (u, long) in SCALARS.items():
+        ds[k].attrs.update(units=u, long_name=long)
+    ds["V_OC"].attrs.update(units="V", long_name="Eq. (12) open-circuit voltage under load control")
+    ds["area_fraction"].attrs.update(units="1", long_name="charged-area fraction A/S")
+    ds["V_OC_at"].attrs.update(units="V", long_name="V_OC at the named pressures")
+    ds["seconds"].attrs["units"] = "s"
+    from tengsim import __version__
+
+    ds.attrs.update({"study": json.dumps({k: spec[k] for k in ("source", "sampling", "n", "seed", "base")},
+                                         default=str),
+                     "axes": json.dumps(axes), "observables": json.dumps(settings),
+                     "tengsim_version": __version__})
+    write_dataset(ds, root / "study.nc")
+    write_text(root / "study.csv", _csv(spec, rows, per_point, vat, labels))
+    counts = {s: int(np.count_nonzero(per_point["status"] == s)) for s in STATUSES}
+    return {**counts, "points": n}
+
+
+def _cell(v):
+    if v is None:
+        return ""
+    if isinstance(v, (float, np.floating)):
+        return "" if not math.isfinite(v) else repr(float(v))
+    return str(v)
+
+
+def _csv(spec, rows, per_point, vat, labels) -> str:
+    cols = []
+    for a in spec["axes"]:
+        if len(a["members"]) > 1:
+            cols.append(a["name"])
+        cols.extend(a["members"])
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    scal = list(SCALARS)
+    w.writerow(cols + ["id", "status"] + scal + [f"V_OC_{lab}" for lab in labels] + ["seconds", "message"])
+    for i, r in enumerate(rows):
+        vals = []
+        for a in spec["axes"]:
+            if len(a["members"]) > 1:
+                vals.append(r["axes"].get(a["name"], ""))
+            vals.extend(r["axes"][m] for m in a["members"])
+        w.writerow([_cell(v) for v in vals] + [r["id"], r["status"]]
+                   + [_cell(per_point[k][i]) for k in scal] + [_cell(x) for x in vat[i]]
+                   + [_cell(per_point["seconds"][i]), r["message"]])
+    return buf.getvalue()

@@ -1,0 +1,369 @@
+"""Running a study on Dask: validate every point, submit, write each finished point atomically, resume.
+
+Layout of a study directory::
+
+    DIR/study.json            resolved points of the study (checked on --resume)
+    DIR/points/<id>.nc        one finished contact computation (result + params, timings, status, version)
+    DIR/points/<id>.failed.json   a point that raised (its message); rerun only with --retry-failed
+    DIR/log.jsonl             one line per finished or failed point, in completion order
+    DIR/study.nc, study.csv   the assembled dataset (tengsim.study.dataset), rebuilt at the end
+
+Points are computed on a ``dask.distributed`` client: a LocalCluster (one single-threaded worker
+process per core, BLAS/FFT threads pinned to 1) or an existing scheduler.  The client writes each
+result the moment it arrives (``as_completed``), through a temporary file and an atomic rename, so a
+sweep killed at any moment keeps every finished point and never holds a half-written one.
+"""
+from __future__ import annotations
+
+import json
+import os
+import socket
+import sys
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+from tengsim.errors import TengsimError
+
+WORKER_ENV = {"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1",
+              "TENGSIM_THREADS": "1", "TENGSIM_FFT_WORKERS": "1"}
+"""Environment of every worker: one thread per process (the parallelism is across points)."""
+
+
+# ---- the task that runs on a worker --------------------------------------------------------------
+
+def compute_point(contact: dict, pid: str) -> dict:
+    """Run one point (exactly what ``tengsim run`` runs for the same [contact] table) on a worker.
+
+    Never raises: returns {'status': 'ok' | 'unconverged' | 'failed', 'message', 'data' (the result's
+    xarray Dataset with its attrs; the client writes it), 'seconds', 'host', 'pid', 'started', 'finished'}.
+    """
+    for k, v in WORKER_ENV.items():  # for workers of an external scheduler (LocalCluster sets them already)
+        os.environ.setdefault(k, v)
+    import traceback
+
+    from tengsim import __version__
+    from tengsim.config import run_contact
+
+    t0 = time.time()
+    c0 = time.perf_counter()
+    info = {"host": socket.gethostname(), "pid": os.getpid(), "started": t0}
+    try:
+        res = run_contact(dict(contact))
+    except Exception as exc:  # noqa: BLE001 - recorded as a failed point, the others go on
+        msg = str(exc) if isinstance(exc, TengsimError) else \
+            f"{type(exc).__name__}: {exc}\n{traceback.format_exc(limit=-3)}"
+        return {**info, "status": "failed", "message": msg.strip(), "seconds": time.perf_counter() - c0,
+                "finished": time.time(), "data": None}
+    seconds = time.perf_counter() - c0
+    status = "ok" if res.all_converged else "unconverged"
+    message = str(res.params.get("warning", ""))
+    ds = res.to_dataset()
+    ds.attrs.update({"point_id": pid, "status": status, "message": message, "compute_seconds": seconds,
+                     "tengsim_version": __version__, "host": info["host"], "worker_pid": info["pid"],
+                     "started_unix": t0, "finished_unix": time.time(),
+                     "point_contact": json.dumps(contact, sort_keys=True, default=str)})
+    return {**info, "status": status, "message": message, "seconds": seconds, "finished": time.time(),
+            "data": ds}
+
+
+def warm_up() -> int:
+    """Import the solver stack on a worker (before the first point, so that no point pays for it)."""
+    for k, v in WORKER_ENV.items():
+        os.environ.setdefault(k, v)
+    import tengsim.config  # noqa: F401
+    import tengsim.contact  # noqa: F401
+    import xarray  # noqa: F401
+
+    return os.getpid()
+
+
+# ---- validation ---------------------------------------------------------------------------------
+
+def validate(study) -> tuple[dict, dict]:
+    """Plan every distinct point (no solving).  Returns ({id: contact table} of the valid points,
+    {id: message} of the invalid ones).  An error that every point shares is an error in the study
+    file: raised as one TengsimError before anything is written."""
+    from tengsim.config import plan_contact
+    from tengsim.study.observe import device_values
+
+    valid, invalid, first = {}, {}, None
+    for p in study.points:
+        device_values(p.tables["device"])  # a bad device value is a study error
+        pid = p.id
+        if pid in valid or pid in invalid:
+            continue
+        try:
+            plan_contact(dict(p.contact))
+        except TengsimError as exc:
+            invalid[pid] = str(exc)
+            if first is None:
+                first = (p, str(exc))
+            continue
+        valid[pid] = p.contact
+    if not valid:
+        if first is None:
+            raise TengsimError(f"{study.source or 'study'}: no points")
+        p, msg = first
+        where = ", ".join(f"{k} = {v!r}" for k, v in p.axes.items())
+        raise TengsimError(f"{study.source or 'study'}: {msg}" + (f" (at {where})" if where and len(invalid) == 1
+                                                                  else ""))
+    return valid, invalid
+
+
+# ---- directory state ----------------------------------------------------------------------------
+
+@dataclass
+class StudyDir:
+    root: Path
+
+    @property
+    def points(self) -> Path:
+        return self.root / "points"
+
+    def nc(self, pid) -> Path:
+        return self.points / f"{pid}.nc"
+
+    def failed(self, pid) -> Path:
+        return self.points / f"{pid}.failed.json"
+
+    @property
+    def spec(self) -> Path:
+        return self.root / "study.json"
+
+    @property
+    def log(self) -> Path:
+        return self.root / "log.jsonl"
+
+    def done(self) -> set:
+        if not self.points.is_dir():
+            return set()
+        return {f.name[:-3] for f in self.points.glob("*.nc")}
+
+    def failures(self) -> set:
+        if not self.points.is_dir():
+            return set()
+        return {f.name[: -len(".failed.json")] for f in self.points.glob("*.failed.json")}
+
+
+def check_resume(study, sd: StudyDir, resume: bool) -> None:
+    """Refuse to mix two studies in one directory; on --resume the new study may only add points."""
+    if not sd.spec.exists():
+        if sd.points.is_dir() and any(sd.points.iterdir()):
+            raise TengsimError(f"{sd.root} holds points but no study.json; use another --out")
+        return
+    if not resume:
+        raise TengsimError(f"{sd.root} already holds a study; add --resume to continue it, or use another --out")
+    try:
+        old = json.loads(sd.spec.read_text())
+        old_ids = {p["id"] for p in old["points"]}
+        old_axes = {json.dumps(p["axes"], sort_keys=True) for p in old["points"]}
+    except (OSError, ValueError, KeyError, TypeError) as exc:
+        raise TengsimError(f"cannot read {sd.spec}: {exc}") from None
+    new_ids = {p.id for p in study.points}
+    new_axes = {json.dumps(p.axes, sort_keys=True) for p in study.points}
+    lost = old_ids - new_ids
+    if lost or not old_axes <= new_axes:
+        n = len(lost) or len(old_axes - new_axes)
+        raise TengsimError(f"the study file changed: {n} point(s) of {sd.spec} are not in it any more "
+                           "(a resumed study may only add points); use another --out")
+
+
+# ---- progress -----------------------------------------------------------------------------------
+
+class SweepProgress:
+    """done/total, failed, rate and ETA on stderr: one updating line on a TTY, plain lines otherwise."""
+
+    def __init__(self, total, done=0, failed=0, quiet=False, stream=None):
+        self.total, self.done, self.failed = total, done, failed
+        self.start_done = done + failed
+        self.quiet = quiet
+        self.stream = stream or sys.stderr
+        self.tty = bool(getattr(self.stream, "isatty", lambda: False)())
+        self.t0 = time.perf_counter()
+
+    def update(self, status=None):
+        if status == "failed":
+            self.failed += 1
+        elif status is not None:
+            self.done += 1
+        if self.quiet:
+            return
+        n = self.done + self.failed - self.start_done
+        dt = time.perf_counter() - self.t0
+        rate = n / dt * 3600 if dt > 0 and n else 0.0
+        left = self.total - self.done - self.failed
+        eta = _hms(left / rate * 3600) if rate > 0 else "?"
+        line = (f"sweep: {self.done + self.failed}/{self.total} points ({self.failed} failed), "
+                f"{rate:.4g} points/h, ETA {eta}")
+        if self.tty:
+            self.stream.write("\r" + line + " ")
+            if left == 0:
+                self.stream.write("\n")
+        else:
+            self.stream.write(line + "\n")
+        self.stream.flush()
+
+    def close(self):
+        if self.tty and not self.quiet:
+            self.stream.write("\n")
+            self.stream.flush()
+
+
+def _hms(s):
+    s = int(round(s))
+    return f"{s // 3600}:{s // 60 % 60:02d}:{s % 60:02d}"
+
+
+# ---- the client ---------------------------------------------------------------------------------
+
+def connect(workers=None, scheduler=None, timeout: float = 3.0):
+    """A dask Client: on ``scheduler`` (an address) or on a new LocalCluster; returns (client, cluster)."""
+    if workers is not None and scheduler is not None:
+        raise TengsimError("give either --workers or --scheduler, not both")
+    try:
+        from dask.distributed import Client, LocalCluster
+    except ImportError:  # pragma: no cover - a dependency
+        raise TengsimError("tengsim sweep needs dask[distributed]: pip install 'dask[distributed]'") from None
+    if scheduler is not None:
+        try:
+            client = Client(scheduler, timeout=f"{timeout}s")
+        except (OSError, TimeoutError, ValueError) as exc:
+            raise TengsimError(f"cannot reach the dask scheduler at {scheduler!r}: {exc}") from None
+        return client, None
+    if workers is not None and (not isinstance(workers, int) or workers < 1):
+        raise TengsimError(f"--workers must be a positive integer, got {workers!r}")
+    import logging
+
+    n = workers or os.cpu_count() or 1
+    cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, env=dict(WORKER_ENV),
+                           dashboard_address=":0", silence_logs=logging.ERROR)
+    return Client(cluster), cluster
+
+
+def run_study(study, out, *, workers=None, scheduler=None, client=None, resume=False, retry_failed=False,
+              quiet=False, stream=None) -> dict:
+    """Validate, then compute the study's missing points on Dask and assemble DIR/study.nc and study.csv.
+
+    ``client`` (an existing dask Client) overrides ``workers``/``scheduler``.  Returns a summary dict.
+    Nothing is written if validation, the directory check or the connection fails.
+    """
+    from tengsim.io import write_json
+
+    stream = stream or sys.stderr
+    say = (lambda m: None) if quiet else (lambda m: print(m, file=stream, flush=True))
+    if workers is not None and scheduler is not None:
+        raise TengsimError("give either --workers or --scheduler, not both")
+    valid, invalid = validate(study)
+    sd = StudyDir(Path(out))
+    if sd.root.exists() and not sd.root.is_dir():
+        raise TengsimError(f"--out {sd.root} is a file, not a directory")
+    check_resume(study, sd, resume)
+    own = None
+    if client is None:
+        client, own = connect(workers, scheduler)
+        own = (client, own)
+    try:
+        from tengsim.io import check_writable
+
+        check_writable(sd.root / "study.json")
+        say(f"sweep: {len(study.points)} points ({len(valid) + len(invalid)} distinct computations) on "
+            f"{len(client.scheduler_info().get('workers', {}))} worker(s); dashboard {client.dashboard_link}")
+        sd.points.mkdir(parents=True, exist_ok=True)
+        write_json(sd.spec, study.resolved())
+        done, failures = sd.done(), sd.failures()
+        for pid, msg in invalid.items():
+            if pid not in done and (pid not in failures or retry_failed):
+                write_json(sd.failed(pid), {"id": pid, "status": "failed", "stage": "validation",
+                                            "message": msg, "contact": _contact_of(study, pid)})
+        failures = sd.failures()
+        todo = [pid for pid in valid if pid not in done and (pid not in failures or retry_failed)]
+        n_total = len(valid) + len(invalid)
+        n_failed = len((failures - done) - set(todo))
+        bar = SweepProgress(n_total, len(done & (set(valid) | set(invalid))), n_failed, quiet, stream)
+        if len(todo) < len(valid):
+            say(f"sweep: {len(valid) - len(todo)} point(s) already in {sd.points}, {len(todo)} to compute")
+        _append_log(sd, {"event": "start", "time": time.time(), "todo": todo})
+        if todo:
+            client.run(warm_up)
+        t0 = time.perf_counter()
+        computed = _compute(client, valid, todo, sd, bar)
+        t_compute = time.perf_counter() - t0
+        bar.close()
+    finally:
+        if own is not None:
+            _close(*own)
+    from tengsim.study.dataset import build_study
+
+    import dask
+
+    t0 = time.perf_counter()
+    with dask.config.set(scheduler="synchronous"):
+        summary = build_study(sd.root)
+    summary.update(computed=computed, compute_phase_s=t_compute, assemble_s=time.perf_counter() - t0)
+    say(f"sweep: wrote {sd.root / 'study.nc'} and {sd.root / 'study.csv'}: {summary['ok']} ok, "
+        f"{summary['failed']} failed, {summary['unconverged']} unconverged, {summary['pending']} pending")
+    return summary
+
+
+def _contact_of(study, pid):
+    for p in study.points:
+        if p.id == pid:
+            return p.contact
+    return None
+
+
+def _append_log(sd, entry):
+    with open(sd.log, "a") as fh:
+        fh.write(json.dumps(entry, default=str) + "\n")
+        fh.flush()
+
+
+def _compute(client, valid, todo, sd, bar) -> list:
+    """Submit ``todo``; write each result as it completes.  Returns the ids computed here."""
+    import dask
+    from dask.distributed import as_completed
+
+    from tengsim.io import write_dataset, write_json
+
+    futures = {client.submit(compute_point, valid[pid], pid, key=f"tengsim-point-{pid}", pure=False): pid
+               for pid in todo}
+    computed = []
+    try:
+        for fut in as_completed(list(futures)):
+            pid = futures[fut]
+            try:
+                r = fut.result()
+            except Exception as exc:  # noqa: BLE001 - a worker died (KilledWorker) or the task was lost
+                r = {"status": "failed", "message": f"{type(exc).__name__}: {exc}", "seconds": None,
+                     "data": None}
+            if r["status"] == "failed":
+                write_json(sd.failed(pid), {"id": pid, "status": "failed", "stage": "compute",
+                                            "message": r["message"], "contact": valid[pid],
+                                            **{k: r.get(k) for k in ("seconds", "host", "pid")}})
+            else:
+                with dask.config.set(scheduler="synchronous"):  # a local file: no distributed write lock
+                    write_dataset(r["data"], sd.nc(pid))
+                try:
+                    sd.failed(pid).unlink()
+                except FileNotFoundError:
+                    pass
+            computed.append(pid)
+            _append_log(sd, {"event": "point", "id": pid, "status": r["status"], "seconds": r.get("seconds"),
+                             "host": r.get("host"), "worker_pid": r.get("pid"), "time": time.time()})
+            bar.update(r["status"])
+            fut.release()
+    except BaseException:
+        client.cancel(list(futures))
+        raise
+    return computed
+
+
+def _close(client, cluster):
+    import contextlib
+
+    with contextlib.suppress(Exception):
+        client.close(timeout=5)
+    if cluster is not None:
+        with contextlib.suppress(Exception):
+            cluster.close(timeout=5)

@@ -1,0 +1,247 @@
+"""Per-point observables of a design study (definitions in docs/design.md).
+
+From one contact result (approach–retraction, dimensionless, Eq. 7/10) and the Eq. (12) device inputs
+σ, ε_r, T.  Observables in the contact's own units (pull-off F, jump D, transition D, hysteresis,
+charged-area fraction at zero load) exist for every run; those in pressure (V_OC at named pressures,
+sensitivity, linear range, saturation, V_OC(P) curves) need a physical scaling and are NaN otherwise.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from tengsim.errors import TengsimError
+
+OBSERVABLE_DEFAULTS = {
+    "pressures": ("1kPa", "10kPa", "100kPa"),
+    "fit_range": ("0kPa", "10kPa"),
+    "linear_tolerance": 0.1,
+    "saturation_fraction": 0.9,
+    "grid_max": "150kPa",
+    "grid_num": 61,
+    "transition_fraction": 0.95,
+    "full_contact_fraction": 0.9,
+}
+
+SCALARS = {
+    # name: (units, long name)
+    "pull_off_F": ("3π W ε m²/n² (Eq. 10)", "most tensile force on retraction (negative: tensile)"),
+    "pull_off_Pa": ("Pa", "pull-off force per cell area (negative: tensile)"),
+    "jump_in_D": ("ε", "D at which the approach first lands on the jumped-in state"),
+    "jump_out_D": ("ε", "D at which the retraction first lands on the jumped-out state"),
+    "transition_D": ("ε", "approach D where Λc reaches transition_fraction of full contact"),
+    "area_fraction_0": ("1", "charged-area fraction A/S at zero load (approach)"),
+    "adhesive_full_contact": ("1", "1 if Λc at zero load >= full_contact_fraction × full contact (2N)"),
+    "S_V_per_kPa": ("V/kPa", "dV_OC/dP, least-squares line over fit_range"),
+    "linear_range_Pa": ("Pa", "highest P up to which V_OC stays within linear_tolerance of the fit "
+                        "(fit_range[0] if the first state is off)"),
+    "V_sat": ("V", "largest V_OC of the run"),
+    "P_sat_Pa": ("Pa", "lowest P where V_OC reaches saturation_fraction × V_sat"),
+    "hysteresis": ("3π W ε² m²/n² per cell (∮F dD)", "approach minus retraction ∮ F dD"),
+    "hysteresis_J_m2": ("J/m²", "energy lost per cycle per unit nominal area"),
+}
+
+
+def parse_observables(table: dict, where: str = "study") -> dict:
+    """Typed [observables] settings with defaults (pressures in Pa)."""
+    from tengsim.schema import Field, Table
+
+    t = Table("observables", [
+        Field("pressures", "floats", OBSERVABLE_DEFAULTS["pressures"], dim="pressure",
+              help="pressures at which V_OC is reported"),
+        Field("fit_range", "floats", OBSERVABLE_DEFAULTS["fit_range"], dim="pressure",
+              help="low-pressure range [lo, hi] of the sensitivity fit"),
+        Field("linear_tolerance", "float", 0.1, help="relative deviation that ends the linear range"),
+        Field("saturation_fraction", "float", 0.9, help="fraction of V_sat that defines P_sat"),
+        Field("grid_max", "float", OBSERVABLE_DEFAULTS["grid_max"], dim="pressure",
+              help="top of the common pressure grid (from 0)"),
+        Field("grid_num", "int", 61, help="points of the common pressure grid"),
+        Field("transition_fraction", "float", 0.95, help="Λc fraction of full contact for transition_D"),
+        Field("full_contact_fraction", "float", 0.9, help="Λc fraction of full contact at zero load flagged"),
+    ])
+    raw = dict(table)
+    labels = raw.get("pressures", OBSERVABLE_DEFAULTS["pressures"])
+    if isinstance(labels, str):
+        labels = [s.strip() for s in labels.split(",") if s.strip()]
+    elif not isinstance(labels, (list, tuple)):
+        labels = [labels]
+    out = t.parse(raw, where=f"{where}: [observables] ")
+    defaults = {k: out[k] for k in out}
+    for k in ("pressures", "fit_range", "grid_max"):
+        if defaults[k] == OBSERVABLE_DEFAULTS[k]:
+            defaults[k] = t.fields[k].parse(OBSERVABLE_DEFAULTS[k])
+    fr = defaults["fit_range"]
+    if len(fr) != 2 or not fr[1] > fr[0] >= 0:
+        raise TengsimError(f"{where}: [observables] fit_range must be [lo, hi] with 0 <= lo < hi, got {fr!r}")
+    if not defaults["grid_max"] > 0 or defaults["grid_num"] < 2:
+        raise TengsimError(f"{where}: [observables] grid_max must be > 0 and grid_num >= 2")
+    defaults["pressure_labels"] = [str(s).replace(" ", "") for s in labels]
+    defaults["pressures"] = list(defaults["pressures"])
+    defaults["fit_range"] = list(fr)
+    return defaults
+
+
+def pressure_grid(settings: dict) -> np.ndarray:
+    return np.linspace(0.0, settings["grid_max"], int(settings["grid_num"]))
+
+
+# ---- units: the one place that knows how a result maps to pressure -------------------------------
+
+def physical_scale(res) -> tuple[float, float] | None:
+    """(Pa per unit F, metres per unit D) of a result, or None for a dimensionless run.
+
+    Uses the result's ``pressure_Pa`` column (with its D in metres from ``eps_m``) when present, else the
+    paper's pyramid scaling (Eq. 7, :class:`tengsim.units.PaperScaling`) rebuilt from its parameters.
+    """
+    p = res.params
+    t = res.table
+    eps = p.get("eps_m")
+    if "pressure_Pa" in t and eps:
+        F, P = np.asarray(t["F"], float), np.asarray(t["pressure_Pa"], float)
+        ok = np.abs(F) > 1e-12 * max(1.0, float(np.max(np.abs(F))))
+        if np.any(ok):
+            return float(np.median(P[ok] / F[ok])), float(eps)
+    need = ("E_star_Pa", "W_J_m2", "base_m", "height_m", "pitch_m", "eps_m")
+    if str(p.get("shape", "")).lower() == "pyramid" and all(p.get(k) for k in need):
+        from tengsim.units import PaperScaling
+
+        sc = PaperScaling(p["E_star_Pa"], p["W_J_m2"], p["base_m"], p["height_m"], p["pitch_m"], p["eps_m"])
+        return sc.pressure(1.0), sc.eps
+    return None
+
+
+def area_fraction(res, contact_length) -> np.ndarray:
+    """Charged-area fraction A/S of the cell: (Λc/L̄)² for a 2-D pattern, Λc/L̄ for a line grating."""
+    p = res.params
+    cell = float(p.get("cell", math.nan))
+    x = np.asarray(contact_length, float) / cell
+    if str(p.get("shape", "")).lower() == "line":
+        return np.clip(x, 0.0, 1.0)
+    return np.clip(x**2, 0.0, 1.0)
+
+
+def full_length(params: dict) -> float:
+    """Λc of full contact (2N for the pyramid, the diameter or width of other shapes); NaN if none."""
+    s = str(params.get("shape", "")).lower()
+    if s == "pyramid":
+        return 2 * float(params["N"])
+    if s == "hemisphere":
+        return 2 * float(params["radius"])
+    if s in ("cube", "line"):
+        return 2 * float(params["half_width"])
+    if s == "cone" and math.isfinite(float(params.get("height", math.inf))):
+        return 2 * float(params["height"]) / float(params["slope"])
+    return math.nan
+
+
+# ---- the observables ----------------------------------------------------------------------------
+
+def load_control(res):
+    """Approach states a pressed device passes under increasing load: F above every earlier F, F > 0;
+    the zero-load state is put first, Λc interpolated linearly in F between the last F <= 0 and the first
+    F > 0.  Returns (F, Λc) arrays (possibly empty)."""
+    a = res.branch("approach")
+    F, L = np.asarray(a["F"], float), np.asarray(a["contact_length"], float)
+    keep, best = [], 0.0
+    for i, f in enumerate(F):
+        if f > best:
+            keep.append(i)
+            best = f
+    if not keep:
+        return np.array([]), np.array([])
+    i0 = keep[0]
+    Fk, Lk = list(F[keep]), list(L[keep])
+    if i0 > 0 and F[i0 - 1] <= 0:
+        w = -F[i0 - 1] / (F[i0] - F[i0 - 1])
+        Fk.insert(0, 0.0)
+        Lk.insert(0, L[i0 - 1] + w * (L[i0] - L[i0 - 1]))
+    return np.array(Fk), np.array(Lk)
+
+
+def _first_jump(res, kind):
+    for j in res.jumps:
+        if j.kind == kind:
+            return j.D_after
+    return math.nan
+
+
+def device_values(device: dict) -> tuple[float, float, float]:
+    """(σ in C/m², ε_r, T in m) of a point's [device] table; a TengsimError naming a bad value."""
+    from tengsim.schema import Field
+
+    sigma = Field("sigma", dim="charge/area").parse(device["sigma"], "device.")
+    eps_r = Field("eps_r").parse(device["eps_r"], "device.")
+    T = Field("thickness", dim="length").parse(device["thickness"], "device.")
+    for k, v in (("sigma", sigma), ("eps_r", eps_r), ("thickness", T)):
+        if not v > 0:
+            raise TengsimError(f"device.{k} must be > 0, got {device[k]!r}")
+    return sigma, eps_r, T
+
+
+def observe(res, device: dict, settings: dict) -> dict:
+    """Scalars (dict name → float) and curves ('V_OC', 'area_fraction' on the common pressure grid,
+    'V_OC_at' at the named pressures) of one contact result."""
+    from tengsim.device.formulas import voc_polymer
+
+    sigma, eps_r, T = device_values(device)
+    nan = math.nan
+    out = {k: nan for k in SCALARS}
+    out["pull_off_F"] = res.pull_off_force
+    out["jump_in_D"] = _first_jump(res, "jump-in")
+    retr = [j for j in res.jumps if j.kind == "jump-out"]
+    out["jump_out_D"] = retr[0].D_after if retr else nan
+    full = full_length(res.params)
+    if math.isfinite(full):
+        out["transition_D"] = res.transition_D(full, settings["transition_fraction"])
+    out["hysteresis"] = res.hysteresis
+    Fk, Lk = load_control(res)
+    grid = pressure_grid(settings)
+    curves = {"V_OC": np.full(grid.shape, nan), "area_fraction": np.full(grid.shape, nan),
+              "V_OC_at": np.full(len(settings["pressures"]), nan)}
+    if len(Fk):
+        A = area_fraction(res, Lk)
+        out["area_fraction_0"] = float(A[0])
+        if math.isfinite(full):
+            out["adhesive_full_contact"] = float(Lk[0] >= settings["full_contact_fraction"] * full)
+    scale = physical_scale(res)
+    if scale is None or len(Fk) < 2:
+        return {"scalars": out, "curves": curves}
+    k_p, k_D = scale
+    out["pull_off_Pa"] = k_p * out["pull_off_F"]
+    out["hysteresis_J_m2"] = k_p * k_D * out["hysteresis"]
+    P = k_p * Fk
+    V = voc_polymer(A, sigma, eps_r, T)
+
+    def at(x):
+        x = np.asarray(x, float)
+        y = np.interp(x, P, V)
+        return np.where((x >= P[0]) & (x <= P[-1]), y, nan)
+
+    curves["V_OC"] = at(grid)
+    curves["area_fraction"] = np.where(np.isfinite(curves["V_OC"]), np.interp(grid, P, A), nan)
+    curves["V_OC_at"] = at(settings["pressures"])
+    lo, hi = settings["fit_range"]
+    a, b = max(lo, P[0]), min(hi, P[-1])
+    if b > a:  # least squares over the piecewise-linear V_OC(P) sampled evenly on [lo, hi] ∩ the run
+        xs = np.linspace(a, b, 41)
+        slope, icpt = np.polyfit(xs, np.interp(xs, P, V), 1)
+        out["S_V_per_kPa"] = slope * 1e3
+        fit = icpt + slope * P
+        ok = np.abs(V - fit) <= settings["linear_tolerance"] * np.abs(fit)
+        idx = np.flatnonzero(P >= lo)
+        last = float(lo) if len(idx) else nan  # the first state already off the line: no linear range
+        for i in idx:
+            if not ok[i]:
+                break
+            last = P[i]
+        out["linear_range_Pa"] = last
+    vs = float(np.max(V))
+    out["V_sat"] = vs
+    target = settings["saturation_fraction"] * vs
+    i = int(np.flatnonzero(V >= target)[0])
+    if i == 0:
+        out["P_sat_Pa"] = float(P[0])
+    else:
+        out["P_sat_Pa"] = float(P[i - 1] + (target - V[i - 1]) * (P[i] - P[i - 1]) / (V[i] - V[i - 1]))
+    return {"scalars": out, "curves": curves}

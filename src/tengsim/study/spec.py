@@ -1,0 +1,399 @@
+"""A study file: a ``[base]`` run, its ``[axes]``, and how the points are drawn; expanded to points.
+
+Format (TOML)::
+
+    [base.contact]            # exactly what the [contact] table of a `tengsim run` file holds
+    shape = "pyramid"
+    ...
+    [base.device]             # optional: σ, ε_r, T of Eq. (12) for V_OC (defaults: paper Fig. 5)
+    [axes]
+    "contact.N" = [0.946, 1.5]                                   # a list
+    "contact.tabor" = { start = 0.3, stop = 0.5, num = 2 }        # a range (scale = "linear" | "log")
+    group = { zip = { "contact.pitch" = ["2um", "5um"], "contact.base" = ["1um", "2.5um"] },
+              labels = ["A", "B"] }                              # parameters that vary together
+    [study]                   # optional
+    sampling = "grid"         # or "lhs" / "sobol" with n and seed
+    [observables]             # optional, see tengsim.study.observe
+
+A point is the base with the axis values put in.  Its id is a short SHA-256 of the canonical JSON of
+its resolved ``[contact]`` table (the computation), so points that run the same contact share it.
+"""
+from __future__ import annotations
+
+import hashlib
+import itertools
+import json
+import math
+import re
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from tengsim.errors import TengsimError
+
+POINT_TABLES = ("contact", "device")
+"""Tables of a point; an axis is named 'table.key' with table one of these."""
+STUDY_TABLES = ("base", "axes", "study", "observables", "objective")
+SAMPLINGS = ("grid", "lhs", "sobol")
+DEVICE_DEFAULTS = {"sigma": "5.84uC/m2", "eps_r": 2.40, "thickness": "400um"}
+"""Eq. (12) inputs of the paper's Fig. 5: tribo-charge density σ, relative permittivity ε_r, thickness T."""
+IGNORED_CONTACT_KEYS = ("out", "plot")
+"""Keys of a `tengsim run` [contact] table that name output files; a sweep writes its own."""
+
+_NUM_UNIT = re.compile(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*([^\d\s].*)?\s*$")
+
+
+@dataclass(frozen=True)
+class Axis:
+    """One dimension of the study: ``name`` and, per index, the values of its ``members``.
+
+    A plain axis has one member (its own name); a zip group several, varied together.
+    """
+
+    name: str
+    members: tuple
+    values: tuple          # values[k] = tuple of member values at index k
+    labels: tuple = ()     # zip group: one label per index (default 0, 1, ...)
+    continuous: tuple = () # range axes: (start, stop, scale, unit) for sampling
+
+    def __len__(self):
+        return len(self.values)
+
+    def coord(self):
+        """Index values along this dimension (the axis value, or the zip label)."""
+        if len(self.members) == 1:
+            return [v[0] for v in self.values]
+        return list(self.labels) if self.labels else list(range(len(self.values)))
+
+
+@dataclass
+class Point:
+    """One study point: its axis values (by axis member name) and resolved tables."""
+
+    axes: dict
+    tables: dict
+    index: tuple = ()
+
+    @property
+    def contact(self) -> dict:
+        return self.tables["contact"]
+
+    @property
+    def id(self) -> str:
+        return point_id(self.contact)
+
+
+@dataclass
+class Study:
+    """A parsed study: base tables, axes, sampling, observables and objective settings, points."""
+
+    base: dict
+    axes: list
+    sampling: str = "grid"
+    n: int = 0
+    seed: int = 0
+    observables: dict = field(default_factory=dict)
+    objective: dict = field(default_factory=dict)
+    points: list = field(default_factory=list)
+    source: str = ""
+
+    @property
+    def is_grid(self) -> bool:
+        return self.sampling == "grid"
+
+    @property
+    def columns(self) -> list:
+        """Axis value columns, named as in [axes] (zip members by their own names)."""
+        out = []
+        for a in self.axes:
+            if len(a.members) > 1:
+                out.append(a.name)
+            out.extend(a.members)
+        return out
+
+    def resolved(self) -> dict:
+        """What DIR/study.json stores: enough to check a resumed study against the first one."""
+        return {
+            "format": "tengsim-study/1",
+            "source": self.source,
+            "sampling": self.sampling, "n": self.n, "seed": self.seed,
+            "axes": [{"name": a.name, "members": list(a.members), "coord": _jsonable(a.coord()),
+                      "values": [list(v) for v in a.values]}
+                     for a in self.axes],
+            "base": self.base,
+            "observables": self.observables,
+            "points": [{"id": p.id, "axes": p.axes, "index": list(p.index), "tables": p.tables}
+                       for p in self.points],
+        }
+
+
+def canonical(obj) -> str:
+    """Canonical JSON: sorted keys, no spaces, integers that are whole floats written as floats."""
+    return json.dumps(_norm(obj), sort_keys=True, separators=(",", ":"), ensure_ascii=False)
+
+
+def _norm(x):
+    if isinstance(x, dict):
+        return {str(k): _norm(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [_norm(v) for v in x]
+    if isinstance(x, bool) or x is None or isinstance(x, str):
+        return x
+    if isinstance(x, (int, float, np.integer, np.floating)):
+        return float(x)
+    return str(x)
+
+
+def _jsonable(x):
+    return json.loads(canonical(x))
+
+
+def point_id(contact: dict) -> str:
+    """Deterministic id of a contact computation: first 16 hex digits of SHA-256(canonical JSON)."""
+    return hashlib.sha256(canonical(contact).encode()).hexdigest()[:16]
+
+
+# ---- parsing ------------------------------------------------------------------------------------
+
+def load_study(path) -> Study:
+    """Read, check and expand a study file; every error is one TengsimError naming the bad value."""
+    from tengsim.schema import read_config
+
+    return parse_study(read_config(path), source=str(path))
+
+
+def parse_study(cfg: dict, source: str = "") -> Study:
+    from tengsim.schema import check_tables
+
+    where = source or "study"
+    check_tables(cfg, STUDY_TABLES, where=where)
+    base_in = cfg.get("base")
+    if not base_in:
+        raise TengsimError(f"{where}: needs a [base.contact] table (the run every point starts from)")
+    unknown = [k for k in base_in if k not in POINT_TABLES]
+    if unknown:
+        raise TengsimError(f"{where}: unknown table(s) [base.{unknown[0]}] (known: "
+                           f"{', '.join('base.' + t for t in POINT_TABLES)})")
+    for k, v in base_in.items():
+        if not isinstance(v, dict):
+            raise TengsimError(f"{where}: [base.{k}] must be a table, got {v!r}")
+    if "contact" not in base_in:
+        raise TengsimError(f"{where}: needs a [base.contact] table (the run every point starts from)")
+    contact = {k: v for k, v in base_in["contact"].items() if k not in IGNORED_CONTACT_KEYS}
+    device = dict(DEVICE_DEFAULTS)
+    device.update(base_in.get("device", {}))
+    bad = [k for k in device if k not in DEVICE_DEFAULTS]
+    if bad:
+        raise TengsimError(f"{where}: [base.device] unknown key(s) {', '.join(map(repr, bad))} "
+                           f"(known: {', '.join(DEVICE_DEFAULTS)})")
+    base = {"contact": contact, "device": device}
+
+    axes = [_parse_axis(name, spec, where) for name, spec in (cfg.get("axes") or {}).items()]
+    seen = {}
+    for a in axes:
+        for m in a.members:
+            if m in seen:
+                raise TengsimError(f"{where}: parameter {m!r} is on two axes ({seen[m]!r} and {a.name!r})")
+            seen[m] = a.name
+
+    st = dict(cfg.get("study") or {})
+    sampling = str(st.pop("sampling", "grid")).lower()
+    if sampling not in SAMPLINGS:
+        raise TengsimError(f"{where}: [study] sampling = {sampling!r} is not one of {', '.join(SAMPLINGS)}")
+    n = st.pop("n", None)
+    seed = st.pop("seed", 0)
+    if st:
+        raise TengsimError(f"{where}: [study] unknown key(s) {', '.join(map(repr, st))} (known: sampling, n, seed)")
+    if sampling != "grid":
+        if not isinstance(n, int) or isinstance(n, bool) or n < 1:
+            raise TengsimError(f"{where}: [study] sampling = {sampling!r} needs n = a positive integer, got {n!r}")
+        if not isinstance(seed, int) or isinstance(seed, bool):
+            raise TengsimError(f"{where}: [study] seed must be an integer, got {seed!r}")
+        if not axes:
+            raise TengsimError(f"{where}: sampling = {sampling!r} needs at least one axis")
+    elif n is not None:
+        raise TengsimError(f"{where}: [study] n is only for sampling = 'lhs' or 'sobol'")
+
+    from tengsim.study.observe import parse_observables
+
+    study = Study(base=base, axes=axes, sampling=sampling, n=int(n or 0), seed=int(seed),
+                  observables=parse_observables(cfg.get("observables") or {}, where),
+                  objective=dict(cfg.get("objective") or {}), source=source)
+    study.points = expand(study)
+    return study
+
+
+def _member_name(name, where):
+    if not isinstance(name, str) or "." not in name:
+        raise TengsimError(f"{where}: axis {name!r} must be named 'table.key' (table one of "
+                           f"{', '.join(POINT_TABLES)}), e.g. 'contact.N'")
+    table, key = name.split(".", 1)
+    if table not in POINT_TABLES or not key or "." in key:
+        raise TengsimError(f"{where}: axis {name!r} must be named 'table.key' (table one of "
+                           f"{', '.join(POINT_TABLES)}), e.g. 'contact.N'")
+    if table == "device" and key not in DEVICE_DEFAULTS:
+        raise TengsimError(f"{where}: axis {name!r}: unknown device parameter {key!r} "
+                           f"(known: {', '.join(DEVICE_DEFAULTS)})")
+    if table == "contact" and key in IGNORED_CONTACT_KEYS:
+        raise TengsimError(f"{where}: axis {name!r}: the sweep names its own output files")
+    return name
+
+
+def _values(name, spec, where):
+    """Values of one parameter: a list, or a range table; returns (values, continuous-or-None)."""
+    if isinstance(spec, list):
+        if not spec:
+            raise TengsimError(f"{where}: axis {name!r} is empty")
+        for v in spec:
+            if isinstance(v, (dict, list)):
+                raise TengsimError(f"{where}: axis {name!r}: values must be numbers or strings, got {v!r}")
+        return list(spec), None
+    if isinstance(spec, dict):
+        keys = set(spec)
+        bad = keys - {"start", "stop", "num", "scale"}
+        if bad:
+            raise TengsimError(f"{where}: axis {name!r}: unknown range key(s) {', '.join(map(repr, sorted(bad)))} "
+                               "(a range has start, stop, num, scale; a zip group has zip)")
+        if not {"start", "stop"} <= keys:
+            raise TengsimError(f"{where}: axis {name!r}: a range needs start and stop")
+        scale = str(spec.get("scale", "linear")).lower()
+        if scale not in ("linear", "log"):
+            raise TengsimError(f"{where}: axis {name!r}: scale = {spec.get('scale')!r} is not 'linear' or 'log'")
+        num = spec.get("num", 0 if "num" in spec else None)
+        a, ua = _split_unit(spec["start"], name, where)
+        b, ub = _split_unit(spec["stop"], name, where)
+        if ua != ub:
+            raise TengsimError(f"{where}: axis {name!r}: start and stop must have the same unit, "
+                               f"got {spec['start']!r} and {spec['stop']!r}")
+        if scale == "log" and not (a > 0 and b > 0):
+            raise TengsimError(f"{where}: axis {name!r}: a log range needs start, stop > 0")
+        cont = (a, b, scale, ua)
+        if num is None:
+            return None, cont   # only for sampling
+        if isinstance(num, bool) or not isinstance(num, int):
+            raise TengsimError(f"{where}: axis {name!r}: num must be an integer, got {num!r}")
+        if num < 1:
+            raise TengsimError(f"{where}: axis {name!r} is empty (num = {num})")
+        if num == 1:
+            xs = [a]
+        elif scale == "log":
+            xs = list(np.geomspace(a, b, num))
+        else:
+            xs = list(np.linspace(a, b, num))
+        return [_with_unit(x, ua) for x in xs], cont
+    raise TengsimError(f"{where}: axis {name!r} must be a list, a range {{start, stop, num}} or a zip group, "
+                       f"got {spec!r}")
+
+
+def _split_unit(v, name, where):
+    if isinstance(v, bool):
+        raise TengsimError(f"{where}: axis {name!r}: {v!r} is not a number")
+    if isinstance(v, (int, float)):
+        return float(v), ""
+    m = _NUM_UNIT.fullmatch(str(v))
+    if not m:
+        raise TengsimError(f"{where}: axis {name!r}: cannot read {v!r} as a number with a unit")
+    return float(m.group(1)), (m.group(2) or "").strip()
+
+
+def _with_unit(x, unit):
+    """A generated axis value: a float (12 significant digits), or '<6 significant digits><unit>'."""
+    if unit:
+        return f"{float(x):.6g}{unit}"
+    return float(f"{float(x):.12g}")
+
+
+def _parse_axis(name, spec, where) -> Axis:
+    if isinstance(spec, dict) and "zip" in spec:
+        extra = set(spec) - {"zip", "labels"}
+        if extra:
+            raise TengsimError(f"{where}: zip group {name!r}: unknown key(s) {', '.join(map(repr, sorted(extra)))} "
+                               "(known: zip, labels)")
+        z = spec["zip"]
+        if not isinstance(z, dict) or not z:
+            raise TengsimError(f"{where}: zip group {name!r} needs zip = {{ 'table.key' = [...], ... }}")
+        members, cols = [], []
+        for m, v in z.items():
+            members.append(_member_name(m, where))
+            vals, _ = _values(m, v, where)
+            if vals is None:
+                raise TengsimError(f"{where}: zip group {name!r}: {m!r} needs num")
+            cols.append(vals)
+        lens = {len(c) for c in cols}
+        if len(lens) != 1:
+            raise TengsimError(f"{where}: zip group {name!r}: its parameters have different lengths "
+                               f"({', '.join(f'{m}: {len(c)}' for m, c in zip(members, cols))})")
+        labels = spec.get("labels", ())
+        if labels and (not isinstance(labels, list) or len(labels) != len(cols[0])):
+            raise TengsimError(f"{where}: zip group {name!r}: labels must be a list of {len(cols[0])} names")
+        if "." in name:
+            raise TengsimError(f"{where}: zip group {name!r}: name a group without a dot (e.g. 'group')")
+        return Axis(name, tuple(members), tuple(zip(*cols)), tuple(str(s) for s in labels))
+    _member_name(name, where)
+    vals, cont = _values(name, spec, where)
+    return Axis(name, (name,), tuple((v,) for v in vals) if vals is not None else (), (), cont or ())
+
+
+# ---- expansion ----------------------------------------------------------------------------------
+
+def _resolve(base: dict, assign: dict) -> dict:
+    tables = {t: dict(v) for t, v in base.items()}
+    for name, v in assign.items():
+        t, k = name.split(".", 1)
+        tables[t][k] = v
+    return tables
+
+
+def expand(study: Study) -> list:
+    """The study's points: the full grid of its axes, or n lhs/sobol samples of them."""
+    axes = study.axes
+    if study.sampling == "grid":
+        for a in axes:
+            if not a.values and study.objective:
+                return []  # an optimisation: tengsim optimize draws the points
+            if not a.values:
+                raise TengsimError(f"axis {a.name!r} is a range without num (only sampling = 'lhs' or "
+                                   "'sobol' may leave num out)")
+        pts = []
+        for idx in itertools.product(*(range(len(a)) for a in axes)):
+            assign, labels = {}, {}
+            for a, k in zip(axes, idx):
+                assign.update(zip(a.members, a.values[k]))
+                if len(a.members) > 1:
+                    labels[a.name] = a.coord()[k]
+            pts.append(Point({**labels, **assign}, _resolve(study.base, assign), tuple(idx)))
+        return pts
+    from scipy.stats import qmc
+
+    d = len(axes)
+    if study.sampling == "lhs":
+        u = qmc.LatinHypercube(d=d, seed=study.seed).random(study.n)
+    else:
+        u = qmc.Sobol(d=d, scramble=True, seed=study.seed).random(study.n)
+    pts = []
+    for i, row in enumerate(u):
+        assign, labels = {}, {}
+        for a, x in zip(axes, row):
+            if a.continuous and len(a.members) == 1:
+                lo, hi, scale, unit = a.continuous
+                v = lo * (hi / lo) ** x if scale == "log" else lo + (hi - lo) * x
+                assign[a.members[0]] = _with_unit(v, unit)
+            else:
+                k = min(int(x * len(a)), len(a) - 1)
+                assign.update(zip(a.members, a.values[k]))
+                if len(a.members) > 1:
+                    labels[a.name] = a.coord()[k]
+        pts.append(Point({**labels, **assign}, _resolve(study.base, assign), (i,)))
+    return pts
+
+
+def numeric(v) -> float:
+    """An axis value as a number in SI (unit strings parsed); NaN if it is not a quantity."""
+    from tengsim.units import parse_quantity
+
+    if isinstance(v, (int, float)) and not isinstance(v, bool):
+        return float(v)
+    try:
+        return parse_quantity(v)
+    except Exception:  # noqa: BLE001 - names such as 'pyramid'
+        return math.nan

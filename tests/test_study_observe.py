@@ -1,0 +1,98 @@
+"""Observables of a design study on synthetic curves with known answers (docs/design.md definitions)."""
+import math
+
+import numpy as np
+import pytest
+
+from tengsim.grid import Grid
+from tengsim.results import CURVE_COLUMNS, ContactResult
+from tengsim.study.observe import observe, parse_observables
+from tengsim.units import paper_scaling
+
+EPS_0 = 8.8541878128e-12
+SC = paper_scaling("A")
+DEVICE = {"sigma": "5.84uC/m2", "eps_r": 2.40, "thickness": "400um"}
+K_V = 5.84e-6 * 400e-6 / (2.40 * EPS_0)  # Eq. (12): V_OC = K_V · A/S
+
+
+def synthetic(P_Pa, area, D_retract=None, F_retract=None, physical=True):
+    """A ContactResult whose approach passes through pressures P_Pa with charged-area fractions ``area``."""
+    F = np.asarray(P_Pa, float) / SC.pressure(1.0)
+    L = SC.cell * np.sqrt(np.asarray(area, float))
+    n = len(F)
+    D = np.linspace(-1.0, 3.0, n)
+    Dr = np.asarray(D_retract if D_retract is not None else D[::-1])
+    Fr = np.asarray(F_retract if F_retract is not None else F[::-1])
+    rows = {k: np.zeros(n + len(Dr)) for k in CURVE_COLUMNS}
+    rows["branch"] = np.array(["approach"] * n + ["retraction"] * len(Dr))
+    rows["D"] = np.r_[D, Dr]
+    rows["F"] = np.r_[F, Fr]
+    rows["contact_length"] = np.r_[L, L[::-1][: len(Dr)]]
+    rows["converged"] = np.ones(n + len(Dr), bool)
+    rows["jump"] = np.zeros(n + len(Dr), bool)
+    params = {"shape": "Pyramid", "N": SC.N, "cell": SC.cell}
+    if physical:
+        params.update(SC.params())
+    return ContactResult(table=rows, grid=Grid(8, 8, 1.0, 1.0), params=params)
+
+
+def settings(**kw):
+    return parse_observables(kw)
+
+
+def test_linear_response_gives_exact_sensitivity_and_full_linear_range():
+    P = np.linspace(0, 50e3, 51)
+    A = 0.05 + 2e-6 * P  # A/S rises 0.002 per kPa
+    o = observe(synthetic(P, A), DEVICE, settings(fit_range=["0kPa", "10kPa"]))
+    s, c = o["scalars"], o["curves"]
+    assert s["S_V_per_kPa"] == pytest.approx(K_V * 2e-3, rel=1e-9)
+    assert s["linear_range_Pa"] == pytest.approx(50e3)
+    assert s["V_sat"] == pytest.approx(K_V * A[-1])
+    assert s["P_sat_Pa"] == pytest.approx((0.9 * A[-1] - 0.05) / 2e-6, rel=1e-9)
+    assert s["area_fraction_0"] == pytest.approx(0.05)
+    want = (K_V * (0.05 + 2e-6 * np.array([1e3, 1e4]))).tolist() + [math.nan]  # 100 kPa: beyond the run
+    assert c["V_OC_at"].tolist() == pytest.approx(want, nan_ok=True)
+    grid = np.linspace(0, 150e3, 61)
+    inside = grid <= 50e3
+    np.testing.assert_allclose(c["V_OC"][inside], K_V * (0.05 + 2e-6 * grid[inside]), rtol=1e-9)
+    assert np.all(np.isnan(c["V_OC"][~inside]))
+
+
+def test_saturating_response_ends_linear_range_where_it_bends():
+    P = np.linspace(0, 150e3, 301)
+    A = np.minimum(0.02 + 4e-6 * P, 0.5)  # linear up to 120 kPa, then flat
+    s = observe(synthetic(P, A), DEVICE, settings())["scalars"]
+    assert s["S_V_per_kPa"] == pytest.approx(K_V * 4e-3, rel=1e-9)
+    # flat beyond 120 kPa: V/fit = 0.5/(0.02 + 4e-6 P) drops below 0.9 at P = (0.5/0.9 - 0.02)/4e-6
+    p_end = (0.5 / 0.9 - 0.02) / 4e-6
+    assert p_end - 500 <= s["linear_range_Pa"] <= p_end
+    assert s["V_sat"] == pytest.approx(K_V * 0.5)
+    assert s["P_sat_Pa"] == pytest.approx((0.45 - 0.02) / 4e-6, rel=1e-9)
+
+
+def test_load_control_skips_states_where_force_falls_back():
+    P = np.array([-2e3, 0.0, 5e3, 3e3, 8e3, 12e3])  # the 3 kPa state comes after 5 kPa: a device jumps ahead
+    A = np.array([0.01, 0.02, 0.05, 0.2, 0.21, 0.22])
+    c = observe(synthetic(P, A), DEVICE, settings(pressures=["4kPa"], grid_max="12kPa", grid_num=13))["curves"]
+    # between 0 and 5 kPa on the load-control path: linear in A from 0.02 to 0.05
+    assert c["V_OC_at"][0] == pytest.approx(K_V * (0.02 + 0.03 * 4 / 5))
+
+
+def test_pull_off_and_hysteresis_in_physical_units():
+    P = np.linspace(0, 20e3, 11)
+    A = 0.1 + 1e-6 * P
+    res = synthetic(P, A, F_retract=np.r_[P[::-1] / SC.pressure(1.0) - 0.3])
+    s = observe(res, DEVICE, settings())["scalars"]
+    assert s["pull_off_F"] == pytest.approx(-0.3)
+    assert s["pull_off_Pa"] == pytest.approx(SC.pressure(-0.3))
+    assert s["hysteresis"] == pytest.approx(0.3 * 4.0)  # ∮ F dD of a 0.3 offset over D ∈ [-1, 3]
+    assert s["hysteresis_J_m2"] == pytest.approx(SC.pressure(1.0) * SC.eps * 1.2)
+
+
+def test_dimensionless_run_has_no_pressure_observables():
+    P = np.linspace(0, 20e3, 11)
+    s = observe(synthetic(P, 0.1 + 1e-6 * P, physical=False), DEVICE, settings())
+    for k in ("pull_off_Pa", "S_V_per_kPa", "linear_range_Pa", "V_sat", "P_sat_Pa", "hysteresis_J_m2"):
+        assert math.isnan(s["scalars"][k]), k
+    assert not math.isnan(s["scalars"]["pull_off_F"]) and not math.isnan(s["scalars"]["area_fraction_0"])
+    assert np.all(np.isnan(s["curves"]["V_OC"]))

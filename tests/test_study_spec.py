@@ -1,0 +1,103 @@
+"""Study files: parsing, expansion, point ids, observables settings (no Dask, no physics)."""
+import math
+
+import numpy as np
+import pytest
+
+from tengsim.errors import TengsimError
+from tengsim.study.spec import parse_study, point_id
+
+BASE = {"shape": "pyramid", "N": 0.946, "cell": 3.78, "tabor": 0.5, "dx": 0.2, "d_min": -1.0,
+        "d_max": 3.0, "d_step": 0.25, "boundary": "free"}
+
+
+def study(axes, **extra):
+    return parse_study({"base": {"contact": dict(BASE)}, "axes": axes, **extra})
+
+
+def test_issue_minimal_study_expands_to_full_grid():
+    s = study({"contact.N": [0.946, 1.5], "contact.tabor": {"start": 0.3, "stop": 0.5, "num": 2}})
+    assert s.is_grid and len(s.points) == 4
+    got = sorted((p.contact["N"], p.contact["tabor"]) for p in s.points)
+    assert got == [(0.946, 0.3), (0.946, 0.5), (1.5, 0.3), (1.5, 0.5)]
+    for p in s.points:  # everything else is the base, unchanged
+        assert {k: v for k, v in p.contact.items() if k not in ("N", "tabor")} == \
+            {k: v for k, v in BASE.items() if k not in ("N", "tabor")}
+    assert s.columns == ["contact.N", "contact.tabor"]
+    assert len({p.id for p in s.points}) == 4
+
+
+def test_point_id_is_deterministic_and_canonical():
+    a = dict(BASE)
+    b = dict(reversed(list(BASE.items())))
+    assert point_id(a) == point_id(b)
+    c = dict(BASE, N=1)
+    d = dict(BASE, N=1.0)
+    assert point_id(c) == point_id(d)
+    assert point_id(a) != point_id(c)
+    assert len(point_id(a)) == 16
+
+
+def test_ranges_log_units_and_zip_group():
+    s = study({"contact.E_star": {"start": "0.1MPa", "stop": "10MPa", "num": 3, "scale": "log"},
+               "group": {"zip": {"contact.N": [0.5, 1.0, 1.5], "contact.cell": [2.0, 4.0, 6.0]},
+                         "labels": ["A", "B", "C"]}})
+    assert [a.name for a in s.axes] == ["contact.E_star", "group"]
+    assert s.axes[0].coord() == ["0.1MPa", "1MPa", "10MPa"]
+    assert s.axes[1].coord() == ["A", "B", "C"]
+    assert len(s.points) == 9
+    for p in s.points:  # zipped members vary together
+        assert p.contact["cell"] == 4 * p.contact["N"]
+        assert p.axes["group"] == "ABC"[int(p.contact["N"] / 0.5) - 1]
+    assert s.columns == ["contact.E_star", "group", "contact.N", "contact.cell"]
+
+
+@pytest.mark.parametrize("method", ["lhs", "sobol"])
+def test_sampling_is_seeded_and_within_bounds(method):
+    axes = {"contact.tabor": {"start": 0.2, "stop": 0.8}, "contact.N": {"start": 0.5, "stop": 1.5, "scale": "log"},
+            "contact.boundary": ["free", "periodic"]}
+    s1 = study(axes, study={"sampling": method, "n": 8, "seed": 3})
+    s2 = study(axes, study={"sampling": method, "n": 8, "seed": 3})
+    s3 = study(axes, study={"sampling": method, "n": 8, "seed": 4})
+    assert len(s1.points) == 8
+    assert [p.id for p in s1.points] == [p.id for p in s2.points]
+    assert [p.id for p in s1.points] != [p.id for p in s3.points]
+    t = np.array([p.contact["tabor"] for p in s1.points])
+    assert np.all((t >= 0.2) & (t <= 0.8))
+    assert {p.contact["boundary"] for p in s1.points} <= {"free", "periodic"}
+    if method == "lhs":  # one sample in each of the 8 strata
+        assert sorted(np.floor((t - 0.2) / 0.6 * 8).astype(int)) == list(range(8))
+
+
+@pytest.mark.parametrize("cfg, msg", [
+    ({"base": {"contact": BASE}, "axes": {"contact.N": []}}, "axis 'contact.N' is empty"),
+    ({"base": {"contact": BASE}, "axes": {"contact.N": {"start": 1, "stop": 2, "num": 0}}}, "is empty"),
+    ({"base": {"contact": BASE}, "axes": {"N": [1.0]}}, "must be named 'table.key'"),
+    ({"base": {"contact": BASE}, "axes": {"shape.N": [1.0]}}, "must be named 'table.key'"),
+    ({"base": {"contact": BASE}, "axes": {"device.charge": [1.0]}}, "unknown device parameter 'charge'"),
+    ({"base": {"contact": BASE}, "axes": {"g": {"zip": {"contact.N": [1, 2], "contact.cell": [4]}}}},
+     "different lengths"),
+    ({"base": {"contact": BASE}, "axes": {"contact.N": [1.0]}, "bogus": {}}, "unknown table(s) 'bogus'"),
+    ({"axes": {"contact.N": [1.0]}}, "needs a [base.contact] table"),
+    ({"base": {"contact": BASE}, "study": {"sampling": "lhs"}, "axes": {"contact.N": [1.0]}}, "needs n"),
+    ({"base": {"contact": BASE}, "study": {"sampling": "random", "n": 2}}, "not one of grid, lhs, sobol"),
+    ({"base": {"contact": BASE}, "axes": {"contact.tabor": {"start": 0.1, "stop": 0.2}}}, "without num"),
+    ({"base": {"contact": BASE}, "observables": {"fit_range": ["10kPa", "1kPa"]}}, "fit_range"),
+    ({"base": {"contact": BASE}, "observables": {"grid_num": "1MPa"}}, "grid_num"),
+])
+def test_malformed_study_one_clear_error(cfg, msg):
+    with pytest.raises(TengsimError) as e:
+        parse_study(cfg)
+    assert msg in str(e.value)
+    assert "\n" not in str(e.value)
+
+
+def test_observables_defaults_in_SI():
+    s = study({"contact.N": [1.0]})
+    o = s.observables
+    assert o["pressures"] == [1e3, 1e4, 1e5]
+    assert o["pressure_labels"] == ["1kPa", "10kPa", "100kPa"]
+    assert o["fit_range"] == [0.0, 1e4]
+    assert o["grid_max"] == 1.5e5
+    assert s.base["device"] == {"sigma": "5.84uC/m2", "eps_r": 2.40, "thickness": "400um"}
+    assert not math.isnan(o["linear_tolerance"])

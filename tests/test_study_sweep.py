@@ -1,0 +1,343 @@
+"""Sweeps on a Dask LocalCluster: same numbers as direct runs, failed points, resume, bad input."""
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from tengsim.cli.main import main
+from tengsim.config import plan_contact, run_contact
+from tengsim.errors import TengsimError
+from tengsim.study import parse_study, run_study
+
+MINIMAL = """
+[base.contact]             # exactly what the [contact] table of a `tengsim run` file holds
+shape = "pyramid"
+N = 0.946
+cell = 3.78
+tabor = 0.5
+dx = 0.2
+d_min = -1.0
+d_max = 3.0
+d_step = 0.25
+boundary = "free"
+
+[axes]
+"contact.N" = [0.946, 1.5]
+"contact.tabor" = { start = 0.3, stop = 0.5, num = 2 }
+"""
+TINY = {"shape": "pyramid", "N": 0.946, "cell": 3.78, "tabor": 0.5, "dx": 0.4, "d_min": -1.0,
+        "d_max": 2.5, "d_step": 0.25}
+
+
+@pytest.fixture(scope="module")
+def client():
+    from dask.distributed import Client, LocalCluster
+
+    from tengsim.study.execute import WORKER_ENV
+
+    cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=True, env=dict(WORKER_ENV),
+                           dashboard_address=":0")
+    c = Client(cluster)
+    yield c
+    c.close()
+    cluster.close()
+
+
+def tiny_study(axes, **extra):
+    return parse_study({"base": {"contact": dict(TINY)}, "axes": axes, **extra}, source="test")
+
+
+def test_issue_minimal_study_equals_direct_runs(tmp_path, client):
+    import tomllib
+
+    f = tmp_path / "study.toml"
+    f.write_text(MINIMAL)
+    study = parse_study(tomllib.loads(MINIMAL), source=str(f))
+    s = run_study(study, tmp_path / "out", client=client, quiet=True)
+    assert {k: s[k] for k in ("ok", "unconverged", "failed", "pending", "points")} == \
+        {"ok": 4, "unconverged": 0, "failed": 0, "pending": 0, "points": 4}
+    ds = xr.load_dataset(tmp_path / "out" / "study.nc")
+    assert ds["pull_off_F"].dims == ("contact.N", "contact.tabor")
+    lines = (tmp_path / "out" / "study.csv").read_text().splitlines()
+    head = lines[0].split(",")
+    assert head[:4] == ["contact.N", "contact.tabor", "id", "status"]
+    assert "pull_off_F" in head and "jump_in_D" in head and len(lines) == 5
+    for p in study.points:
+        direct = run_contact(dict(p.contact))
+        got = ds["pull_off_F"].sel({"contact.N": p.contact["N"], "contact.tabor": p.contact["tabor"]})
+        assert float(got) == direct.pull_off_force
+        point = xr.load_dataset(tmp_path / "out" / "points" / f"{p.id}.nc")
+        np.testing.assert_array_equal(point["F"].values, direct.table["F"])
+        np.testing.assert_array_equal(point["contact_length"].values, direct.table["contact_length"])
+        assert point.attrs["status"] == "ok" and point.attrs["tengsim_version"]
+        assert json.loads(point.attrs["point_contact"]) == p.contact
+        row = next(r for r in lines[1:] if p.id in r).split(",")
+        assert float(row[head.index("pull_off_F")]) == direct.pull_off_force
+        # no jump at this coarse step: an empty cell, never 'nan'
+        jumps = [j for j in direct.jumps if j.kind == "jump-in"]
+        cell = row[head.index("jump_in_D")]
+        assert (cell == "") == (not jumps)
+        assert "nan" not in row
+
+
+def test_bad_point_fails_with_message_others_finish(tmp_path, client):
+    study = tiny_study({"contact.N": [0.946, 2.5, 1.2]})  # 2N = 5 > cell 3.78
+    s = run_study(study, tmp_path / "out", client=client, quiet=True)
+    assert (s["ok"], s["failed"]) == (2, 1)
+    bad = next(p for p in study.points if p.contact["N"] == 2.5)
+    rec = json.loads((tmp_path / "out" / "points" / f"{bad.id}.failed.json").read_text())
+    assert "wider than its cell" in rec["message"]
+    rows = {r.split(",")[0]: r for r in (tmp_path / "out" / "study.csv").read_text().splitlines()[1:]}
+    assert ",failed," in rows["2.5"] and "wider than its cell" in rows["2.5"]
+    assert ",ok," in rows["0.946"] and ",ok," in rows["1.2"]
+    # --retry-failed recomputes the failed point only (and it fails again); --resume alone skips it
+    s2 = run_study(study, tmp_path / "out", client=client, quiet=True, resume=True)
+    assert s2["computed"] == [] and s2["failed"] == 1
+    s3 = run_study(study, tmp_path / "out", client=client, quiet=True, resume=True, retry_failed=True)
+    assert s3["failed"] == 1
+
+
+def test_failure_at_compute_is_recorded(monkeypatch):
+    """An exception inside a run becomes a failed point with its message (compute_point never raises)."""
+    import tengsim.config
+    from tengsim.study.execute import compute_point
+
+    def boom(cfg, progress=None):
+        raise FloatingPointError("overflow in the solver")
+
+    monkeypatch.setattr(tengsim.config, "run_contact", boom)
+    r = compute_point(dict(TINY), "abc")
+    assert r["status"] == "failed" and "FloatingPointError: overflow in the solver" in r["message"]
+    assert r["data"] is None
+
+
+def test_resume_only_adds_points(tmp_path, client):
+    out = tmp_path / "out"
+    s1 = run_study(tiny_study({"contact.N": [0.946, 1.2]}), out, client=client, quiet=True)
+    assert len(s1["computed"]) == 2
+    before = {f.name: f.stat().st_mtime_ns for f in (out / "points").glob("*.nc")}
+    with pytest.raises(TengsimError, match="already holds a study"):
+        run_study(tiny_study({"contact.N": [0.946, 1.2]}), out, client=client, quiet=True)
+    grown = tiny_study({"contact.N": [0.946, 1.2, 1.4]})
+    s2 = run_study(grown, out, client=client, quiet=True, resume=True)
+    assert len(s2["computed"]) == 1 and s2["ok"] == 3
+    after = {f.name: f.stat().st_mtime_ns for f in (out / "points").glob("*.nc")}
+    assert all(after[k] == v for k, v in before.items())
+    with pytest.raises(TengsimError, match="may only add points"):
+        run_study(tiny_study({"contact.N": [0.946]}), out, client=client, quiet=True, resume=True)
+    with pytest.raises(TengsimError, match="may only add points"):  # a changed base changes every point
+        run_study(parse_study({"base": {"contact": dict(TINY, dx=0.45)}, "axes": {"contact.N": [0.946, 1.2, 1.4]}}),
+                  out, client=client, quiet=True, resume=True)
+
+
+def test_physical_study_has_pressure_observables(tmp_path, client):
+    base = {"shape": "pyramid", "pitch": "2um", "base": "1um", "height": "0.7um", "E_star": "0.59MPa",
+            "W": "54mJ/m2", "tabor": 0.5, "dx": 0.3, "d_min": -1.0, "d_max": 5.0, "d_step": 0.25}
+    study = parse_study({"base": {"contact": base},
+                         "axes": {"contact.E_star": ["0.59MPa", "2MPa"]},
+                         "observables": {"pressures": ["5kPa"], "fit_range": ["0kPa", "10kPa"]}})
+    run_study(study, tmp_path / "out", client=client, quiet=True)
+    ds = xr.load_dataset(tmp_path / "out" / "study.nc")
+    from tengsim.units import PaperScaling
+
+    for e in ("0.59MPa", "2MPa"):
+        row = ds.sel({"contact.E_star": e})
+        sc = PaperScaling.from_tabor(float(e[:-3]) * 1e6, 54e-3, 1e-6, 0.7e-6, 2e-6, 0.5)
+        assert float(row["pull_off_Pa"]) == pytest.approx(sc.pressure(float(row["pull_off_F"])), rel=1e-12)
+        v, a = row["V_OC"].values, row["area_fraction"].values
+        ok = np.isfinite(v)
+        assert ok.sum() >= 2 and np.all(np.isfinite(a) == ok)
+        # Eq. (12) on the common grid: V_OC = σ (A/S) T / (ε_r ε0), paper Fig. 5 defaults
+        np.testing.assert_allclose(v[ok], 5.84e-6 * a[ok] * 400e-6 / (2.40 * 8.8541878128e-12), rtol=1e-9)
+        assert float(row["V_sat"]) >= np.nanmax(v) - 1e-9
+        assert float(row["P_sat_Pa"]) > 0
+        assert np.isfinite(float(row["S_V_per_kPa"])) and np.isfinite(float(row["hysteresis_J_m2"]))
+
+
+def test_sampled_study_indexed_by_point(tmp_path, client):
+    study = tiny_study({"contact.tabor": {"start": 0.3, "stop": 0.6},
+                        "g": {"zip": {"contact.N": [0.9, 1.1], "contact.cell": [3.6, 4.0]}, "labels": ["s", "t"]}},
+                       study={"sampling": "lhs", "n": 3, "seed": 5})
+    s = run_study(study, tmp_path / "out", client=client, quiet=True)
+    assert s["ok"] == 3
+    ds = xr.load_dataset(tmp_path / "out" / "study.nc")
+    assert ds["pull_off_F"].dims == ("point",) and ds.sizes["point"] == 3
+    np.testing.assert_array_equal(ds["contact.tabor"].values, [p.contact["tabor"] for p in study.points])
+    lines = (tmp_path / "out" / "study.csv").read_text().splitlines()
+    assert lines[0].startswith("contact.tabor,g,contact.N,contact.cell,id,status,")
+    for line, p in zip(lines[1:], study.points):
+        assert line.split(",")[1] == p.axes["g"] and line.split(",")[4] == p.id
+
+
+CLI_BAD = [
+    ('"contact.bogus" = [1.0, 2.0]', "bogus"),
+    ('"contact.N" = []', "axis 'contact.N' is empty"),
+    ('"contact.N" = { start = 1.0, stop = 2.0, num = 0 }', "is empty"),
+]
+
+
+@pytest.mark.parametrize("axis, msg", CLI_BAD)
+def test_cli_malformed_study_exit_2_nothing_written(tmp_path, capsys, axis, msg):
+    f = tmp_path / "s.toml"
+    f.write_text(MINIMAL.split("[axes]")[0] + "[axes]\n" + axis + "\n")
+    rc = main(["sweep", str(f), "--out", str(tmp_path / "out"), "--quiet"])
+    err = capsys.readouterr().err.strip()
+    assert rc == 2 and len(err.splitlines()) == 1 and msg in err, err
+    assert not (tmp_path / "out").exists()
+
+
+def test_cli_unit_on_dimensionless_key(tmp_path, capsys):
+    try:
+        plan_contact(dict(TINY, tabor="0.5MPa"))
+    except TengsimError:
+        pass
+    else:
+        pytest.skip("this config.plan_contact accepts a unit on tabor (the schema-validated one refuses it)")
+    f = tmp_path / "s.toml"
+    f.write_text(MINIMAL.split("[axes]")[0] + '[axes]\n"contact.tabor" = ["0.5MPa", "0.3MPa"]\n')
+    rc = main(["sweep", str(f), "--out", str(tmp_path / "out"), "--quiet"])
+    err = capsys.readouterr().err.strip()
+    assert rc == 2 and len(err.splitlines()) == 1 and "tabor" in err, err
+    assert not (tmp_path / "out").exists()
+
+
+def test_cli_workers_and_scheduler_exclusive(tmp_path, capsys):
+    f = tmp_path / "s.toml"
+    f.write_text(MINIMAL)
+    rc = main(["sweep", str(f), "--out", str(tmp_path / "out"), "--workers", "2", "--scheduler", "tcp://127.0.0.1:1"])
+    err = capsys.readouterr().err.strip()
+    assert rc == 2 and len(err.splitlines()) == 1 and "not both" in err
+    assert not (tmp_path / "out").exists()
+
+
+def test_cli_unreachable_scheduler(tmp_path, capsys):
+    f = tmp_path / "s.toml"
+    f.write_text(MINIMAL)
+    t0 = time.perf_counter()
+    rc = main(["sweep", str(f), "--out", str(tmp_path / "out"), "--scheduler", "tcp://127.0.0.1:9"])
+    err = capsys.readouterr().err.strip()
+    assert rc == 2 and len(err.splitlines()) == 1 and "cannot reach the dask scheduler" in err, err
+    assert time.perf_counter() - t0 < 20
+    assert not (tmp_path / "out").exists()
+
+
+KILL_STUDY = """
+[base.contact]
+shape = "pyramid"
+N = 0.946
+cell = 3.78
+tabor = 0.5
+dx = 0.1
+d_min = -1.0
+d_max = 3.0
+d_step = 0.1
+
+[axes]
+"contact.tabor" = { start = 0.3, stop = 0.6, num = 6 }
+"""
+
+
+def _sweep_cmd(study, out):
+    return [sys.executable, "-m", "tengsim.cli.main", "sweep", str(study), "--out", str(out), "--workers", "1"]
+
+
+@pytest.mark.slow
+def test_kill_and_resume_equals_uninterrupted(tmp_path, client):
+    import tomllib
+
+    f = tmp_path / "k.toml"
+    f.write_text(KILL_STUDY)
+    out = tmp_path / "killed"
+    env = dict(os.environ, PYTHONPATH=str(Path(__file__).resolve().parents[1] / "src"))
+    proc = subprocess.Popen(_sweep_cmd(f, out), env=env, start_new_session=True,
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        t0 = time.time()
+        while not list((out / "points").glob("*.nc")):
+            assert proc.poll() is None, "the sweep ended before writing a point"
+            assert time.time() - t0 < 120
+            time.sleep(0.02)
+    finally:
+        os.killpg(proc.pid, signal.SIGKILL)  # the client and its LocalCluster processes, at once
+        proc.wait()
+    kept = {p.name: (p.stat().st_ino, p.stat().st_mtime_ns) for p in (out / "points").glob("*.nc")}
+    assert 1 <= len(kept) < 6, "kill came too late to test a resume"
+    assert not list((out / "points").glob("*.part"))  # nothing half written under a final name
+    r = subprocess.run(_sweep_cmd(f, out) + ["--resume"], env=env, capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    after = {p.name: (p.stat().st_ino, p.stat().st_mtime_ns) for p in (out / "points").glob("*.nc")}
+    assert len(after) == 6 and all(after[k] == v for k, v in kept.items())  # finished points never redone
+    # each point computed once: the resumed run's log names exactly the points that were missing
+    log = [json.loads(x) for x in (out / "log.jsonl").read_text().splitlines()]
+    starts = [i for i, e in enumerate(log) if e["event"] == "start"]
+    resumed = [e["id"] for e in log[starts[-1]:] if e["event"] == "point"]
+    assert sorted(resumed) == sorted(k[:-3] for k in after if k not in kept)
+    ref = run_study(parse_study(tomllib.loads(KILL_STUDY), source=str(f)), tmp_path / "ref", client=client,
+                    quiet=True)
+    assert ref["ok"] == 6
+    a = xr.load_dataset(out / "study.nc").drop_vars("seconds")
+    b = xr.load_dataset(tmp_path / "ref" / "study.nc").drop_vars("seconds")
+    a.attrs.pop("study"), b.attrs.pop("study")  # the study's source path differs
+    xr.testing.assert_identical(a, b)
+
+
+OPT = {"base": {"contact": {"shape": "pyramid", "pitch": "2um", "base": "1um", "height": "0.7um",
+                            "E_star": "0.59MPa", "W": "54mJ/m2", "eps": "0.37um", "dx": 0.45, "d_min": -1.0,
+                            "d_max": 4.0, "d_step": 0.25}},
+       "axes": {"contact.E_star": {"start": "0.5MPa", "stop": "3MPa", "scale": "log"}},
+       "objective": {"maximize": "V_sat", "maxiter": 1, "popsize": 2, "seed": 2}}
+
+
+@pytest.mark.slow
+def test_optimize_stores_points_and_resumes(tmp_path, client):
+    from tengsim.study.optimize import optimize_study
+
+    study = parse_study(OPT, source="opt")
+    assert study.points == []
+    r = optimize_study(study, tmp_path / "o", client=client, quiet=True)
+    files = {f.name: f.stat().st_mtime_ns for f in (tmp_path / "o" / "points").glob("*.nc")}
+    assert r["feasible"] and r["evaluations"] == len(files) >= 4
+    ds = xr.load_dataset(tmp_path / "o" / "study.nc")
+    assert ds.sizes["point"] == r["evaluations"]
+    assert r["value"] == pytest.approx(float(ds["V_sat"].max()))  # the best of all evaluations
+    # the optimum is a stored point whose V_sat is a direct run's
+    direct = run_contact(dict(OPT["base"]["contact"], E_star=r["x"]["contact.E_star"]))
+    from tengsim.study.observe import observe
+
+    v = observe(direct, study.base["device"], study.observables)["scalars"]["V_sat"]
+    assert v == pytest.approx(r["value"], rel=1e-12)
+    r2 = optimize_study(parse_study(OPT, source="opt"), tmp_path / "o", client=client, quiet=True, resume=True)
+    after = {f.name: f.stat().st_mtime_ns for f in (tmp_path / "o" / "points").glob("*.nc")}
+    assert after == files and r2["x"] == r["x"]  # same seed: the same points, all found on disk
+
+
+def test_optimize_objective_errors():
+    from tengsim.study.optimize import parse_objective
+
+    for obj, msg in [({"maximize": "nope"}, "not an observable"), ({}, "needs an [objective]"),
+                     ({"maximize": "V_sat", "minimize": "V_sat"}, "exactly one"),
+                     ({"maximize": "V_sat", "subject_to": {"P_sat_Pa": {"low": 1}}}, "subject_to.P_sat_Pa")]:
+        with pytest.raises(TengsimError, match=msg.replace("[", r"\[").replace("]", r"\]")):
+            parse_objective(parse_study(dict(OPT, objective=obj)) if obj else parse_study(
+                {k: v for k, v in OPT.items() if k != "objective"} | {"axes": {"contact.N": [1.0]}}))
+    with pytest.raises(TengsimError, match="range axes only"):
+        parse_objective(parse_study(dict(OPT, axes={"contact.E_star": ["1MPa", "2MPa"]})))
+
+
+def test_plot_study_maps(tmp_path, client):
+    study = tiny_study({"contact.N": [0.946, 1.2], "contact.tabor": [0.4, 0.5]})
+    run_study(study, tmp_path / "s", client=client, quiet=True)
+    rc = main(["plot", str(tmp_path / "s")])
+    assert rc == 0 and (tmp_path / "s" / "design.png").stat().st_size > 10000
+    one = tiny_study({"contact.N": [0.946, 1.2]})
+    run_study(one, tmp_path / "l", client=client, quiet=True)
+    from tengsim.study.plot import plot_study
+
+    assert plot_study(tmp_path / "l", tmp_path / "l.png")[0].stat().st_size > 10000
