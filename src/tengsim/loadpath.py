@@ -22,7 +22,8 @@ to the first D where F returns to the fold's load on a rising part (the landing 
 with ``jump`` True.  On the approach this is the jump-in (for an adhesive law at the very start:
 the body at rest at ``d_min`` is drawn in); on the retraction the fold is the minimum of F, the
 load-controlled pull-off, and the jump-out leaves the D range (separation): the retraction ends
-with a row at ``d_min`` marked ``jump`` and the loads below the pull-off have no state.
+with a row at the last D of the walk above ``d_min`` (out of contact), marked ``jump``, and the
+loads below the pull-off have no state.
 Approach loads below the start's F (the body stays away) are skipped.
 """
 from __future__ import annotations
