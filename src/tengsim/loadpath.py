@@ -292,7 +292,7 @@ def run_load_path(U0, law, kernel, solver, spec: LoadPathSpec, start: State | No
     if spec.retract:
         down = _LoadBranch(U0, law, kernel, solver, spec, make_emit("retraction"))
         down.set(up.D, up.eq)
-        down.emit(up.D, up.eq, True, False)
+        down.emit(up.D, up.eq, bool(abs(up.Fc - targets[-1]) <= spec.tol_F), False)
         for Ft in targets[::-1][1:]:
             if not down.to(Ft, True):
                 break  # pulled off: no state under the lower loads
