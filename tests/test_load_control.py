@@ -101,21 +101,23 @@ def test_load_spec_validation():
 
 @pytest.mark.slow
 def test_sphere_load_pull_off_is_jkr_at_large_mu():
-    """Sphere (Paraboloid R = 1, free kernel), μ = 3: the load-controlled pull-off, F = ∬P/(3π), against
-    JKR's −(3/2)πWR, i.e. F = −1/2 in these units (references.jkr_pulloff / (3π W R)).
+    """Sphere (Paraboloid R = 1, cell 12, free kernel), μ = 3, dx 0.1: the load-controlled pull-off,
+    F = ∬P/(3π), against JKR's −(3/2)πWR, i.e. F = −1/2 in these units (references.jkr_pulloff with
+    W = R = 1, divided by 3π).
 
-    Tolerance 5 %: the LJ sphere at μ = 3 sits +0.85 % above JKR by Maugis–Dugdale (λ = 1.157 μ,
-    P̄ = 1.5128), the LJ-vs-MD law difference is +1.6 % at μ = 3 (docs/validation.md), and dx 0.2 vs
-    0.1 changes the pull-off by the amount measured here (asserted below to be < 2 %)."""
+    Tolerance 5 %: at μ = 3 Maugis–Dugdale (λ = 1.157 μ) is +0.85 % above JKR, and the D-controlled
+    minimum of F on this grid is +3.5 % (tests/test_engine_adhesion.py, 1.553π); dx 0.2 is not
+    converged here (the contact edge advances ring by ring on the pixel lattice, F(D) is a saw-tooth
+    of ±0.01), so the grid error is bounded by the dx 0.1 vs MD comparison, not by a finer grid.
+    The load path starts at D = −3, where the zero state already snaps into contact, as in the D test.
+    Measured: −0.51784 (+3.57 % vs JKR; the D-controlled minimum on the same grid is −0.5177, so the two
+    controls agree to 0.03 %); ~5 CPU-minutes (8279 convolutions on 120² points)."""
     mu = 3.0
-    out = {}
-    for dx in (0.2, 0.1):
-        shape = ts.Paraboloid(1.0, 12.0)
-        grid = shape.grid(dx)
-        res = run_load_path(shape.gap(grid), ts.LJ93(), FreeKernel(grid, mu**1.5), ts.FastSolver(1e-6),
-                            LoadPathSpec(-0.4, 0.4, 0.2, d_min=-3.0, d_max=3.0, d_step=0.1))
-        out[dx] = res.pull_off_force
+    shape = ts.Paraboloid(1.0, 12.0)
+    grid = shape.grid(0.1)
+    res = run_load_path(shape.gap(grid), ts.LJ93(), FreeKernel(grid, mu**1.5), ts.FastSolver(1e-6),
+                        LoadPathSpec(-0.6, -0.3, 0.05, d_min=-3.0, d_max=4.0, d_step=0.2))
     jkr = ref.jkr_pulloff(1.0, 1.0, 1.0).force / (3 * np.pi)     # W = R = 1: −1/2
     assert jkr == pytest.approx(-0.5)
-    assert out[0.1] == pytest.approx(out[0.2], rel=0.02)
-    assert out[0.1] == pytest.approx(jkr, rel=0.05)
+    assert res.pull_off_force == pytest.approx(jkr, rel=0.05)
+    assert any(j.branch == "retraction" and j.kind == "jump-out" for j in res.jumps)
