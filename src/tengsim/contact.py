@@ -62,6 +62,7 @@ def simulate(shape: Shape, tabor: float, dx: float, path: PathSpec, boundary: st
         "d_step": path.d_step,
         "refine_levels": path.refine_levels,
         "jump_h": path.jump_h,
+        **path.extra_params(),  # adaptive steps or load control (none for a fixed-step D path)
         **(extra_params or {}),
     }
     if scaling is not None:

@@ -5,15 +5,18 @@ the path follows the stable branch and shows jump-in, jump-out and hysteresis as
 does.  Step control: when the gap field changes by more than ``jump_h`` (in ε, beyond the rigid
 shift |ΔD|) across a step, the step is bisected, up to ``refine_levels`` times; a change that
 survives the finest step is recorded as a jump.
+
+With ``PathSpec(adaptive=True)`` the step also adapts where the path is smooth (:class:`_Adaptive`):
+``d_step`` is then the largest step and d_step/2^refine_levels the smallest.
 """
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
-from tengsim.analysis import apex_index
+from tengsim.analysis import apex_index, force
 from tengsim.errors import TengsimError, finite, positive
 from tengsim.solvers import Problem, State
 from tengsim.status import process_zone_width
@@ -25,6 +28,24 @@ class PathSpec:
 
     Every branch has a row at each D = d_min + k·d_step; step refinement only adds rows between.
     ``maps_at`` lists D values whose pressure and gap maps are kept (on both branches).
+
+    ``adaptive=True``: the step h takes the values d_step/2^k (k = 0 … ``refine_levels``) and stays on
+    the lattice D = d_min + j·d_step/2^k, so every row lies on the finest lattice and every
+    D = d_min + k·d_step is still visited (those rows keep ``on_grid`` True: they are the rows a
+    fixed-step run with the same ``d_step`` has; the others are the adaptive run's own).  After each
+    step the solved state is compared with the linear extrapolation of the two before it (the
+    secant predictor): the force error e_F = |F − F_pred| against ``adapt_tol`` × max(|F|, the most
+    tensile |F| met so far on the path), and the gap error max|H − H_pred| (ε) against
+    ``adapt_h``.  A step whose larger ratio ρ exceeds 1 keeps its (exact) end state and is refined by
+    midpoints (recursively, each half judged by the midpoint's deviation from the chord), and the
+    next step is divided by 2^⌈log₄ ρ⌉ (the error goes as h²); ρ < 1/4 lets the next step double
+    (where the lattice allows).  The same second difference, centred on the step's start, also
+    judges the step before it (look-back), which is refined the same way; each branch starts with
+    d_step (its second step's look-back judges it).  Jumps are bisected to the smallest step as in
+    the fixed scheme (a step that jumps is retried at half its length).  With refine_levels three
+    above a fixed run's and d_step eight times its d_step, the smallest steps (and so the jump
+    resolution) agree.  Measured (benchmarks/adaptive_path.py): adapt_tol = 0.075 reproduces the
+    fixed curve of the paper's groups to about 0.5 % of max(|F|, |pull-off F|) with half the solves.
     """
 
     d_min: float
@@ -35,6 +56,9 @@ class PathSpec:
     predictor: bool = True
     retract: bool = True
     maps_at: tuple = ()
+    adaptive: bool = False
+    adapt_tol: float = 0.075
+    adapt_h: float = 1.0
 
     def __post_init__(self):
         finite("d_min", self.d_min)
@@ -48,6 +72,16 @@ class PathSpec:
         if int(self.refine_levels) < 0:
             raise TengsimError(f"refine_levels must be >= 0, got {self.refine_levels!r}")
         object.__setattr__(self, "maps_at", tuple(float(d) for d in self.maps_at))
+        positive("adapt_tol", self.adapt_tol)
+        positive("adapt_h", self.adapt_h)
+        if self.adaptive and int(self.refine_levels) > 30:
+            raise TengsimError(f"refine_levels must be <= 30 with adaptive steps, got {self.refine_levels!r}")
+
+    def extra_params(self) -> dict:
+        """Path parameters beyond d_min, d_max, d_step, refine_levels, jump_h (none for fixed steps)."""
+        if not self.adaptive:
+            return {}
+        return {"adaptive": True, "adapt_tol": self.adapt_tol, "adapt_h": self.adapt_h}
 
     def targets(self) -> np.ndarray:
         k = int(np.floor((self.d_max - self.d_min) / self.d_step + 1e-9))
@@ -107,72 +141,307 @@ class _Branch:
         return eqb
 
 
+@dataclass
+class _S:
+    """A bare state holder (``.state``) for rows kept only as states."""
+
+    state: State
+
+
+class _Adaptive(_Branch):
+    """Walks one branch with adaptive steps on the dyadic lattice of ``d_step`` (see PathSpec)."""
+
+    def __init__(self, U0, law, kernel, solver, spec, on_row, f_scale):
+        super().__init__(U0, law, kernel, solver, spec, on_row)
+        self.f_scale = f_scale      # one-element list: the most tensile |F| met so far on the path
+        self.hist_F: list = []      # F of the states in hist
+        self.curve: list = []       # (D, F) of the last rows accepted on this piece, in path order
+        self.level = 0  # the first step has no error estimate: the look-back of the second judges it
+
+    def _start(self, D):
+        (D1, s1) = self.hist[-1]
+        if len(self.hist) >= 2:
+            D0, s0 = self.hist[-2]
+            c = (D - D1) / (D1 - D0)
+            if 0 < c <= 2.0:
+                return State(s1.q + c * (s1.q - s0.q), s1.w + c * (s1.w - s0.w)), True
+        return s1, False
+
+    def _error(self, Db, eqb):
+        """Larger of the force and gap extrapolation errors over their tolerances (0 without history)."""
+        if len(self.hist) < 2:
+            return 0.0
+        (D0, s0), (D1, s1) = self.hist
+        c = (Db - D1) / (D1 - D0)
+        F0, F1 = self.hist_F
+        Fb = force(eqb.P, self.kernel.grid)
+        scale = max(abs(Fb), self.f_scale[0], 1e-12)
+        eF = abs(Fb - (F1 + c * (F1 - F0)))
+        eF /= self.spec.adapt_tol * scale
+        # H = U0 − D + w, and D is extrapolated exactly: the gap error is the error of w
+        eH = float(np.max(np.abs(eqb.state.w - (s1.w + c * (s1.w - s0.w))))) / self.spec.adapt_h
+        return max(eF, eH)
+
+    def _on_grid(self, D):
+        return abs((D - self.spec.d_min) / self.spec.d_step - round((D - self.spec.d_min) / self.spec.d_step)) < 1e-9
+
+    def _insert(self, Da, eqa, Fa, Db, eqb, Fb, err, level):
+        """Midpoints of a step whose error ratio ``err`` exceeds 1, in path order [(D, eq, F), …].
+
+        The midpoint starts from the mean of the end states; its deviation δ from the chord gives
+        each half its own ratio (F'' h² = 8δ, so a half's ratio is 2δ over the tolerance)."""
+        if err <= 1.0 or level > int(self.spec.refine_levels):
+            return []
+        Dm = 0.5 * (Da + Db)
+        sa, sb = eqa.state, eqb.state
+        eqm = self.solve(Dm, State(0.5 * (sa.q + sb.q), 0.5 * (sa.w + sb.w)))
+        Fm = force(eqm.P, self.kernel.grid)
+        scale = max(abs(Fm), self.f_scale[0], 1e-12)
+        eF = 2 * abs(Fm - 0.5 * (Fa + Fb)) / (self.spec.adapt_tol * scale)
+        eH = 2 * float(np.max(np.abs(eqm.state.w - 0.5 * (sa.w + sb.w)))) / self.spec.adapt_h
+        e = max(eF, eH)
+        return (self._insert(Da, eqa, Fa, Dm, eqm, Fm, e, level + 1) + [(Dm, eqm, Fm)]
+                + self._insert(Dm, eqm, Fm, Db, eqb, Fb, e, level + 1))
+
+    def walk(self, D_from, eq, D_to):
+        """From the accepted state ``eq`` at ``D_from`` to ``D_to`` (both on the d_step grid)."""
+        L = int(self.spec.refine_levels)
+        h_min = self.spec.d_step / 2**L
+        sgn = 1 if D_to > D_from else -1
+        j = int(round((D_from - self.spec.d_min) / h_min))
+        j_end = int(round((D_to - self.spec.d_min) / h_min))
+        Da = D_from
+        pending = None  # the last row, emitted once the next step has judged the step before it
+        while j != j_end:
+            k = self.level
+            # the step 2^(L−k) h_min must start on its own lattice and not pass the end
+            while k < L and (j % 2 ** (L - k) != 0 or 2 ** (L - k) > abs(j_end - j)):
+                k += 1
+            nj = j + sgn * 2 ** (L - k)
+            Db = self.spec.d_min + nj * h_min
+            start, predicted = self._start(Db)
+            eqb = self.solve(Db, start)
+            if predicted and self._jumped(eq, eqb, Db - Da):
+                eqb = self.solve(Db, eq.state)  # confirm without the predictor
+            jump = self._jumped(eq, eqb, Db - Da)
+            if jump and k < L:
+                self.level = k + 1
+                continue
+            err = 0.0 if jump else self._error(Db, eqb)
+            Fb = force(eqb.P, self.kernel.grid)
+            inner, back = [], []
+            if err > 1.0 and k < L:
+                # the solved state is kept; the interval is refined by midpoints instead
+                inner = self._insert(Da, eq, self.hist_F[-1], Db, eqb, Fb, err, k + 1)
+                # the error goes as h²: shrink by enough levels to bring it under 1
+                self.level = min(L, k + max(1, int(np.ceil(np.log(err) / np.log(4.0)))))
+            else:
+                self.level = max(k - 1, 0) if err < 0.25 else k
+            if err > 0 and pending is not None and not pending[3]:
+                # look back: the same second difference, centred on Da, judges the step before it
+                (D0, s0), (D1, s1) = self.hist
+                c = (Db - D1) / (D1 - D0)
+                kp = L - int(round(np.log2(abs(D1 - D0) / h_min)))
+                back = self._insert(D0, _S(s0), self.hist_F[0], D1, _S(s1), self.hist_F[1], err / c**2, kp + 1)
+            for Dm, eqm, Fm in back:
+                self.on_row(Dm, eqm, self._on_grid(Dm), False)
+            if pending is not None:
+                self.on_row(*pending)
+            for Dm, eqm, Fm in inner:
+                self.f_scale[0] = max(self.f_scale[0], -Fm)
+                self.on_row(Dm, eqm, self._on_grid(Dm), False)
+            self.f_scale[0] = max(self.f_scale[0], -Fb)
+            if jump:
+                self.hist, self.hist_F = [(Db, eqb.state)], [Fb]
+                self.curve = [(Db, Fb)]
+            else:
+                self.curve = (self.curve + [(d, fm) for d, _, fm in inner] + [(Db, Fb)])[-3:]
+                prev = inner[-1] if inner else (Da, eq, self.hist_F[-1])
+                self.hist = [(prev[0], prev[1].state), (Db, eqb.state)]
+                self.hist_F = [prev[2], Fb]
+            pending = (Db, eqb, nj % 2**L == 0, jump)
+            j, Da, eq = nj, Db, eqb
+        if pending is not None:
+            self.on_row(*pending)
+        return eq
+
+
+class Recorder:
+    """Collects what one path produces: a row per equilibrium (the built-in summary, the status inputs
+    and the observers' columns), the maps asked for, and progress.  Shared by every kind of path.
+
+    ``control`` names the path's control variable ('D' or 'F'); maps are kept at the rows whose
+    control value is within ``map_tol`` of an entry of ``maps_at``.
+    """
+
+    def __init__(self, U0, law, kernel, observers=(), progress=None, total=0, maps_at=(), control="D",
+                 map_tol=1e-9):
+        from tengsim import observers as obs
+        from tengsim.results import CURVE_COLUMNS, PHYSICAL_COLUMNS
+
+        grid = kernel.grid
+        U0 = np.asarray(U0, dtype=float)
+        if U0.shape != grid.shape:
+            raise TengsimError(f"U0 shape {U0.shape} does not match the grid {grid.shape}")
+        if not np.all(np.isfinite(U0)):
+            raise TengsimError("the initial gap U0 contains NaN or infinite values")
+        self.U0, self.law, self.grid = U0, law, grid
+        self.apex = apex_index(U0)
+        self.summary = obs.Summary()
+        self.extra = obs.resolve(observers)
+        self.extra_cols = obs.check_columns(self.extra, CURVE_COLUMNS + PHYSICAL_COLUMNS)
+        self.ctx = obs.Context(grid, self.apex, U0, law, kernel)
+        self._observe = obs.observe
+        self.progress, self.total, self.maps_at = progress, total, tuple(maps_at)
+        self.control, self.map_tol = control, map_tol
+        self.rows, self.maps, self.done, self._map_keys = [], [], 0, set()
+        self.t_start = time.perf_counter()
+
+    def on_row(self, branch):
+        """The callback ``(D, eq, on_grid, jump)`` that records a row of ``branch``."""
+        def record(D, eq, on_grid, jump):
+            s = self.summary(eq, self.ctx)
+            # a state whose gap enters the law's safe extension (g < g_safe) is outside the physical law
+            in_range = bool(s["min_gap"] + 1.0 >= getattr(self.law, "g_safe", -np.inf))
+            more = {}
+            for o in self.extra:
+                more.update(self._observe(o, eq, self.ctx))
+            self.rows.append(dict(branch=branch, D=D, on_grid=on_grid, jump=jump, converged=eq.converged,
+                                  in_law_range=in_range,
+                                  process_zone=process_zone_width(eq.H, self.grid.dx, self.apex, self.law),
+                                  residual=eq.residual, iterations=eq.iterations, n_conv=eq.n_conv,
+                                  seconds=eq.seconds, energy=eq.energy, **s, **more))
+            value = D if self.control == "D" else s["F"]
+            for m in self.maps_at:
+                tol = self.map_tol * (max(1.0, abs(m)) if self.control == "D" else 1.0) + 1e-9
+                if on_grid and abs(value - m) <= tol and (branch, m) not in self._map_keys:
+                    self._map_keys.add((branch, m))
+                    self.maps.append(dict(branch=branch, D=D, P=eq.P.copy(), H=eq.H.copy()))
+            if on_grid:
+                self.done += 1
+                if self.progress:
+                    self.progress(branch, value, self.done, self.total)
+        return record
+
+    def result(self, final_state=None):
+        """The :class:`tengsim.results.ContactResult` of the recorded rows."""
+        from tengsim.results import ContactResult
+
+        res = ContactResult.from_rows(self.rows, self.maps, self.grid, seconds=time.perf_counter() - self.t_start,
+                                      final_state=final_state, extra_columns=self.extra_cols)
+        for o in self.extra:
+            res.units.update(getattr(o, "units", None) or {})
+        return res
+
+
 def run_path(U0, law, kernel, solver, spec: PathSpec, start: State | None = None,
              progress=None, keep_states: bool = False, observers=()):
     """Solve the approach–retraction path; returns a :class:`tengsim.results.ContactResult`.
 
     ``progress(branch, D, done, total)`` is called after each row on the D grid.  ``observers``
-    (registered names or objects, see :mod:`tengsim.observers`) add their columns to every row.
+    (registered names or objects, see :mod:`tengsim.observers`) add their columns to every row.  A
+    :class:`tengsim.loadpath.LoadPathSpec` runs the load-controlled path instead.
     """
-    from tengsim import observers as obs
-    from tengsim.results import CURVE_COLUMNS, PHYSICAL_COLUMNS, ContactResult
-
-    grid = kernel.grid
-    U0 = np.asarray(U0, dtype=float)
-    if U0.shape != grid.shape:
-        raise TengsimError(f"U0 shape {U0.shape} does not match the grid {grid.shape}")
-    if not np.all(np.isfinite(U0)):
-        raise TengsimError("the initial gap U0 contains NaN or infinite values")
-    apex = apex_index(U0)
-    summary = obs.Summary()
-    extra = obs.resolve(observers)
-    extra_cols = obs.check_columns(extra, CURVE_COLUMNS + PHYSICAL_COLUMNS)
-    ctx = obs.Context(grid, apex, U0, law, kernel)
+    if not isinstance(spec, PathSpec):  # a load-controlled path (tengsim.loadpath.LoadPathSpec)
+        from tengsim.loadpath import run_load_path
+        return run_load_path(U0, law, kernel, solver, spec, start=start, progress=progress,
+                             keep_states=keep_states, observers=observers)
     targets = spec.targets()
-    total = len(targets) * (2 if spec.retract else 1)
-    rows, maps, done = [], [], [0]
-    map_keys = set()
-    t_start = time.perf_counter()
-
-    def make_on_row(branch):
-        def on_row(D, eq, on_grid, jump):
-            s = summary(eq, ctx)
-            # a state whose gap enters the law's safe extension (g < g_safe) is outside the physical law
-            in_range = bool(s["min_gap"] + 1.0 >= getattr(law, "g_safe", -np.inf))
-            more = {}
-            for o in extra:
-                more.update(obs.observe(o, eq, ctx))
-            rows.append(dict(branch=branch, D=D, on_grid=on_grid, jump=jump, converged=eq.converged,
-                             in_law_range=in_range,
-                             process_zone=process_zone_width(eq.H, grid.dx, apex, law),
-                             residual=eq.residual, iterations=eq.iterations, n_conv=eq.n_conv,
-                             seconds=eq.seconds, energy=eq.energy, **s, **more))
-            for Dm in spec.maps_at:
-                if on_grid and abs(D - Dm) < 1e-9 * max(1.0, abs(Dm)) + 1e-9 and (branch, Dm) not in map_keys:
-                    map_keys.add((branch, Dm))
-                    maps.append(dict(branch=branch, D=D, P=eq.P.copy(), H=eq.H.copy()))
-            if on_grid:
-                done[0] += 1
-                if progress:
-                    progress(branch, D, done[0], total)
-        return on_row
-
-    state = start if start is not None else State.zero(grid.shape)
-    walker = _Branch(U0, law, kernel, solver, spec, make_on_row("approach"))
+    rec = Recorder(U0, law, kernel, observers, progress, len(targets) * (2 if spec.retract else 1),
+                   spec.maps_at, "D")
+    U0 = rec.U0
+    state = start if start is not None else State.zero(kernel.grid.shape)
+    if spec.adaptive:
+        eq = _run_adaptive(U0, law, kernel, solver, spec, state, targets, rec.on_row)
+        return rec.result(eq.state if keep_states else None)
+    walker = _Branch(U0, law, kernel, solver, spec, rec.on_row("approach"))
     eq = walker.solve(targets[0], state)
     walker.hist = [(targets[0], eq.state)]
     walker.on_row(targets[0], eq, True, False)
     for Da, Db in zip(targets[:-1], targets[1:]):
         eq = walker.advance(Da, eq, Db, 0, True)
     if spec.retract:
-        back = _Branch(U0, law, kernel, solver, spec, make_on_row("retraction"))
+        back = _Branch(U0, law, kernel, solver, spec, rec.on_row("retraction"))
         back.hist = [(targets[-1], eq.state)]
         back.on_row(targets[-1], eq, True, False)
         rev = targets[::-1]
         for Da, Db in zip(rev[:-1], rev[1:]):
             eq = back.advance(Da, eq, Db, 0, True)
-    res = ContactResult.from_rows(rows, maps, grid, seconds=time.perf_counter() - t_start,
-                                  final_state=eq.state if keep_states else None, extra_columns=extra_cols)
-    for o in extra:
-        res.units.update(getattr(o, "units", None) or {})
-    return res
+    return rec.result(eq.state if keep_states else None)
+
+
+def _run_adaptive(U0, law, kernel, solver, spec, state, targets, make_on_row):
+    f_scale = [0.0]
+    walker = _Adaptive(U0, law, kernel, solver, spec, make_on_row("approach"), f_scale)
+    eq = walker.solve(targets[0], state)
+    walker.hist, walker.hist_F = [(targets[0], eq.state)], [force(eq.P, kernel.grid)]
+    walker.curve = [(targets[0], walker.hist_F[0])]
+    walker.on_row(targets[0], eq, True, False)
+    eq = walker.walk(targets[0], eq, targets[-1])
+    if spec.retract:
+        back = _Adaptive(U0, law, kernel, solver, spec, make_on_row("retraction"), f_scale)
+        back.hist, back.hist_F = [(targets[-1], eq.state)], [force(eq.P, kernel.grid)]
+        back.curve = [(targets[-1], back.hist_F[0])]
+        back.on_row(targets[-1], eq, True, False)
+        eq = back.walk(targets[-1], eq, targets[0])
+    return eq
+
+
+def compare_paths(ref, other, interp: str = "pchip") -> dict:
+    """How far the curve ``other`` is from ``ref`` (two ContactResults of the same problem).
+
+    Per branch, ``other`` is cut at its jumps into continuous segments and F is interpolated on each
+    segment (``interp`` 'linear': the curve as plotted; 'pchip': monotone cubic, scipy's PCHIP, linear
+    on a 2-row segment) at every D of ``ref`` that lies
+    inside one of them; D values of ``ref`` inside a jump interval of ``other`` (between its D_before
+    and D_after) are skipped, and so are rows of ``ref`` that start a jump (the state on the far
+    side of ``ref``'s own jump, compared only if ``other`` has a segment there).  The difference is
+    relative to max(|F_ref(D)|, F_adh), F_adh = |most tensile F of ``ref``| (the adhesive force
+    scale), so it is a relative error where |F| is large and an error in units of the pull-off force
+    where F crosses zero.  Returns {'max_rel_dF', 'where' ((branch, D) of it), 'n_compared', 'n_skipped', 'max_rel_dF_same_D'
+    (rows at equal D, no interpolation), 'jumps_ref', 'jumps_other' (lists of (branch, D_before,
+    D_after)), 'max_jump_dD' (largest |ΔD_after| between jumps matched by branch and order; NaN if
+    the counts differ)}.
+    """
+    from scipy.interpolate import PchipInterpolator
+
+    f_adh = max(abs(float(np.min(ref.table["F"]))), 1e-12)
+    worst, worst_same, n_cmp, n_skip, where = 0.0, 0.0, 0, 0, None
+    for br in ("approach", "retraction"):
+        a, b = ref.branch(br), other.branch(br)
+        if len(a["D"]) == 0 or len(b["D"]) == 0:
+            continue
+        cuts = [0] + [i for i in np.flatnonzero(b["jump"]) if i > 0] + [len(b["D"])]
+        segs = []
+        for i0, i1 in zip(cuts[:-1], cuts[1:]):
+            D, F = b["D"][i0:i1], b["F"][i0:i1]
+            if len(D) == 0:
+                continue
+            o = np.argsort(D)
+            D, F = D[o], F[o]
+            fn = PchipInterpolator(D, F) if len(D) >= 3 and interp == "pchip" else (lambda x, D=D, F=F: np.interp(x, D, F))
+            segs.append((D[0], D[-1], fn))
+        for D, F in zip(a["D"], a["F"]):
+            seg = [s for s in segs if s[0] - 1e-12 <= D <= s[1] + 1e-12]
+            if not seg:
+                n_skip += 1
+                continue
+            scale = max(abs(F), f_adh)
+            e = min(abs(float(s[2](D)) - F) for s in seg) / scale
+            if e > worst:
+                worst, where = e, (br, float(D))
+            n_cmp += 1
+            same = np.flatnonzero(np.abs(b["D"] - D) < 1e-9)
+            if len(same):
+                worst_same = max(worst_same, float(np.min(np.abs(b["F"][same] - F))) / scale)
+
+    def jl(res):
+        return [(j.branch, j.D_before, j.D_after) for j in res.jumps]
+
+    ja, jb = jl(ref), jl(other)
+    if len(ja) == len(jb) and all(x[0] == y[0] for x, y in zip(ja, jb)):
+        dj = max((abs(x[2] - y[2]) for x, y in zip(ja, jb)), default=0.0)
+    else:
+        dj = float("nan")
+    return {"max_rel_dF": worst, "where": where, "max_rel_dF_same_D": worst_same, "n_compared": n_cmp,
+            "n_skipped": n_skip, "jumps_ref": ja, "jumps_other": jb, "max_jump_dD": dj}

@@ -50,7 +50,7 @@ def run_group(group: str, settings: RunSettings = RunSettings(), progress=None):
     group = group.upper()
     sc = paper_scaling(group)
     spec = PathSpec(settings.d_min, settings.d_max, settings.d_step, maps_at=FIG3_D)
-    res = simulate(Pyramid(sc.N, sc.cell), sc.mu, settings.dx, spec, boundary=settings.boundary,
+    res = simulate(group_shape(group), sc.mu, settings.dx, spec, boundary=settings.boundary,
                    solver=settings.solver, tol=settings.tol, progress=progress,
                    extra_params={"group": group, **sc.params()}, scaling=sc)
     return res

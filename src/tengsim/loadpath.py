@@ -1,0 +1,274 @@
+"""Load control: a path in the total force F (Eq. 10), D an unknown of each equilibrium.
+
+A device applies a pressure, not an approach.  Each load-controlled state is a D-controlled
+equilibrium (Eq. 9) whose force equals the load: F(D) = F_target.  It is found by an outer 1-D
+solve on D around the existing solver, which keeps every state exactly the one the D-controlled
+path has at that D (the same warm starts, the same branch):
+
+1. walk in D from the current state, in the direction the load moves the body (D up when the
+   target is above the current F, down when below), in steps of ``d_step`` with the D path's own
+   jump bisection (:class:`tengsim.path._Branch`), until F crosses the target;
+2. solve F(D) = F_target in that bracket by regula falsi (Illinois), each trial D warm-started
+   from the bracket's states interpolated, until |F − F_target| <= ``f_tol``.
+
+(An augmented energy E(q) − F·D with D free would need a new solver; the outer solve reuses the
+one solver and is robust because each trial is a warm-started D-controlled equilibrium.)
+
+Stability and jumps.  Under a dead load a state is stable only where dF/dD > 0.  When the walk
+towards the target passes a turning point of F(D) (a fold: F first moves towards the target,
+then away), the body jumps at the fold's load: the fold is located by golden-section search on
+F(D) to the smallest step d_step/2^refine_levels, recorded as a row, and the walk goes on past it
+to the first D where F returns to the fold's load on a rising part (the landing state), recorded
+with ``jump`` True.  On the approach this is the jump-in (for an adhesive law at the very start:
+the body at rest at ``d_min`` is drawn in); on the retraction the fold is the minimum of F, the
+load-controlled pull-off, and the jump-out leaves the D range (separation): the retraction ends
+with a row at the last D of the walk above ``d_min`` (out of contact), marked ``jump``, and the
+loads below the pull-off have no state.
+Approach loads below the start's F (the body stays away) are skipped.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from tengsim.analysis import force
+from tengsim.errors import TengsimError, finite, positive
+from tengsim.path import PathSpec, _Branch
+from tengsim.solvers import State
+
+
+@dataclass(frozen=True)
+class LoadPathSpec:
+    """Load from ``f_min`` up to ``f_max`` then back, in steps of ``f_step`` (F of Eq. 10).
+
+    The approach starts at rest at D = ``d_min``; D is searched within [``d_min``, ``d_max``] by a
+    walk of step ``d_step`` (jumps bisected ``refine_levels`` times, gap criterion ``jump_h`` as
+    in :class:`tengsim.path.PathSpec`).  ``f_tol``: accepted |F − target| (default 1e-4 f_step).
+    Rows at the targets have ``on_grid`` True; fold, landing and separation rows have it False.
+    ``maps_at`` lists loads whose maps are kept.
+    """
+
+    f_min: float
+    f_max: float
+    f_step: float
+    d_min: float = -1.0
+    d_max: float = 20.0
+    d_step: float = 0.05
+    refine_levels: int = 4
+    jump_h: float = 0.3
+    f_tol: float | None = None
+    retract: bool = True
+    maps_at: tuple = ()
+
+    def __post_init__(self):
+        finite("f_min", self.f_min)
+        finite("f_max", self.f_max)
+        positive("f_step", self.f_step)
+        finite("d_min", self.d_min)
+        finite("d_max", self.d_max)
+        positive("d_step", self.d_step)
+        if not self.f_max > self.f_min:
+            raise TengsimError(f"f_max ({self.f_max}) must be greater than f_min ({self.f_min})")
+        if not self.d_max > self.d_min:
+            raise TengsimError(f"d_max ({self.d_max}) must be greater than d_min ({self.d_min})")
+        if (self.f_max - self.f_min) / self.f_step > 100000:
+            raise TengsimError(f"f_step={self.f_step} gives too many load steps; choose a larger step")
+        if int(self.refine_levels) < 0:
+            raise TengsimError(f"refine_levels must be >= 0, got {self.refine_levels!r}")
+        if self.f_tol is not None:
+            positive("f_tol", self.f_tol)
+        object.__setattr__(self, "maps_at", tuple(float(f) for f in self.maps_at))
+
+    @property
+    def tol_F(self) -> float:
+        return self.f_tol if self.f_tol is not None else 1e-4 * self.f_step
+
+    def targets(self) -> np.ndarray:
+        k = int(np.floor((self.f_max - self.f_min) / self.f_step + 1e-9))
+        return self.f_min + self.f_step * np.arange(k + 1)
+
+    def extra_params(self) -> dict:
+        return {"control": "load", "f_min": self.f_min, "f_max": self.f_max, "f_step": self.f_step,
+                "f_tol": self.tol_F}
+
+    def d_spec(self) -> PathSpec:
+        return PathSpec(self.d_min, self.d_max, self.d_step, refine_levels=self.refine_levels,
+                        jump_h=self.jump_h)
+
+
+class _Out(Exception):
+    """The walk left [d_min, d_max] without meeting the load."""
+
+
+class _LoadBranch:
+    """One branch under load control; ``emit(D, eq, on_grid, jump)`` receives its rows in order."""
+
+    def __init__(self, U0, law, kernel, solver, spec: LoadPathSpec, emit):
+        self.spec, self.emit, self.grid = spec, emit, kernel.grid
+        self.trail: list = []
+        self.walker = _Branch(U0, law, kernel, solver, spec.d_spec(),
+                              lambda D, eq, on_grid, jump: self.trail.append((D, eq, jump)))
+        self.h_min = spec.d_step / 2 ** int(spec.refine_levels)
+
+    def F(self, eq) -> float:
+        return force(eq.P, self.grid)
+
+    def set(self, D, eq):
+        self.D, self.eq, self.Fc = D, eq, self.F(eq)
+        self.walker.hist = [(D, eq.state)]
+
+    def _walk(self, s):
+        """One D step in direction s from the current end of the walk; returns its new points."""
+        D0, eq0 = self.pts[-1][0], self.pts[-1][1]
+        D1 = D0 + s * self.spec.d_step
+        if D1 < self.spec.d_min - 1e-12 or D1 > self.spec.d_max + 1e-12:
+            raise _Out()
+        self.trail = []
+        self.walker.advance(D0, eq0, D1, 0, False)
+        new = [(D, eq, self.F(eq), jump) for D, eq, jump in self.trail]
+        self.pts += new
+        return new
+
+    def _root(self, a, b, Ft):
+        """Regula falsi (Illinois) for F(D) = Ft between walk points a and b (F on either side)."""
+        (Da, ea, Fa), (Db, eb, Fb) = a[:3], b[:3]
+        side = 0
+        best = min((a, b), key=lambda p: abs(p[2] - Ft))
+        for _ in range(60):
+            if abs(best[2] - Ft) <= self.spec.tol_F or abs(Db - Da) < 1e-12:
+                break
+            t = (Ft - Fa) / (Fb - Fa)
+            D = Da + t * (Db - Da)
+            start = State(ea.state.q + t * (eb.state.q - ea.state.q), ea.state.w + t * (eb.state.w - ea.state.w))
+            eq = self.walker.solve(D, start)
+            F = self.F(eq)
+            best = (D, eq, F) if abs(F - Ft) < abs(best[2] - Ft) else best
+            if (F - Ft) * (Fa - Ft) > 0:
+                Da, ea, Fa = D, eq, F
+                if side == -1:
+                    Fb = Ft + 0.5 * (Fb - Ft)
+                side = -1
+            else:
+                Db, eb, Fb = D, eq, F
+                if side == 1:
+                    Fa = Ft + 0.5 * (Fa - Ft)
+                side = 1
+        return best[0], best[1]
+
+    def _fold(self, i, s):
+        """Refine the fold around walk point i (largest s·F) by golden section; returns (D, eq, F)."""
+        lo = self.pts[max(i - 1, 0)][0]
+        hi = self.pts[min(i + 1, len(self.pts) - 1)][0]
+        if i == 0:
+            return self.pts[0][:3]
+        a, b = min(lo, hi), max(lo, hi)
+        best = self.pts[i][:3]
+
+        def at(D):
+            near = min(self.pts, key=lambda p: abs(p[0] - D))
+            eq = self.walker.solve(D, near[1].state)
+            return D, eq, self.F(eq)
+        g = 0.5 * (math.sqrt(5.0) - 1.0)
+        x1, x2 = b - g * (b - a), a + g * (b - a)
+        p1, p2 = at(x1), at(x2)
+        while b - a > self.h_min:
+            if s * p1[2] >= s * p2[2]:
+                b, x2, p2 = x2, x1, p1
+                x1 = b - g * (b - a)
+                p1 = at(x1)
+            else:
+                a, x1, p1 = x1, x2, p2
+                x2 = a + g * (b - a)
+                p2 = at(x2)
+        for p in (p1, p2):
+            if s * p[2] > s * best[2]:
+                best = p
+        return best
+
+    def _cross(self, Ft, s, fold_check):
+        """Walk from the current state to F = Ft; returns ('root', D, eq) or ('fold', D, eq, F)."""
+        self.pts = [(self.D, self.eq, self.Fc, False)]
+        ibest = 0
+        noise = self.spec.tol_F
+        below = s * (self.Fc - Ft) < 0
+        while True:
+            start = len(self.pts)
+            self._walk(s)
+            for i in range(start, len(self.pts)):
+                Fi = self.pts[i][2]
+                if s * (Fi - Ft) >= 0 and below:
+                    if self.pts[i][3]:  # crossed through a D-controlled jump: take the far state
+                        return ("root", self.pts[i][0], self.pts[i][1])
+                    D, eq = self._root(self.pts[i - 1], self.pts[i], Ft)
+                    return ("root", D, eq)
+                below = below or s * (Fi - Ft) < 0
+                if fold_check:
+                    if s * Fi > s * self.pts[ibest][2]:
+                        ibest = i
+                    elif s * Fi < s * self.pts[ibest][2] - noise:
+                        return ("fold",) + tuple(self._fold(ibest, s))
+
+    def to(self, Ft, on_grid) -> bool:
+        """Bring the branch to load Ft, emitting fold/landing rows on the way; False if it left."""
+        while abs(self.Fc - Ft) > self.spec.tol_F:
+            s = 1 if Ft > self.Fc else -1
+            try:
+                res = self._cross(Ft, s, fold_check=True)
+            except _Out:
+                return self._left(s)
+            if res[0] == "root":
+                self.set(res[1], res[2])
+                break
+            _, Df, eqf, Ff = res
+            if abs(Df - self.D) > 1e-12:
+                self.set(Df, eqf)
+                self.emit(Df, eqf, False, False)  # the last stable state before the jump
+            try:
+                land = self._cross(Ff, s, fold_check=False)
+            except _Out:
+                return self._left(s)
+            self.set(land[1], land[2])
+            self.emit(land[1], land[2], False, True)
+        self.emit(self.D, self.eq, on_grid, False)
+        return True
+
+    def _left(self, s):
+        """The body left the D range under this load: record the state at the end of the walk."""
+        D, eq, F, _ = self.pts[-1]
+        if abs(D - self.D) > 1e-12:
+            self.set(D, eq)
+            self.emit(D, eq, False, True)
+        return False
+
+
+def run_load_path(U0, law, kernel, solver, spec: LoadPathSpec, start: State | None = None,
+                  progress=None, keep_states: bool = False, observers=()):
+    """Solve the load-controlled approach–retraction path; returns a ContactResult (same columns as
+    :func:`tengsim.path.run_path`: D is an output, F the control).  ``progress(branch, F, done, total)``."""
+    from tengsim.path import Recorder
+
+    targets = spec.targets()
+    rec = Recorder(U0, law, kernel, observers, progress, len(targets) * (2 if spec.retract else 1),
+                   spec.maps_at, "F", map_tol=2 * spec.tol_F)
+    U0 = rec.U0
+    state = start if start is not None else State.zero(kernel.grid.shape)
+    up = _LoadBranch(U0, law, kernel, solver, spec, rec.on_row("approach"))
+    eq0 = up.walker.solve(spec.d_min, state)
+    up.set(spec.d_min, eq0)
+    up.emit(spec.d_min, eq0, False, False)  # at rest, out of contact
+    for Ft in targets:
+        if Ft < up.Fc - spec.tol_F and up.D == spec.d_min:
+            continue  # a load pulling harder than the far field: the body stays away
+        if not up.to(Ft, True):
+            raise TengsimError(f"load F={Ft:g} is not reached within d_max={spec.d_max:g}; raise d_max")
+    if spec.retract:
+        down = _LoadBranch(U0, law, kernel, solver, spec, rec.on_row("retraction"))
+        down.set(up.D, up.eq)
+        down.emit(up.D, up.eq, bool(abs(up.Fc - targets[-1]) <= spec.tol_F), False)
+        for Ft in targets[::-1][1:]:
+            if not down.to(Ft, True):
+                break  # pulled off: no state under the lower loads
+    eq_last = (down if spec.retract else up).eq
+    return rec.result(eq_last.state if keep_states else None)

@@ -1,0 +1,142 @@
+"""Load control (issue 15): states against the D-controlled path, jumps, and the JKR pull-off."""
+from __future__ import annotations
+
+from functools import lru_cache
+
+import numpy as np
+import pytest
+
+import tengsim as ts
+from tengsim import references as ref
+from tengsim.kernels import FreeKernel
+from tengsim.loadpath import LoadPathSpec, run_load_path
+from tengsim.path import PathSpec, run_path
+from tengsim.solvers import Problem, State
+from tengsim.units import paper_scaling
+
+TOL = 1e-7
+F_TARGETS = (-0.75, -0.5, 0.0, 0.5, 1.0)
+
+
+@lru_cache(maxsize=None)
+def group_a():
+    sc = paper_scaling("A")
+    shape = ts.Pyramid(sc.N, sc.cell)
+    grid = shape.grid(0.3)
+    kernel = FreeKernel(grid, sc.mu**1.5)
+    U0 = shape.gap(grid)
+    spec = LoadPathSpec(-1.0, 1.0, 0.25, d_max=4.0, d_step=0.1, maps_at=F_TARGETS)
+    load = run_load_path(U0, ts.LJ93(), kernel, ts.FastSolver(TOL), spec)
+    dspec = PathSpec(-1.0, 3.0, 0.1)
+    dctl = run_path(U0, ts.LJ93(), kernel, ts.FastSolver(TOL), PathSpec(-1.0, 3.0, 0.1,
+                                                                          maps_at=tuple(dspec.targets())))
+    return U0, kernel, load, dctl
+
+
+def test_load_states_are_the_d_controlled_states():
+    """Each load-controlled state, solved again under D control at its D from the D-controlled path's
+    nearest state on the same branch, is the same state to the solver tolerance."""
+    U0, kernel, load, dctl = group_a()
+    assert load.all_converged and dctl.all_converged
+    solver = ts.FastSolver(TOL)
+    checked = 0
+    for m in load.maps:
+        D = m["D"]
+        cands = [d for d in dctl.maps if d["branch"] == m["branch"]]
+        near = min(cands, key=lambda d: abs(d["D"] - D))
+        start = State(near["P"].copy(), kernel.apply(near["P"]))  # w = K q exactly
+        eq = solver.solve(Problem(U0 - D + 1.0, ts.LJ93(), kernel), start)
+        # from a start already at the tolerance the line search may stop at round-off: judge the residual
+        assert eq.converged or eq.residual < 10 * TOL
+        assert np.max(np.abs(eq.H - m["H"])) < 1e-5
+        assert ts.force(eq.P, kernel.grid) == pytest.approx(ts.force(m["P"], kernel.grid), abs=1e-6)
+        checked += 1
+    assert checked >= 6  # approach 0, 0.5, 1 and retraction 1 … −0.75 (targets met on both branches)
+    # the loads are met: on-grid rows sit at their targets
+    on = load.table["on_grid"].astype(bool)
+    F = load.table["F"][on]
+    assert np.allclose(F, np.round(F / 0.25) * 0.25, atol=2e-5)
+
+
+def test_load_jumps_and_pull_off():
+    """Group A (μ = 0.5) has no D-controlled jump, but under load it jumps in at the start's load and
+    pulls off at the minimum of F(D): the most tensile D-controlled force, to its sampling error."""
+    U0, kernel, load, dctl = group_a()
+    assert dctl.jumps == []
+    kinds = [(j.branch, j.kind) for j in load.jumps]
+    assert kinds == [("approach", "jump-in"), ("retraction", "jump-out")]
+    jin, jout = load.jumps
+    assert jin.F_after == pytest.approx(jin.F_before, abs=1e-4)   # a load-controlled jump keeps F
+    f_pull = load.pull_off_force
+    assert jout.F_before == pytest.approx(f_pull)
+    # the fold is refined below the D grid: at least as tensile as the sampled D-controlled minimum
+    assert f_pull <= dctl.pull_off_force + 1e-6
+    # the D grid (step 0.1) samples the sharp minimum of F(D) to ~1 % (measured 0.84 %)
+    assert f_pull == pytest.approx(dctl.pull_off_force, rel=1.5e-2)
+    # every load-controlled state on a target is load-stable: F rises with D on the D-controlled curve
+    a = dctl.branch("retraction")
+    D, F = a["D"][::-1], a["F"][::-1]
+    r = load.branch("retraction")
+    for Dl in r["D"][r["on_grid"].astype(bool)]:
+        i = np.searchsorted(D, Dl)
+        assert F[min(i, len(F) - 1)] >= F[max(i - 1, 0)]
+
+
+def test_simulate_dispatches_on_the_load_spec():
+    res = ts.simulate(ts.Pyramid(0.946, 3.78), 0.5, 0.4,
+                      LoadPathSpec(0.0, 0.5, 0.5, d_max=4.0, d_step=0.2, retract=False))
+    on = res.table["on_grid"].astype(bool)
+    assert np.allclose(res.table["F"][on], [0.0, 0.5], atol=1e-4)
+    assert res.params["control"] == "load"
+
+
+def test_load_spec_validation():
+    with pytest.raises(ts.TengsimError, match="f_step"):
+        LoadPathSpec(0, 1, 0)
+    with pytest.raises(ts.TengsimError, match="f_max"):
+        LoadPathSpec(1, 0, 0.1)
+    with pytest.raises(ts.TengsimError, match="d_max"):
+        LoadPathSpec(0, 1, 0.1, d_min=2, d_max=1)
+
+
+@pytest.mark.slow
+def test_sphere_load_pull_off_is_jkr_at_large_mu():
+    """Sphere (Paraboloid R = 1, cell 12, free kernel), μ = 3, dx 0.1: the load-controlled pull-off,
+    F = ∬P/(3π), against JKR's −(3/2)πWR, i.e. F = −1/2 in these units (references.jkr_pulloff with
+    W = R = 1, divided by 3π).
+
+    Tolerance 5 %: at μ = 3 Maugis–Dugdale (λ = 1.157 μ) is +0.85 % above JKR, and the D-controlled
+    minimum of F on this grid is +3.5 % (tests/test_engine_adhesion.py, 1.553π); dx 0.2 is not
+    converged here (the contact edge advances ring by ring on the pixel lattice, F(D) is a saw-tooth
+    of ±0.01), so the grid error is bounded by the dx 0.1 vs MD comparison, not by a finer grid.
+    The load path starts at D = −3, where the zero state already snaps into contact, as in the D test.
+    Measured: −0.51784 (+3.57 % vs JKR; the D-controlled minimum on the same grid is −0.5177, so the two
+    controls agree to 0.03 %); ~5 CPU-minutes (8279 convolutions on 120² points)."""
+    mu = 3.0
+    shape = ts.Paraboloid(1.0, 12.0)
+    grid = shape.grid(0.1)
+    res = run_load_path(shape.gap(grid), ts.LJ93(), FreeKernel(grid, mu**1.5), ts.FastSolver(1e-6),
+                        LoadPathSpec(-0.6, -0.3, 0.05, d_min=-3.0, d_max=4.0, d_step=0.2))
+    jkr = ref.jkr_pulloff(1.0, 1.0, 1.0).force / (3 * np.pi)     # W = R = 1: −1/2
+    assert jkr == pytest.approx(-0.5)
+    assert res.pull_off_force == pytest.approx(jkr, rel=0.05)
+    assert any(j.branch == "retraction" and j.kind == "jump-out" for j in res.jumps)
+
+
+def test_load_path_has_the_status_and_observer_columns_of_a_d_path():
+    """Both paths record rows through one Recorder: status inputs and user observers alike."""
+    class Gap:
+        columns = ("apex_gap",)
+
+        def __call__(self, eq, ctx):
+            return {"apex_gap": float(eq.H[ctx.apex])}
+
+    sc = paper_scaling("A")
+    shape = ts.Pyramid(sc.N, sc.cell)
+    grid = shape.grid(0.4)
+    kernel = FreeKernel(grid, sc.mu**1.5)
+    spec = LoadPathSpec(-0.5, 0.5, 0.5, d_max=3.0, d_step=0.2)
+    res = run_load_path(shape.gap(grid), ts.LJ93(), kernel, ts.FastSolver(1e-6), spec, observers=[Gap()])
+    assert {"apex_gap", "process_zone", "status"} <= set(res.table)
+    assert np.all(np.isfinite(res.table["apex_gap"]))
+    assert res.status in ("ok", "under_resolved")
