@@ -115,6 +115,8 @@ def contact_table(shape: str = "pyramid", mode: str | None = None) -> Table:
         merged = {f.name: dataclasses.replace(f, default=None) if f.required else f for f in dims}
         for f in phys:
             d = merged.get(f.name)
+            if d == f:  # the same field in both: keep it as it is
+                continue
             if d is None:
                 merged[f.name] = dataclasses.replace(f, default=None)
             else:  # same name in both: a plain number, or a quantity in a physical run

@@ -169,6 +169,7 @@ class Topography:
     )
     lateral_unit = "ε"
     positional = "file"  # tengsim contact topography FILE
+    is_pattern = False  # not a cell pattern of tengsim.arrays
 
     def __post_init__(self):
         z = np.asarray(self.heights, dtype=float)
