@@ -123,3 +123,32 @@ def test_array_config_table_dimensionless_and_mixing_refused():
     res = run_contact(dict(shape="array", K=2, d_min=-1, d_max=0, d_step=0.5, dx=0.3, boundary="periodic",
                            observers="array_area", **A))
     assert res.params["K"] == 2 and "area_fraction_repulsive" in res.table
+
+
+def test_toml_array_run(tmp_path):
+    """An array from a TOML [contact] table through `tengsim run` (scatter, waviness, the observer)."""
+    out = tmp_path / "r.csv"
+    (tmp_path / "a.toml").write_text(f'''[contact]
+shape = "array"
+pattern = "pyramid"
+N = 0.946
+cell = 3.78
+K = 2
+scatter_height = 0.05
+distribution = "uniform"
+seed = 4
+waviness_amplitude = 0.1
+waviness_wavelength = 2
+boundary = "periodic"
+dx = 0.3
+d_min = -1
+d_max = 0
+d_step = 0.5
+observers = ["array_area"]
+out = "{out}"
+''')
+    assert main(["run", str(tmp_path / "a.toml"), "--quiet"]) == 0
+    rows = _rows(out)
+    assert len(rows) >= 6 and "cells_in_contact" in rows[0]
+    head = "".join(l for l in open(out) if l.startswith("#"))
+    assert '"uniform"' in head and "waviness_amplitude: 0.1" in head
