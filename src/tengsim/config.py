@@ -115,6 +115,8 @@ def contact_table(shape: str = "pyramid", mode: str | None = None) -> Table:
         merged = {f.name: dataclasses.replace(f, default=None) if f.required else f for f in dims}
         for f in phys:
             d = merged.get(f.name)
+            if d == f:  # the same field in both: keep it as it is
+                continue
             if d is None:
                 merged[f.name] = dataclasses.replace(f, default=None)
             else:  # same name in both: a plain number, or a quantity in a physical run
@@ -225,7 +227,7 @@ def plan_contact(cfg: dict) -> ContactPlan:
         if name == "pyramid" and cls.__name__ == "Pyramid":
             scaling = PaperScaling(E, W, p["base"], p["height"], p["pitch"], eps)
         else:
-            scaling = Scaling(E, W, eps, lateral, (shape.cell * lateral) ** 2)
+            scaling = Scaling(E, W, eps, lateral, getattr(shape, "cell_area", shape.cell**2) * lateral**2)
         tabor = scaling.mu
         if vals["tabor"] is not None and abs(tabor - vals["tabor"]) > 1e-8 * vals["tabor"]:
             raise TengsimError(f"could not solve eps for tabor = {vals['tabor']:g} (got μ = {tabor:g})")
@@ -233,6 +235,9 @@ def plan_contact(cfg: dict) -> ContactPlan:
         extra.update(scaling.params())
         extra["lateral_m"] = lateral
     else:
+        if not dims and phys:
+            raise TengsimError(f"shape {name} has physical input only: give {', '.join(phys_names)} "
+                               "with E_star, W and eps or tabor")
         missing = [f.name for f in dims if f.required and f.name not in given]
         if missing:
             raise TengsimError(f"{name} needs {', '.join(missing)} (dimensionless)"
@@ -241,7 +246,8 @@ def plan_contact(cfg: dict) -> ContactPlan:
         vals = contact_table(name, "dimensionless").parse(cfg)
         tabor = positive("tabor", 0.5 if vals["tabor"] is None else vals["tabor"])
         shape = _build(cls, name, {f.name: vals[f.name] for f in dims if vals[f.name] is not None})
-    dx = _dx(cfg.get("dx", 0.1) if cfg.get("dx") not in (None, "") else 0.1, lateral)
+    raw_dx = cfg.get("dx")  # not given: the shape's own pixel (a height map's) or 0.1
+    dx = _dx(raw_dx, lateral) if raw_dx not in (None, "") else getattr(shape, "native_dx", 0.1)
     path = PathSpec(vals["d_min"], vals["d_max"], vals["d_step"], maps_at=tuple(vals["maps_at"]),
                     refine_levels=vals["refine_levels"])
     tol = positive("tol", vals["tol"])

@@ -462,3 +462,7 @@ SHAPES.register("cube", Cube, summary="square flat-topped pillar")
 SHAPES.register("line", Line, summary="flat-topped ridge along Y")
 SHAPES.register("flat_punch", FlatPunch, summary="circular flat punch")
 SHAPES.register("sinusoid", Sinusoid1D, summary="1-D sinusoid (periodic kernel)")
+
+# shapes defined in their own modules register themselves on import
+from tengsim import topography as _topography  # noqa: E402,F401  ('topography')
+from tengsim import arrays as _arrays  # noqa: E402,F401  ('array')

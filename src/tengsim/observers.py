@@ -89,3 +89,39 @@ def observe(o, eq, ctx) -> dict:
     if not isinstance(vals, dict) or set(vals) != set(o.columns):
         raise TengsimError(f"observer {type(o).__name__} must return a dict with keys {tuple(o.columns)}")
     return {k: float(v) for k, v in vals.items()}
+
+
+@OBSERVERS.register("array_area")
+class ArrayArea:
+    """Charged area over a K × K array (``tengsim.arrays``; a plain grid is one cell).
+
+    ``area_fraction_greenwood`` = Σ_cells Λc,k² / (K L̄)²: the paper's A/S of Eq. (12), λc²/L², summed
+    over the cells, with Λc,k the Greenwood contact length of cell k (twice the distance from the
+    cell's highest point to the tensile pressure peak along X, as the built-in ``contact_length``).
+    ``area_fraction_repulsive`` = (area with P > 0)/(K L̄)²; ``cells_in_contact`` counts the cells
+    with Λc,k > 0.
+    """
+
+    columns = ("area_fraction_greenwood", "area_fraction_repulsive", "cells_in_contact")
+    units = {"area_fraction_greenwood": "1 (A/S, Eq. 12)", "area_fraction_repulsive": "1 (A/S)",
+             "cells_in_contact": "cells"}
+
+    def __call__(self, eq, ctx: Context) -> dict:
+        from tengsim.analysis import apex_index, contact_length
+        from tengsim.grid import Grid
+
+        g = ctx.grid
+        K = int(getattr(g, "cells", 1))
+        nx, ny = g.nx // K, g.ny // K
+        cg = Grid(nx, ny, g.dx, g.dy)
+        total, n_in = 0.0, 0
+        for i in range(K):
+            for j in range(K):
+                sl = (slice(i * nx, (i + 1) * nx), slice(j * ny, (j + 1) * ny))
+                lam = contact_length(eq.P[sl], cg, apex_index(ctx.U0[sl]))
+                total += lam * lam
+                n_in += lam > 0
+        A = g.lx * g.ly
+        return {"area_fraction_greenwood": min(total / A, 1.0),
+                "area_fraction_repulsive": float(np.count_nonzero(eq.P > 0)) * g.area / A,
+                "cells_in_contact": n_in}

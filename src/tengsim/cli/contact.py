@@ -33,6 +33,7 @@ def _option_help():
 
 
 def register(sub):
+    from tengsim.config import contact_table
     from tengsim.registry import SHAPES
 
     p = sub.add_parser(
@@ -44,7 +45,10 @@ def register(sub):
         "--E-star 0.59MPa --W 54mJ/m2 --tabor 0.5, or --eps instead of --tabor). Shapes: " + SHAPES.help(),
     )
     p.add_argument("shape", choices=SHAPES.names(), help="registered shape")
+    p.add_argument("positional", nargs="?", metavar="INPUT",
+                   help="the shape's positional input, for shapes that declare one (topography: FILE)")
     common, per_key = _option_help()
+    bools = {f.name for s in SHAPES.names() for f in contact_table(s).fields.values() if f.kind == "bool"}
     for k, f in common.items():
         if k == "shape" or k in _CLI_ONLY:
             continue
@@ -53,7 +57,8 @@ def register(sub):
     for k, h in per_key.items():
         if k in _CLI_ONLY:
             continue
-        p.add_argument("--" + k.replace("_", "-"), dest=k, help=h.replace("%", "%%"))
+        flag = {"nargs": "?", "const": "true"} if k in bools else {}  # '--fill-missing' alone means true
+        p.add_argument("--" + k.replace("_", "-"), dest=k, help=h.replace("%", "%%"), **flag)
     p.add_argument("--out", required=True, help="output file: .csv (curves) or .nc (everything)")
     p.add_argument("--plot", help="also draw F(D), Λc(D), Λc(F) to this .png/.pdf")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
@@ -66,6 +71,15 @@ def run(args) -> int:
 
     keys = [k for k in contact_keys() if k not in _CLI_ONLY]
     cfg = {k: getattr(args, k) for k in keys if getattr(args, k, None) not in (None, "")}
+    if getattr(args, "positional", None) is not None:
+        from tengsim.registry import SHAPES
+
+        key = getattr(SHAPES.get(args.shape), "positional", None)
+        if key is None:
+            raise TengsimError(f"shape {args.shape} takes no positional input (got {args.positional!r})")
+        if cfg.get(key) not in (None, args.positional):
+            raise TengsimError(f"{key} given twice: {args.positional!r} and --{key.replace('_', '-')} {cfg[key]!r}")
+        cfg[key] = args.positional
     plan_contact(cfg)  # every option checked before anything is written
     out = Path(args.out)
     if out.suffix.lower() not in (".csv", ".nc"):
