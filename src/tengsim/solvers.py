@@ -105,7 +105,6 @@ class FastSolver:
     name: str = "fast"
     monitor: object = None
     monitor_every: int = 100
-    _spare: Spare = field(default_factory=Spare, init=False, repr=False, compare=False)
 
     def __post_init__(self):
         if not self.tol > 0:
@@ -114,6 +113,8 @@ class FastSolver:
             raise TengsimError(f"memory must be >= 1, got {self.memory!r}")
         if int(self.monitor_every) < 1:
             raise TengsimError(f"monitor_every must be >= 1, got {self.monitor_every!r}")
+        # the spare workspace is no field: not in fields(), repr, ==, hash or replace()
+        object.__setattr__(self, "_spare", Spare())
 
     def __getstate__(self):  # copies and pickles start without a spare workspace
         return {k: v for k, v in self.__dict__.items() if k != "_spare"}
