@@ -302,3 +302,142 @@ def test_fast_solver_holds_the_periodic_gauge():
     # q − P is constant at equilibrium (K kills only the mean): r = K(q − P) with max|r| <= 1e-9 and
     # K's smallest non-zero multiplier 2κ/|k|max ≈ 0.04 on this grid bound each mode by ~2.5e-8
     assert np.ptp(dev) < 1e-6
+
+
+# ---- issue 13: the fast solver in named pieces (workspace, line search), its cost, the FFT seam ----
+
+def test_fast_solver_convolution_count_is_as_documented():
+    """FastSolver's docstring: one solve of k iterations spends 1 + k + ⌊k / resync⌋ convolutions;
+    counted here by wrapping the kernel's ``apply`` (free and periodic kernels, several resync)."""
+    grid, U0, K = _group_a(dx=0.2)
+    probs = [Problem(U0 - D + 1.0, LJ93(), K) for D in (0.5, 2.0)] + [_rough_periodic(64)]
+    for prob in probs:
+        for resync in (25, 7):
+            calls = []
+
+            class Counting:
+                grid, periodic = prob.kernel.grid, getattr(prob.kernel, "periodic", False)
+
+                def apply(self, p, out=None):
+                    calls.append(1)
+                    return prob.kernel.apply(p, out=out)
+
+            eq = FastSolver(1e-8, resync=resync).solve(Problem(prob.g0, prob.law, Counting()),
+                                                     State.zero(prob.g0.shape))
+            assert eq.converged, eq.message
+            k = eq.iterations
+            assert len(calls) == eq.n_conv == 1 + k + k // resync, (len(calls), eq.n_conv, k, resync)
+
+
+def test_fast_solver_workspace_is_reused_and_never_aliased():
+    """A solver keeps one workspace for its next solve on the same grid: the second solve gives
+    exactly what a fresh solver gives, and the first result is not overwritten by it.  Copies,
+    pickles and ``replace`` start without one; equality ignores it."""
+    import copy
+    import dataclasses
+    import pickle
+
+    grid, U0, K = _group_a(dx=0.2)
+    a_prob, b_prob = (Problem(U0 - D + 1.0, LJ93(), K) for D in (1.0, 2.0))
+    solver = FastSolver(1e-8)
+    a = solver.solve(a_prob, State.zero(grid.shape))
+    assert len(solver._spare) == 1
+    kept = (a.H.copy(), a.P.copy(), a.state.q.copy(), a.state.w.copy())
+    b = solver.solve(b_prob, State.zero(grid.shape))
+    b_fresh = FastSolver(1e-8).solve(b_prob, State.zero(grid.shape))
+    assert b.iterations == b_fresh.iterations and np.array_equal(b.H, b_fresh.H)
+    assert b.energy == b_fresh.energy
+    for x, y in zip(kept, (a.H, a.P, a.state.q, a.state.w)):
+        assert np.array_equal(x, y)
+    for other in (copy.copy(solver), copy.deepcopy(solver), pickle.loads(pickle.dumps(solver)),
+                  dataclasses.replace(solver, tol=1e-7)):
+        assert len(other._spare) == 0
+    assert pickle.loads(pickle.dumps(solver)) == solver and hash(copy.copy(solver)) == hash(solver)
+
+
+def test_fast_solver_gives_back_large_workspaces(monkeypatch):
+    """Grids above KEEP_MAX_SIZE points do not keep their workspace (memory goes back with the solve)."""
+    import tengsim._workspace as W
+
+    grid, U0, K = _group_a(dx=0.2)
+    monkeypatch.setattr(W, "KEEP_MAX_SIZE", grid.nx * grid.ny - 1)
+    solver = FastSolver(1e-6)
+    assert solver.solve(Problem(U0 + 1.0, LJ93(), K), State.zero(grid.shape)).converged
+    assert len(solver._spare) == 0
+
+
+def test_fast_solver_shared_between_threads():
+    """One solver used by several threads at once: each solve gets its own workspace (same answers)."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    grid, U0, K = _group_a(dx=0.2)
+    probs = [Problem(U0 - D + 1.0, LJ93(), K) for D in (0.0, 0.5, 1.0, 1.5, 2.0, 2.5)]
+    solver = FastSolver(1e-8)
+    ref = [FastSolver(1e-8).solve(p, State.zero(grid.shape)) for p in probs]
+    with ThreadPoolExecutor(3) as ex:
+        got = list(ex.map(lambda p: solver.solve(p, State.zero(grid.shape)), probs * 2))
+    for r, g in zip(ref * 2, got):
+        assert g.iterations == r.iterations and np.array_equal(g.H, r.H)
+
+
+def test_line_search_accepts_a_wolfe_point_and_leaves_it_in_its_buffers():
+    """The line search object on a solver's first direction: the accepted α satisfies the (strong or
+    approximate) Wolfe conditions of its docstring, E(α) equals the energy recomputed from scratch
+    at q + α d, and the trial buffers hold g + α K d and P(g + α K d)."""
+    from tengsim._workspace import Workspace
+    from tengsim.solvers import _Descent
+
+    grid, U0, K = _group_a(dx=0.2)
+    law = LJ93()
+    start = FastSolver(1e-8).solve(Problem(U0 - 1.0 + 1.0, law, K), State.zero(grid.shape)).state
+    prob = Problem(U0 - 1.3 + 1.0, law, K)  # the next D: a real warm step
+    run = _Descent(prob, start, Workspace(grid.nx * grid.ny, 10, grid.area))
+    ray = run.direction()
+    ls = run.search
+    assert ray.slope < 0
+    trial = ls.search(ls.first_step(ray.Kd), ray, run.lowest_energy())
+    assert trial is not None and trial.alpha > 0
+    g_new = ray.g + trial.alpha * ray.Kd
+    assert np.allclose(ls.g_trial, g_new, rtol=0, atol=1e-14)
+    assert np.allclose(ls.P_trial, law.pressure(g_new), rtol=1e-12, atol=1e-14)
+    q_new = run.q + trial.alpha * run.d
+    w_new = K.apply(q_new.reshape(grid.shape)).ravel()
+    E_scratch = grid.area * (0.5 * np.vdot(q_new, w_new) + law.energy(g_new).sum())
+    assert trial.E == pytest.approx(E_scratch, rel=1e-10)
+    _, de, _, _ = ls.evaluate(trial.alpha, ray)
+    strong = trial.E <= ray.E0 + ls.c1 * trial.alpha * ray.slope and abs(de) <= -ls.c2 * ray.slope
+    approx = trial.E <= ray.E0 + 1e-11 * abs(ray.E0) and ls.c2 * ray.slope <= de <= -0.8 * ray.slope
+    assert strong or approx
+    assert trial.E < ray.E0
+
+
+@pytest.mark.parametrize("how", ["no binding", "binding disagrees"])
+def test_fft_fallback_is_announced_once_and_recorded(monkeypatch, how):
+    """Without scipy's pocketfft binding (or when it disagrees with scipy.fft) the kernels use the
+    public scipy.fft path: one FFTBackendWarning per process, ``_fft.BACKEND`` says "scipy.fft",
+    and the convolution gives the direct path's numbers to round-off."""
+    import warnings
+
+    from tengsim import _fft
+    from tengsim.grid import Grid
+    from tengsim.kernels import PeriodicKernel
+
+    grid = Grid(24, 20, 0.3, 0.25)
+    p = np.random.default_rng(1).standard_normal(grid.shape)
+    ref = FreeKernel(grid, 0.8).apply(p), PeriodicKernel(grid, 0.8).apply(p)
+    assert _fft.BACKEND == ("pocketfft" if _fft._pp is not None else "scipy.fft")
+    monkeypatch.setattr(_fft, "BACKEND", _fft.BACKEND)
+    monkeypatch.setattr(_fft, "_warned", False)
+    if how == "no binding":
+        monkeypatch.setattr(_fft, "_pp", None)
+    else:
+        monkeypatch.setattr(_fft, "_checked", lambda conv, shape: False)
+    with pytest.warns(_fft.FFTBackendWarning, match="scipy.fft"):
+        Kf = FreeKernel(grid, 0.8)
+    assert _fft.BACKEND == "scipy.fft" and Kf._conv.backend == "scipy.fft"
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # the second fall-back says nothing
+        Kp = PeriodicKernel(grid, 0.8)
+    assert Kp._conv.backend == "scipy.fft"
+    for K, w in zip((Kf, Kp), ref):
+        assert np.allclose(K.apply(p), w, rtol=0, atol=1e-13 * np.abs(w).max())

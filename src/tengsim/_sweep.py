@@ -46,10 +46,11 @@ def _pool(workers: int) -> ThreadPoolExecutor:
 
 
 class Sweeper:
-    """Runs ``fn(sl, m, scratch, acc)`` over the blocks of range(n).
+    """Runs ``fn(sl, m, scratch, acc, *args)`` over the blocks of range(n).
 
     ``scratch`` is the group's dict of per-name scratch arrays (``Sweeper.buf``), ``acc`` the
-    group's accumulator list; :meth:`run` returns the list of accumulators, one per group.
+    group's accumulator list, ``args`` the extra arguments given to :meth:`run`; :meth:`run` returns
+    the list of accumulators, one per group.
     """
 
     def __init__(self, n: int, threads: int | None = None, block: int | None = None):
@@ -72,17 +73,17 @@ class Sweeper:
             a = scratch[name] = np.empty(self.block_len)
         return a[:m]
 
-    def run(self, fn, init):
+    def run(self, fn, init, *args):
         if self._single is not None:  # small grids: no loop, no threads
             acc = list(init)
-            fn(self._single[0], self.n, self._scratch[0], acc)
+            fn(self._single[0], self.n, self._scratch[0], acc, *args)
             return [acc]
 
         def group(i):
             acc = list(init)
             sc = self._scratch[i]
             for sl, m in self.groups[i]:
-                fn(sl, m, sc, acc)
+                fn(sl, m, sc, acc, *args)
             return acc
 
         if len(self.groups) == 1:
@@ -92,9 +93,9 @@ class Sweeper:
         first = group(0)
         return [first] + [f.result() for f in futs]
 
-    def sum(self, fn, init):
+    def sum(self, fn, init, *args):
         """:meth:`run`, accumulators summed element-wise."""
-        accs = self.run(fn, init)
+        accs = self.run(fn, init, *args)
         if len(accs) == 1:
             return accs[0]
         return [sum(a[j] for a in accs) for j in range(len(init))]

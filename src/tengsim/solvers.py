@@ -14,6 +14,7 @@ Both solvers descend E, so from a warm start they settle in a local minimum: a s
 """
 from __future__ import annotations
 
+import functools
 import inspect
 import math
 import time
@@ -21,8 +22,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from tengsim._lbfgs import KMetricLBFGS
-from tengsim._sweep import Sweeper
+from tengsim._linesearch import Ray, Trial, WolfeLineSearch
+from tengsim._workspace import Spare
 from tengsim.errors import TengsimError
 from tengsim.registry import SOLVERS
 
@@ -85,12 +86,17 @@ def _finish(problem, state, P, r, energy, converged, it, n_conv, t0, msg):
 class FastSolver:
     """L-BFGS on E(q) in the metric of the elastic kernel (K-preconditioned), Wolfe line search.
 
-    Each iteration spends one convolution, K P(g) at the new state (plus one every ``resync``
-    iterations to re-anchor w = K q): the direction's image K d is assembled from stored images
-    (K s = Δw, K y = Δr, K G = r) by the compact L-BFGS form (tengsim._lbfgs), and the line search
-    along d needs only element-wise work, since g(α) = g + α K d.  Converged when max|r| <= ``tol``.
+    Cost in convolutions (FFT pairs, the unit of ``Equilibrium.n_conv``): one to start (K P at the
+    start state), one per iteration (K P(g) at the new state), and one more every ``resync``
+    iterations to re-anchor w = K q; one solve of k iterations spends 1 + k + ⌊k / resync⌋.  Nothing
+    else convolves: the direction's image K d is assembled from stored images (K s = Δw, K y = Δr,
+    K G = r) by the compact L-BFGS form (tengsim._lbfgs), and the line search along d needs only
+    element-wise work, since g(α) = g + α K d (tengsim._linesearch).  Converged when max|r| <= ``tol``.
     ``monitor(iteration, max|r|, energy)``, if given, is called every ``monitor_every`` iterations
     (progress on long solves).
+
+    The arrays of an iteration live in a workspace (tengsim._workspace), allocated once per grid and,
+    on grids up to 512² points, kept by the solver for its next solve (a path's equilibria share one).
     """
 
     tol: float = 1e-6
@@ -108,194 +114,275 @@ class FastSolver:
             raise TengsimError(f"memory must be >= 1, got {self.memory!r}")
         if int(self.monitor_every) < 1:
             raise TengsimError(f"monitor_every must be >= 1, got {self.monitor_every!r}")
+        # the spare workspace is no field: not in fields(), repr, ==, hash or replace()
+        object.__setattr__(self, "_spare", Spare())
+
+    def __getstate__(self):  # copies and pickles start without a spare workspace
+        return {k: v for k, v in self.__dict__.items() if k != "_spare"}
+
+    def __setstate__(self, state):
+        self.__dict__.update(state, _spare=Spare())
 
     def solve(self, problem: Problem, start: State) -> Equilibrium:
         t0 = time.perf_counter()
-        K, law, dA = problem.kernel, problem.law, problem.dA
-        shape = problem.g0.shape
-        g0 = np.ascontiguousarray(problem.g0, dtype=float).ravel()
-        n = g0.size
-        q = np.array(start.q, dtype=float).ravel()
-        w = np.array(start.w, dtype=float).ravel()
-        # every per-iteration array is preallocated, and the element-wise work runs in fused,
-        # cache-blocked (on large grids threaded) sweeps: the loop is memory-bound, not FFT-bound
-        g, gt, P, Pt, d, Kd, r, rn, G, Gn, y, ky = (np.empty(n) for _ in range(12))
-        sw = Sweeper(n)
-        buf = sw.buf
-        mem = KMetricLBFGS(self.memory, n, dA)
-        B, KB = mem.B, mem.KB
+        ws = self._spare.take(np.size(problem.g0), self.memory, problem.dA)
+        try:
+            return self._descend(_Descent(problem, start, ws), t0)
+        finally:
+            self._spare.give(ws)
 
-        cP = np.empty(n)
-        takes_out = _takes_out(K.apply)
-
-        def conv(x, out=cP):
-            if takes_out:
-                K.apply(x.reshape(shape), out=out.reshape(shape))
-            else:  # a kernel of the caller's own without ``out=``
-                out[:] = K.apply(x.reshape(shape)).ravel()
-            return out
-
-        # A periodic kernel has K(0) = 0: the mean of q is a gauge (E and w do not see it), and the
-        # K metric cannot control it.  Left alone, a near-flat line search (near round-off) can push a
-        # huge mean into q, which then spoils q·w and G in floating point and throws the iterate
-        # away from the minimum it had reached.  So the mean of q is held fixed and G = q − P is used
-        # without its mean (the K-metric gradient is the same); ΣP comes with the law's sweeps and
-        # Σd with the direction's, so this costs no extra pass.
-        proj = bool(getattr(K, "periodic", False))
-
-        def law_sweep(gg, PP):
-            """ΣΦ(gg) and ΣP (periodic kernels only, else 0), with P(gg) written into PP."""
-            def fn(sl, m, sc, acc):
-                acc[0] += law.energy_pressure(gg[sl], PP[sl], (buf(sc, "a", m), buf(sc, "b", m)))
-                if proj:
-                    acc[1] += float(PP[sl].sum())
-            return sw.sum(fn, [0.0, 0.0])
-
-        np.add(g0, w, out=g)
-        phis, sum_p = law_sweep(g, P)
-        np.subtract(w, conv(P), out=r)
-        n_conv = 1
-        mean_q = float(q.mean())
-        np.subtract(q, P, out=G)
-        if proj:
-            G -= mean_q - sum_p / n
-        qw = float(np.vdot(q, w))
-        E = dA * (0.5 * qw + phis)
-        rmax = max(float(r.max()), -float(r.min()))
-        E_best = E
-
-        def done(ok, it, msg):
-            st = State(q.reshape(shape), w.reshape(shape))
-            return _finish(problem, st, P.reshape(shape).copy(), r, E, ok, it, n_conv, t0, msg)
-
-        def direction(gamma, c):
-            """d = −H G, K d = −K H G, and the products d·w, d·K d, d·r (and Σd), in one sweep.
-
-            The slope E'(0) = ΔA (d·w − P·K d) is taken as ΔA d·r (equal, since r = w − K P and K is
-            symmetric): near convergence d·w and P·K d nearly cancel, and their difference is noise."""
-            k2 = 0 if c is None else c.size
-
-            def fn(sl, m, sc, acc):
-                ds, kds = d[sl], Kd[sl]
-                np.multiply(G[sl], -gamma, out=ds)
-                np.multiply(r[sl], -gamma, out=kds)
-                if k2:
-                    h = buf(sc, "h", m)
-                    np.matmul(c, B[:k2, sl], out=h)
-                    ds -= h
-                    np.matmul(c, KB[:k2, sl], out=h)
-                    kds -= h
-                acc[0] += float(np.vdot(ds, w[sl]))
-                acc[1] += float(np.vdot(ds, kds))
-                acc[2] += float(np.vdot(ds, r[sl]))
-                if proj:
-                    acc[3] += float(ds.sum())
-            return sw.sum(fn, [0.0, 0.0, 0.0, 0.0])
-
+    def _descend(self, run: "_Descent", t0: float) -> Equilibrium:
+        search = run.search
         for it in range(self.max_iter + 1):
-            if not math.isfinite(rmax):
-                return done(False, it, "non-finite residual")
-            if rmax <= self.tol:
-                return done(True, it, "converged")
+            if not math.isfinite(run.rmax):
+                return run.finish(False, it, "non-finite residual", t0)
+            if run.rmax <= self.tol:
+                return run.finish(True, it, "converged", t0)
             if it == self.max_iter:
                 break
             if self.monitor is not None and it % self.monitor_every == 0:
-                self.monitor(it, rmax, E)
-            a0, a1, dr, sum_d = direction(*mem.coefficients())
-            if not dr < 0:  # not a descent direction: restart from the preconditioned gradient
-                mem.reset()
-                a0, a1, dr, sum_d = direction(*mem.coefficients())
-            slope = dA * dr
-            # E may rise by round-off in an accepted step (approximate Wolfe); measured from the
-            # lowest E so far, such rises cannot add up over many steps near convergence
-            E_best = min(E_best, E)
-            alpha, E_new, phis_t, sum_pt = _wolfe(law, g, P, Kd, gt, Pt, sw, qw, a0, a1, E, slope, dA,
-                                                  first=mem.empty, sum_p=proj, E_ref=E_best)
-            if alpha is None:
-                return done(False, it, "line search failed")
-            resynced = (it + 1) % self.resync == 0
-            if resynced:
-                # the images K d are assembled, not convolved: round-off lets w drift from K q;
-                # re-anchor w = K q (one extra convolution) so the metric stays exact
-                _axpy(d, q, alpha, gt)
-                w_exact = conv(q)
-                n_conv += 1
-                # the correction (w = K q exactly, minus the assembled step α K d) goes to w and r
-                # only: the stored pair keeps the assembled images K s = α K d, K y = K s − Δ(K P),
-                # as every other pair does, so the drift is not fed back into later directions
-                corr = np.subtract(w_exact, w, out=gt)
-                _axpy(Kd, corr, -alpha, Pt)
-                w[:] = w_exact
-                np.add(g0, w, out=g)
-                phis, sum_p = law_sweep(g, P)
-                qw = float(np.vdot(q, w))
-                E_best = math.inf  # E is recomputed exactly: the bookkeeping restarts from it
-            else:
-                g, gt = gt, g
-                P, Pt = Pt, P
-                phis, sum_p = phis_t, sum_pt
-                qw += alpha * (2.0 * a0 + alpha * a1)
-            E = dA * (0.5 * qw + phis)
-            mean_q += alpha * sum_d / n
-            mu = mean_q - sum_p / n if proj else 0.0
-            conv(P)
-            n_conv += 1
-            k2 = 2 * len(mem.order)
-            step = not resynced
+                self.monitor(it, run.rmax, run.E)
+            ray = run.direction()
+            alpha0 = search.first_step(ray.Kd) if run.mem.empty else 1.0
+            trial = search.search(alpha0, ray, run.lowest_energy())
+            if trial is None:
+                return run.finish(False, it, "line search failed", t0)
+            resync = (it + 1) % self.resync == 0
+            run.accept(trial, ray, resync)                     # E at the new point (re-anchor w = K q)
+            pair = run.new_residual(trial.alpha, resync)       # one convolution: r, G, y, K y
+            run.remember(trial.alpha, ray, pair, resync)       # the L-BFGS memory
+        return run.finish(False, self.max_iter, f"not converged in {self.max_iter} iterations", t0)
 
-            def fn(sl, m, sc, acc):
-                # q ← q + α d, w ← w + α K d; r_new = w − K P; K y = Δr; G_new = q − P; y = ΔG
-                ds = d[sl]
-                if step:
-                    tmp = buf(sc, "t", m)
-                    qs, ws = q[sl], w[sl]
-                    np.multiply(ds, alpha, out=tmp)
-                    qs += tmp
-                    np.multiply(Kd[sl], alpha, out=tmp)
-                    ws += tmp
-                rns, kys, Gns, ys = rn[sl], ky[sl], Gn[sl], y[sl]
-                np.subtract(w[sl], cP[sl], out=rns)
-                np.subtract(rns, r[sl], out=kys)
-                if resynced:
-                    kys -= corr[sl]
-                np.subtract(q[sl], P[sl], out=Gns)
-                if proj:
-                    Gns -= mu
-                np.subtract(Gns, G[sl], out=ys)
-                acc[0] += float(np.vdot(ds, kys))
-                acc[1] += float(np.vdot(ys, kys))
-                acc[2] += float(np.vdot(ds, rns))
-                acc[3] += float(np.vdot(ys, rns))
-                acc[4] = max(acc[4], float(rns.max()), -float(rns.min()))
-                if k2:
-                    acc[5] = acc[5] + B[:k2, sl] @ kys
-            accs = sw.run(fn, [0.0, 0.0, 0.0, 0.0, 0.0, 0.0])
-            if len(accs) == 1:
-                dky, yky, drn, yrn, rmax, x = accs[0]
-            else:
-                dky, yky, drn, yrn, _, x = (sum(a[j] for a in accs) for j in range(6))
-                rmax = max(a[4] for a in accs)
-            sy = dA * alpha * dky
-            yy = dA * yky
-            sks = dA * alpha * alpha * abs(a1)
-            store = sy > 1e-14 * max(sks, 1e-300) and yy > 0
-            slot = mem.update(alpha, dA * x if k2 else None, sy, yy, dA * drn, dA * yrn, store)
-            if slot is not None:
-                def put(sl, m, sc, acc):
-                    np.multiply(d[sl], alpha, out=B[2 * slot, sl])
-                    B[2 * slot + 1, sl] = y[sl]
-                    np.multiply(Kd[sl], alpha, out=KB[2 * slot, sl])
-                    KB[2 * slot + 1, sl] = ky[sl]
-                sw.run(put, ())
-            r, rn = rn, r
-            G, Gn = Gn, G
-            if resynced:
-                mem.refresh(r)
-        return done(False, self.max_iter, f"not converged in {self.max_iter} iterations")
+
+class _Descent:
+    """One FastSolver solve: the iterate and what is carried with it, and its steps.
+
+    Carried: q and w = K q (the solve's own arrays, returned in the State); g = g0 + w, P = P(g),
+    the residual r = w − K P, the K-metric gradient G = q − P, its next values rn, Gn, and the
+    scalars E, q·w, ΣΦ, ΣP, the mean of q, max|r| and the lowest E so far.  All other arrays are
+    the workspace's.
+
+    A periodic kernel has K(0) = 0: the mean of q is a gauge (E and w do not see it), and the K
+    metric cannot control it.  Left alone, a near-flat line search (near round-off) can push a huge
+    mean into q, which then spoils q·w and G in floating point and throws the iterate away from the
+    minimum it had reached.  So the mean of q is held fixed and G = q − P is used without its mean
+    (the K-metric gradient is the same); ΣP comes with the law's sweeps and Σd with the direction's,
+    so this costs no extra pass.
+    """
+
+    def __init__(self, problem: Problem, start: State, ws):
+        K = problem.kernel
+        self.problem, self.law, self.dA = problem, problem.law, problem.dA
+        self.shape = problem.g0.shape
+        self.g0 = np.ascontiguousarray(problem.g0, dtype=float).ravel()
+        self.n = self.g0.size
+        self.q = np.array(start.q, dtype=float).ravel()
+        self.w = np.array(start.w, dtype=float).ravel()
+        self.sw, self.mem, self.cP = ws.sweeper, ws.memory, ws.cP
+        self.g, self.P, self.d, self.Kd = ws.g, ws.P, ws.d, ws.Kd
+        self.r, self.rn, self.G, self.Gn, self.y, self.ky = ws.r, ws.rn, ws.G, ws.Gn, ws.y, ws.ky
+        self.proj = bool(getattr(K, "periodic", False))
+        self.search = WolfeLineSearch(problem.law, ws.sweeper, self.dA, ws.gt, ws.Pt, sum_p=self.proj)
+        self._apply, self._takes_out = K.apply, _takes_out(K.apply)
+        # the start: g, P, ΣΦ, r (one convolution), G, E
+        np.add(self.g0, self.w, out=self.g)
+        self.phis, self.sum_p = self.law_sweep()
+        np.subtract(self.w, self.convolve(self.P), out=self.r)
+        self.n_conv = 1
+        self.mean_q = float(self.q.mean())
+        np.subtract(self.q, self.P, out=self.G)
+        if self.proj:
+            self.G -= self.mean_q - self.sum_p / self.n
+        self.qw = float(np.vdot(self.q, self.w))
+        self.E = self.dA * (0.5 * self.qw + self.phis)
+        self.rmax = max(float(self.r.max()), -float(self.r.min()))
+        self.E_best = self.E
+        self.sum_d = 0.0
+        self.corr = None
+
+    # ---- the pieces ---------------------------------------------------------------------------
+    def convolve(self, x):
+        """K x into the workspace's output array (one convolution; not counted here)."""
+        out, shape = self.cP, self.shape
+        if self._takes_out:
+            self._apply(x.reshape(shape), out=out.reshape(shape))
+        else:  # a kernel of the caller's own without ``out=``
+            out[:] = self._apply(x.reshape(shape)).ravel()
+        return out
+
+    def _law_block(self, sl, m, sc, acc):
+        buf = self.sw.buf
+        acc[0] += self.law.energy_pressure(self.g[sl], self.P[sl], (buf(sc, "a", m), buf(sc, "b", m)))
+        if self.proj:
+            acc[1] += float(self.P[sl].sum())
+
+    def law_sweep(self):
+        """ΣΦ(g) and ΣP (periodic kernels only, else 0), with P(g) written into P."""
+        return self.sw.sum(self._law_block, [0.0, 0.0])
+
+    def lowest_energy(self) -> float:
+        """The lowest E so far: E may rise by round-off in an accepted step (approximate Wolfe);
+        measured from it, such rises cannot add up over many steps near convergence."""
+        self.E_best = min(self.E_best, self.E)
+        return self.E_best
+
+    # ---- the direction --------------------------------------------------------------------------
+    def _direction_block(self, sl, m, sc, acc, gamma, c, k2):
+        ds, kds = self.d[sl], self.Kd[sl]
+        np.multiply(self.G[sl], -gamma, out=ds)
+        np.multiply(self.r[sl], -gamma, out=kds)
+        if k2:
+            h = self.sw.buf(sc, "h", m)
+            np.matmul(c, self.mem.B[:k2, sl], out=h)
+            ds -= h
+            np.matmul(c, self.mem.KB[:k2, sl], out=h)
+            kds -= h
+        acc[0] += float(np.vdot(ds, self.w[sl]))
+        acc[1] += float(np.vdot(ds, kds))
+        acc[2] += float(np.vdot(ds, self.r[sl]))
+        if self.proj:
+            acc[3] += float(ds.sum())
+
+    def _direction(self):
+        gamma, c = self.mem.coefficients()
+        k2 = 0 if c is None else c.size
+        return self.sw.sum(self._direction_block, [0.0, 0.0, 0.0, 0.0], gamma, c, k2)
+
+    def direction(self) -> Ray:
+        """d = −H G and K d = −K H G (one sweep), and E along d.
+
+        The slope E'(0) = ΔA (d·w − P·K d) is taken as ΔA d·r (equal, since r = w − K P and K is
+        symmetric): near convergence d·w and P·K d nearly cancel, and their difference is noise.
+        Not a descent direction (d·r >= 0): the memory is dropped, d = −G."""
+        dw, dKd, dr, sum_d = self._direction()
+        if not dr < 0:
+            self.mem.reset()
+            dw, dKd, dr, sum_d = self._direction()
+        self.sum_d = sum_d
+        return Ray(self.g, self.P, self.Kd, self.qw, dw, dKd, self.E, self.dA * dr)
+
+    # ---- the step -------------------------------------------------------------------------------
+    def accept(self, trial: Trial, ray: Ray, resync: bool) -> None:
+        """Move E, q·w, ΣΦ, ΣP, mean(q) to the accepted point (q and w themselves move in
+        :meth:`new_residual`); on a ``resync`` step q moves here and w is re-anchored (:meth:`_reanchor`)."""
+        alpha = trial.alpha
+        if resync:
+            self.corr = self._reanchor(alpha)
+            self.E_best = math.inf  # E is recomputed exactly: the bookkeeping restarts from it
+        else:
+            self.g, self.P = self.search.swap(self.g, self.P)
+            self.phis, self.sum_p = trial.phis, trial.sum_p
+            self.qw += alpha * (2.0 * ray.dw + alpha * ray.dKd)
+            self.corr = None
+        self.E = self.dA * (0.5 * self.qw + self.phis)
+        self.mean_q += alpha * self.sum_d / self.n
+
+    def _reanchor(self, alpha):
+        """q ← q + α d and w = K q exactly (one convolution), then g, P, ΣΦ, q·w anew.
+
+        The images K d are assembled, not convolved: round-off lets w drift from K q.  The
+        correction (w = K q exactly, minus the assembled step α K d) goes to w and r only: the
+        stored pair keeps the assembled images K s = α K d, K y = K s − Δ(K P), as every other
+        pair does, so the drift is not fed back into later directions.  Returns the correction."""
+        q, w, gt, Pt = self.q, self.w, self.search.g_trial, self.search.P_trial
+        _axpy(self.d, q, alpha, gt)
+        w_exact = self.convolve(q)
+        self.n_conv += 1
+        corr = np.subtract(w_exact, w, out=gt)
+        _axpy(self.Kd, corr, -alpha, Pt)
+        w[:] = w_exact
+        np.add(self.g0, w, out=self.g)
+        self.phis, self.sum_p = self.law_sweep()
+        self.qw = float(np.vdot(q, w))
+        return corr
+
+    def _residual_block(self, sl, m, sc, acc, alpha, step, corr, mu, k2):
+        # q ← q + α d, w ← w + α K d; r_new = w − K P; K y = Δr; G_new = q − P; y = ΔG
+        ds = self.d[sl]
+        if step:
+            tmp = self.sw.buf(sc, "t", m)
+            qs, ws = self.q[sl], self.w[sl]
+            np.multiply(ds, alpha, out=tmp)
+            qs += tmp
+            np.multiply(self.Kd[sl], alpha, out=tmp)
+            ws += tmp
+        rns, kys, Gns, ys = self.rn[sl], self.ky[sl], self.Gn[sl], self.y[sl]
+        np.subtract(self.w[sl], self.cP[sl], out=rns)
+        np.subtract(rns, self.r[sl], out=kys)
+        if corr is not None:
+            kys -= corr[sl]
+        np.subtract(self.q[sl], self.P[sl], out=Gns)
+        if self.proj:
+            Gns -= mu
+        np.subtract(Gns, self.G[sl], out=ys)
+        acc[0] += float(np.vdot(ds, kys))
+        acc[1] += float(np.vdot(ys, kys))
+        acc[2] += float(np.vdot(ds, rns))
+        acc[3] += float(np.vdot(ys, rns))
+        acc[4] = max(acc[4], float(rns.max()), -float(rns.min()))
+        if k2:
+            acc[5] = acc[5] + self.mem.B[:k2, sl] @ kys
+
+    def new_residual(self, alpha: float, resync: bool):
+        """K P at the new point (one convolution) and, in one sweep, the step of q and w (unless
+        re-anchored), the new residual and gradient, the pair y = ΔG, K y = Δr and their products.
+
+        Returns (d·K y, y·K y, d·r_new, y·r_new, B K y): what the memory update needs; sets max|r|."""
+        mu = self.mean_q - self.sum_p / self.n if self.proj else 0.0
+        self.convolve(self.P)
+        self.n_conv += 1
+        k2 = 2 * len(self.mem.order)
+        accs = self.sw.run(self._residual_block, [0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+                           alpha, not resync, self.corr, mu, k2)
+        if len(accs) == 1:
+            dky, yky, drn, yrn, self.rmax, x = accs[0]
+        else:
+            dky, yky, drn, yrn, _, x = (sum(a[j] for a in accs) for j in range(6))
+            self.rmax = max(a[4] for a in accs)
+        return dky, yky, drn, yrn, (x if k2 else None)
+
+    def _store_block(self, sl, m, sc, acc, alpha, slot):
+        B, KB = self.mem.B, self.mem.KB
+        np.multiply(self.d[sl], alpha, out=B[2 * slot, sl])
+        B[2 * slot + 1, sl] = self.y[sl]
+        np.multiply(self.Kd[sl], alpha, out=KB[2 * slot, sl])
+        KB[2 * slot + 1, sl] = self.ky[sl]
+
+    def remember(self, alpha: float, ray: Ray, pair, resync: bool) -> None:
+        """Update the L-BFGS memory with the pair (s = α d, y) if ⟨s, y⟩ > 0 (curvature), then make
+        the new residual and gradient current (on a re-anchored step, the memory's products anew)."""
+        dky, yky, drn, yrn, x = pair
+        dA = self.dA
+        sy = dA * alpha * dky
+        yy = dA * yky
+        sks = dA * alpha * alpha * abs(ray.dKd)
+        store = sy > 1e-14 * max(sks, 1e-300) and yy > 0
+        slot = self.mem.update(alpha, None if x is None else dA * x, sy, yy, dA * drn, dA * yrn, store)
+        if slot is not None:
+            self.sw.run(self._store_block, (), alpha, slot)
+        self.r, self.rn = self.rn, self.r
+        self.G, self.Gn = self.Gn, self.G
+        if resync:
+            self.mem.refresh(self.r)
+
+    def finish(self, ok: bool, it: int, msg: str, t0: float) -> Equilibrium:
+        st = State(self.q.reshape(self.shape), self.w.reshape(self.shape))
+        return _finish(self.problem, st, self.P.reshape(self.shape).copy(), self.r, self.E, ok, it,
+                       self.n_conv, t0, msg)
 
 
 def _takes_out(fn) -> bool:
-    """Does ``fn`` accept an ``out=`` keyword (the package's kernels do)?"""
+    """Does ``fn`` accept an ``out=`` keyword (the package's kernels do)?  Asked once per function:
+    ``inspect.signature`` costs ~20 µs, a tenth of a warm equilibrium on group A's grid."""
+    func = getattr(fn, "__func__", fn)  # a bound method's function: the same answer for every instance
+    try:
+        return _signature_takes_out(func)
+    except TypeError:  # an unhashable callable: not cached
+        return _signature_takes_out.__wrapped__(func)
+
+
+@functools.lru_cache(maxsize=64)
+def _signature_takes_out(fn) -> bool:
     try:
         params = inspect.signature(fn).parameters.values()
     except (TypeError, ValueError):
@@ -310,80 +397,6 @@ def _axpy(x, y, a, tmp):
     """
     np.multiply(x, a, out=tmp)
     np.add(y, tmp, out=y)
-
-
-def _wolfe(law, g, P, Kd, gt, Pt, sw, qw, a0, a1, E0, slope0, dA, first, c1=1e-4, c2=0.9, max_eval=40,
-           sum_p=False, E_ref=None):
-    """Line search along d; element-wise only (no convolution).
-
-    E(α) = dA[½ q·w + α d·w + ½ α² d·K d + Σ Φ(g + α K d)],
-    E'(α) = E'(0) + dA[α d·K d − (P(g + α K d) − P(g))·K d]   (qw = q·w, a0 = d·w, a1 = d·K d;
-    the pressure change is summed point by point, so E' keeps its precision near convergence).
-    Accepts the strong Wolfe conditions, or near round-off the approximate Wolfe conditions of
-    Hager & Zhang (2005): E(α) <= E_ref + 1e-11|E(0)| and 0.9 E'(0) <= E'(α) <= −0.8 E'(0), with
-    E_ref = min(E(0), ``E_ref``) (the caller's lowest energy, so round-off rises cannot accumulate).
-    The bracket is narrowed by safeguarded secant steps on E'.  On return the buffers gt, Pt hold
-    the gap and pressure at the accepted α; returns (α, E(α), ΣΦ, ΣP) (ΣP only if ``sum_p``, else 0)
-    or (None, None, None, None).
-    """
-    eps_E = 1e-11 * max(1.0, abs(E0))
-    E_lo = E0 if E_ref is None else min(E0, E_ref)
-
-    buf = sw.buf
-
-    def f(a):
-        def fn(sl, m, sc, acc):
-            # block by block (a sweep): the gap, the law's scratch and the pressure stay in cache
-            gb, pb, kb = gt[sl], Pt[sl], Kd[sl]
-            np.multiply(kb, a, out=gb)
-            np.add(gb, g[sl], out=gb)
-            acc[0] += law.energy_pressure(gb, pb, (buf(sc, "a", m), buf(sc, "b", m)))
-            dp = buf(sc, "c", m)
-            np.subtract(pb, P[sl], out=dp)
-            acc[1] += float(np.vdot(dp, kb))
-            if sum_p:
-                acc[2] += float(pb.sum())
-        phis, dpk, sp = sw.sum(fn, [0.0, 0.0, 0.0])
-        e = dA * (0.5 * qw + a * a0 + 0.5 * a * a * a1 + phis)
-        de = slope0 + dA * (a * a1 - dpk)
-        return e, de, phis, sp
-
-    alpha = 1.0
-    if first:  # scale the first trial step so that the gap moves by at most 0.25 ε
-        m = max(float(Kd.max()), -float(Kd.min()))
-        if m > 0.25:
-            alpha = 0.25 / m
-    lo, de_lo = 0.0, slope0
-    hi, de_hi = None, None
-    best = None
-    for _ in range(max_eval):
-        e, de, phis, sp = f(alpha)
-        if not np.isfinite(e):
-            hi, de_hi = alpha, None
-        else:
-            wolfe = e <= E0 + c1 * alpha * slope0 and abs(de) <= -c2 * slope0
-            approx = e <= E_lo + eps_E and c2 * slope0 <= de <= -0.8 * slope0
-            if wolfe or approx:
-                return alpha, e, phis, sp
-            if e <= E_lo + eps_E and (best is None or abs(de) < best[0]):
-                best = (abs(de), alpha)
-            if e > E0 + c1 * alpha * slope0 + eps_E or de > 0:
-                hi, de_hi = alpha, (de if e <= E0 + eps_E or de > 0 else None)
-            else:
-                lo, de_lo = alpha, de
-        if hi is None:
-            alpha = 2.0 * alpha
-            continue
-        width = hi - lo
-        if de_hi is not None and de_hi > de_lo:
-            cand = lo - de_lo * width / (de_hi - de_lo)
-        else:
-            cand = lo + 0.5 * width
-        alpha = min(max(cand, lo + 0.1 * width), hi - 0.1 * width)
-    if best is not None:
-        e, _, phis, sp = f(best[1])  # the buffers must hold the accepted point
-        return best[1], e, phis, sp
-    return None, None, None, None
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,129 @@
+"""The fast solver's line search: (approximate) Wolfe conditions along d, element-wise only.
+
+Along a direction d with image K d the gap is g(α) = g + α K d, so the energy of Eq. (9)'s cell
+
+    E(α) = ΔA [½ q·w + α d·w + ½ α² d·K d + Σ Φ(g + α K d)],
+    E'(α) = E'(0) + ΔA [α d·K d − (P(g + α K d) − P(g))·K d]
+
+needs no convolution: one sweep over the grid per trial α (the pressure change is summed point by
+point, so E' keeps its precision near convergence).  Accepted: the strong Wolfe conditions, or near
+round-off the approximate Wolfe conditions of Hager & Zhang (2005),
+E(α) <= E_ref + 1e-11 |E(0)| and 0.9 E'(0) <= E'(α) <= −0.8 E'(0).  The bracket is narrowed by
+safeguarded secant steps on E'.
+"""
+from __future__ import annotations
+
+import math
+from typing import NamedTuple
+
+import numpy as np
+
+
+class Ray(NamedTuple):
+    """E along the direction: the current gap g and pressure P, the image K d, and the scalars of E(α)."""
+
+    g: np.ndarray
+    P: np.ndarray
+    Kd: np.ndarray
+    qw: float       # q·w
+    dw: float       # d·w
+    dKd: float      # d·K d
+    E0: float       # E(0)
+    slope: float    # E'(0) = ΔA d·r
+
+
+class Trial(NamedTuple):
+    """An accepted step: α, E(α), ΣΦ(g(α)) and ΣP(g(α)) (0 unless the search sums P)."""
+
+    alpha: float
+    E: float
+    phis: float
+    sum_p: float
+
+
+class WolfeLineSearch:
+    """Wolfe line search on one grid: its constants and the trial buffers g(α), P(α).
+
+    ``sum_p``: also sum P(g(α)) (the periodic gauge needs ΣP).  After :meth:`search` accepts α the
+    trial buffers hold g(α) and P(α); :meth:`swap` hands them over and takes the old current arrays
+    as the next trial buffers.
+    """
+
+    def __init__(self, law, sweeper, dA, g_trial, P_trial, sum_p=False, c1=1e-4, c2=0.9, max_eval=40,
+                 first_move=0.25):
+        self.law, self.sweeper, self.dA = law, sweeper, float(dA)
+        self.g_trial, self.P_trial = g_trial, P_trial
+        self.sum_p = bool(sum_p)
+        self.c1, self.c2, self.max_eval, self.first_move = c1, c2, int(max_eval), first_move
+
+    def first_step(self, Kd) -> float:
+        """α for a first direction (empty memory): the gap moves by at most ``first_move`` (0.25 ε)."""
+        m = max(float(Kd.max()), -float(Kd.min()))
+        return self.first_move / m if m > self.first_move else 1.0
+
+    def swap(self, g, P):
+        """The accepted (g(α), P(α)); ``g``, ``P`` become the trial buffers."""
+        gt, Pt = self.g_trial, self.P_trial
+        self.g_trial, self.P_trial = g, P
+        return gt, Pt
+
+    def _block(self, sl, m, sc, acc, a, g, P, Kd):
+        # block by block (a sweep): the gap, the law's scratch and the pressure stay in cache
+        buf = self.sweeper.buf
+        gb, pb, kb = self.g_trial[sl], self.P_trial[sl], Kd[sl]
+        np.multiply(kb, a, out=gb)
+        np.add(gb, g[sl], out=gb)
+        acc[0] += self.law.energy_pressure(gb, pb, (buf(sc, "a", m), buf(sc, "b", m)))
+        dp = buf(sc, "c", m)
+        np.subtract(pb, P[sl], out=dp)
+        acc[1] += float(np.vdot(dp, kb))
+        if self.sum_p:
+            acc[2] += float(pb.sum())
+
+    def evaluate(self, a, ray: Ray):
+        """(E(α), E'(α), ΣΦ, ΣP) at α = ``a``, with g(α), P(α) written into the trial buffers."""
+        phis, dpk, sp = self.sweeper.sum(self._block, [0.0, 0.0, 0.0], a, ray.g, ray.P, ray.Kd)
+        e = self.dA * (0.5 * ray.qw + a * ray.dw + 0.5 * a * a * ray.dKd + phis)
+        de = ray.slope + self.dA * (a * ray.dKd - dpk)
+        return e, de, phis, sp
+
+    def search(self, alpha0: float, ray: Ray, E_ref: float = math.inf) -> Trial | None:
+        """The accepted step from the trial α = ``alpha0`` (doubled until bracketed), or None.
+
+        ``E_ref``: the caller's lowest energy so far; the approximate test is measured from
+        min(E(0), E_ref), so round-off rises of E cannot add up over many accepted steps."""
+        E0, slope0, c1, c2 = ray.E0, ray.slope, self.c1, self.c2
+        eps_E = 1e-11 * max(1.0, abs(E0))
+        E_lo = min(E0, E_ref)
+        alpha = alpha0
+        lo, de_lo = 0.0, slope0
+        hi, de_hi = None, None
+        best = None
+        for _ in range(self.max_eval):
+            e, de, phis, sp = self.evaluate(alpha, ray)
+            if not np.isfinite(e):
+                hi, de_hi = alpha, None
+            else:
+                wolfe = e <= E0 + c1 * alpha * slope0 and abs(de) <= -c2 * slope0
+                approx = e <= E_lo + eps_E and c2 * slope0 <= de <= -0.8 * slope0
+                if wolfe or approx:
+                    return Trial(alpha, e, phis, sp)
+                if e <= E_lo + eps_E and (best is None or abs(de) < best[0]):
+                    best = (abs(de), alpha)
+                if e > E0 + c1 * alpha * slope0 + eps_E or de > 0:
+                    hi, de_hi = alpha, (de if e <= E0 + eps_E or de > 0 else None)
+                else:
+                    lo, de_lo = alpha, de
+            if hi is None:
+                alpha = 2.0 * alpha
+                continue
+            width = hi - lo
+            if de_hi is not None and de_hi > de_lo:
+                cand = lo - de_lo * width / (de_hi - de_lo)
+            else:
+                cand = lo + 0.5 * width
+            alpha = min(max(cand, lo + 0.1 * width), hi - 0.1 * width)
+        if best is not None:
+            e, _, phis, sp = self.evaluate(best[1], ray)  # the buffers must hold the accepted point
+            return Trial(best[1], e, phis, sp)
+        return None
