@@ -13,13 +13,15 @@ from tengsim.solvers import make_solver
 
 def simulate(shape: Shape, tabor: float, dx: float, path: PathSpec, boundary: str = "free",
              solver="fast", tol: float = 1e-6, law: Law | str | None = None, progress=None,
-             grid=None, extra_params: dict | None = None, observers=(), scaling=None):
+             grid=None, extra_params: dict | None = None, observers=(), scaling=None,
+             kernel_params: dict | None = None):
     """Approach–retraction run of ``shape`` against a rigid flat plate (paper Eq. 9).
 
     ``tabor`` is μ (the elastic coupling is μ^{3/2}); ``dx`` the grid spacing in X units;
     ``boundary`` a registered kernel name ('free', 'periodic'); ``solver`` a registered name
     ('fast', 'vsr') or a solver object; ``law`` a law object or registered name (default the
-    paper's LJ93).  ``observers`` (registered names or objects) add columns to the table; with a
+    paper's LJ93).  ``kernel_params`` go to the kernel's factory (e.g. a film: ``thickness`` in X
+    units, ``substrate``, ``poisson``; see :mod:`tengsim.kernels`).  ``observers`` (registered names or objects) add columns to the table; with a
     ``scaling`` (:class:`tengsim.units.Scaling`) the table also gets F_N, pressure_Pa and
     contact_length_m and the units metadata of that scaling.  Returns a ContactResult.
     """
@@ -29,7 +31,7 @@ def simulate(shape: Shape, tabor: float, dx: float, path: PathSpec, boundary: st
     law = make_law(law) if isinstance(law, str) else (law or LJ93())
     boundary = KERNELS.canonical(boundary)
     grid = grid or shape.grid(dx)
-    kernel = make_kernel(boundary, grid, tabor**1.5)
+    kernel = make_kernel(boundary, grid, tabor**1.5, **(kernel_params or {}))
     solver_obj = make_solver(solver, tol=tol) if isinstance(solver, str) else solver
     res = run_path(shape.gap(grid), law, kernel, solver_obj, path, progress=progress, observers=observers)
     res.params = {
@@ -38,6 +40,7 @@ def simulate(shape: Shape, tabor: float, dx: float, path: PathSpec, boundary: st
         "lateral_unit": getattr(shape, "lateral_unit", "ℓ"),
         "tabor": tabor,
         "boundary": boundary,
+        **{k: v for k, v in (getattr(kernel, "params", dict)() or {}).items() if k not in ("boundary", "coupling")},
         "solver": solver_obj.name,
         "tol": solver_obj.tol,
         "dx": grid.dx,
@@ -62,8 +65,8 @@ def simulate(shape: Shape, tabor: float, dx: float, path: PathSpec, boundary: st
     n_out = int((~res.table["in_law_range"].astype(bool)).sum())
     if n_out:
         warnings.append(f"{n_out} equilibria have gaps below the law's safe limit g_safe={law.g_safe} "
-                        "(compressed beyond the physical law; with the periodic kernel this happens once the "
-                        "whole cell is flattened)")
+                        "(compressed beyond the physical law; with the periodic half-space kernel this happens "
+                        "once the whole cell is flattened: its mean mode has no compliance; a film gives it one)")
     if warnings:
         res.params["warning"] = "; ".join(warnings)
     return res

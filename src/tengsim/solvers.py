@@ -141,7 +141,8 @@ class FastSolver:
         # away from the minimum it had reached.  So the mean of q is held fixed and G = q − P is used
         # without its mean (the K-metric gradient is the same); ΣP comes with the law's sweeps and
         # Σd with the direction's, so this costs no extra pass.
-        proj = bool(getattr(K, "periodic", False))
+        # (A film's periodic kernel has a finite mean compliance, K(0) > 0: it says pinned_mean = False.)
+        proj = bool(getattr(K, "pinned_mean", getattr(K, "periodic", False)))
 
         def law_sweep(gg, PP):
             """ΣΦ(gg) and ΣP (periodic kernels only, else 0), with P(gg) written into PP."""

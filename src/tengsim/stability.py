@@ -43,7 +43,8 @@ def hessian_min_eigenvalue(problem, H: np.ndarray, Kmat: np.ndarray | None = Non
     K = kernel_matrix(problem.kernel) if Kmat is None else Kmat
     stiff = problem.law.stiffness(H + 1.0).ravel()
     A = K + K @ (stiff[:, None] * K)
-    if problem.kernel.periodic:  # drop the mean mode (K is singular there)
+    k = problem.kernel
+    if getattr(k, "pinned_mean", k.periodic):  # drop the mean mode (K is singular there)
         n = K.shape[0]
         Q = np.linalg.qr(np.hstack([np.ones((n, 1)), np.eye(n)[:, : n - 1]]))[0][:, 1:]
         A, K = Q.T @ A @ Q, Q.T @ K @ Q
