@@ -76,7 +76,8 @@ def study_voc(group, ratios, dx, d_step, d_max, poisson, p_lo, p_hi, out_dir, bo
         res = results[r]
         rows.append({"t_over_pitch": r, "t_um": r * sc.L * 1e6,
                      "max_rel_change": float(rel[ok].max()) if ok.any() else float("nan"),
-                     "at_P_kPa": float(pgrid[i] / 1e3), "compared_kPa": (float(pgrid[ok][0] / 1e3), float(pgrid[ok][-1] / 1e3)) if ok.any() else None,
+                     "at_P_kPa": float(pgrid[i] / 1e3),
+                     "compared_kPa": (float(pgrid[ok][0] / 1e3), float(pgrid[ok][-1] / 1e3)) if ok.any() else None,
                      "V_at_10kPa": float(np.interp(1e4, P, V, left=np.nan, right=np.nan)),
                      "V_at_150kPa": float(np.interp(1.5e5, P, V, left=np.nan, right=np.nan)),
                      "P_min_kPa": float(P[0] / 1e3), "P_max_kPa": float(P[-1] / 1e3),
@@ -186,19 +187,22 @@ def main(argv=None):
                                         1e3, 150e3, out.parent, boundary)
             lines += [f"## V_OC(P), Eq. (12), group {args.group}, {boundary} kernel: bonded film (ν = {args.poisson}) "
                       f"vs {ref['reference']}", "",
-                      f"dx = {args.dx}, d_step = {args.d_step}, D ≤ {args.d_max} ε (+ the film's mean compression at "
+                      f"dx = {args.dx}, d_step = {args.d_step}, D ≤ {args.d_max} ε (+ the film's mean "
+                      "compression at "
                       "150 kPa); relative change of V_OC against the reference on 41 log-spaced pressures 1–150 kPa, "
                       f"where both curves have states; {secs:.0f} s. Half-space run: P from {ref['P_min_kPa']:.4g} "
                       f"to {ref['P_max_kPa']:.4g} kPa, first V_OC {ref['V_first']:.4g} V, "
                       f"{ref['out_of_law_range']} of {ref['n_states']} states out of the law's range.",
-                      "", "| t/pitch | t (µm) | max rel. change of V_OC | at P (kPa) | compared over (kPa) | V(10 kPa) | "
+                      "", "| t/pitch | t (µm) | max rel. change of V_OC | at P (kPa) | compared over (kPa) | "
+                      "V(10 kPa) | "
                       "V(150 kPa) | P range (kPa) | out of law range / states |",
                       "|---|---|---|---|---|---|---|---|---|"]
             for w in rows:
                 cmp = "—" if w["compared_kPa"] is None else f"{w['compared_kPa'][0]:.3g}–{w['compared_kPa'][1]:.3g}"
                 lines.append(f"| {w['t_over_pitch']:g} | {w['t_um']:g} | {w['max_rel_change']:.3g} | "
                              f"{w['at_P_kPa']:.3g} | {cmp} | {w['V_at_10kPa']:.5g} | {w['V_at_150kPa']:.5g} | "
-                             f"{w['P_min_kPa']:.3g}–{w['P_max_kPa']:.4g} | {w['out_of_law_range']} / {w['n_states']} |")
+                             f"{w['P_min_kPa']:.3g}–{w['P_max_kPa']:.4g} | "
+                             f"{w['out_of_law_range']} / {w['n_states']} |")
             lines.append("")
             print("\n".join(lines[-len(rows) - 4:]), flush=True)
     out.write_text("\n".join(lines) + "\n")

@@ -75,7 +75,7 @@ def test_thick_film_recovers_half_space():
 
 
 def test_correction_profile_against_quadrature():
-    """h(ρ) = ∫ (C − 1) J0(sρ) ds: table + closed-form parts against adaptive quadrature, and h = −1/ρ far out."""
+    """h(ρ) = ∫ (C − 1) J0(sρ) ds: table + closed-form parts against adaptive quadrature; h = −1/ρ far out."""
     rho = np.array([0.0, 0.37, 1.0, 3.3, 10.0, 25.0, 39.9, 45.0])
     for sub, nu in NUS:
         h = film.correction_profile(rho, nu, sub)
