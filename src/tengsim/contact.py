@@ -23,7 +23,8 @@ def simulate(shape: Shape, tabor: float, dx: float, path: PathSpec, boundary: st
     paper's LJ93).  ``kernel_params`` go to the kernel's factory (e.g. a film: ``thickness`` in X
     units, ``substrate``, ``poisson``; see :mod:`tengsim.kernels`).  ``observers`` (registered names
     or objects) add columns to the table; with a ``scaling`` (:class:`tengsim.units.Scaling`) the
-    table also gets F_N, pressure_Pa and contact_length_m and the units metadata of that scaling.  Returns a ContactResult.
+    table also gets F_N, pressure_Pa and contact_length_m and the units metadata of that scaling.
+    Returns a ContactResult.
     """
     tabor = positive("tabor", tabor)
     if scaling is not None and abs(scaling.mu - tabor) > 1e-9 * tabor:

@@ -13,9 +13,10 @@ Both take an optional film (``thickness`` T in X units, ``substrate`` 'bonded' o
 ``poisson`` ν; :mod:`tengsim.film`): a layer of thickness T on a rigid substrate instead of the
 half-space, E* keeping its meaning.  The periodic multiplier becomes (2κ/|q|) C(|q|T, ν) with the
 finite mean compliance κT(1 − 2ν)/(1 − ν)² at q = 0; the free kernel adds to the exact half-space
-pixel coefficients the layer's smooth correction (κ/π)(1/T) h(r/T), pixel-averaged by 3×3 Gauss
-points.  A kernel whose mean mode has no compliance (the half-space, or an incompressible bonded
-periodic film) says so with ``pinned_mean = True``; the solvers then hold the mean of q fixed.
+pixel coefficients the layer's smooth correction (κ/π)(1/T) h(r/T), pixel-averaged by Gauss points
+(:func:`film_pixel_correction`), which cancels them exactly beyond 40 thicknesses.  A kernel whose
+mean mode has no compliance (the half-space, or an incompressible periodic film) says so with
+``pinned_mean = True``; the solvers then hold the mean of q fixed.
 """
 from __future__ import annotations
 
@@ -53,15 +54,30 @@ def _gauss3():
 
 def film_pixel_correction(X, Y, dx: float, dy: float, thickness: float, poisson: float,
                           substrate: str) -> np.ndarray:
-    """∬ over the pixel at offsets (X, Y) of (1/T) h(|r|/T): the layer-minus-half-space influence
-    per κ/π (3×3 Gauss points per pixel; h is smooth on the scale T)."""
+    """∬ over the pixel at offsets (X, Y) of (1/T) h(|r|/T): the layer-minus-half-space influence per κ/π.
+
+    A pixel wholly beyond ``film.RHO_FAR`` thicknesses gets −pixel_influence exactly (there h = −1/ρ:
+    the layer's influence vanishes); a nearer one is split into k × k sub-pixels, k = ⌈max(dx, dy)/T⌉,
+    with 3 × 3 Gauss points each (h is smooth on the scale T, so a film thinner than a pixel still
+    has its correction resolved)."""
+    X, Y = np.broadcast_arrays(np.asarray(X, float), np.asarray(Y, float))
+    out = -pixel_influence(X, Y, dx, dy)
+    gap = np.hypot(np.maximum(np.abs(X) - dx / 2, 0.0), np.maximum(np.abs(Y) - dy / 2, 0.0))
+    near = gap < film.RHO_FAR * thickness
+    if not near.any():
+        return out
+    Xn, Yn = X[near], Y[near]
+    k = int(np.ceil(max(dx, dy) / thickness))
     xg, wg = _gauss3()
-    out = np.zeros(np.broadcast(X, Y).shape)
-    for xi, wi in zip(xg, wg):
-        for yj, wj in zip(xg, wg):
-            r = np.hypot(X + xi * dx, Y + yj * dy)
-            out += (wi * wj) * film.correction_profile(r / thickness, poisson, substrate)
-    return out * (dx * dy / thickness)
+    sub = (np.arange(k) + 0.5) / k - 0.5  # sub-pixel centres on [−1/2, 1/2]
+    nodes = [(c + x / k, w / k) for c in sub for x, w in zip(xg, wg)]
+    acc = np.zeros(Xn.shape)
+    for xi, wi in nodes:
+        for yj, wj in nodes:
+            r = np.hypot(Xn + xi * dx, Yn + yj * dy)
+            acc += (wi * wj) * film.correction_profile(r / thickness, poisson, substrate)
+    out[near] = acc * (dx * dy / thickness)
+    return out
 
 
 class _Film:
