@@ -275,3 +275,38 @@ def test_cli_film_run_writes_its_parameters(tmp_path):
     assert p.returncode == 0, p.stderr
     head = out.read_text()
     assert "# thickness: 4.0" in head and '# substrate: "frictionless"' in head and "# poisson: 0.3" in head
+
+
+def test_nested_solve_keeps_the_film_on_coarse_levels(monkeypatch):
+    """multilevel's coarse grids get the same film; the nested result is an equilibrium of the film problem
+    and the same state as a cold start on the fine grid (energy to 1e-9)."""
+    from tengsim import multilevel
+    from tengsim.geometry import random_rough
+    from tengsim.interaction import LJ93
+    from tengsim.multilevel import nested_solve
+    from tengsim.solvers import FastSolver, Problem, State
+
+    made = []
+
+    class Spy(PeriodicKernel):
+        def __post_init__(self):
+            super().__post_init__()
+            made.append(self.film_params())
+
+    monkeypatch.setattr(multilevel, "PeriodicKernel", Spy)
+
+    surf = random_rough(64, 16.0, hurst=0.8, rms_height=1.0, short_cutoff=2.0, seed=3)
+    grid = surf.grid()
+    U0 = surf.gap(grid)
+    g0 = U0 - float(np.quantile(U0, 0.05)) + 1.0
+    K = Spy(grid, 0.5**1.5, thickness=4.0, poisson=0.45)
+    made.clear()
+    solver = FastSolver(tol=1e-7)
+    ns = nested_solve(solver, g0, LJ93(), K, min_size=32, max_dx=1.0)
+    eq = ns.equilibrium
+    assert [lv.shape for lv in ns.levels] == [(32, 32), (64, 64)] and eq.converged
+    assert made == [{"thickness": 4.0, "substrate": "bonded", "poisson": 0.45}]
+    r = eq.H - (g0 - 1.0 + K.apply(LJ93().pressure(eq.H + 1.0)))
+    assert np.max(np.abs(r)) < 1.01e-7
+    cold = solver.solve(Problem(g0, LJ93(), K), State.zero(g0.shape))
+    assert cold.converged and abs(eq.energy - cold.energy) <= 1e-9 * abs(cold.energy)

@@ -91,7 +91,8 @@ class _Film:
                                                                        self.poisson)
         self.film = True
 
-    def _film_params(self) -> dict:
+    def film_params(self) -> dict:
+        """thickness, substrate, poisson of the film ({} for the half-space): rebuilds the same body."""
         if not self.film:
             return {}
         return {"thickness": self.thickness, "substrate": self.substrate, "poisson": self.poisson}
@@ -133,7 +134,7 @@ class FreeKernel(_Film):
         return self._conv(np.asarray(p, dtype=float), out)
 
     def params(self) -> dict:
-        return {"boundary": "free", "coupling": self.coupling, **self._film_params()}
+        return {"boundary": "free", "coupling": self.coupling, **self.film_params()}
 
 
 @dataclass
@@ -171,7 +172,7 @@ class PeriodicKernel(_Film):
         return self._conv(p, out)
 
     def params(self) -> dict:
-        return {"boundary": "periodic", "coupling": self.coupling, **self._film_params()}
+        return {"boundary": "periodic", "coupling": self.coupling, **self.film_params()}
 
 
 def make_kernel(boundary: str, grid: Grid, coupling: float, **params):
