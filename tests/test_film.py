@@ -310,3 +310,15 @@ def test_nested_solve_keeps_the_film_on_coarse_levels(monkeypatch):
     assert np.max(np.abs(r)) < 1.01e-7
     cold = solver.solve(Problem(g0, LJ93(), K), State.zero(g0.shape))
     assert cold.converged and abs(eq.energy - cold.energy) <= 1e-9 * abs(cold.energy)
+
+
+def test_incompressible_periodic_film_warns_like_the_half_space():
+    """ν = 1/2 (the default) on a bonded periodic film: no mean compliance, states leave the law's range
+    once the array is flat, and the warning says why and what to do."""
+    base = {"shape": "pyramid", "pitch": "2um", "base": "1um", "height": "0.7um", "E_star": "0.59MPa",
+            "W": "54mJ/m2", "tabor": 0.5, "boundary": "periodic", "dx": 0.25, "d_min": -1.0, "d_max": 6.0,
+            "d_step": 0.5, "thickness": "400um"}
+    res = run_contact(base)
+    assert not bool(np.all(res.table["in_law_range"]))
+    assert "incompressible (poisson = 0.5)" in res.params["warning"]
+    assert "warning" not in run_contact({**base, "poisson": 0.49}).params

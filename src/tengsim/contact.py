@@ -68,6 +68,9 @@ def simulate(shape: Shape, tabor: float, dx: float, path: PathSpec, boundary: st
         warnings.append(f"{n_out} equilibria have gaps below the law's safe limit g_safe={law.g_safe} "
                         "(compressed beyond the physical law; with the periodic half-space kernel this happens "
                         "once the whole cell is flattened: its mean mode has no compliance; a film gives it one)")
+        if getattr(kernel, "film", False) and getattr(kernel, "pinned_mean", False):
+            warnings.append("the film is incompressible (poisson = 0.5), so its mean mode has no compliance "
+                            "either: give poisson < 0.5 (PDMS ≈ 0.49) and small D steps, or drive it by load")
     if warnings:
         res.params["warning"] = "; ".join(warnings)
     return res
