@@ -12,6 +12,7 @@ import dataclasses
 import inspect
 from dataclasses import dataclass, field
 
+from tengsim import film
 from tengsim.errors import TengsimError, positive
 from tengsim.interaction import make_law
 from tengsim.path import PathSpec
@@ -56,6 +57,13 @@ def common_fields() -> list:
         Field("refine_levels", "int", 4, help="step bisections before a change is called a jump"),
         Field("maps_at", "floats", (), help="D values whose pressure and gap maps are kept (.nc)"),
         Field("boundary", "str", "free", choices=KERNELS.names, help="elastic kernel: " + KERNELS.help()),
+        Field("thickness", "any", None,
+              help="film thickness on a rigid substrate (default: half-space), in X units; in a physical run "
+              "also a length, e.g. '400um'"),
+        Field("substrate", "str", "bonded", choices=film.SUBSTRATES,
+              help="film on its substrate: bonded (no slip) or frictionless (needs thickness)"),
+        Field("poisson", default=0.5, help="Poisson ratio ν of the film, -1 < ν <= 0.5; E* keeps its meaning, "
+              "E = E*(1 - ν²) (needs thickness)"),
         Field("solver", "str", "fast", choices=SOLVERS.names, help="solver: " + SOLVERS.help()),
         Field("tol", default=1e-6, help="max residual of Eq. (9) in ε"),
         Field("law", "str", "lj93", check=lambda v: LAWS.canonical(v), help="interaction law: " + LAWS.help()),
@@ -154,22 +162,42 @@ class ContactPlan:
     extra: dict = field(default_factory=dict)
     scaling: Scaling | PaperScaling | None = None
     observers: tuple = ()
+    kernel_params: dict = field(default_factory=dict)
 
 
-def _dx(raw, lateral):
-    """dx in X units: a number, or (physical runs only) a length with a unit."""
+def _dx(raw, lateral, name="dx"):
+    """A length in X units (dx, thickness): a number, or (physical runs only) a length with a unit."""
     if isinstance(raw, str):
         try:
-            return positive("dx", float(raw))
+            number = float(raw)
         except ValueError:
-            pass
+            number = None
+        if number is not None:
+            return positive(name, number)
         if lateral is None:
-            raise TengsimError(f"dx = {raw!r} has a unit, but this run is dimensionless: give dx in X units "
-                               "(or the shape's physical sizes with E_star and W)")
-        return positive("dx", parse_quantity(raw, "length", name="dx") / lateral)
+            raise TengsimError(f"{name} = {raw!r} has a unit, but this run is dimensionless: give {name} in X "
+                               "units (or the shape's physical sizes with E_star and W)")
+        return positive(name, parse_quantity(raw, "length", name=name) / lateral)
     if isinstance(raw, bool) or not isinstance(raw, (int, float)):
-        raise TengsimError(f"dx must be a number, got {raw!r}")
-    return positive("dx", raw)
+        raise TengsimError(f"{name} must be a number, got {raw!r}")
+    return positive(name, raw)
+
+
+def _film(cfg, vals, lateral, extra) -> dict:
+    """Kernel parameters of a film (empty for the half-space); its thickness in X units."""
+    raw = cfg.get("thickness")
+    if raw in (None, ""):
+        given = [k for k in ("substrate", "poisson") if cfg.get(k) not in (None, "")]
+        if given:
+            raise TengsimError(f"{' and '.join(given)} {'describe' if len(given) > 1 else 'describes'} a film: "
+                               "give its thickness too "
+                               "(without one the elastic body is a half-space)")
+        return {}
+    t = _dx(raw, lateral, "thickness")
+    t, substrate, nu = film.check_film(t, vals["substrate"], vals["poisson"])
+    if lateral is not None:
+        extra["thickness_m"] = t * lateral
+    return {"thickness": t, "substrate": substrate, "poisson": nu}
 
 
 def _build(cls, name, kw):
@@ -248,6 +276,7 @@ def plan_contact(cfg: dict) -> ContactPlan:
         shape = _build(cls, name, {f.name: vals[f.name] for f in dims if vals[f.name] is not None})
     raw_dx = cfg.get("dx")  # not given: the shape's own pixel (a height map's) or 0.1
     dx = _dx(raw_dx, lateral) if raw_dx not in (None, "") else getattr(shape, "native_dx", 0.1)
+    kernel_params = _film(cfg, vals, lateral, extra)
     path = PathSpec(vals["d_min"], vals["d_max"], vals["d_step"], maps_at=tuple(vals["maps_at"]),
                     refine_levels=vals["refine_levels"])
     tol = positive("tol", vals["tol"])
@@ -257,7 +286,7 @@ def plan_contact(cfg: dict) -> ContactPlan:
 
     check_memory(grid.nx, grid.ny, vals["boundary"], vals["solver"], maps=2 * len(path.maps_at))
     return ContactPlan(shape, tabor, dx, path, vals["boundary"], vals["solver"], tol, law, extra, scaling,
-                       tuple(vals["observers"]))
+                       tuple(vals["observers"]), kernel_params)
 
 
 def _common_names():
@@ -271,6 +300,7 @@ def run_contact(cfg: dict, progress=None):
     plan = plan_contact(cfg)
     res = simulate(plan.shape, plan.tabor, plan.dx, plan.path, boundary=plan.boundary,
                    solver=plan.solver, tol=plan.tol, law=plan.law, progress=progress,
-                   extra_params=plan.extra, observers=plan.observers, scaling=plan.scaling)
+                   extra_params=plan.extra, observers=plan.observers, scaling=plan.scaling,
+                   kernel_params=plan.kernel_params)
     res.params["config"] = {k: v for k, v in cfg.items() if k not in ("out", "plot")}
     return res

@@ -18,18 +18,21 @@ MONITOR_MIN_POINTS = 1024**2  # grids from this size on report progress inside e
 
 def simulate(shape: Shape, tabor: float, dx: float, path: PathSpec, boundary: str = "free",
              solver="fast", tol: float = 1e-6, law: Law | str | None = None, progress=None,
-             grid=None, extra_params: dict | None = None, observers=(), scaling=None, throw: bool = False):
+             grid=None, extra_params: dict | None = None, observers=(), scaling=None,
+             kernel_params: dict | None = None, throw: bool = False):
     """Approach–retraction run of ``shape`` against a rigid flat plate (paper Eq. 9).
 
     ``tabor`` is μ (the elastic coupling is μ^{3/2}); ``dx`` the grid spacing in X units;
     ``boundary`` a registered kernel name ('free', 'periodic'); ``solver`` a registered name
     ('fast', 'vsr') or a solver object; ``law`` a law object or registered name (default the
-    paper's LJ93).  ``observers`` (registered names or objects) add columns to the table; with a
-    ``scaling`` (:class:`tengsim.units.Scaling`) the table also gets F_N, pressure_Pa and
-    contact_length_m and the units metadata of that scaling.  Returns a ContactResult whose ``status``
-    (and per-row ``status`` column) says ok / not_converged / out_of_law_range / under_resolved
-    (:mod:`tengsim.status`); with ``throw=True`` a status other than 'ok' raises
-    :class:`tengsim.status.ResultStatusError`, which carries the result.
+    paper's LJ93).  ``kernel_params`` go to the kernel's factory (e.g. a film: ``thickness`` in X
+    units, ``substrate``, ``poisson``; see :mod:`tengsim.kernels`).  ``observers`` (registered names
+    or objects) add columns to the table; with a ``scaling`` (:class:`tengsim.units.Scaling`) the
+    table also gets F_N, pressure_Pa and contact_length_m and the units metadata of that scaling.
+    Returns a ContactResult whose ``status`` (and per-row ``status`` column) says ok /
+    not_converged / out_of_law_range / under_resolved (:mod:`tengsim.status`); with ``throw=True``
+    a status other than 'ok' raises :class:`tengsim.status.ResultStatusError`, which carries the
+    result.
     """
     tabor = positive("tabor", tabor)
     if scaling is not None and abs(scaling.mu - tabor) > 1e-9 * tabor:
@@ -43,7 +46,7 @@ def simulate(shape: Shape, tabor: float, dx: float, path: PathSpec, boundary: st
     if (hasattr(progress, "monitor") and grid.nx * grid.ny >= MONITOR_MIN_POINTS and is_dataclass(solver_obj)
             and getattr(solver_obj, "monitor", 0) is None):  # long solves report as they go
         solver_obj = replace(solver_obj, monitor=progress.monitor(), monitor_every=10)
-    kernel = make_kernel(boundary, grid, tabor**1.5)
+    kernel = make_kernel(boundary, grid, tabor**1.5, **(kernel_params or {}))
     res = run_path(shape.gap(grid), law, kernel, solver_obj, path, progress=progress, observers=observers)
     res.params = {
         "tengsim_version": __version__,
@@ -51,6 +54,7 @@ def simulate(shape: Shape, tabor: float, dx: float, path: PathSpec, boundary: st
         "lateral_unit": getattr(shape, "lateral_unit", "ℓ"),
         "tabor": tabor,
         "boundary": boundary,
+        **{k: v for k, v in (getattr(kernel, "params", dict)() or {}).items() if k not in ("boundary", "coupling")},
         "solver": solver_obj.name,
         "tol": solver_obj.tol,
         "dx": grid.dx,
@@ -70,6 +74,11 @@ def simulate(shape: Shape, tabor: float, dx: float, path: PathSpec, boundary: st
             res.params.setdefault(k, v)
         res.add_physical(scaling)
     status.attach(res, law, kernel.coupling)  # per-row 'status' column, params['status'] (tengsim.status)
+    if (getattr(kernel, "film", False) and getattr(kernel, "pinned_mean", False)
+            and not res.table["in_law_range"].all()):
+        res.params["warning"] = res.params.get("warning", "") + (
+            "; the film is incompressible (poisson = 0.5), so its mean mode has no compliance either: give "
+            "poisson < 0.5 (PDMS ≈ 0.49) and small D steps, or drive it by load")
     if throw:
         res.raise_for_status()
     return res

@@ -8,6 +8,15 @@ A kernel's ``apply`` is one convolution (a forward and an inverse real FFT): the
   rectangular pixel (Love 1929; Johnson 1985 §3.3).
 * :class:`PeriodicKernel` — an infinite array of cells: Fourier multiplier 2κ/|q|, the mean
   displacement (q = 0) held at zero, so D is measured from the mean surface.
+
+Both take an optional film (``thickness`` T in X units, ``substrate`` 'bonded' or 'frictionless',
+``poisson`` ν; :mod:`tengsim.film`): a layer of thickness T on a rigid substrate instead of the
+half-space, E* keeping its meaning.  The periodic multiplier becomes (2κ/|q|) C(|q|T, ν) with the
+finite mean compliance κT(1 − 2ν)/(1 − ν)² at q = 0; the free kernel adds to the exact half-space
+pixel coefficients the layer's smooth correction (κ/π)(1/T) h(r/T), pixel-averaged by Gauss points
+(:func:`film_pixel_correction`), which cancels them exactly beyond 40 thicknesses.  A kernel whose
+mean mode has no compliance (the half-space, or an incompressible periodic film) says so with
+``pinned_mean = True``; the solvers then hold the mean of q fixed.
 """
 from __future__ import annotations
 
@@ -15,7 +24,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from tengsim import _fft
+from tengsim import _fft, film
 from tengsim.errors import positive
 from tengsim.grid import Grid
 from tengsim.registry import KERNELS
@@ -38,16 +47,71 @@ def pixel_influence(x, y, dx: float, dy: float) -> np.ndarray:
     return _F(x + a, y + b) - _F(x + a, y - b) - _F(x - a, y + b) + _F(x - a, y - b)
 
 
+def _gauss3():
+    x, w = np.polynomial.legendre.leggauss(3)
+    return 0.5 * x, 0.5 * w  # nodes and weights on [−1/2, 1/2]
+
+
+def film_pixel_correction(X, Y, dx: float, dy: float, thickness: float, poisson: float,
+                          substrate: str) -> np.ndarray:
+    """∬ over the pixel at offsets (X, Y) of (1/T) h(|r|/T): the layer-minus-half-space influence per κ/π.
+
+    A pixel wholly beyond ``film.RHO_FAR`` thicknesses gets −pixel_influence exactly (there h = −1/ρ:
+    the layer's influence vanishes); a nearer one is split into k × k sub-pixels, k = ⌈max(dx, dy)/T⌉,
+    with 3 × 3 Gauss points each (h is smooth on the scale T, so a film thinner than a pixel still
+    has its correction resolved)."""
+    X, Y = np.broadcast_arrays(np.asarray(X, float), np.asarray(Y, float))
+    out = -pixel_influence(X, Y, dx, dy)
+    gap = np.hypot(np.maximum(np.abs(X) - dx / 2, 0.0), np.maximum(np.abs(Y) - dy / 2, 0.0))
+    near = gap < film.RHO_FAR * thickness
+    if not near.any():
+        return out
+    Xn, Yn = X[near], Y[near]
+    k = int(np.ceil(max(dx, dy) / thickness))
+    xg, wg = _gauss3()
+    sub = (np.arange(k) + 0.5) / k - 0.5  # sub-pixel centres on [−1/2, 1/2]
+    nodes = [(c + x / k, w / k) for c in sub for x, w in zip(xg, wg)]
+    acc = np.zeros(Xn.shape)
+    for xi, wi in nodes:
+        for yj, wj in nodes:
+            r = np.hypot(Xn + xi * dx, Yn + yj * dy)
+            acc += (wi * wj) * film.correction_profile(r / thickness, poisson, substrate)
+    out[near] = acc * (dx * dy / thickness)
+    return out
+
+
+class _Film:
+    """The optional film fields shared by both kernels (validated; all None for the half-space)."""
+
+    def _init_film(self):
+        if self.thickness is None:
+            self.film = False
+            return
+        self.thickness, self.substrate, self.poisson = film.check_film(self.thickness, self.substrate,
+                                                                       self.poisson)
+        self.film = True
+
+    def film_params(self) -> dict:
+        """thickness, substrate, poisson of the film ({} for the half-space): rebuilds the same body."""
+        if not self.film:
+            return {}
+        return {"thickness": self.thickness, "substrate": self.substrate, "poisson": self.poisson}
+
+
 @dataclass
-class FreeKernel:
-    """Isolated cell (non-periodic) half-space, paper Eq. (9)."""
+class FreeKernel(_Film):
+    """Isolated cell (non-periodic) half-space, paper Eq. (9); or a film of ``thickness`` T."""
 
     grid: Grid
     coupling: float
+    thickness: float | None = None
+    substrate: str = "bonded"
+    poisson: float = 0.5
     padded_shape: tuple = field(init=False)
 
     def __post_init__(self):
         positive("coupling", self.coupling)
+        self._init_film()
         g = self.grid
         self.padded_shape = (_fft.fast_len(2 * g.nx - 1), _fft.fast_len(2 * g.ny - 1))
         px, py = self.padded_shape
@@ -56,34 +120,48 @@ class FreeKernel:
         ox = np.where(ix < g.nx, ix, ix - px) * g.dx
         oy = np.where(iy < g.ny, iy, iy - py) * g.dy
         X, Y = np.meshgrid(ox, oy, indexing="ij")
-        coeff = pixel_influence(X, Y, g.dx, g.dy) * (self.coupling / np.pi)
+        coeff = pixel_influence(X, Y, g.dx, g.dy)
+        if self.film:
+            coeff += film_pixel_correction(X, Y, g.dx, g.dy, self.thickness, self.poisson, self.substrate)
+        coeff *= self.coupling / np.pi
         self._spectrum = _fft.rfft2(coeff)
         self._conv = _fft.PaddedConvolver(g.shape, self.padded_shape, self._spectrum)
         self.periodic = False
+        self.pinned_mean = False
 
     def apply(self, p: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
         """w = K p on the cell (one convolution), into ``out`` if given."""
         return self._conv(np.asarray(p, dtype=float), out)
 
     def params(self) -> dict:
-        return {"boundary": "free", "coupling": self.coupling}
+        return {"boundary": "free", "coupling": self.coupling, **self.film_params()}
 
 
 @dataclass
-class PeriodicKernel:
-    """Periodic array of cells: ŵ(q) = (2κ/|q|) P̂(q), ŵ(0) = 0."""
+class PeriodicKernel(_Film):
+    """Periodic array of cells: ŵ(q) = (2κ/|q|) P̂(q), ŵ(0) = 0; with a film of ``thickness`` T,
+    ŵ(q) = (2κ/|q|) C(|q|T, ν) P̂(q) and ŵ(0) = κT(1 − 2ν)/(1 − ν)² P̂(0) (uniaxial strain)."""
 
     grid: Grid
     coupling: float
+    thickness: float | None = None
+    substrate: str = "bonded"
+    poisson: float = 0.5
 
     def __post_init__(self):
         positive("coupling", self.coupling)
+        self._init_film()
         g = self.grid
         qx = 2 * np.pi * np.fft.fftfreq(g.nx, d=g.dx)
         qy = 2 * np.pi * np.fft.rfftfreq(g.ny, d=g.dy)
         q = np.hypot(*np.meshgrid(qx, qy, indexing="ij"))
         with np.errstate(divide="ignore"):
             mult = np.where(q > 0, 2 * self.coupling / np.where(q > 0, q, 1.0), 0.0)
+        if self.film:
+            mult *= film.compliance_factor(q * self.thickness, self.poisson, self.substrate)
+            mult[0, 0] = film.mean_compliance(self.thickness, self.poisson, self.coupling)
+        self.mean_compliance = float(mult[0, 0])
+        self.pinned_mean = not self.mean_compliance > 0
         self._spectrum = mult
         self._conv = _fft.PeriodicConvolver(g.shape, mult)
         self.padded_shape = g.shape
@@ -94,15 +172,15 @@ class PeriodicKernel:
         return self._conv(p, out)
 
     def params(self) -> dict:
-        return {"boundary": "periodic", "coupling": self.coupling}
+        return {"boundary": "periodic", "coupling": self.coupling, **self.film_params()}
 
 
 def make_kernel(boundary: str, grid: Grid, coupling: float, **params):
     """Kernel by registered name (see ``tengsim.registry.KERNELS``): 'free' (isolated cell, Eq. 9 as
-    printed) or 'periodic' (array of cells).  A registered kernel is a factory
-    ``(grid, coupling, **params) -> kernel``."""
+    printed) or 'periodic' (array of cells); both take ``thickness``, ``substrate``, ``poisson`` for a
+    film on a rigid substrate.  A registered kernel is a factory ``(grid, coupling, **params) -> kernel``."""
     return KERNELS.get(boundary)(grid, coupling, **params)
 
 
-KERNELS.register("free", FreeKernel, summary="isolated cell on a half-space, Eq. (9)")
-KERNELS.register("periodic", PeriodicKernel, summary="periodic array of cells")
+KERNELS.register("free", FreeKernel, summary="isolated cell on a half-space, Eq. (9), or on a film")
+KERNELS.register("periodic", PeriodicKernel, summary="periodic array of cells (half-space or film)")

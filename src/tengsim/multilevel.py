@@ -127,7 +127,7 @@ def nested_solve(solver, g0: np.ndarray, law, kernel: PeriodicKernel, min_size: 
             k, g = kernel, g0
         else:
             cg = Grid(shape[0], shape[1], grid.lx / shape[0], grid.ly / shape[1])
-            k = PeriodicKernel(cg, kernel.coupling)
+            k = PeriodicKernel(cg, kernel.coupling, **kernel.film_params())
             g = fourier_resample(g0, shape)
         n_conv = 0
         if q is None:

@@ -18,7 +18,7 @@ import functools
 import inspect
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -181,7 +181,8 @@ class _Descent:
         self.sw, self.mem, self.cP = ws.sweeper, ws.memory, ws.cP
         self.g, self.P, self.d, self.Kd = ws.g, ws.P, ws.d, ws.Kd
         self.r, self.rn, self.G, self.Gn, self.y, self.ky = ws.r, ws.rn, ws.G, ws.Gn, ws.y, ws.ky
-        self.proj = bool(getattr(K, "periodic", False))
+        # a film's periodic kernel has a finite mean compliance, K(0) > 0: it says pinned_mean = False
+        self.proj = bool(getattr(K, "pinned_mean", getattr(K, "periodic", False)))
         self.search = WolfeLineSearch(problem.law, ws.sweeper, self.dA, ws.gt, ws.Pt, sum_p=self.proj)
         self._apply, self._takes_out = K.apply, _takes_out(K.apply)
         # the start: g, P, ΣΦ, r (one convolution), G, E
