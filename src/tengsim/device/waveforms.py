@@ -5,6 +5,7 @@ jumps or kinks (``breakpoints``) so that the integrator never steps across one.
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 
@@ -40,9 +41,30 @@ def _grid_breaks(period, duty, t0, t1):
     return np.unique(b[(b > t0) & (b < t1)])
 
 
+class _Waveform:
+    """What every waveform shares: ``to_dict`` (``kind`` plus the dataclass fields, for saved parameters)."""
+
+    def to_dict(self) -> dict:
+        d = {"kind": WAVEFORMS.name_of(self)}
+        for f in dataclasses.fields(self):
+            v = getattr(self, f.name)
+            d[f.name] = v.tolist() if isinstance(v, np.ndarray) else list(v) if isinstance(v, tuple) else v
+        return d
+
+
+class _Periodic(_Waveform):
+    """A waveform repeating at ``frequency_Hz`` (endless unless the class sets a duration)."""
+
+    duration = None
+
+    @property
+    def period(self) -> float:
+        return 1.0 / self.frequency_Hz
+
+
 @WAVEFORMS.register("square")
 @dataclass(frozen=True)
-class SquareWave:
+class SquareWave(_Periodic):
     """P = amplitude for the first ``duty`` of each period, ``low_Pa`` otherwise (Fig. 7)."""
 
     amplitude_Pa: float = _f("pressure while pressed")
@@ -56,12 +78,6 @@ class SquareWave:
         object.__setattr__(self, "duty", _duty(self.duty))
         object.__setattr__(self, "low_Pa", finite("low_Pa", self.low_Pa))
 
-    @property
-    def period(self) -> float:
-        return 1.0 / self.frequency_Hz
-
-    duration = None
-
     def __call__(self, t):
         t = np.asarray(t, dtype=float)
         phase = np.mod(t, self.period) / self.period
@@ -70,14 +86,11 @@ class SquareWave:
     def breakpoints(self, t0: float, t1: float) -> np.ndarray:
         return _grid_breaks(self.period, self.duty, t0, t1)
 
-    def to_dict(self) -> dict:
-        return {"kind": "square", "amplitude_Pa": self.amplitude_Pa, "frequency_Hz": self.frequency_Hz,
-                "duty": self.duty, "low_Pa": self.low_Pa}
 
 
 @WAVEFORMS.register("staircase")
 @dataclass(frozen=True)
-class Staircase:
+class Staircase(_Periodic):
     """Square wave whose k-th pulse has amplitude ``amplitudes_Pa[k]`` (Fig. 8); zero afterwards."""
 
     amplitudes_Pa: tuple = _f("pressure of each pulse, in order (one pulse per period)")
@@ -104,10 +117,6 @@ class Staircase:
         return cls(tuple(float(start_Pa) + k * step for k in range(n + 1)), frequency_Hz, duty)
 
     @property
-    def period(self) -> float:
-        return 1.0 / self.frequency_Hz
-
-    @property
     def duration(self) -> float:
         return len(self.amplitudes_Pa) * self.period
 
@@ -123,14 +132,11 @@ class Staircase:
     def breakpoints(self, t0: float, t1: float) -> np.ndarray:
         return _grid_breaks(self.period, self.duty, t0, t1)
 
-    def to_dict(self) -> dict:
-        return {"kind": "staircase", "amplitudes_Pa": list(self.amplitudes_Pa),
-                "frequency_Hz": self.frequency_Hz, "duty": self.duty}
 
 
 @WAVEFORMS.register("sine")
 @dataclass(frozen=True)
-class Sine:
+class Sine(_Periodic):
     """P = offset + amplitude sin(2 pi f t + phase); offset = amplitude, phase = -pi/2 gives 0 -> 2A."""
 
     amplitude_Pa: float = _f("amplitude")
@@ -143,12 +149,6 @@ class Sine:
             object.__setattr__(self, name, finite(name, getattr(self, name)))
         object.__setattr__(self, "frequency_Hz", positive("frequency_Hz", self.frequency_Hz))
 
-    @property
-    def period(self) -> float:
-        return 1.0 / self.frequency_Hz
-
-    duration = None
-
     def __call__(self, t):
         t = np.asarray(t, dtype=float)
         return self.offset_Pa + self.amplitude_Pa * np.sin(2 * np.pi * self.frequency_Hz * t + self.phase_rad)
@@ -156,14 +156,11 @@ class Sine:
     def breakpoints(self, t0: float, t1: float) -> np.ndarray:
         return np.empty(0)
 
-    def to_dict(self) -> dict:
-        return {"kind": "sine", "amplitude_Pa": self.amplitude_Pa, "frequency_Hz": self.frequency_Hz,
-                "offset_Pa": self.offset_Pa, "phase_rad": self.phase_rad}
 
 
 @WAVEFORMS.register("table")
 @dataclass(frozen=True, eq=False)
-class TableWaveform:
+class TableWaveform(_Waveform):
     """User table (t_s, pressure_Pa); ``interp`` "linear" or "step" (hold previous); end value held.
 
     With ``periodic`` the table repeats with period t_s[-1] (t_s[0] must be 0).
@@ -219,9 +216,6 @@ class TableWaveform:
             b = self.t_s
         return np.unique(b[(b > t0) & (b < t1)])
 
-    def to_dict(self) -> dict:
-        return {"kind": "table", "t_s": self.t_s.tolist(), "pressure_Pa": self.pressure_Pa.tolist(),
-                "interp": self.interp, "periodic": self.periodic}
 
 
 def waveform_from_dict(d: dict):
