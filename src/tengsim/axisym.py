@@ -167,15 +167,17 @@ class AxisymSphere:
             D = D + dx[n]
         return None
 
-    def trace(self, d_start: float = -2.5, d_end: float = 0.5, ds: float = 0.01, ds_max: float = 0.02,
+    def trace(self, d_start: float | None = None, d_end: float = 0.5, ds: float = 0.01, ds_max: float = 0.02,
               dh_max: float = 0.05, tol: float = 1e-9, max_steps: int = 20000) -> Curve:
-        """Follow the equilibrium curve from D = ``d_start`` (apart) until D >= ``d_end``.
+        """Follow the equilibrium curve from D = ``d_start`` (apart; default −(1.5 + 1.5μ)) until D >= ``d_end``.
 
         Pseudo-arclength in x = (nodal gaps, D) with the metric mean(ΔH²) + ΔD², secant predictor; a
         step is halved when Newton fails or when any nodal gap moves by more than ``dh_max`` (so the
         curve is resolved where the contact edge runs), and grows again after easy steps, up to
         ``ds_max``.  The curve passes turning points in D, where D alone could not parametrise it.
         """
+        if d_start is None:
+            d_start = -(1.5 + 1.5 * self.mu)           # apart, beyond the jump-out (≈ −1.74 at μ = 1, −3.38 at μ = 2)
         H = self.solve_at(d_start)
         D = d_start
         n = H.size
@@ -238,6 +240,22 @@ def _turning(D, i):
     return float(y1 - (y0 - y2) ** 2 / (8 * den))
 
 
+def pull_off_state(curve: Curve) -> tuple[float, float, float]:
+    """(∬P dA, D, contact radius) at the force minimum of the curve: vertex of the parabola through the
+    minimal sample and its neighbours (in arclength index), D and radius interpolated to it."""
+    F = curve.force
+    i = int(np.argmin(F))
+    if i == 0 or i == len(F) - 1:
+        return float(F[i]), float(curve.D[i]), float(curve.contact_radius[i])
+    f0, f1, f2 = F[i - 1], F[i], F[i + 1]
+    den = f0 - 2 * f1 + f2
+    u = 0.5 * (f0 - f2) / den if den > 0 else 0.0       # vertex offset in samples, |u| <= 1/2
+    fmin = f1 - 0.25 * (f0 - f2) * u
+    j = i + (1 if u > 0 else -1)
+    lerp = lambda y: float(y[i] + abs(u) * (y[j] - y[i]))
+    return float(fmin), lerp(curve.D), lerp(curve.contact_radius)
+
+
 def walk(curve: Curve) -> Walk:
     """Displacement-controlled approach (D up) and retraction (D down) along ``curve``.
 
@@ -280,3 +298,34 @@ def walk(curve: Curve) -> Walk:
     ret, jout = run(range(n - 1, -1, -1))
     return Walk(float(jin), float(jout), float(F[ret].min()), float(F.min()),
                 bool(not np.isnan(jin) or not np.isnan(jout)))
+
+
+@dataclass(frozen=True)
+class MaugisSphere:
+    """Maugis–Dugdale theory in this module's (and the engine's) sphere units: pull-off ∬P/π (= |F|/(πWR)),
+    contact radii in ℓ = sqrt(Rε) at pull-off and at zero load, approach D (ε) at pull-off."""
+
+    lam: float
+    pull_off: float
+    a_pull_off: float
+    a_zero_load: float
+    D_pull_off: float
+
+
+def maugis_sphere(mu: float, sigma0: float | None = None) -> MaugisSphere:
+    """Maugis' theory (tengsim.references) for the dimensionless sphere R = ε = W = 1, E* = μ^{−3/2}.
+
+    With these values the references' SI-like formulas return the engine's units directly: forces in
+    W R (so P̄ = |F|/(πWR) = −∬P/π), lengths in ℓ = sqrt(Rε) = 1, indentation in ε.  λ from the
+    Dugdale stress ``sigma0`` (default the LJ93 peak 16/(9√3), giving λ = 1.157 μ)."""
+    from tengsim import references as ref
+    from tengsim.interaction import LJ_PEAK_TENSION
+
+    R, E_star, W = 1.0, positive("mu", mu) ** -1.5, 1.0
+    lam = ref.md_lambda(R, E_star, W, LJ_PEAK_TENSION if sigma0 is None else sigma0)
+    sc = ref.md_scales(R, E_star, W)
+    pt = ref.maugis_dugdale_pulloff_point(lam)
+    c = ref.maugis_dugdale_curve(lam, A_max=4.0, n=4000, A_min=1e-3)
+    i = int(np.argmin(c.P))
+    a0 = float(np.interp(0.0, c.P[i:], c.A[i:]))          # P increases with A past the minimum
+    return MaugisSphere(lam, -pt.P, pt.A * sc.length, a0 * sc.length, pt.D * sc.indentation)

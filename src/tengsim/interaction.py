@@ -181,8 +181,8 @@ class MaugisDugdale(Law):
     """
 
     tension: float = LJ_PEAK_TENSION
-    wall_stiffness: float = 100.0
-    smoothing: float = 0.02
+    wall_stiffness: float = 1000.0
+    smoothing: float = 0.2
     g_safe: float = 0.6
 
     def __post_init__(self):
@@ -230,8 +230,8 @@ class Exponential(Law):
     means the same as for LJ93.  Φ in W, P in W/ε.
     """
 
-    range: float = 1.0 / LJ_PEAK_TENSION - LJ_PEAK_TENSION / 200.0
-    wall_stiffness: float = 100.0
+    range: float = 1.0 / LJ_PEAK_TENSION - LJ_PEAK_TENSION / 2000.0
+    wall_stiffness: float = 1000.0
     g_safe: float = 0.6
 
     def __post_init__(self):
