@@ -135,8 +135,9 @@ def md_sphere(mu, dx, cell, d_min, **law):
 
 
 def test_md_sphere_pulloff_vs_maugis_mu03():
-    """2-D engine, MD law, μ = 0.3 (λ = 0.347), dx = 0.1: pull-off +0.16 % from Maugis (asserted
-    0.5 %); contact radius at pull-off +3 % (a = 4 pixels; asserted 6 %)."""
+    """2-D engine, MD law, μ = 0.3 (λ = 0.347), dx = 0.1, cell 4: pull-off +0.08 % from Maugis
+    (asserted 0.5 %); wall-zone radius at pull-off −1.9 % (a = 4 pixels, and dP/dA = 0 there, so it
+    is ill-conditioned: +3.1 % with cell 6; asserted 6 %)."""
     m = maugis_sphere(0.3)
     p, a = md_sphere(0.3, 0.1, 4.0, -1.2)
     assert p == pytest.approx(m.pull_off, rel=5e-3)
