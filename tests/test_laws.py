@@ -162,7 +162,9 @@ def test_md_sphere_converged_mu03():
 
 @pytest.mark.slow
 def test_md_sphere_converged_mu1():
-    """μ = 1 (λ = 1.157), cell 6: pull-off +0.98 % at dx 0.1, +0.07 % at dx 0.05; asserted 1 % at dx 0.05."""
+    """μ = 1 (λ = 1.157), cell 6, dx 0.1 → 0.05: pull-off +0.98 → +0.07 %, zero-load radius
+    +0.69 → +0.22 %; asserted 1 % at dx 0.05."""
     m = maugis_sphere(1.0)
-    p, _, _ = md_sphere(1.0, 0.05, 6.0, -2.0)
+    p, _, a0 = md_sphere(1.0, 0.05, 6.0, -1.2, d_max=4.0)
     assert p == pytest.approx(m.pull_off, rel=1e-2)
+    assert a0 == pytest.approx(m.a_zero_load, rel=1e-2)
