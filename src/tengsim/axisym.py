@@ -111,13 +111,14 @@ class AxisymSphere:
         self.U0 = 0.5 * self.r ** 2
         self.contact_gap = contact_gap
 
-    # -- the law, with a finite-difference derivative only where a law gives none -------------------
     def _p_dp(self, g):
+        """P(g) and dP/dg (= −``law.stiffness``) at the nodal gaps."""
         P = self.law.pressure(g)
         dP = -self.law.stiffness(g)
         return P, dP
 
     def residual(self, H, D):
+        """Residual of Eq. (9) at the ring mid-radii, units of ε."""
         P, _ = self._p_dp(H + 1.0)
         return H + D - self.U0 - self.C @ P
 
