@@ -74,7 +74,7 @@ def test_axisym_mu1_has_turning_points():
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("mu", [0.5, 1.0])
+@pytest.mark.parametrize("mu", [0.5, 1.0, 2.0])
 def test_axisym_converged_in_radial_mesh(mu):
     (_, w1), (_, w2) = axisym(mu, 0.04), axisym(mu, 0.02)
     assert w1.pull_off == pytest.approx(w2.pull_off, rel=1e-4)
