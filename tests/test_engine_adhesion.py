@@ -7,8 +7,10 @@ Units: lateral ℓ = sqrt(Rε), κ = μ^{3/2}; the total force is f = W R ∬P d
 
 Measured (docs/validation.md): the LJ sphere's |pull-off| exceeds MD by +1.4 % (μ = 0.1),
 +5.6 % (μ = 0.5), +5.4 % (μ = 1), +1.6 % (μ = 3); converged in dx, cell and D step to < 0.1 %.
-The stated tolerance against MD is therefore 7 % (relative); the checks against the DMT/JKR
-limits and the grid-convergence checks are tighter.
+That difference is the LJ law's, not an error, so Maugis–Dugdale is no reference for these runs: the
+pull-off is checked against the independent axisymmetric solution of the same LJ problem
+(tengsim.axisym; tests/test_axisym.py for μ = 0.5 and 1 at 0.3 %, here μ = 1 and 3 on fine grids), and
+against the DMT/JKR limits and grid convergence.
 """
 from __future__ import annotations
 
@@ -24,7 +26,16 @@ from tengsim.kernels import FreeKernel
 from tengsim.path import PathSpec, run_path
 from tengsim.solvers import FastSolver
 
-MD_TOL = 0.07
+AXISYM_TOL = 3e-3  # the 2-D engine at dx 0.1–0.2 against the rings (dr 0.04, mesh-converged to 1e-4, 1e-3 at μ = 3)
+
+
+@lru_cache(maxsize=None)
+def axisym_pulloff(mu: float) -> float:
+    """|∬P|/π at pull-off of the axisymmetric reference (rings, dr 0.04)."""
+    from tengsim.axisym import AxisymSphere, walk
+
+    c = AxisymSphere(mu, LJ93(), dr=0.04).trace(d_start=-2.0 * mu)
+    return -walk(c).pull_off / np.pi
 
 
 @lru_cache(maxsize=None)
@@ -46,14 +57,14 @@ CHEAP = {0.1: (0.1, 0.2, 16.0, -1.2), 0.5: (0.5, 0.2, 16.0, -1.2), 1.0: (1.0, 0.
 
 
 @pytest.mark.parametrize("mu", [0.1, 0.5, 1.0])
-def test_pulloff_vs_maugis_dugdale(mu):
+def test_pulloff_between_jkr_and_dmt_and_above_maugis_dugdale(mu):
+    """Between the JKR (1.5) and DMT (2) limits, and above Maugis–Dugdale: the LJ law's tension acts
+    over a longer range than Dugdale's step (measured +1.4 / +5.6 / +5.4 %)."""
     res = sphere_run(*CHEAP[mu])
     assert res.all_converged
-    p_md = ref.maugis_dugdale_pulloff_from_tabor(mu)
     measured = -pulloff_integral(res) / np.pi
-    assert measured == pytest.approx(p_md, rel=MD_TOL)
-    # bounded by the two limits
     assert 1.5 < measured < 2.0
+    assert measured > ref.maugis_dugdale_pulloff_from_tabor(mu)
 
 
 def test_pulloff_small_mu_tends_to_dmt():
@@ -92,24 +103,25 @@ def test_no_jumps_at_small_mu_and_jumps_at_mu_1():
 
 @pytest.mark.slow
 @pytest.mark.parametrize("mu", [0.5, 1.0])
-def test_pulloff_vs_md_fine_grid(mu):
+def test_pulloff_fine_grid_vs_axisym(mu):
     res = sphere_run(mu, 0.1, 16.0, -2.0)
     assert res.all_converged
     measured = -pulloff_integral(res) / np.pi
-    assert measured == pytest.approx(ref.maugis_dugdale_pulloff_from_tabor(mu), rel=MD_TOL)
+    assert measured == pytest.approx(axisym_pulloff(mu), rel=AXISYM_TOL)
     assert measured == pytest.approx(-pulloff_integral(sphere_run(*CHEAP[mu])) / np.pi, rel=2e-3)
 
 
 @pytest.mark.slow
 def test_pulloff_large_mu_tends_to_jkr():
-    """μ = 3 (dx = 0.1, cell 12): |∬P| within 4 % of JKR 1.5π (measured 1.553π, +3.5 %) and MD_TOL of MD; jumps and hysteresis.
+    """μ = 3 (dx = 0.1, cell 12): |∬P| within 4 % of JKR 1.5π (measured 1.553π, +3.5 %) and within 0.3 % of
+    the axisymmetric reference (1.5522π at dr 0.04, 1.5511π at dr 0.02); jumps and hysteresis.
 
     (At this μ the process zone is narrower than a few pixels, so the contact edge also advances
     ring by ring on the pixel lattice: several small 'jumps' are recorded on each branch.)"""
     res = sphere_run(3.0, 0.1, 12.0, -3.0)
     measured = -pulloff_integral(res) / np.pi
     assert measured == pytest.approx(1.5, rel=0.04)
-    assert measured == pytest.approx(ref.maugis_dugdale_pulloff_from_tabor(3.0), rel=MD_TOL)
+    assert measured == pytest.approx(axisym_pulloff(3.0), rel=AXISYM_TOL)
     assert len([j for j in res.jumps if j.branch == "approach"]) > 0
     assert len([j for j in res.jumps if j.branch == "retraction"]) > 0
     assert res.hysteresis > 0

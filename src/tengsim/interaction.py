@@ -146,10 +146,127 @@ class Repulsive(Law):
         return phi, p, dp
 
 
+#: Peak tension of the LJ93 law, 16/(9√3) W/ε (at g = 3^{1/6}): the default stress of the other laws,
+#: so that the Tabor parameter μ means the same for every built-in law.
+LJ_PEAK_TENSION = 16.0 / (9.0 * 3.0**0.5)
+
+
+def _check_common(law):
+    positive("wall_stiffness", law.wall_stiffness)
+    if not 0 < law.g_safe < 1:
+        raise TengsimError(f"g_safe must lie in (0, 1), got {law.g_safe!r}")
+
+
+def _wall(g, sigma, k, phi1):
+    """Linear wall for g < 1: P = −σ + k(1 − g), Φ = Φ(1) − σ(1 − g) + k(1 − g)²/2, dP/dg = −k.
+
+    Continuous with a tension σ at g = 1; zero load at g = 1 − σ/k, where Φ = Φ(1) − σ²/(2k).
+    """
+    t = 1.0 - g
+    return phi1 - sigma * t + 0.5 * k * t * t, -sigma + k * t, np.full_like(g, -k)
+
+
+@dataclass(frozen=True)
+class MaugisDugdale(Law):
+    """Dugdale law (Maugis 1992): constant tension σ0 = ``tension`` over 1 < g < 1 + h0, a wall below.
+
+    Wall (g < 1): P = −σ0 + k(1 − g), k = ``wall_stiffness`` (W/ε²), so the contact zone g <= 1 carries
+    any pressure down to −σ0, as in Maugis' model, and is rigid as k → ∞ (its compliance σ0/k ε).
+    Beyond the range the law is zero.  The range is h0 = 1/σ0 − σ0/(2k) (ε), so that the work of
+    adhesion, −Φ at the zero-load gap 1 − σ0/k, is exactly 1 (= W); h0 → W/σ0 as k → ∞.  With the
+    default σ0 = 16/(9√3), the LJ93 peak tension, Maugis' λ = 2σ0 (R/(πWK²))^{1/3} = 1.157 μ
+    (Greenwood 1997), so ``tabor`` means the same as for LJ93.  The step at g = 1 + h0 is a smoothstep
+    ramp 3t² − 2t³ of width ``smoothing`` centred on it (area, hence W, unchanged), so P and dP/dg are
+    continuous for the solvers.  Φ is in W, P in W/ε.
+    """
+
+    tension: float = LJ_PEAK_TENSION
+    wall_stiffness: float = 1000.0
+    smoothing: float = 0.2
+    g_safe: float = 0.6
+
+    def __post_init__(self):
+        positive("tension", self.tension)
+        _check_common(self)
+        if not self.smoothing > 0:
+            raise TengsimError(f"smoothing must be > 0, got {self.smoothing!r}")
+        if not self.range > 0:
+            raise TengsimError(f"wall_stiffness={self.wall_stiffness!r} is too small for tension={self.tension!r}: "
+                               "the range h0 = 1/σ0 − σ0/(2k) must be > 0")
+        if not self.smoothing < self.range:
+            raise TengsimError(f"smoothing must be smaller than the range h0 = {self.range:.4g}, "
+                               f"got {self.smoothing!r}")
+
+    @property
+    def range(self) -> float:
+        """h0 = 1/σ0 − σ0/(2k) in ε (W = σ0 h0 + σ0²/(2k) = 1)."""
+        return 1.0 / self.tension - self.tension / (2.0 * self.wall_stiffness)
+
+    def _raw(self, g, need_dp=True):
+        s0, k, s = self.tension, self.wall_stiffness, self.smoothing
+        h0 = self.range
+        ge = 1.0 + h0                                    # the range's end, centre of the ramp
+        hi = ge + 0.5 * s
+        phi_w, p_w, dp_w = _wall(g, s0, k, -s0 * h0)
+        t = np.clip((hi - g) / s, 0.0, 1.0)              # 1 inside the zone, 0 beyond
+        phi_z = np.where(g > ge - 0.5 * s, -s0 * s * (t**3 - 0.5 * t**4), -s0 * (ge - g))
+        p_z = -s0 * t * t * (3.0 - 2.0 * t)               # smoothstep: P and dP/dg continuous
+        dp_z = 6.0 * s0 / s * t * (1.0 - t)
+        wall = g < 1.0
+        phi = np.where(wall, phi_w, phi_z)
+        p = np.where(wall, p_w, p_z)
+        dp = np.where(wall, dp_w, dp_z) if need_dp else None
+        return phi, p, dp
+
+
+@dataclass(frozen=True)
+class Exponential(Law):
+    """Exponential attraction with a wall (the contact-mechanics challenge's kind, Müser et al. 2017).
+
+    g >= 1: Φ = −A exp(−(g − 1)/ρ), P = −(A/ρ) exp(−(g − 1)/ρ), range ρ = ``range`` (ε); peak
+    tension A/ρ at g = 1.  Wall (g < 1): P = −A/ρ + k(1 − g), k = ``wall_stiffness`` (W/ε²), as in
+    :class:`MaugisDugdale`.  A = 2/(1 + sqrt(1 + 2/(kρ²))) makes the work of adhesion exactly 1 (= W).
+    The default ρ = 1/σ − σ/(2k) with σ = 16/(9√3) gives the LJ93 peak tension, so ``tabor``
+    means the same as for LJ93.  Φ in W, P in W/ε.
+    """
+
+    range: float = 1.0 / LJ_PEAK_TENSION - LJ_PEAK_TENSION / 2000.0
+    wall_stiffness: float = 1000.0
+    g_safe: float = 0.6
+
+    def __post_init__(self):
+        positive("range", self.range)
+        _check_common(self)
+
+    @property
+    def amplitude(self) -> float:
+        """A, the depth Φ(1) of the attraction (W): A + (A/ρ)²/(2k) = 1."""
+        return 2.0 / (1.0 + np.sqrt(1.0 + 2.0 / (self.wall_stiffness * self.range**2)))
+
+    @property
+    def tension(self) -> float:
+        """Peak tension A/ρ (W/ε), at g = 1."""
+        return self.amplitude / self.range
+
+    def _raw(self, g, need_dp=True):
+        A, rho, k = self.amplitude, self.range, self.wall_stiffness
+        e = np.exp(-np.maximum(g - 1.0, 0.0) / rho)
+        phi_w, p_w, dp_w = _wall(g, A / rho, k, -A)
+        wall = g < 1.0
+        phi = np.where(wall, phi_w, -A * e)
+        p = np.where(wall, p_w, -(A / rho) * e)
+        dp = np.where(wall, dp_w, (A / rho**2) * e) if need_dp else None
+        return phi, p, dp
+
+
 def make_law(name: str, **params) -> Law:
-    """Law by registered name or alias (see ``tengsim.registry.LAWS``): 'lj93' (the paper's) or 'repulsive'."""
+    """Law by registered name or alias (see ``tengsim.registry.LAWS``): 'lj93' (the paper's), 'repulsive',
+    'md' (Maugis–Dugdale) or 'exp' (exponential)."""
     return LAWS.get(name)(**params)
 
 
 LAWS.register("lj93", LJ93, aliases=("lj", "paper", "lj82"), summary="the paper's 9-3 law, Eq. (2)/(8)")
 LAWS.register("repulsive", Repulsive, aliases=("hertz", "nonadhesive"), summary="non-adhesive wall")
+LAWS.register("md", MaugisDugdale, aliases=("maugis_dugdale", "dugdale"),
+              summary="Maugis–Dugdale: constant tension over a range, stiff wall")
+LAWS.register("exp", Exponential, aliases=("exponential",), summary="exponential attraction, stiff wall")

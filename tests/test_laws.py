@@ -1,0 +1,170 @@
+"""Interaction laws beyond the paper's: Maugis–Dugdale (``md``) and exponential (``exp``).
+
+Checks: P = −dΦ/dg and Φ'' = −dP/dg; work of adhesion exactly 1 (= W); peak tension equal to the
+LJ93 law's 16/(9√3), so Maugis' λ (references.md_lambda with the dimensionless R = ε = W = 1,
+E* = μ^{−3/2}) equals Greenwood's 1.157 μ; registry names, CLI and TOML; and the MD law on a sphere
+against Maugis' theory (docs/validation.md, section "Interaction laws").
+"""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from tengsim import references as ref
+from tengsim.axisym import maugis_sphere
+from tengsim.cli.main import main
+from tengsim.errors import TengsimError
+from tengsim.interaction import LJ93, LJ_PEAK_TENSION, Exponential, MaugisDugdale, make_law
+from tengsim.registry import LAWS
+
+LAWS_UNDER_TEST = [MaugisDugdale(), MaugisDugdale(smoothing=0.1, wall_stiffness=30.0),
+                   Exponential(), Exponential(range=0.5, wall_stiffness=50.0)]
+
+
+def sphere_md_units(mu):
+    """Dimensionless sphere (R = 1, ε = 1, W = 1 so E* = μ^{−3/2}) as the SI-like arguments of
+    tengsim.references: κ = μ^{3/2} = 1/E*, forces in W R, lengths in ℓ = sqrt(Rε) = 1."""
+    return dict(R=1.0, E_star=mu ** -1.5, W=1.0)
+
+
+@pytest.mark.parametrize("law", LAWS_UNDER_TEST)
+def test_pressure_is_minus_energy_derivative(law):
+    g = np.linspace(0.7, 3.5, 28001)
+    h = 1e-6
+    phi_p, _ = law.evaluate(g + h)
+    phi_m, _ = law.evaluate(g - h)
+    _, p = law.evaluate(g)
+    sel = np.abs(g - 1.0) > 1e-3                  # away from the wall's kink in dP/dg at g = 1
+    assert np.max(np.abs(-(phi_p - phi_m) / (2 * h) - p)[sel]) < 1e-6
+    assert np.max(np.abs(-(phi_p - phi_m) / (2 * h) - p)) < law.wall_stiffness * h   # P continuous across it
+    dp = (law.pressure(g + h) - law.pressure(g - h)) / (2 * h)
+    assert np.max(np.abs((dp + law.stiffness(g))[sel])) < 1e-4 * max(1.0, np.max(np.abs(dp)))
+
+
+@pytest.mark.parametrize("law", LAWS_UNDER_TEST)
+def test_work_of_adhesion_is_one_and_range_finite(law):
+    k = law.wall_stiffness
+    sigma = law.tension
+    g_eq = 1.0 - sigma / k                       # zero-load gap of the wall
+    phi, p = law.evaluate(np.array([g_eq, 1.0, 40.0]))
+    assert p[0] == pytest.approx(0.0, abs=1e-12)
+    assert phi[0] == pytest.approx(-1.0, abs=1e-12)
+    assert p[1] == pytest.approx(-sigma, rel=1e-12)       # tension at contact edge
+    assert abs(phi[2]) < 1e-12 and abs(p[2]) < 1e-12
+    g = np.linspace(0.5, 4.0, 70001)
+    assert law.pressure(g).min() == pytest.approx(-sigma, rel=1e-9)
+
+
+def test_default_tension_is_lj_peak_and_lambda_is_1157_mu():
+    g = np.linspace(1.0, 2.0, 200001)
+    assert -LJ93().pressure(g).min() == pytest.approx(LJ_PEAK_TENSION, rel=1e-9)
+    assert MaugisDugdale().tension == pytest.approx(LJ_PEAK_TENSION, rel=1e-12)
+    assert Exponential().tension == pytest.approx(LJ_PEAK_TENSION, rel=1e-12)
+    for mu in (0.3, 1.0, 3.0):
+        lam = ref.md_lambda(sigma0=MaugisDugdale().tension, **sphere_md_units(mu))
+        assert lam == pytest.approx(ref.md_lambda_from_tabor(mu), rel=1e-12)
+        assert lam / mu == pytest.approx(1.157, abs=5e-4)
+    # range h0 -> W/σ0 = 9√3/16 as the wall gets rigid
+    assert MaugisDugdale(wall_stiffness=1e9).range == pytest.approx(9 * 3**0.5 / 16, rel=1e-8)
+
+
+def test_bad_parameters_are_named():
+    with pytest.raises(TengsimError, match="smoothing"):
+        MaugisDugdale(smoothing=2.0)
+    with pytest.raises(TengsimError, match="wall_stiffness"):
+        MaugisDugdale(wall_stiffness=0.1)
+    with pytest.raises(TengsimError, match="range"):
+        Exponential(range=-1.0)
+
+
+def test_registered_names_and_params():
+    assert type(make_law("md")) is MaugisDugdale
+    for alias in ("maugis_dugdale", "dugdale"):
+        assert LAWS.canonical(alias) == "md"
+    assert type(make_law("exponential")) is Exponential
+    p = MaugisDugdale().params()
+    assert set(p) == {"tension", "wall_stiffness", "smoothing", "g_safe", "law"}
+    assert all(isinstance(v, (float, str)) for v in p.values())
+    assert set(Exponential().params()) == {"range", "wall_stiffness", "g_safe", "law"}
+
+
+ARGS = ["contact", "sphere", "--tabor", "1", "--dx", "0.5", "--cell", "4", "--d-min", "-2",
+        "--d-max", "0", "--d-step", "1", "--quiet"]
+
+
+def test_cli_and_toml_select_md(tmp_path):
+    out = tmp_path / "md.csv"
+    assert main(ARGS + ["--law", "md", "--out", str(out)]) == 0
+    head = "".join(l for l in open(out) if l.startswith("#"))
+    assert '# law: "MaugisDugdale"' in head and "# smoothing: 0.2" in head
+    cfg = tmp_path / "md.toml"
+    out2 = tmp_path / "md2.csv"
+    cfg.write_text(f'[contact]\nshape = "sphere"\ntabor = 1\ndx = 0.5\ncell = 4\nd_min = -2\nd_max = 0\n'
+                   f'd_step = 1\nlaw = "dugdale"\nout = "{out2}"\n')
+    assert main(["run", str(cfg), "--quiet"]) == 0
+    import csv
+    cols = lambda f: [(r["branch"], r["D"], r["F"]) for r in
+                      csv.DictReader(l for l in open(f) if not l.startswith("#"))]
+    assert cols(out) == cols(out2)
+
+
+def test_cli_unknown_law_lists_md(tmp_path, capsys):
+    assert main(ARGS + ["--law", "bogus", "--out", str(tmp_path / "x.csv")]) == 2
+    err = capsys.readouterr().err
+    assert "bogus" in err and "md" in err
+    assert not (tmp_path / "x.csv").exists()
+
+
+class WallZone:
+    """Observer: radius sqrt(A/π) of the wall zone g <= 1 (Maugis' contact area: gap closed)."""
+
+    columns = ("a_wall",)
+
+    def __call__(self, eq, ctx):
+        return {"a_wall": float(np.sqrt((eq.H <= 0.0).sum() * ctx.grid.area / np.pi))}
+
+
+def md_sphere(mu, dx, cell, d_min, d_max=0.5, **law):
+    """2-D engine, MD law: (P̄ = −∬P/π at pull-off, wall-zone radius there, wall-zone radius at zero
+    load on retraction (NaN if F never turns compressive))."""
+    import tengsim
+    res = tengsim.simulate(tengsim.Paraboloid(1.0, cell), mu, dx, tengsim.PathSpec(d_min, d_max, 0.05),
+                           law=MaugisDugdale(**law), observers=[WallZone()])
+    assert res.all_converged
+    r = res.branch("retraction")
+    i = int(np.argmin(r["F"]))
+    F, a = r["F"], r["a_wall"]
+    j = np.flatnonzero((F[:-1] > 0) & (F[1:] <= 0))
+    a0 = float(a[j[0]] + (a[j[0] + 1] - a[j[0]]) * F[j[0]] / (F[j[0]] - F[j[0] + 1])) if len(j) else np.nan
+    return -3 * F[i], a[i], a0
+
+
+def test_md_sphere_pulloff_vs_maugis_mu03():
+    """2-D engine, MD law, μ = 0.3 (λ = 0.347), dx = 0.1, cell 4: pull-off +0.08 % from Maugis
+    (asserted 0.5 %); wall-zone radius at pull-off −1.9 % (a = 4 pixels, and dP/dA = 0 there, so it
+    is ill-conditioned: +3.1 % with cell 6; asserted 6 %)."""
+    m = maugis_sphere(0.3)
+    p, a, _ = md_sphere(0.3, 0.1, 4.0, -1.2)
+    assert p == pytest.approx(m.pull_off, rel=5e-3)
+    assert a == pytest.approx(m.a_pull_off, rel=0.06)
+
+
+@pytest.mark.slow
+def test_md_sphere_converged_mu03():
+    """μ = 0.3, dx 0.1 → 0.05 (cell 6): pull-off +0.16 → +0.07 %, zero-load radius +2.5 → +0.75 %
+    (the rings give +0.05 % and +0.5 %, the rest of the radius error is the wall's compliance at
+    k = 1000); asserted 1 % at dx 0.05."""
+    m = maugis_sphere(0.3)
+    p, _, a0 = md_sphere(0.3, 0.05, 6.0, -1.2, d_max=1.5)
+    assert p == pytest.approx(m.pull_off, rel=1e-2)
+    assert a0 == pytest.approx(m.a_zero_load, rel=1e-2)
+
+
+@pytest.mark.slow
+def test_md_sphere_converged_mu1():
+    """μ = 1 (λ = 1.157), cell 6, dx 0.1 → 0.05: pull-off +0.98 → +0.07 %, zero-load radius
+    +0.69 → +0.22 %; asserted 1 % at dx 0.05."""
+    m = maugis_sphere(1.0)
+    p, _, a0 = md_sphere(1.0, 0.05, 6.0, -1.2, d_max=4.0)
+    assert p == pytest.approx(m.pull_off, rel=1e-2)
+    assert a0 == pytest.approx(m.a_zero_load, rel=1e-2)
