@@ -128,7 +128,7 @@ def common_fields() -> list:
         Field("f_max", "any", None, check=_load_value, help="control = load: largest load (as f_min)"),
         Field("f_step", "any", None, check=_load_value, help="control = load: load step (as f_min)"),
         Field("adaptive", "bool", False, help="control = approach: adaptive steps in D (d_step the largest)"),
-        Field("adapt_tol", "float", None, help="adaptive: force error tolerance of a step (default 0.075)"),
+        Field("adapt_tol", "float", None, help="adaptive: force error tolerance of a step (PathSpec default 0.15)"),
         Field("boundary", "str", "free", choices=KERNELS.names, help="elastic kernel: " + KERNELS.help()),
         Field("solver", "str", "fast", choices=SOLVERS.names, help="solver: " + SOLVERS.help()),
         Field("tol", default=1e-6, help="max residual of Eq. (9) in ε"),
