@@ -141,8 +141,8 @@ def main(argv=None):
     ap.add_argument("--fixed-step", type=float, default=0.1)
     ap.add_argument("--refine", type=int, default=4)
     ap.add_argument("--factor", type=int, default=8, help="largest adaptive step / fixed step (power of 2)")
-    ap.add_argument("--tol", type=float, default=0.075, help="adapt_tol")
-    ap.add_argument("--adapt-h", type=float, default=1.0, help="adapt_h")
+    ap.add_argument("--tol", type=float, default=0.15, help="adapt_tol")
+    ap.add_argument("--adapt-h", type=float, default=0.5, help="adapt_h")
     ap.add_argument("--out", default=None)
     args = ap.parse_args(argv)
     rows = []

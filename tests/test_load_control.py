@@ -140,3 +140,24 @@ def test_load_path_has_the_status_and_observer_columns_of_a_d_path():
     assert {"apex_gap", "process_zone", "status"} <= set(res.table)
     assert np.all(np.isfinite(res.table["apex_gap"]))
     assert res.status in ("ok", "under_resolved")
+
+
+def test_paper_area_table_load_controlled_matches_d_picked():
+    """Figs. 5 and 8 (issue 15): the load-controlled A(P) of group A lies, at every load, between the
+    A/S of the two D-picked states that bracket its pressure, to one grid pixel of λc."""
+    from tengsim.cases.paper.contact import (RunSettings, area_table_from_load_result, area_table_from_result,
+                                             compare_area_tables, run_group, run_group_load)
+
+    s = RunSettings(dx=0.3, d_step=0.25, d_max=5.0, tol=1e-5, n_loads=12, p_step_Pa=1e9)
+    res = run_group("A", s)
+    f_max = float(np.max(res.branch("approach")["F"]))
+    lres = run_group_load("A", f_max, s)
+    assert lres.params["control"] == "load" and lres.all_converged
+    on = lres.branch("approach")
+    F_on = on["F"][on["on_grid"].astype(bool)]
+    np.testing.assert_allclose(F_on, f_max / 12 * np.arange(13), atol=1e-4 * f_max / 12)
+    load, picked = area_table_from_load_result(lres, "A"), area_table_from_result(res, "A")
+    assert load.pressure_Pa[-1] == pytest.approx(picked.pressure_Pa[-1], rel=1e-3)
+    cmp = compare_area_tables(load, picked, "A", s.dx)
+    assert cmp["n_compared"] >= 11
+    assert cmp["max_excess"] == 0.0

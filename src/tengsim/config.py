@@ -13,7 +13,7 @@ import inspect
 from dataclasses import dataclass, field
 
 from tengsim import film
-from tengsim.errors import TengsimError, positive
+from tengsim.errors import TengsimError, finite, positive
 from tengsim.interaction import make_law
 from tengsim.path import PathSpec
 from tengsim.registry import KERNELS, LAWS, OBSERVERS, SHAPES, SOLVERS, ensure_builtins
@@ -39,6 +39,69 @@ def _observer_names(v):
     return tuple(OBSERVERS.canonical(x) for x in v)
 
 
+CONTROLS = ("approach", "load")
+"""Path controls of a [contact] table: the rigid approach D (PathSpec) or the load F (LoadPathSpec)."""
+
+_LOAD_KEYS = ("f_min", "f_max", "f_step")
+_ADAPTIVE_KEYS = ("adaptive", "adapt_tol")
+
+
+def _load_value(v, label="load"):
+    """A load key: a number (F of Eq. 10) or a string, a number or a pressure with a unit (checked later)."""
+    if isinstance(v, bool) or not isinstance(v, (int, float, str)):
+        raise TengsimError(f"{label} must be a number or a pressure with a unit, got {v!r}")
+    if isinstance(v, str):
+        try:
+            return float(v)
+        except ValueError:
+            return v.strip()
+    return float(v)
+
+
+def _load_F(name, v, scaling):
+    """A load key's value as F of Eq. (10): numbers as they are, a pressure p as p·cell area / force unit."""
+    from tengsim.units import parse_quantity
+
+    if not isinstance(v, str):
+        return finite(name, v)
+    if scaling is None:
+        raise TengsimError(f"{name} = {v!r} has a unit, but this run is dimensionless: give {name} as F of "
+                           "Eq. (10) (or the shape's physical sizes with E_star and W)")
+    return finite(name, parse_quantity(v, "pressure", name=name) / scaling.pressure(1.0))
+
+
+def _path_spec(vals, given, scaling):
+    """The PathSpec (control = approach, fixed or adaptive) or LoadPathSpec (control = load) of a table."""
+    control = vals["control"]
+    if control == "load":
+        bad = [k for k in _ADAPTIVE_KEYS if k in given and (k != "adaptive" or vals[k])]
+        if bad:
+            raise TengsimError(f"{', '.join(bad)} {'does' if len(bad) == 1 else 'do'} not apply to control = "
+                               "'load' (adaptive steps are a D-path option)")
+        missing = [k for k in ("f_max", "f_step") if k not in given]
+        if missing:
+            raise TengsimError(f"control = 'load' needs {', '.join(missing)}")
+        from tengsim.loadpath import LoadPathSpec
+
+        f = {k: _load_F(k, vals[k], scaling) for k in _LOAD_KEYS if vals[k] is not None}
+        kw = {"d_min": vals["d_min"], "d_step": vals["d_step"]}
+        if "d_max" in given:  # else LoadPathSpec's wider search range
+            kw["d_max"] = vals["d_max"]
+        return LoadPathSpec(f.get("f_min", 0.0), f["f_max"], f["f_step"], refine_levels=vals["refine_levels"],
+                            maps_at=tuple(vals["maps_at"]), **kw)
+    bad = [k for k in _LOAD_KEYS if k in given]
+    if bad:
+        raise TengsimError(f"{', '.join(bad)} {'does' if len(bad) == 1 else 'do'} not apply to control = "
+                           "'approach' (give control = 'load')")
+    if "adapt_tol" in given and not vals["adaptive"]:
+        raise TengsimError("adapt_tol applies only with adaptive = true")
+    kw = {"adaptive": True} if vals["adaptive"] else {}
+    if vals["adapt_tol"] is not None:
+        kw["adapt_tol"] = vals["adapt_tol"]
+    return PathSpec(vals["d_min"], vals["d_max"], vals["d_step"], maps_at=tuple(vals["maps_at"]),
+                    refine_levels=vals["refine_levels"], **kw)
+
+
 def common_fields() -> list:
     """The [contact] keys every shape has (choices and help read from the registries)."""
     ensure_builtins()
@@ -55,7 +118,18 @@ def common_fields() -> list:
         Field("d_max", default=4.0, help="last rigid approach D, in ε"),
         Field("d_step", default=0.05, help="step in D, in ε"),
         Field("refine_levels", "int", 4, help="step bisections before a change is called a jump"),
-        Field("maps_at", "floats", (), help="D values whose pressure and gap maps are kept (.nc)"),
+        Field("maps_at", "floats", (), help="D values (control = load: loads F) whose pressure and gap maps "
+              "are kept (.nc)"),
+        Field("control", "str", "approach", choices=CONTROLS,
+              help="path control: approach (rigid approach D, Eq. 9) or load (total force F of Eq. 10, "
+              "D an unknown)"),
+        Field("f_min", "any", None, check=_load_value,
+              help="control = load: first load, F of Eq. (10) per cell (default 0); in a physical run "
+              "also a nominal pressure with a unit, e.g. '-2kPa'"),
+        Field("f_max", "any", None, check=_load_value, help="control = load: largest load (as f_min)"),
+        Field("f_step", "any", None, check=_load_value, help="control = load: load step (as f_min)"),
+        Field("adaptive", "bool", False, help="control = approach: adaptive steps in D (d_step the largest)"),
+        Field("adapt_tol", "float", None, help="adaptive: force error tolerance of a step (PathSpec default 0.15)"),
         Field("boundary", "str", "free", choices=KERNELS.names, help="elastic kernel: " + KERNELS.help()),
         Field("thickness", "any", None,
               help="film thickness on a rigid substrate (default: half-space), in X units; in a physical run "
@@ -154,7 +228,7 @@ class ContactPlan:
     shape: object
     tabor: float
     dx: float
-    path: PathSpec
+    path: object  # PathSpec or tengsim.loadpath.LoadPathSpec
     boundary: str
     solver: str
     tol: float
@@ -277,8 +351,7 @@ def plan_contact(cfg: dict) -> ContactPlan:
     raw_dx = cfg.get("dx")  # not given: the shape's own pixel (a height map's) or 0.1
     dx = _dx(raw_dx, lateral) if raw_dx not in (None, "") else getattr(shape, "native_dx", 0.1)
     kernel_params = _film(cfg, vals, lateral, extra)
-    path = PathSpec(vals["d_min"], vals["d_max"], vals["d_step"], maps_at=tuple(vals["maps_at"]),
-                    refine_levels=vals["refine_levels"])
+    path = _path_spec(vals, given, scaling)
     tol = positive("tol", vals["tol"])
     law = make_law(vals["law"])
     grid = shape.grid(dx)  # validates dx against the cell

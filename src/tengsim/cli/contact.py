@@ -52,7 +52,8 @@ def register(sub):
     for k, f in common.items():
         if k == "shape" or k in _CLI_ONLY:
             continue
-        p.add_argument("--" + k.replace("_", "-"), *_ALIASES.get(k, ()), dest=k,
+        flag = {"nargs": "?", "const": "true"} if f.kind == "bool" else {}  # --adaptive alone means true
+        p.add_argument("--" + k.replace("_", "-"), *_ALIASES.get(k, ()), dest=k, **flag,
                        help=f.describe().split(": ", 1)[1].replace("%", "%%"))
     for k, h in per_key.items():
         if k in _CLI_ONLY:

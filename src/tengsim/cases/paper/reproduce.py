@@ -16,8 +16,9 @@ import numpy as np
 
 from tengsim import __version__, io
 from tengsim.cases._json import json_safe
-from tengsim.cases.paper.contact import (FIG3_D, GROUPS, PAPER_TRANSITION_D, RunSettings, area_table_from_result,
-                                         contact_summary, run_group)
+from tengsim.cases.paper.contact import (FIG3_D, GROUPS, PAPER_TRANSITION_D, RunSettings,
+                                         area_table_from_load_result, area_table_from_result, compare_area_tables,
+                                         contact_summary, run_group, run_group_load)
 from tengsim.cases.paper.device import fig7_summary, fig8_summary, run_fig7, run_fig8
 
 # Section 4 (Fig. 5) constants: σ = 5.84 µC/m², ε_r = 2.40, T = 400 µm.
@@ -60,15 +61,28 @@ def reproduce(out_dir, quick: bool = False, progress_factory=None, log=None,
         plot_fig3(results, stage / "fig3.pdf", FIG3_D)
         plot_fig4(results, stage / "fig4.png", PAPER_TRANSITION_D)
         plot_fig4(results, stage / "fig4.pdf", PAPER_TRANSITION_D)
-        # Fig. 5: V_OC(pressure) by Eq. (12) from the load-controlled A(P) of each group
+        # Fig. 5: V_OC(pressure) by Eq. (12) from the load-controlled A(P) of each group (issue 15): a
+        # LoadPathSpec approach from F = 0 to the largest F the D path reached; the table picked from the
+        # D path is kept beside it for comparison (fig5.csv, summary 'area_table_vs_D_picked')
         curves, cols = {}, {}
         tables = {}
+        picked = {}
         for g, res in results.items():
-            tab = area_table_from_result(res, g)
+            f_max = float(np.max(res.branch("approach")["F"]))
+            say(f"contact: group {g} under load control (F 0..{f_max:.4g}, steps <= {settings.p_step_Pa:g} Pa)")
+            prog = progress_factory(f"group {g} load") if progress_factory else None
+            lres = run_group_load(g, f_max, settings, progress=prog)
+            if prog is not None and hasattr(prog, "close"):
+                prog.close()
+            lres.save(stage / f"contact_{g}_load.csv")
+            tab = area_table_from_load_result(lres, g)
             tables[g] = tab
+            picked[g] = area_table_from_result(res, g)
             v = voc_polymer(tab.area_fraction, FIG5_SIGMA, FIG5_EPS_R, FIG5_T)
             curves[g] = (tab.pressure_Pa, v)
             c = summary["contact"][g]
+            c["area_table"] = "load-controlled"
+            c["area_table_vs_D_picked"] = compare_area_tables(tab, picked[g], g, settings.dx)
             c["voc_saturation_V"] = float(v[-1])  # at the highest pressure reached (D = d_max)
             c["voc_saturation_pressure_Pa"] = float(tab.pressure_Pa[-1])
             c["area_fraction_final"] = float(tab.area_fraction[-1])
@@ -76,11 +90,21 @@ def reproduce(out_dir, quick: bool = False, progress_factory=None, log=None,
                 P = kpa * 1e3
                 c[f"voc_at_{kpa}kPa_V"] = float(np.interp(P, tab.pressure_Pa, v)) \
                     if tab.pressure_Pa[0] <= P <= tab.pressure_Pa[-1] else None  # outside the table
-        n = max(len(c[0]) for c in curves.values())
+        n = max(max(len(c[0]) for c in curves.values()), max(len(t.pressure_Pa) for t in picked.values()))
+
+        def pad(x):
+            return np.pad(np.asarray(x, float), (0, n - len(x)), constant_values=np.nan)
         for g, (p, v) in curves.items():
-            cols[f"pressure_Pa_{g}"] = np.pad(p, (0, n - len(p)), constant_values=np.nan)
-            cols[f"voc_V_{g}"] = np.pad(v, (0, n - len(v)), constant_values=np.nan)
-        io.write_csv(stage / "fig5.csv", cols, header={"model": "Eq. (12)", "sigma_C_m2": FIG5_SIGMA,
+            cols[f"pressure_Pa_{g}"] = pad(p)
+            cols[f"area_fraction_{g}"] = pad(tables[g].area_fraction)
+            cols[f"voc_V_{g}"] = pad(v)
+        for g, t in picked.items():  # the D-picked table, for comparison
+            cols[f"pressure_Pa_Dpicked_{g}"] = pad(t.pressure_Pa)
+            cols[f"area_fraction_Dpicked_{g}"] = pad(t.area_fraction)
+            cols[f"voc_V_Dpicked_{g}"] = pad(voc_polymer(t.area_fraction, FIG5_SIGMA, FIG5_EPS_R, FIG5_T))
+        io.write_csv(stage / "fig5.csv", cols, header={"model": "Eq. (12)", "area_table": "load-controlled "
+                                                       "(columns *_Dpicked_*: picked from the D path)",
+                                                       "sigma_C_m2": FIG5_SIGMA,
                                                        "eps_r": FIG5_EPS_R, "T_m": FIG5_T})
         plot_fig5(curves, stage / "fig5.png")
         plot_fig5(curves, stage / "fig5.pdf")
