@@ -166,9 +166,23 @@ def test_issue_question_study_file_expands():
     from tengsim.config import plan_contact
     from tengsim.study.spec import load_study
 
-    s = load_study("examples/design/question.toml")
+    from pathlib import Path
+
+    s = load_study(Path(__file__).parents[1] / "examples" / "design" / "question.toml")
     shapes = {p.contact["shape"] for p in s.points}
     assert shapes == {"pyramid", "cone", "hemisphere", "line", "cube"}
     for p in s.points:
         plan = plan_contact(dict(p.contact))
         assert plan.scaling is not None and plan.shape.grid(plan.dx).nx == 45
+
+
+@pytest.mark.parametrize("name", ["minimal", "quick", "pyramids", "patterns", "question"])
+def test_example_studies_have_no_invalid_point(name):
+    from pathlib import Path
+
+    from tengsim.study.execute import validate
+    from tengsim.study.spec import load_study
+
+    s = load_study(Path(__file__).parents[1] / "examples" / "design" / f"{name}.toml")
+    valid, invalid = validate(s)
+    assert valid and not invalid, invalid
