@@ -35,7 +35,7 @@ class LoadSampler:
         self._stop.set()
         self._t.join()
 
-STUDY = {"base": {"contact": {"shape": "pyramid", "N": 0.946, "cell": 3.78, "dx": 0.07, "d_min": -1.0,
+STUDY = {"base": {"contact": {"shape": "pyramid", "N": 0.946, "cell": 3.78, "dx": 0.045, "d_min": -1.0,
                               "d_max": 3.0, "d_step": 0.1}},
          "axes": {"contact.tabor": {"start": 0.3, "stop": 0.65, "num": 8}}}
 
@@ -79,7 +79,7 @@ def main(out=Path(__file__).parent / "results"):
     out.mkdir(parents=True, exist_ok=True)
     (out / "sweep_scaling.json").write_text(json.dumps({"rows": rows, "ratio_2_vs_1": ratio}, indent=2) + "\n")
     lines = ["# Sweep scaling: 1 vs 2 LocalCluster workers", "",
-             f"Study: 8 dimensionless pyramid points (N = 0.946, L̄ = 3.78, dx = 0.07, d_step = 0.1, μ = 0.3…0.65; "
+             f"Study: 8 dimensionless pyramid points (N = 0.946, L̄ = 3.78, dx = 0.045, d_step = 0.1, μ = 0.3…0.65; "
              f"one point {rows[0]['point_seconds_min']:.1f}–{rows[0]['point_seconds_max']:.1f} s on 1 worker); "
              "one run each, same machine, in one process (`python benchmarks/sweep_scaling.py`).", "",
              "| workers | start-up (s) | wall (s) | compute phase (s) | assembly (s) | Σ compute (s) | points/h | "

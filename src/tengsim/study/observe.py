@@ -164,14 +164,16 @@ def area_fraction(res, contact_length) -> np.ndarray:
 
 
 def full_length(params: dict) -> float:
-    """Λc of full contact (2N for the pyramid, the diameter or width of other shapes); NaN if none."""
+    """Λc of full contact (2N for the pyramid, the base diameter of a cone or hemisphere; for flat-topped
+    pillars and ridges, whose top is in full contact from the first touch, the cell: the plate lies on
+    the land between them); NaN if none."""
     s = shape_name(params)
     if s == "pyramid":
         return 2 * float(params["N"])
     if s == "hemisphere":
         return 2 * float(params["radius"])
     if s in ("cube", "line"):
-        return 2 * float(params["half_width"])
+        return float(params["cell"])
     if s == "cone" and math.isfinite(float(params.get("height", math.inf))):
         return 2 * float(params["height"]) / float(params["slope"])
     return math.nan
