@@ -84,7 +84,7 @@ def main(study_dir, out):
            "", "Failed points: " + ("; ".join(f"{r['contact.shape']} {r['contact.pitch']} {r['var.aspect']:g} "
                                               f"{r['contact.E_star']}: {r['message'][:120]}"
                                               for r in uniq if r["status"] == "failed") or "none") + ".",
-           f"", f"Compute: {sum(r['seconds'] for r in uniq if math.isfinite(r['seconds'])):.0f} s summed over points."]
+           "", f"Compute: {sum(r['seconds'] for r in uniq if math.isfinite(r['seconds'])):.0f} s summed over points."]
     (out / "question_tables.md").write_text("\n".join(md) + "\n")
     shutil.copy(study_dir / "study.csv", out / "question.csv")
 

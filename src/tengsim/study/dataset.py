@@ -223,7 +223,8 @@ def _csv(spec, rows, per_point, vat, labels) -> str:
     buf = io.StringIO()
     w = csv.writer(buf, lineterminator="\n")
     scal = list(SCALARS)
-    w.writerow(cols + ["id", "status", "run_status"] + scal + [f"V_OC_{lab}" for lab in labels] + ["seconds", "message"])
+    w.writerow(cols + ["id", "status", "run_status"] + scal + [f"V_OC_{lab}" for lab in labels]
+               + ["seconds", "message"])
     for i, r in enumerate(rows):
         vals = []
         for a in spec["axes"]:

@@ -22,7 +22,8 @@ Format (TOML)::
     [observables]             # optional, see tengsim.study.observe
 
 A point is the base with the axis values put in: [base.contact], then [base.shapes.<its shape>],
-then its axis values; then every expression value is evaluated (in SI; see :func:`evaluate`).  Its id is a short SHA-256 of the canonical JSON of
+then its axis values; then every expression value is evaluated (in SI; see :func:`evaluate`).
+Its id is a short SHA-256 of the canonical JSON of
 its resolved ``[contact]`` table (the computation), so points that run the same contact share it.
 """
 from __future__ import annotations
