@@ -5,15 +5,37 @@ the ratio, and the scheduler + I/O overhead: (workers × wall − Σ point compu
 Writes benchmarks/results/sweep_scaling.md and .json.   python benchmarks/sweep_scaling.py
 """
 import json
-import os
 import logging
+import os
 import shutil
 import sys
 import tempfile
+import threading
 import time
 from pathlib import Path
 
-STUDY = {"base": {"contact": {"shape": "pyramid", "N": 0.946, "cell": 3.78, "dx": 0.1, "d_min": -1.0,
+
+class LoadSampler:
+    """1-minute load average sampled every 5 s while a run goes on (other jobs on the machine show here)."""
+
+    def __init__(self):
+        self.samples, self._stop = [], threading.Event()
+        self._t = threading.Thread(target=self._run, daemon=True)
+
+    def _run(self):
+        while not self._stop.is_set():
+            self.samples.append(os.getloadavg()[0])
+            self._stop.wait(5.0)
+
+    def __enter__(self):
+        self._t.start()
+        return self
+
+    def __exit__(self, *exc):
+        self._stop.set()
+        self._t.join()
+
+STUDY = {"base": {"contact": {"shape": "pyramid", "N": 0.946, "cell": 3.78, "dx": 0.045, "d_min": -1.0,
                               "d_max": 3.0, "d_step": 0.1}},
          "axes": {"contact.tabor": {"start": 0.3, "stop": 0.65, "num": 8}}}
 
@@ -32,14 +54,21 @@ def main(out=Path(__file__).parent / "results"):
         cluster = LocalCluster(n_workers=n, threads_per_worker=1, env=dict(WORKER_ENV), dashboard_address=":0",
                                silence_logs=logging.ERROR)
         client = Client(cluster)
+        load_before = os.getloadavg()[0]
         t1 = time.perf_counter()
-        s = run_study(parse_study(STUDY, source="sweep_scaling"), tmp / "s", client=client, quiet=True)
+        with LoadSampler() as load:
+            s = run_study(parse_study(STUDY, source="sweep_scaling"), tmp / "s", client=client, quiet=True)
         t2 = time.perf_counter()
         client.close()
         cluster.close()
-        compute = sum(float(xr.open_dataset(f, engine="h5netcdf").attrs["compute_seconds"])
-                      for f in (tmp / "s" / "points").glob("*.nc"))
-        rows.append({"workers": n, "load_average_1min_after": os.getloadavg()[0], "cpus": os.cpu_count(), "points": s["points"], "ok": s["ok"], "startup_s": t1 - t0, "wall_s": t2 - t1,
+        secs = [float(xr.open_dataset(f, engine="h5netcdf").attrs["compute_seconds"])
+                for f in (tmp / "s" / "points").glob("*.nc")]
+        compute = sum(secs)
+        rows.append({"workers": n, "load_average_1min_after": os.getloadavg()[0],
+                     "load_average_1min_before": load_before, "load_average_1min_during_max": max(load.samples),
+                     "load_average_1min_during_mean": sum(load.samples) / len(load.samples),
+                     "point_seconds_min": min(secs), "point_seconds_max": max(secs), "cpus": os.cpu_count(),
+                     "points": s["points"], "ok": s["ok"], "startup_s": t1 - t0, "wall_s": t2 - t1,
                      "compute_s": compute, "points_per_hour": s["points"] / (t2 - t1) * 3600,
                      "points_per_hour_with_startup": s["points"] / (t2 - t0) * 3600,
                      "overhead_fraction": (n * (t2 - t1) - compute) / compute,
@@ -51,7 +80,8 @@ def main(out=Path(__file__).parent / "results"):
     out.mkdir(parents=True, exist_ok=True)
     (out / "sweep_scaling.json").write_text(json.dumps({"rows": rows, "ratio_2_vs_1": ratio}, indent=2) + "\n")
     lines = ["# Sweep scaling: 1 vs 2 LocalCluster workers", "",
-             f"Study: 8 dimensionless pyramid points (N = 0.946, L̄ = 3.78, dx = 0.1, d_step = 0.1, μ = 0.3…0.65); "
+             f"Study: 8 dimensionless pyramid points (N = 0.946, L̄ = 3.78, dx = 0.045, d_step = 0.1, μ = 0.3…0.65; "
+             f"one point {rows[0]['point_seconds_min']:.1f}–{rows[0]['point_seconds_max']:.1f} s on 1 worker); "
              "one run each, same machine, in one process (`python benchmarks/sweep_scaling.py`).", "",
              "| workers | start-up (s) | wall (s) | compute phase (s) | assembly (s) | Σ compute (s) | points/h | "
              "points/h incl. start-up | overhead (wall) | overhead (compute phase) |",
@@ -67,8 +97,10 @@ def main(out=Path(__file__).parent / "results"):
               "overhead = (workers × time − Σ point compute seconds) / Σ compute: scheduler round trips, "
               "result transfer and the client's NetCDF write of each point (compute phase), plus warm-up and "
               "assembly (wall).", "",
-              f"Machine: {os.cpu_count()} CPUs; 1-minute load average after each run: "
-              + ", ".join(f"{r['load_average_1min_after']:.1f} ({r['workers']} worker(s))" for r in rows)
+              f"Machine: {os.cpu_count()} CPUs; 1-minute load average before / during (mean, max) / after each run: "
+              + ", ".join(f"{r['load_average_1min_before']:.1f} / {r['load_average_1min_during_mean']:.1f}, "
+                          f"{r['load_average_1min_during_max']:.1f} / {r['load_average_1min_after']:.1f} "
+                          f"({r['workers']} worker(s))" for r in rows)
               + ". A load above the CPU count means other jobs shared the cores: a second worker then "
               "gets no core of its own and the ratio measures the contention, not the sweep."]
     (out / "sweep_scaling.md").write_text("\n".join(lines) + "\n")

@@ -96,3 +96,36 @@ def test_dimensionless_run_has_no_pressure_observables():
         assert math.isnan(s["scalars"][k]), k
     assert not math.isnan(s["scalars"]["pull_off_F"]) and not math.isnan(s["scalars"]["area_fraction_0"])
     assert np.all(np.isnan(s["curves"]["V_OC"]))
+
+
+def test_area_fraction_per_shape_family():
+    from tengsim.study.observe import area_fraction, family
+
+    L = np.array([0.0, 1.0, 2.0, 10.0])
+    for shape, fam, want in [("Pyramid", "square", (L / 4) ** 2), ("Cube", "square", (L / 4) ** 2),
+                             ("Cone", "disc", math.pi / 4 * (L / 4) ** 2),
+                             ("Hemisphere", "disc", math.pi / 4 * (L / 4) ** 2),
+                             ("Line", "line", L / 4)]:
+        res = ContactResult(table={"F": np.zeros(4)}, grid=Grid(3, 3, 1.0, 1.0), params={"shape": shape, "cell": 4.0})
+        assert family(res.params) == fam
+        np.testing.assert_allclose(area_fraction(res, L), np.clip(want, 0, 1), rtol=1e-12)
+    res = ContactResult(table={}, grid=Grid(3, 3, 1.0, 1.0), params={"shape": "Pyramid", "config": {"shape": "cone"}})
+    assert family(res.params) == "disc"  # the run's [contact] shape name wins over the class name
+
+
+def test_physical_scale_of_any_shape_from_its_columns():
+    """Any physical run: Pa per unit F from pressure_Pa (or F_N / cell area), metres per unit D = eps_m."""
+    from tengsim.config import run_contact
+    from tengsim.study.observe import physical_scale
+
+    res = run_contact({"shape": "cone", "slope": 1.0, "pitch": "2um", "height": "0.4um", "E_star": "1MPa",
+                       "W": "54mJ/m2", "eps": "0.1um", "dx": "0.2um", "d_min": -1.0, "d_max": 2.0,
+                       "d_step": 1.0})
+    k_p, k_D = physical_scale(res)
+    assert k_D == pytest.approx(1e-7)
+    F = np.asarray(res.table["F"])
+    np.testing.assert_allclose(k_p * F, res.table["pressure_Pa"], rtol=1e-9, atol=1e-9)
+    # 3π W ℓ²/ε per cell / cell area, with ℓ = ε/slope (cone) and cell area pitch²
+    assert k_p == pytest.approx(3 * math.pi * 54e-3 * (1e-7) ** 2 / 1e-7 / (2e-6) ** 2, rel=1e-9)
+    del res.table["pressure_Pa"]
+    assert physical_scale(res)[0] == pytest.approx(k_p, rel=1e-9)  # from F_N and cell_area_m2

@@ -101,3 +101,88 @@ def test_observables_defaults_in_SI():
     assert o["grid_max"] == 1.5e5
     assert s.base["device"] == {"sigma": "5.84uC/m2", "eps_r": 2.40, "thickness": "400um"}
     assert not math.isnan(o["linear_tolerance"])
+
+
+# ---- shape axis: per-shape base tables and expressions ---------------------------------------------
+
+SHAPES_BASE = {
+    "contact": {"E_star": "0.59MPa", "W": "54mJ/m2", "eps": "0.37um", "pitch": "2um", "dx": "=pitch/12",
+                "d_min": -1.0, "d_max": "=1.2*height/eps + 2", "d_step": "=(d_max - d_min)/8"},
+    "var": {"aspect": 0.7},
+    "shapes": {"pyramid": {"base": "=0.5*pitch", "height": "=aspect*base"},
+               "cone": {"slope": "=2*aspect", "height": "=aspect*0.5*pitch"}},
+}
+
+
+def test_shape_axis_merges_its_own_table_and_evaluates_expressions():
+    s = parse_study({"base": SHAPES_BASE, "axes": {"contact.shape": ["pyramid", "cone"],
+                                                   "var.aspect": [0.5, 1.5]}})
+    assert len(s.points) == 4
+    for p in s.points:
+        c, a = p.contact, p.axes["var.aspect"]
+        assert "aspect" not in c and p.tables["var"]["aspect"] == a
+        assert c["dx"] == f"{2e-6 / 12:.12g}m"
+        if c["shape"] == "pyramid":
+            assert set(c) >= {"base", "height"} and "slope" not in c
+            assert c["base"] == pytest.approx(1e-6) and c["height"] == pytest.approx(a * 1e-6)
+        else:
+            assert "base" not in c and c["slope"] == pytest.approx(2 * a)
+            assert c["height"] == pytest.approx(a * 1e-6)
+        assert c["d_max"] == pytest.approx(1.2 * a * 1e-6 / 0.37e-6 + 2)
+        assert c["d_step"] == pytest.approx((c["d_max"] + 1) / 8)
+    from tengsim.config import plan_contact
+
+    for p in s.points:  # every point is a valid run of its own shape
+        plan_contact(dict(p.contact))
+
+
+def test_axis_value_beats_the_shape_table():
+    s = parse_study({"base": SHAPES_BASE, "axes": {"contact.shape": ["cone"], "contact.slope": [3.0]}})
+    assert s.points[0].contact["slope"] == 3.0
+
+
+@pytest.mark.parametrize("bad, msg", [
+    ({"shapes": {"pyramid": {"base": "=0.5*pich"}}}, "unknown name 'pich'"),
+    ({"shapes": {"pyramid": {"base": "=__import__('os')"}}}, "only numbers, names"),
+    ({"shapes": {"pyramid": {"base": "=base*2"}}}, "depends on itself"),
+    ({"shapes": {"blob": {}}}, "blob"),
+    ({"shapes": {"cone": {"shape": "line"}}}, "may not set shape"),
+    ({"var": {"aspect": "big"}}, "must be a number"),
+])
+def test_bad_shape_tables_are_study_errors(bad, msg):
+    base = {k: dict(v) for k, v in SHAPES_BASE.items()}
+    base["shapes"] = {k: dict(v) for k, v in SHAPES_BASE["shapes"].items()}
+    for k, v in bad.items():
+        if k == "shapes":
+            for name, t in v.items():
+                base["shapes"][name] = {**base["shapes"].get(name, {}), **t}
+        else:
+            base[k] = v
+    with pytest.raises(TengsimError, match=msg.replace("(", r"\(").replace(")", r"\)")):
+        parse_study({"base": base, "axes": {"contact.shape": ["pyramid", "cone"]}})
+
+
+def test_issue_question_study_file_expands():
+    from tengsim.config import plan_contact
+    from tengsim.study.spec import load_study
+
+    from pathlib import Path
+
+    s = load_study(Path(__file__).parents[1] / "examples" / "design" / "question.toml")
+    shapes = {p.contact["shape"] for p in s.points}
+    assert shapes == {"pyramid", "cone", "hemisphere", "line", "cube"}
+    for p in s.points:
+        plan = plan_contact(dict(p.contact))
+        assert plan.scaling is not None and plan.shape.grid(plan.dx).nx == 45
+
+
+@pytest.mark.parametrize("name", ["minimal", "quick", "pyramids", "patterns", "question"])
+def test_example_studies_have_no_invalid_point(name):
+    from pathlib import Path
+
+    from tengsim.study.execute import validate
+    from tengsim.study.spec import load_study
+
+    s = load_study(Path(__file__).parents[1] / "examples" / "design" / f"{name}.toml")
+    valid, invalid = validate(s)
+    assert valid and not invalid, invalid

@@ -341,3 +341,76 @@ def test_plot_study_maps(tmp_path, client):
     from tengsim.study.plot import plot_study
 
     assert plot_study(tmp_path / "l", tmp_path / "l.png")[0].stat().st_size > 10000
+
+
+TWO_SHAPES = """
+[base.contact]
+E_star = "1MPa"
+W = "54mJ/m2"
+eps = "0.2um"
+pitch = "1.2um"
+dx = "=pitch/9"
+d_min = -1.0
+d_max = "=1.2*height/eps + 1"
+d_step = "=(d_max - d_min)/6"
+
+[base.var]
+aspect = 0.5
+
+[base.shapes.pyramid]
+base = "=0.5*pitch"
+height = "=aspect*base"
+
+[base.shapes.cone]
+slope = "=2*aspect"
+height = "=aspect*0.5*pitch"
+
+[axes]
+"contact.shape" = ["pyramid", "cone"]
+"var.aspect" = [0.5, 1.0]
+"""
+
+
+def test_two_shape_study_equals_direct_runs(tmp_path, client):
+    """A shape axis (pyramid, cone) with per-shape tables: every point is the direct run of its table,
+    with pressure observables and the family's A/S (square for the pyramid, disc for the cone)."""
+    from tengsim.study.spec import load_study
+
+    f = tmp_path / "two.toml"
+    f.write_text(TWO_SHAPES)
+    study = load_study(f)
+    s = run_study(study, tmp_path / "out", client=client, quiet=True)
+    assert s["ok"] + s["unconverged"] == 4 and s["failed"] == 0
+    ds = xr.load_dataset(tmp_path / "out" / "study.nc")
+    assert ds["pull_off_F"].dims == ("contact.shape", "var.aspect")
+    for p in study.points:
+        res = run_contact(dict(p.contact))
+        row = ds.sel({"contact.shape": p.axes["contact.shape"], "var.aspect": p.axes["var.aspect"]})
+        assert float(row["pull_off_F"]) == res.pull_off_force
+        assert np.isfinite(float(row["pull_off_Pa"])) and np.isfinite(float(row["V_sat"]))
+        k = float(row["pull_off_Pa"]) / float(row["pull_off_F"])
+        np.testing.assert_allclose(k * res.table["F"], res.table["pressure_Pa"], rtol=1e-9, atol=1e-9)
+    a = ds["area_fraction"].sel({"contact.shape": "cone"}).values
+    assert np.nanmax(a) <= np.pi / 4 + 1e-12  # a disc never covers more than π/4 of its square cell
+
+
+def test_shape_axis_invalid_points(tmp_path, capsys, client):
+    """A key only the pyramid has, in [base.contact]: the cone points fail with its message; when every
+    point is invalid for its shape it is a study-file error (exit 2, one line, nothing written)."""
+    text = TWO_SHAPES.replace('[base.var]', 'base = "0.6um"\n\n[base.var]').replace(
+        'base = "=0.5*pitch"\n', '')
+    f = tmp_path / "mixed.toml"
+    f.write_text(text)
+    from tengsim.study.spec import load_study
+
+    s = run_study(load_study(f), tmp_path / "out", client=client, quiet=True)
+    assert s["failed"] == 2 and s["ok"] + s["unconverged"] == 2
+    ds = xr.load_dataset(tmp_path / "out" / "study.nc")
+    msg = str(ds["message"].sel({"contact.shape": "cone"}).values[0])
+    assert "cone has no key 'base'" in msg, msg
+    g = tmp_path / "allbad.toml"
+    g.write_text(text.replace('"contact.shape" = ["pyramid", "cone"]', '"contact.shape" = ["cone"]'))
+    rc = main(["sweep", str(g), "--out", str(tmp_path / "out2"), "--quiet"])
+    err = capsys.readouterr().err.strip()
+    assert rc == 2 and len(err.splitlines()) == 1 and "has no key 'base'" in err, err
+    assert not (tmp_path / "out2").exists()

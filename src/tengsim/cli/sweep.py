@@ -1,7 +1,9 @@
 """``tengsim sweep STUDY.toml``: a design study over any contact/device parameters, on Dask, resumable.
 
 The study file holds a ``[base.contact]`` table (exactly a ``tengsim run`` [contact] table) and
-``[axes]`` ("contact.N" = [..], ranges {start, stop, num, scale}, zip groups); see docs/design.md.
+``[axes]`` ("contact.N" = [..], ranges {start, stop, num, scale}, zip groups); a "contact.shape" axis
+takes per-shape tables [base.shapes.<name>] and '=' expressions over [contact] keys and [base.var]
+variables ("var.aspect" axes); see docs/design.md.
 Every finished point is written at once to DIR/points/<id>.nc; DIR/study.nc and DIR/study.csv are
 rebuilt at the end.  A killed sweep continues with --resume and never recomputes a finished point.
 Exit code 0 when every point finished, 1 when some failed (see study.csv), 2 for a bad study file.
@@ -16,7 +18,8 @@ from tengsim.errors import TengsimError
 def register(sub):
     p = sub.add_parser("sweep", help="design study: a grid or sample of runs on Dask, resumable",
                        description=__doc__.split("\n\n", 1)[1])
-    p.add_argument("study", help="study TOML file ([base.contact], [axes], optional [study], [observables])")
+    p.add_argument("study", help="study TOML file ([base.contact], [axes], optional [base.shapes.<name>], [base.var], "
+                   "[study], [observables])")
     p.add_argument("--out", help="study directory (default: the study file's name without .toml)")
     g = p.add_argument_group("where the points run (default: a LocalCluster with one worker per core)")
     g.add_argument("--workers", type=int, help="number of local worker processes")

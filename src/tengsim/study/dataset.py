@@ -2,7 +2,8 @@
 
 study.nc is indexed by the axes for a full grid (a zip group is one dimension, its parameters
 coordinates along it) and by ``point`` for sampled studies.  study.csv has one row per point: the axis
-values in columns named as in [axes], ``id``, ``status``, the scalar observables (units in
+values in columns named as in [axes], ``id``, ``status``, ``run_status`` (the run's grid status,
+tengsim.status), the scalar observables (units in
 tengsim.study.observe.SCALARS; pull_off_F and jump_in_D as in ``tengsim contact``'s CSV), V_OC at the
 named pressures, and an empty cell wherever there is no value.
 """
@@ -42,7 +43,8 @@ def _read_point(sd, pid):
     return "pending", "", None, math.nan
 
 
-_COLUMNS = ("branch", "D", "F", "contact_length", "jump", "converged", "pressure_Pa", "F_N", "contact_length_m")
+_COLUMNS = ("branch", "D", "F", "contact_length", "jump", "converged", "pressure_Pa", "F_N", "contact_length_m",
+            "status")
 
 
 def _light_result(nc):
@@ -60,10 +62,22 @@ def _light_result(nc):
                  for k, v in f.attrs.items() if k in ("status", "message", "compute_seconds", "params")}
         table = {k: f[k][()] for k in _COLUMNS if k in f}
     table["branch"] = np.array([text(b) for b in table["branch"]])
+    if "status" in table:
+        table["status"] = np.array([text(b) for b in table["status"]])
     for k in ("jump", "converged"):
         table[k] = table[k].astype(bool)
     params = json.loads(attrs.get("params", "{}"))
     return ContactResult(table=table, grid=Grid(3, 3, 1.0, 1.0), params=params), attrs
+
+
+def _run_status(res) -> str:
+    """The run's overall status (tengsim.status: ok, under_resolved, out_of_law_range, not_converged);
+    '' for a point without a result, or a file from before the status column."""
+    if res is None or "status" not in res.table:
+        return ""
+    from tengsim.status import overall
+
+    return overall(res.table["status"])
 
 
 def collect(root) -> dict:
@@ -91,7 +105,7 @@ def collect(root) -> dict:
             except (TengsimError, ValueError, FloatingPointError) as exc:
                 msg = (msg + "; " if msg else "") + f"observables: {exc}"
         rows.append({"axes": p["axes"], "index": p["index"], "id": pid, "status": status, "message": msg,
-                     "seconds": secs, "obs": obs})
+                     "seconds": secs, "obs": obs, "run_status": _run_status(res)})
     return {"spec": spec, "rows": rows, "settings": settings}
 
 
@@ -129,6 +143,7 @@ def build_study(root) -> dict:
     per_point = {
         "id": np.array([r["id"] for r in rows]),
         "status": np.array([r["status"] for r in rows]),
+        "run_status": np.array([r["run_status"] for r in rows]),
         "message": np.array([r["message"] for r in rows]),
         "seconds": np.array([r["seconds"] for r in rows], dtype=float),
         **scal,
@@ -177,6 +192,8 @@ def build_study(root) -> dict:
     ds["area_fraction"].attrs.update(units="1", long_name="charged-area fraction A/S")
     ds["V_OC_at"].attrs.update(units="V", long_name="V_OC at the named pressures")
     ds["seconds"].attrs["units"] = "s"
+    ds["run_status"].attrs["long_name"] = ("worst status of the run's equilibria (tengsim.status): ok, "
+                                           "under_resolved, out_of_law_range, not_converged")
     from tengsim import __version__
 
     ds.attrs.update({"study": json.dumps({k: spec[k] for k in ("source", "sampling", "n", "seed", "base")},
@@ -206,14 +223,15 @@ def _csv(spec, rows, per_point, vat, labels) -> str:
     buf = io.StringIO()
     w = csv.writer(buf, lineterminator="\n")
     scal = list(SCALARS)
-    w.writerow(cols + ["id", "status"] + scal + [f"V_OC_{lab}" for lab in labels] + ["seconds", "message"])
+    w.writerow(cols + ["id", "status", "run_status"] + scal + [f"V_OC_{lab}" for lab in labels]
+               + ["seconds", "message"])
     for i, r in enumerate(rows):
         vals = []
         for a in spec["axes"]:
             if len(a["members"]) > 1:
                 vals.append(r["axes"].get(a["name"], ""))
             vals.extend(r["axes"][m] for m in a["members"])
-        w.writerow([_cell(v) for v in vals] + [r["id"], r["status"]]
+        w.writerow([_cell(v) for v in vals] + [r["id"], r["status"], r["run_status"]]
                    + [_cell(per_point[k][i]) for k in scal] + [_cell(x) for x in vat[i]]
                    + [_cell(per_point["seconds"][i]), r["message"]])
     return buf.getvalue()

@@ -91,19 +91,24 @@ def pressure_grid(settings: dict) -> np.ndarray:
 def physical_scale(res) -> tuple[float, float] | None:
     """(Pa per unit F, metres per unit D) of a result, or None for a dimensionless run.
 
-    Uses the result's ``pressure_Pa`` column (with its D in metres from ``eps_m``) when present, else the
-    paper's pyramid scaling (Eq. 7, :class:`tengsim.units.PaperScaling`) rebuilt from its parameters.
+    Every physical run (any shape, :class:`tengsim.units.Scaling`) carries ``pressure_Pa`` (or ``F_N``
+    with ``cell_area_m2``) and ``eps_m``: the ratio to F is one constant.  Older pyramid files without
+    those columns: the paper's scaling (Eq. 7, :class:`tengsim.units.PaperScaling`) from their parameters.
     """
     p = res.params
     t = res.table
     eps = p.get("eps_m")
-    if "pressure_Pa" in t and eps:
-        F, P = np.asarray(t["F"], float), np.asarray(t["pressure_Pa"], float)
-        ok = np.abs(F) > 1e-12 * max(1.0, float(np.max(np.abs(F))))
-        if np.any(ok):
+    F = np.asarray(t["F"], float)
+    ok = np.abs(F) > 1e-12 * max(1.0, float(np.max(np.abs(F)))) if len(F) else np.zeros(0, bool)
+    if eps and np.any(ok):
+        if "pressure_Pa" in t:
+            P = np.asarray(t["pressure_Pa"], float)
             return float(np.median(P[ok] / F[ok])), float(eps)
+        if "F_N" in t and p.get("cell_area_m2"):
+            fn = np.asarray(t["F_N"], float)
+            return float(np.median(fn[ok] / F[ok])) / float(p["cell_area_m2"]), float(eps)
     need = ("E_star_Pa", "W_J_m2", "base_m", "height_m", "pitch_m", "eps_m")
-    if str(p.get("shape", "")).lower() == "pyramid" and all(p.get(k) for k in need):
+    if shape_name(p) == "pyramid" and all(p.get(k) for k in need):
         from tengsim.units import PaperScaling
 
         sc = PaperScaling(p["E_star_Pa"], p["W_J_m2"], p["base_m"], p["height_m"], p["pitch_m"], p["eps_m"])
@@ -111,25 +116,64 @@ def physical_scale(res) -> tuple[float, float] | None:
     return None
 
 
+FAMILIES = {
+    "square": ("pyramid", "cube"),
+    "disc": ("cone", "hemisphere", "sphere", "paraboloid", "flat_punch", "flatpunch"),
+    "line": ("line", "sinusoid", "sinusoid1d"),
+}
+"""Contact-patch family of each built-in shape for the charged-area fraction A/S (docs/design.md);
+a shape not listed (a plugin) is taken as 'square' unless its class sets ``contact_family``."""
+
+
+def shape_name(params: dict) -> str:
+    """The registered name of a result's shape (from its [contact] table, else its class name)."""
+    cfg = params.get("config")
+    if isinstance(cfg, dict) and cfg.get("shape"):
+        return str(cfg["shape"]).lower()
+    return str(params.get("shape", "")).lower()
+
+
+def family(params: dict) -> str:
+    """'square', 'disc' or 'line': how Λc (Greenwood's tensile-peak length along X through the apex)
+    maps to the charged area."""
+    name = shape_name(params)
+    for fam, names in FAMILIES.items():
+        if name in names:
+            return fam
+    try:
+        from tengsim.registry import SHAPES
+
+        return getattr(SHAPES.get(name), "contact_family", "square")
+    except Exception:  # noqa: BLE001 - an unregistered plugin's file
+        return "square"
+
+
 def area_fraction(res, contact_length) -> np.ndarray:
-    """Charged-area fraction A/S of the cell: (Λc/L̄)² for a 2-D pattern, Λc/L̄ for a line grating."""
+    """Charged-area fraction A/S of the cell (Eq. 12) from the contact length Λc:
+    square patches (pyramid, cube) (Λc/L̄)², discs (cone, hemisphere, sphere, flat punch) π(Λc/2)²/L̄²,
+    line gratings (line, sinusoid) Λc/L̄; clipped to [0, 1].  Λc/L̄ is the same ratio in ℓ or in metres."""
     p = res.params
     cell = float(p.get("cell", math.nan))
     x = np.asarray(contact_length, float) / cell
-    if str(p.get("shape", "")).lower() == "line":
+    fam = family(p)
+    if fam == "line":
         return np.clip(x, 0.0, 1.0)
+    if fam == "disc":
+        return np.clip(math.pi / 4 * x**2, 0.0, 1.0)
     return np.clip(x**2, 0.0, 1.0)
 
 
 def full_length(params: dict) -> float:
-    """Λc of full contact (2N for the pyramid, the diameter or width of other shapes); NaN if none."""
-    s = str(params.get("shape", "")).lower()
+    """Λc of full contact (2N for the pyramid, the base diameter of a cone or hemisphere; for flat-topped
+    pillars and ridges, whose top is in full contact from the first touch, the cell: the plate lies on
+    the land between them); NaN if none."""
+    s = shape_name(params)
     if s == "pyramid":
         return 2 * float(params["N"])
     if s == "hemisphere":
         return 2 * float(params["radius"])
     if s in ("cube", "line"):
-        return 2 * float(params["half_width"])
+        return float(params["cell"])
     if s == "cone" and math.isfinite(float(params.get("height", math.inf))):
         return 2 * float(params["height"]) / float(params["slope"])
     return math.nan

@@ -6,7 +6,13 @@ Format (TOML)::
     shape = "pyramid"
     ...
     [base.device]             # optional: σ, ε_r, T of Eq. (12) for V_OC (defaults: paper Fig. 5)
+    [base.shapes.cone]        # optional: merged into [contact] when a point's shape is 'cone'
+    slope = "=2*aspect"       # an expression ('=' first): + - * / of numbers, [contact] keys and [var]s
+    [base.var]                # optional: free variables (defaults) that expressions read
+    aspect = 1.0
     [axes]
+    "contact.shape" = ["pyramid", "cone"]                          # the shape itself
+    "var.aspect" = [0.5, 1.5]
     "contact.N" = [0.946, 1.5]                                   # a list
     "contact.tabor" = { start = 0.3, stop = 0.5, num = 2 }        # a range (scale = "linear" | "log")
     group = { zip = { "contact.pitch" = ["2um", "5um"], "contact.base" = ["1um", "2.5um"] },
@@ -15,7 +21,9 @@ Format (TOML)::
     sampling = "grid"         # or "lhs" / "sobol" with n and seed
     [observables]             # optional, see tengsim.study.observe
 
-A point is the base with the axis values put in.  Its id is a short SHA-256 of the canonical JSON of
+A point is the base with the axis values put in: [base.contact], then [base.shapes.<its shape>],
+then its axis values; then every expression value is evaluated (in SI; see :func:`evaluate`).
+Its id is a short SHA-256 of the canonical JSON of
 its resolved ``[contact]`` table (the computation), so points that run the same contact share it.
 """
 from __future__ import annotations
@@ -31,8 +39,9 @@ import numpy as np
 
 from tengsim.errors import TengsimError
 
-POINT_TABLES = ("contact", "device")
-"""Tables of a point; an axis is named 'table.key' with table one of these."""
+POINT_TABLES = ("contact", "device", "var")
+"""Tables of a point; an axis is named 'table.key' with table one of these ('var': free variables that
+only expressions read, e.g. an aspect ratio)."""
 STUDY_TABLES = ("base", "axes", "study", "observables", "objective")
 SAMPLINGS = ("grid", "lhs", "sobol")
 DEVICE_DEFAULTS = {"sigma": "5.84uC/m2", "eps_r": 2.40, "thickness": "400um"}
@@ -170,10 +179,10 @@ def parse_study(cfg: dict, source: str = "") -> Study:
     base_in = cfg.get("base")
     if not base_in:
         raise TengsimError(f"{where}: needs a [base.contact] table (the run every point starts from)")
-    unknown = [k for k in base_in if k not in POINT_TABLES]
+    unknown = [k for k in base_in if k not in (*POINT_TABLES, "shapes")]
     if unknown:
         raise TengsimError(f"{where}: unknown table(s) [base.{unknown[0]}] (known: "
-                           f"{', '.join('base.' + t for t in POINT_TABLES)})")
+                           f"{', '.join('base.' + t for t in (*POINT_TABLES, 'shapes'))})")
     for k, v in base_in.items():
         if not isinstance(v, dict):
             raise TengsimError(f"{where}: [base.{k}] must be a table, got {v!r}")
@@ -186,7 +195,14 @@ def parse_study(cfg: dict, source: str = "") -> Study:
     if bad:
         raise TengsimError(f"{where}: [base.device] unknown key(s) {', '.join(map(repr, bad))} "
                            f"(known: {', '.join(DEVICE_DEFAULTS)})")
-    base = {"contact": contact, "device": device}
+    var = dict(base_in.get("var", {}))
+    for k, v in var.items():
+        if isinstance(v, bool) or not isinstance(v, (int, float)):
+            raise TengsimError(f"{where}: [base.var] {k} must be a number, got {v!r}")
+    shapes = _parse_shapes(base_in.get("shapes", {}), where)
+    base = {"contact": contact, "device": device, "var": var}
+    if shapes:
+        base["shapes"] = shapes
 
     axes = [_parse_axis(name, spec, where) for name, spec in (cfg.get("axes") or {}).items()]
     seen = {}
@@ -223,6 +239,30 @@ def parse_study(cfg: dict, source: str = "") -> Study:
     return study
 
 
+def _parse_shapes(tables, where) -> dict:
+    """[base.shapes.<name>] tables, keyed by canonical shape name."""
+    from tengsim.registry import SHAPES, ensure_builtins
+
+    ensure_builtins()
+    if not isinstance(tables, dict):
+        raise TengsimError(f"{where}: [base.shapes] must hold one table per shape, got {tables!r}")
+    out = {}
+    for name, t in tables.items():
+        try:
+            canon = SHAPES.canonical(name)
+        except (TengsimError, KeyError, ValueError) as exc:
+            raise TengsimError(f"{where}: [base.shapes.{name}]: {exc}") from None
+        if not isinstance(t, dict):
+            raise TengsimError(f"{where}: [base.shapes.{name}] must be a table, got {t!r}")
+        if "shape" in t:
+            raise TengsimError(f"{where}: [base.shapes.{name}] may not set shape")
+        bad = [k for k in t if k in IGNORED_CONTACT_KEYS]
+        if bad:
+            raise TengsimError(f"{where}: [base.shapes.{name}]: the sweep names its own output files ({bad[0]})")
+        out[canon] = dict(t)
+    return out
+
+
 def _member_name(name, where):
     if not isinstance(name, str) or "." not in name:
         raise TengsimError(f"{where}: axis {name!r} must be named 'table.key' (table one of "
@@ -234,6 +274,8 @@ def _member_name(name, where):
     if table == "device" and key not in DEVICE_DEFAULTS:
         raise TengsimError(f"{where}: axis {name!r}: unknown device parameter {key!r} "
                            f"(known: {', '.join(DEVICE_DEFAULTS)})")
+    if table == "var" and not re.fullmatch(r"[A-Za-z_]\w*", key):
+        raise TengsimError(f"{where}: axis {name!r}: a variable name is letters, digits and _")
     if table == "contact" and key in IGNORED_CONTACT_KEYS:
         raise TengsimError(f"{where}: axis {name!r}: the sweep names its own output files")
     return name
@@ -337,11 +379,100 @@ def _parse_axis(name, spec, where) -> Axis:
 # ---- expansion ----------------------------------------------------------------------------------
 
 def _resolve(base: dict, assign: dict) -> dict:
-    tables = {t: dict(v) for t, v in base.items()}
+    """A point's tables: [base.contact] < [base.shapes.<shape>] < axis values; then expressions evaluated."""
+    tables = {t: dict(v) for t, v in base.items() if t != "shapes"}
+    tables.setdefault("var", {})
     for name, v in assign.items():
         t, k = name.split(".", 1)
         tables[t][k] = v
+    shapes = base.get("shapes") or {}
+    if shapes:
+        from tengsim.registry import SHAPES
+
+        try:
+            shape = SHAPES.canonical(tables["contact"].get("shape") or "pyramid")
+        except (TengsimError, KeyError, ValueError):
+            shape = None  # an unknown shape: plan_contact names it
+        own = {k: v for k, v in shapes.get(shape, {}).items() if f"contact.{k}" not in assign}
+        tables["contact"].update(own)
+    tables["contact"] = evaluate(tables["contact"], tables["var"])
     return tables
+
+
+_EXPR_NAME = re.compile(r"[A-Za-z_]\w*")
+
+
+def evaluate(contact: dict, var: dict) -> dict:
+    """Evaluate the expression values of a [contact] table: strings starting with '='.
+
+    An expression is + - * / and parentheses over numbers, the point's [var] variables, and other
+    [contact] keys (quantities such as '5um' in SI, expressions first evaluated themselves).  Its value
+    is in SI (a bare number, which physical keys read as SI); ``dx``, whose bare number is in X units,
+    gets 'm' appended.  E.g. ``height = "=aspect*0.5*pitch"``, ``d_max = "=1.3*height/eps + 2"``.
+    """
+    import ast
+
+    out = dict(contact)
+    busy = set()
+
+    def value(name):
+        if name in var:
+            return float(var[name])
+        if name not in out:
+            raise TengsimError(f"expression: unknown name {name!r} (a [contact] key or a [var] variable)")
+        v = out[name]
+        if isinstance(v, str) and v.startswith("="):
+            if name in busy:
+                raise TengsimError(f"expression: {name!r} depends on itself")
+            busy.add(name)
+            v = out[name] = calc(name, v)
+            busy.discard(name)
+        if isinstance(v, bool) or isinstance(v, (dict, list)):
+            raise TengsimError(f"expression: {name} = {v!r} is not a number")
+        from tengsim.units import parse_quantity
+
+        return parse_quantity(v, name=name)
+
+    def calc(key, text):
+        src = text[1:].strip()
+        try:
+            tree = ast.parse(src, mode="eval")
+        except SyntaxError:
+            raise TengsimError(f"{key} = {text!r}: cannot read the expression") from None
+
+        def ev(n):
+            if isinstance(n, ast.Expression):
+                return ev(n.body)
+            if isinstance(n, ast.Constant) and isinstance(n.value, (int, float)) and not isinstance(n.value, bool):
+                return float(n.value)
+            if isinstance(n, ast.Name):
+                return value(n.id)
+            if isinstance(n, ast.UnaryOp) and isinstance(n.op, (ast.USub, ast.UAdd)):
+                x = ev(n.operand)
+                return -x if isinstance(n.op, ast.USub) else x
+            if isinstance(n, ast.BinOp) and isinstance(n.op, (ast.Add, ast.Sub, ast.Mult, ast.Div)):
+                a, b = ev(n.left), ev(n.right)
+                if isinstance(n.op, ast.Add):
+                    return a + b
+                if isinstance(n.op, ast.Sub):
+                    return a - b
+                if isinstance(n.op, ast.Mult):
+                    return a * b
+                if b == 0:
+                    raise TengsimError(f"{key} = {text!r}: division by zero")
+                return a / b
+            raise TengsimError(f"{key} = {text!r}: only numbers, names, + - * / and parentheses are allowed")
+
+        return float(f"{ev(tree):.12g}")
+
+    for k in list(out):
+        v = out[k]
+        if isinstance(v, str) and v.startswith("="):
+            out[k] = value(k) if not isinstance(out[k], float) else out[k]
+            out[k] = float(out[k])
+    if isinstance(contact.get("dx"), str) and contact["dx"].startswith("="):
+        out["dx"] = f"{out['dx']:.12g}m"
+    return out
 
 
 def expand(study: Study) -> list:
