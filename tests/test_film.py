@@ -148,8 +148,11 @@ def _punch_stiffness(a, h, nu, px_per_a, cell_over_a=3.0, kappa=1.0):
         p[idx] = v
         return K.apply(p.reshape(n, n)).ravel()[idx]
 
+    import inspect
+
+    tol_kw = "rtol" if "rtol" in inspect.signature(cg).parameters else "tol"  # scipy < 1.12 names it tol
     sol, info = cg(LinearOperator((idx.size, idx.size), matvec=mv, dtype=float), np.ones(idx.size),
-                   rtol=1e-10, maxiter=5000)
+                   maxiter=5000, **{tol_kw: 1e-10})
     assert info == 0
     return sol.sum() * d * d
 
