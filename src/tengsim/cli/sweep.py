@@ -20,21 +20,26 @@ def register(sub):
                        description=__doc__.split("\n\n", 1)[1])
     p.add_argument("study", help="study TOML file ([base.contact], [axes], optional [base.shapes.<name>], [base.var], "
                    "[study], [observables])")
-    p.add_argument("--out", help="study directory (default: the study file's name without .toml)")
-    g = p.add_argument_group("where the points run (default: a LocalCluster with one worker per core)")
-    g.add_argument("--workers", type=int, help="number of local worker processes")
-    g.add_argument("--scheduler", help="address of a running dask scheduler, e.g. tcp://host:8786")
-    p.add_argument("--resume", action="store_true", help="continue the study in --out (skip finished points)")
+    add_study_options(p)
     p.add_argument("--retry-failed", dest="retry_failed", action="store_true",
                    help="with --resume: compute failed points again")
     p.add_argument("--quiet", action="store_true", help="no progress output")
     p.set_defaults(func=run)
 
 
-def run(args) -> int:
+def add_study_options(p) -> None:
+    """--out, --workers | --scheduler and --resume: shared by ``tengsim sweep`` and ``tengsim optimize``."""
+    p.add_argument("--out", help="study directory (default: the study file's name without .toml)")
+    g = p.add_argument_group("where the points run (default: a LocalCluster with one worker per core)")
+    g.add_argument("--workers", type=int, help="number of local worker processes")
+    g.add_argument("--scheduler", help="address of a running dask scheduler, e.g. tcp://host:8786")
+    p.add_argument("--resume", action="store_true", help="continue the study in --out (reuse finished points)")
+
+
+def load_study_args(args):
+    """(study, output directory) from the parsed options, after checking --workers / --scheduler."""
     from pathlib import Path
 
-    from tengsim.study.execute import run_study
     from tengsim.study.spec import load_study
 
     if args.workers is not None and args.scheduler is not None:
@@ -42,7 +47,13 @@ def run(args) -> int:
     if args.workers is not None and args.workers < 1:
         raise TengsimError(f"--workers must be >= 1, got {args.workers}")
     study = load_study(args.study)
-    out = args.out or str(Path(args.study).with_suffix(""))
+    return study, args.out or str(Path(args.study).with_suffix(""))
+
+
+def run(args) -> int:
+    from tengsim.study.execute import run_study
+
+    study, out = load_study_args(args)
     try:
         s = run_study(study, out, workers=args.workers, scheduler=args.scheduler, resume=args.resume,
                       retry_failed=args.retry_failed, quiet=args.quiet)

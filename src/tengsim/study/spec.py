@@ -179,13 +179,7 @@ def parse_study(cfg: dict, source: str = "") -> Study:
     base_in = cfg.get("base")
     if not base_in:
         raise TengsimError(f"{where}: needs a [base.contact] table (the run every point starts from)")
-    unknown = [k for k in base_in if k not in (*POINT_TABLES, "shapes")]
-    if unknown:
-        raise TengsimError(f"{where}: unknown table(s) [base.{unknown[0]}] (known: "
-                           f"{', '.join('base.' + t for t in (*POINT_TABLES, 'shapes'))})")
-    for k, v in base_in.items():
-        if not isinstance(v, dict):
-            raise TengsimError(f"{where}: [base.{k}] must be a table, got {v!r}")
+    check_tables(base_in, (*POINT_TABLES, "shapes"), where=f"{where} [base]")
     if "contact" not in base_in:
         raise TengsimError(f"{where}: needs a [base.contact] table (the run every point starts from)")
     contact = {k: v for k, v in base_in["contact"].items() if k not in IGNORED_CONTACT_KEYS}
