@@ -12,17 +12,22 @@ from tengsim.errors import TengsimError  # noqa: E402
 from tengsim.geometry import (Cone, Cube, FlatPunch, HeightMap, Hemisphere, Line, Paraboloid,  # noqa: E402
                               Pyramid, Sinusoid1D, random_rough)
 from tengsim.grid import Grid  # noqa: E402
-from tengsim.interaction import LJ93, Repulsive  # noqa: E402
+from tengsim.arrays import Array  # noqa: E402
+from tengsim.interaction import LJ93, Exponential, MaugisDugdale, Repulsive  # noqa: E402
 from tengsim.kernels import FreeKernel, PeriodicKernel  # noqa: E402
 from tengsim.observers import Summary  # noqa: E402
+from tengsim.loadpath import LoadPathSpec, run_load_path  # noqa: E402
 from tengsim.path import PathSpec, run_path  # noqa: E402
 from tengsim.registry import KERNELS, LAWS, OBSERVERS, SHAPES, SOLVERS  # noqa: E402
 from tengsim.results import ContactResult, Jump  # noqa: E402
 from tengsim.solvers import Equilibrium, FastSolver, Problem, State, VSRSolver  # noqa: E402
+from tengsim.status import ResultStatusError  # noqa: E402
+from tengsim.topography import Topography  # noqa: E402
 from tengsim.units import PaperScaling, Scaling, paper_scaling, parse_quantity  # noqa: E402
 
 __all__ = [
     "KERNELS", "LAWS", "OBSERVERS", "SHAPES", "SOLVERS", "Scaling", "Summary",
+    "Array", "Exponential", "LoadPathSpec", "MaugisDugdale", "ResultStatusError", "Topography", "run_load_path",
     "Cone", "ContactResult", "Cube", "Equilibrium", "FastSolver", "FlatPunch", "FreeKernel", "Grid",
     "HeightMap", "Hemisphere", "Jump", "LJ93", "Line", "PaperScaling", "Paraboloid", "PathSpec",
     "PeriodicKernel", "Problem", "Pyramid", "Repulsive", "Sinusoid1D", "State", "TengsimError",

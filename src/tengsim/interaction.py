@@ -240,7 +240,7 @@ class Exponential(Law):
 
     @property
     def amplitude(self) -> float:
-        """A, the depth Φ(1) of the attraction (W): A + (A/ρ)²/(2k) = 1."""
+        """The depth A = −Φ(1) of the attraction, in units of W, from A + (A/ρ)²/(2k) = 1."""
         return 2.0 / (1.0 + np.sqrt(1.0 + 2.0 / (self.wall_stiffness * self.range**2)))
 
     @property

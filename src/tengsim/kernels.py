@@ -11,7 +11,7 @@ A kernel's ``apply`` is one convolution (a forward and an inverse real FFT): the
 
 Both take an optional film (``thickness`` T in X units, ``substrate`` 'bonded' or 'frictionless',
 ``poisson`` ν; :mod:`tengsim.film`): a layer of thickness T on a rigid substrate instead of the
-half-space, E* keeping its meaning.  The periodic multiplier becomes (2κ/|q|) C(|q|T, ν) with the
+half-space, E* keeping its meaning.  The periodic multiplier becomes (2κ/|q|) C(|q| T, ν) with the
 finite mean compliance κT(1 − 2ν)/(1 − ν)² at q = 0; the free kernel adds to the exact half-space
 pixel coefficients the layer's smooth correction (κ/π)(1/T) h(r/T), pixel-averaged by Gauss points
 (:func:`film_pixel_correction`), which cancels them exactly beyond 40 thicknesses.  A kernel whose
@@ -140,7 +140,7 @@ class FreeKernel(_Film):
 @dataclass
 class PeriodicKernel(_Film):
     """Periodic array of cells: ŵ(q) = (2κ/|q|) P̂(q), ŵ(0) = 0; with a film of ``thickness`` T,
-    ŵ(q) = (2κ/|q|) C(|q|T, ν) P̂(q) and ŵ(0) = κT(1 − 2ν)/(1 − ν)² P̂(0) (uniaxial strain)."""
+    ŵ(q) = (2κ/|q|) C(|q| T, ν) P̂(q) and ŵ(0) = κT(1 − 2ν)/(1 − ν)² P̂(0) (uniaxial strain)."""
 
     grid: Grid
     coupling: float

@@ -416,7 +416,7 @@ def compare_paths(ref, other, interp: str = "pchip") -> dict:
     inside one of them; D values of ``ref`` inside a jump interval of ``other`` (between its D_before
     and D_after) are skipped, and so are rows of ``ref`` that start a jump (the state on the far
     side of ``ref``'s own jump, compared only if ``other`` has a segment there).  The difference is
-    relative to max(|F_ref(D)|, F_adh), F_adh = |most tensile F of ``ref``| (the adhesive force
+    relative to max(|F_ref(D)|, F_adh), F_adh = the magnitude of the most tensile F of ``ref`` (the adhesive force
     scale), so it is a relative error where |F| is large and an error in units of the pull-off force
     where F crosses zero.  Returns {'max_rel_dF', 'where' ((branch, D) of it), 'n_compared', 'n_skipped', 'max_rel_dF_same_D'
     (rows at equal D, no interpolation), 'jumps_ref', 'jumps_other' (lists of (branch, D_before,
