@@ -13,6 +13,7 @@ fills it by SurfaceTopography's harmonic interpolation (``interpolate_undefined_
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -74,7 +75,9 @@ def read(path, physical_size=None, unit: str | None = None, detrend: str = "heig
     if detrend not in DETREND_MODES:
         raise TengsimError(f"detrend = {detrend!r} is not one of {', '.join(DETREND_MODES)}")
     try:
-        reader = st.open_topography(str(p))
+        with warnings.catch_warnings():  # its text readers warn on NaN pixels; we report those ourselves
+            warnings.simplefilter("ignore", RuntimeWarning)
+            reader = st.open_topography(str(p))
         channel = reader.channels[0]
         file_size, file_unit = channel.physical_sizes, channel.unit
     except Exception as exc:  # noqa: BLE001 - SurfaceTopography's errors list every reader it tried
@@ -104,7 +107,9 @@ def read(path, physical_size=None, unit: str | None = None, detrend: str = "heig
         raise TengsimError(f"topography file {str(path)!r} has its own physical size "
                            f"{tuple(float(s) for s in file_size)} {file_unit}; drop physical_size")
     try:
-        topo = reader.topography(**kw)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            topo = reader.topography(**kw)
     except Exception as exc:  # noqa: BLE001
         raise TengsimError(f"cannot read topography file {str(path)!r}: {exc}") from None
     filled = 0
