@@ -18,7 +18,7 @@ def _plt():
 
 
 def save(fig, path) -> None:
-    """Save a figure atomically (format from the suffix) and close it."""
+    """Save a figure atomically (format from the suffix) and close it: the one figure writer of tengsim."""
     from pathlib import Path
 
     plt = _plt()

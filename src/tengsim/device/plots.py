@@ -18,15 +18,12 @@ def _figure(nrows, ncols, size):
 
 
 def _save(plt, fig, path):
-    from tengsim.io import atomic_path
+    from tengsim.plots import save
 
-    path = Path(path)
-    fmt = path.suffix.lower().lstrip(".")
+    fmt = Path(path).suffix.lower().lstrip(".")
     require(fmt in ("png", "pdf", "svg"), f"plot path must end in .png, .pdf or .svg, got {str(path)!r}")
     fig.tight_layout()
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, format=fmt, dpi=150)
-    plt.close(fig)
+    save(fig, path)
 
 
 def plot_fig7(result, path) -> None:

@@ -92,12 +92,10 @@ def plot_study(root, out, vars=MAP_VARS) -> list:
     for ax in list(axs.flat)[n:]:
         ax.set_visible(False)
     fig.tight_layout()
-    from tengsim.io import atomic_path
+    from tengsim.plots import save
 
     written = []
-    with atomic_path(out) as tmp:
-        fig.savefig(tmp, format=out.suffix.lstrip(".") or "png", dpi=130)
-    plt.close(fig)
+    save(fig, out)
     written.append(out)
     if np.isfinite(ds["V_OC"].values).any():
         voc = out.with_name(out.stem + "_voc" + out.suffix)
@@ -118,8 +116,6 @@ def plot_study(root, out, vars=MAP_VARS) -> list:
         ax.set_xlabel("pressure (kPa)")
         ax.set_ylabel("V_OC (V), Eq. (12)")
         fig.tight_layout()
-        with atomic_path(voc) as tmp:
-            fig.savefig(tmp, format=voc.suffix.lstrip(".") or "png", dpi=130)
-        plt.close(fig)
+        save(fig, voc)
         written.append(voc)
     return written
