@@ -2,6 +2,7 @@
 
     python -m tengsim.cli.main sweep examples/design/question.toml --out question --workers 2
     python docs/data/design/question.py question docs/data/design
+    python docs/data/design/question.py question_periodic docs/data/design question_periodic   # the array study
 
 Writes question_maps.png, question_voc.png, question.csv (a copy of study.csv) and question_tables.md.
 """
@@ -49,7 +50,7 @@ def table(rows, key, n=10):
     return "\n".join(out)
 
 
-def main(study_dir, out):
+def main(study_dir, out, name="question"):
     study_dir, out = Path(study_dir), Path(out)
     ds = xr.load_dataset(study_dir / "study.nc", engine="h5netcdf")
     rows = flat(ds)
@@ -85,8 +86,8 @@ def main(study_dir, out):
                                               f"{r['contact.E_star']}: {r['message'][:120]}"
                                               for r in uniq if r["status"] == "failed") or "none") + ".",
            "", f"Compute: {sum(r['seconds'] for r in uniq if math.isfinite(r['seconds'])):.0f} s summed over points."]
-    (out / "question_tables.md").write_text("\n".join(md) + "\n")
-    shutil.copy(study_dir / "study.csv", out / "question.csv")
+    (out / f"{name}_tables.md").write_text("\n".join(md) + "\n")
+    shutil.copy(study_dir / "study.csv", out / f"{name}.csv")
 
     # maps: rows = pattern; columns = S and linear range at each aspect; pitch × E* heat maps
     shapes = list(ds["contact.shape"].values)
@@ -130,7 +131,7 @@ def main(study_dir, out):
                 fig.colorbar(m, ax=axs[:, j:j + len(aspects)].ravel().tolist(), shrink=0.5, location="bottom")
     fig.suptitle("F: full contact under adhesion alone; *: under-resolved (grid status); "
                  "linear range blank where S ≤ 0", fontsize=8)
-    fig.savefig(out / "question_maps.png", dpi=110, bbox_inches="tight")
+    fig.savefig(out / f"{name}_maps.png", dpi=110, bbox_inches="tight")
     plt.close(fig)
 
     fig, axs = plt.subplots(1, len(shapes), figsize=(3.2 * len(shapes), 3.0), sharey=True, squeeze=False)
@@ -152,10 +153,10 @@ def main(study_dir, out):
     cb.set_ticks(np.arange(len(Es)), labels=Es)
     cb.set_label("E*")
     fig.tight_layout()
-    fig.savefig(out / "question_voc.png", dpi=110)
+    fig.savefig(out / f"{name}_voc.png", dpi=110)
     plt.close(fig)
     print("\n".join(md))
 
 
 if __name__ == "__main__":
-    main(*sys.argv[1:3])
+    main(*sys.argv[1:4])
