@@ -40,7 +40,8 @@ STUDY = {"base": {"contact": {"shape": "pyramid", "N": 0.946, "cell": 3.78, "dx"
          "axes": {"contact.tabor": {"start": 0.3, "stop": 0.65, "num": 8}}}
 
 
-def main(out=Path(__file__).parent / "results"):
+def main(out=Path(__file__).parent / "results", dx=0.045):
+    STUDY["base"]["contact"]["dx"] = dx
     import xarray as xr
     from dask.distributed import Client, LocalCluster
 
@@ -80,9 +81,9 @@ def main(out=Path(__file__).parent / "results"):
     out.mkdir(parents=True, exist_ok=True)
     (out / "sweep_scaling.json").write_text(json.dumps({"rows": rows, "ratio_2_vs_1": ratio}, indent=2) + "\n")
     lines = ["# Sweep scaling: 1 vs 2 LocalCluster workers", "",
-             f"Study: 8 dimensionless pyramid points (N = 0.946, L̄ = 3.78, dx = 0.045, d_step = 0.1, μ = 0.3…0.65; "
+             f"Study: 8 dimensionless pyramid points (N = 0.946, L̄ = 3.78, dx = {dx}, d_step = 0.1, μ = 0.3…0.65; "
              f"one point {rows[0]['point_seconds_min']:.1f}–{rows[0]['point_seconds_max']:.1f} s on 1 worker); "
-             "one run each, same machine, in one process (`python benchmarks/sweep_scaling.py`).", "",
+             f"one run each, same machine, in one process (`python benchmarks/sweep_scaling.py --dx {dx}`).", "",
              "| workers | start-up (s) | wall (s) | compute phase (s) | assembly (s) | Σ compute (s) | points/h | "
              "points/h incl. start-up | overhead (wall) | overhead (compute phase) |",
              "|---|---|---|---|---|---|---|---|---|---|"]
@@ -108,4 +109,10 @@ def main(out=Path(__file__).parent / "results"):
 
 
 if __name__ == "__main__":
-    main()
+    import argparse
+
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--dx", type=float, default=0.045, help="grid spacing of the points (smaller: longer points)")
+    ap.add_argument("--out", type=Path, default=Path(__file__).parent / "results")
+    a = ap.parse_args()
+    main(a.out, a.dx)
