@@ -269,11 +269,13 @@ def test_kill_and_resume_equals_uninterrupted(tmp_path, client):
         proc.wait()
     kept = {p.name: (p.stat().st_ino, p.stat().st_mtime_ns) for p in (out / "points").glob("*.nc")}
     assert 1 <= len(kept) < 6, "kill came too late to test a resume"
-    assert not list((out / "points").glob("*.part"))  # nothing half written under a final name
+    for p in (out / "points").glob("*.nc"):  # nothing half written under a final name: every point file is whole
+        xr.load_dataset(p)
     r = subprocess.run(_sweep_cmd(f, out) + ["--resume"], env=env, capture_output=True, text=True, timeout=300)
     assert r.returncode == 0, r.stderr
     after = {p.name: (p.stat().st_ino, p.stat().st_mtime_ns) for p in (out / "points").glob("*.nc")}
     assert len(after) == 6 and all(after[k] == v for k, v in kept.items())  # finished points never redone
+    assert not list((out / "points").glob(".*.part"))  # a write the kill interrupted left no temporary file behind
     # each point computed once: the resumed run's log names exactly the points that were missing
     log = [json.loads(x) for x in (out / "log.jsonl").read_text().splitlines()]
     starts = [i for i, e in enumerate(log) if e["event"] == "start"]
@@ -414,3 +416,17 @@ def test_shape_axis_invalid_points(tmp_path, capsys, client):
     err = capsys.readouterr().err.strip()
     assert rc == 2 and len(err.splitlines()) == 1 and "has no key 'base'" in err, err
     assert not (tmp_path / "out2").exists()
+
+
+def test_stale_temporary_files_of_a_killed_write_are_removed(tmp_path):
+    """A SIGKILL during a point's atomic write leaves '.<id>.nc.<random>.part'; the next run removes it and
+    leaves the finished points (final names) alone."""
+    from tengsim.study.execute import StudyDir
+
+    sd = StudyDir(tmp_path)
+    sd.points.mkdir()
+    (sd.points / ".abc.nc.x1y2.part").write_bytes(b"half")
+    (sd.points / "def.nc").write_bytes(b"whole")
+    assert sd.drop_partial() == 1
+    assert sorted(p.name for p in sd.points.iterdir()) == ["def.nc"]
+    assert StudyDir(tmp_path / "none").drop_partial() == 0

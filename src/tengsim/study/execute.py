@@ -127,6 +127,14 @@ class StudyDir:
     def failed(self, pid) -> Path:
         return self.points / f"{pid}.failed.json"
 
+    def drop_partial(self) -> int:
+        """Remove the temporary files of writes a kill interrupted (``.<name>.part``; never a finished
+        point, which only appears under its final name by an atomic rename); returns how many."""
+        stale = list(self.points.glob(".*.part")) if self.points.is_dir() else []
+        for f in stale:
+            f.unlink(missing_ok=True)
+        return len(stale)
+
     @property
     def spec(self) -> Path:
         return self.root / "study.json"
@@ -270,6 +278,8 @@ def run_study(study, out, *, workers=None, scheduler=None, client=None, resume=F
         say(f"sweep: {len(study.points)} points ({len(valid) + len(invalid)} distinct computations) on "
             f"{len(client.scheduler_info().get('workers', {}))} worker(s); dashboard {client.dashboard_link}")
         sd.points.mkdir(parents=True, exist_ok=True)
+        if sd.drop_partial():
+            say("sweep: removed the temporary files of point writes a kill interrupted")
         write_json(sd.spec, study.resolved())
         done, failures = sd.done(), sd.failures()
         for pid, msg in invalid.items():
