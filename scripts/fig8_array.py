@@ -37,30 +37,12 @@ NU = 0.49
 
 
 def approach(shape, mu, dx, p_of_F, kernel_params, p_max_kpa=150.0, d_step=0.1, d_max=80.0):
-    """D-controlled approach of ``shape`` (periodic kernel with ``kernel_params``, LJ93, fast solver)
-    from D = −1 in steps of ``d_step`` until the pressure passes ``p_max_kpa``.  Returns row dicts."""
-    from tengsim.analysis import apex_index
-    from tengsim.kernels import make_kernel
-    from tengsim.observers import ArrayArea, Context, Summary
-    from tengsim.solvers import Problem, State, make_solver
+    """D-controlled approach in fixed steps ``d_step``: scripts/scatter_study.py's, with the film."""
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    from scatter_study import approach as stepped
 
-    grid = shape.grid(dx)
-    U0 = shape.gap(grid)
-    law, kern = tengsim.LJ93(), make_kernel("periodic", grid, mu**1.5, **kernel_params)
-    solver = make_solver("fast", tol=1e-6)
-    ctx = Context(grid, apex_index(U0), U0, law, kern)
-    obs, summ = ArrayArea(), Summary()
-    state, D, rows = State.zero(grid.shape), -1.0, []
-    while True:
-        eq = solver.solve(Problem(U0 - D + 1.0, law, kern), state)
-        state = eq.state
-        s, a = summ(eq, ctx), obs(eq, ctx)
-        p = p_of_F(s["F"])
-        rows.append(dict(D=D, P_kPa=p, converged=eq.converged, in_law_range=s["min_gap"] + 1 >= law.g_safe,
-                         n_conv=eq.n_conv, **a))
-        if p >= p_max_kpa or D > d_max:
-            return rows
-        D = round(D + d_step, 10)
+    return stepped(shape, mu, dx, p_of_F, p_max_kpa, coarse=d_step, fine=d_step, kernel_params=kernel_params,
+                   d_max=d_max)
 
 
 def area_at_targets(states):

@@ -29,10 +29,12 @@ SIGMA, EPS_R, T = 5.84e-6, 2.40, 400e-6
 TARGETS_KPA = np.arange(10, 151, 10)
 
 
-def approach(shape, mu, dx, p_of_F, p_max_kpa=150.0, coarse=0.025, fine=0.0025, p_switch_kpa=0.5):
-    """D-controlled approach of ``shape`` (periodic kernel, LJ93, fast solver) from D = −1 in steps of
-    ``coarse`` until the pressure passes ``p_switch_kpa``, then of ``fine`` until it passes
-    ``p_max_kpa``; each state warm-started from the last.  Returns a list of row dicts."""
+def approach(shape, mu, dx, p_of_F, p_max_kpa=150.0, coarse=0.025, fine=0.0025, p_switch_kpa=0.5,
+             kernel_params=None, d_max=20.0):
+    """D-controlled approach of ``shape`` (periodic kernel with ``kernel_params``, e.g. a film; LJ93, fast
+    solver) from D = −1 in steps of ``coarse`` until the pressure passes ``p_switch_kpa``, then of ``fine``
+    until it passes ``p_max_kpa`` (or D passes ``d_max``); each state warm-started from the last.  Returns a
+    list of row dicts (also used by scripts/fig8_array.py)."""
     from tengsim.analysis import apex_index
     from tengsim.kernels import make_kernel
     from tengsim.observers import ArrayArea, Context, Summary
@@ -40,7 +42,7 @@ def approach(shape, mu, dx, p_of_F, p_max_kpa=150.0, coarse=0.025, fine=0.0025, 
 
     grid = shape.grid(dx)
     U0 = shape.gap(grid)
-    law, kern = tengsim.LJ93(), make_kernel("periodic", grid, mu**1.5)
+    law, kern = tengsim.LJ93(), make_kernel("periodic", grid, mu**1.5, **(kernel_params or {}))
     solver = make_solver("fast", tol=1e-6)
     ctx = Context(grid, apex_index(U0), U0, law, kern)
     obs, summ = ArrayArea(), Summary()
@@ -51,8 +53,8 @@ def approach(shape, mu, dx, p_of_F, p_max_kpa=150.0, coarse=0.025, fine=0.0025, 
         s, a = summ(eq, ctx), obs(eq, ctx)
         p = p_of_F(s["F"])
         rows.append(dict(D=D, P_kPa=p, converged=eq.converged, in_law_range=s["min_gap"] + 1 >= law.g_safe,
-                         **a))
-        if p >= p_max_kpa or D > 20:
+                         n_conv=eq.n_conv, **a))
+        if p >= p_max_kpa or D > d_max:
             return rows
         D = round(D + (fine if p >= p_switch_kpa else coarse), 10)
 
