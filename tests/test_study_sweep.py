@@ -38,13 +38,9 @@ TINY = {"shape": "pyramid", "N": 0.946, "cell": 3.78, "tabor": 0.5, "dx": 0.4, "
 
 @pytest.fixture(scope="module")
 def client():
-    from dask.distributed import Client, LocalCluster
+    from tengsim.study.execute import connect
 
-    from tengsim.study.execute import WORKER_ENV
-
-    cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=True, env=dict(WORKER_ENV),
-                           dashboard_address=":0")
-    c = Client(cluster)
+    c, cluster = connect(workers=2)  # the LocalCluster `tengsim sweep --workers 2` starts
     yield c
     c.close()
     cluster.close()
@@ -430,3 +426,35 @@ def test_stale_temporary_files_of_a_killed_write_are_removed(tmp_path):
     assert sd.drop_partial() == 1
     assert sorted(p.name for p in sd.points.iterdir()) == ["def.nc"]
     assert StudyDir(tmp_path / "none").drop_partial() == 0
+
+
+def test_local_cluster_runs_quiet_monitors(client):
+    """The sweep's LocalCluster carries LOCAL_CLUSTER_CONFIG into every worker process (dask's 10 ms
+    task profiler and 20 ms tick would otherwise take CPU from the points) and pins threads."""
+    import dask
+
+    from tengsim.study.execute import LOCAL_CLUSTER_CONFIG
+
+    def settings():
+        return ({k: dask.config.get(k) for k in LOCAL_CLUSTER_CONFIG}, os.environ.get("OPENBLAS_NUM_THREADS"))
+
+    for cfg, blas in client.run(settings).values():
+        assert cfg == LOCAL_CLUSTER_CONFIG
+        assert blas == "1"
+    assert dask.config.get("distributed.worker.profile.enabled") is True  # the caller's config untouched
+
+
+def test_points_submitted_longest_first():
+    """validate() orders the valid points by estimated cost, largest grid first; equal estimates keep
+    the study's order (so a sweep ends on a short point, not a long one)."""
+    from tengsim.study.execute import estimated_cost, validate
+
+    study = tiny_study({"contact.dx": [0.4, 0.1, 0.2], "contact.tabor": [0.3, 0.5]})
+    valid, invalid = validate(study)
+    dxs = [c["dx"] for c in valid.values()]
+    assert dxs == [0.1, 0.1, 0.2, 0.2, 0.4, 0.4] and not invalid
+    assert [c["tabor"] for c in valid.values()] == [0.3, 0.5] * 3
+    fine, coarse = (estimated_cost(plan_contact(dict(TINY, dx=d))) for d in (0.1, 0.4))
+    assert fine > 10 * coarse
+    longer = estimated_cost(plan_contact(dict(TINY, d_step=0.125)))
+    assert longer == pytest.approx(2 * estimated_cost(plan_contact(dict(TINY))))

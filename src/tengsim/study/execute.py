@@ -29,6 +29,19 @@ WORKER_ENV = {"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THRE
               "TENGSIM_THREADS": "1", "TENGSIM_FFT_WORKERS": "1"}
 """Environment of every worker: one thread per process (the parallelism is across points)."""
 
+LOCAL_CLUSTER_CONFIG = {
+    "distributed.admin.tick.interval": "1s",  # event-loop watchdog: 20 ms by default
+    "distributed.admin.system-monitor.interval": "2s",
+    "distributed.admin.system-monitor.gil.enabled": False,
+    "distributed.admin.system-monitor.disk": False,
+    "distributed.worker.profile.enabled": False,  # the 10 ms stack sampler of every running task
+    "distributed.worker.memory.monitor-interval": "1s",
+}
+"""Dask settings of the LocalCluster a sweep starts.  With the defaults an idle 2-worker cluster burns
+about 3 CPU-seconds per 20 s (15 % of a core) in monitors, taken from the points it runs on a
+2-core machine; with these, 0.4 s (benchmarks/results/sweep_scaling.md).  Read when the cluster
+starts; a cluster behind ``--scheduler`` keeps its own configuration."""
+
 
 # ---- the task that runs on a worker --------------------------------------------------------------
 
@@ -80,27 +93,49 @@ def warm_up() -> int:
 
 # ---- validation ---------------------------------------------------------------------------------
 
+def estimated_cost(plan) -> float:
+    """Relative cost of a planned point: pixels × log2(pixels) (one convolution) × path rows.
+
+    Only orders the submissions (the longest first, so that a short point, not a long one, ends a
+    sweep); an estimate that fails gives 1.  The path rows count one per step of each branch."""
+    import math
+
+    try:
+        g = plan.shape.grid(plan.dx)
+        npix = g.nx * g.ny * (1 if plan.boundary == "periodic" else 4)
+        spec = plan.path
+        if hasattr(spec, "f_step"):
+            rows = 2 * (spec.f_max - spec.f_min) / spec.f_step
+        else:
+            rows = 2 * (spec.d_max - spec.d_min) / spec.d_step
+        return float(npix * math.log2(max(npix, 2)) * max(rows, 1.0))
+    except Exception:  # noqa: BLE001 - an estimate only
+        return 1.0
+
+
 def validate(study) -> tuple[dict, dict]:
     """Plan every distinct point (no solving).  Returns ({id: contact table} of the valid points,
-    {id: message} of the invalid ones).  An error that every point shares is an error in the study
-    file: raised as one TengsimError before anything is written."""
+    {id: message} of the invalid ones), the valid ones longest first (:func:`estimated_cost`).
+    An error that every point shares is an error in the study file: raised as one TengsimError
+    before anything is written."""
     from tengsim.config import plan_contact
     from tengsim.study.observe import device_values
 
-    valid, invalid, first = {}, {}, None
+    valid, invalid, first, cost = {}, {}, None, {}
     for p in study.points:
         device_values(p.tables["device"])  # a bad device value is a study error
         pid = p.id
         if pid in valid or pid in invalid:
             continue
         try:
-            plan_contact(dict(p.contact))
+            plan = plan_contact(dict(p.contact))
         except TengsimError as exc:
             invalid[pid] = str(exc)
             if first is None:
                 first = (p, str(exc))
             continue
         valid[pid] = p.contact
+        cost[pid] = estimated_cost(plan)
     if not valid:
         if first is None:
             raise TengsimError(f"{study.source or 'study'}: no points")
@@ -108,7 +143,8 @@ def validate(study) -> tuple[dict, dict]:
         where = ", ".join(f"{k} = {v!r}" for k, v in p.axes.items())
         raise TengsimError(f"{study.source or 'study'}: {msg}" + (f" (at {where})" if where and len(invalid) == 1
                                                                   else ""))
-    return valid, invalid
+    order = sorted(valid, key=lambda pid: -cost[pid])  # stable: equal estimates keep the study's order
+    return {pid: valid[pid] for pid in order}, invalid
 
 
 # ---- directory state ----------------------------------------------------------------------------
@@ -243,10 +279,13 @@ def connect(workers=None, scheduler=None, timeout: float = 3.0):
         raise TengsimError(f"--workers must be a positive integer, got {workers!r}")
     import logging
 
+    import dask
+
     n = workers or os.cpu_count() or 1
-    cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, env=dict(WORKER_ENV),
-                           dashboard_address=":0", silence_logs=logging.ERROR)
-    return Client(cluster), cluster
+    with dask.config.set(LOCAL_CLUSTER_CONFIG):
+        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, env=dict(WORKER_ENV),
+                               dashboard_address=":0", silence_logs=logging.ERROR)
+        return Client(cluster), cluster
 
 
 def run_study(study, out, *, workers=None, scheduler=None, client=None, resume=False, retry_failed=False,
@@ -296,7 +335,7 @@ def run_study(study, out, *, workers=None, scheduler=None, client=None, resume=F
         _append_log(sd, {"event": "start", "time": time.time(), "todo": todo})
         if todo:
             client.run(warm_up)
-        t0 = time.perf_counter()
+        t0, t0_unix = time.perf_counter(), time.time()
         computed = _compute(client, valid, todo, sd, bar)
         t_compute = time.perf_counter() - t0
         bar.close()
@@ -310,7 +349,8 @@ def run_study(study, out, *, workers=None, scheduler=None, client=None, resume=F
     t0 = time.perf_counter()
     with dask.config.set(scheduler="synchronous"):
         summary = build_study(sd.root)
-    summary.update(computed=computed, compute_phase_s=t_compute, assemble_s=time.perf_counter() - t0)
+    summary.update(computed=computed, compute_phase_s=t_compute, compute_phase_start_unix=t0_unix,
+                   assemble_s=time.perf_counter() - t0)
     say(f"sweep: wrote {sd.root / 'study.nc'} and {sd.root / 'study.csv'}: {summary['ok']} ok, "
         f"{summary['failed']} failed, {summary['unconverged']} unconverged, {summary['pending']} pending")
     return summary
@@ -336,8 +376,9 @@ def _compute(client, valid, todo, sd, bar) -> list:
 
     from tengsim.io import write_dataset, write_json
 
-    futures = {client.submit(compute_point, valid[pid], pid, key=f"tengsim-point-{pid}", pure=False): pid
-               for pid in todo}
+    futures = {client.submit(compute_point, valid[pid], pid, key=f"tengsim-point-{pid}", pure=False,
+                             priority=len(todo) - k): pid
+               for k, pid in enumerate(todo)}  # todo is longest first (validate); keep that order
     computed = []
     try:
         for fut in as_completed(list(futures)):
