@@ -458,3 +458,93 @@ def test_points_submitted_longest_first():
     assert fine > 10 * coarse
     longer = estimated_cost(plan_contact(dict(TINY, d_step=0.125)))
     assert longer == pytest.approx(2 * estimated_cost(plan_contact(dict(TINY))))
+
+
+@pytest.mark.slow
+def test_ctrl_c_keeps_points_and_resume_completes(tmp_path):
+    """Ctrl-C (SIGINT to the sweep's process group, as a terminal sends it) after a point is written:
+    exit 130 with one line and no traceback, every written point whole, and --resume computes only the
+    missing points."""
+    f = tmp_path / "k.toml"
+    f.write_text(KILL_STUDY)
+    out = tmp_path / "interrupted"
+    env = dict(os.environ, PYTHONPATH=str(Path(__file__).resolve().parents[1] / "src"))
+    proc = subprocess.Popen(_sweep_cmd(f, out), env=env, start_new_session=True, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+    t0 = time.time()
+    while not list((out / "points").glob("*.nc")):
+        assert proc.poll() is None, "the sweep ended before writing a point"
+        assert time.time() - t0 < 120
+        time.sleep(0.02)
+    os.killpg(proc.pid, signal.SIGINT)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130, err
+    assert "interrupted" in err and "continue with --resume" in err and "Traceback" not in err
+    kept = {p.name: p.stat().st_mtime_ns for p in (out / "points").glob("*.nc")}
+    assert 1 <= len(kept) < 6
+    for p in (out / "points").glob("*.nc"):
+        xr.load_dataset(p)
+    r = subprocess.run(_sweep_cmd(f, out) + ["--resume"], env=env, capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    after = {p.name: p.stat().st_mtime_ns for p in (out / "points").glob("*.nc")}
+    assert len(after) == 6 and all(after[k] == v for k, v in kept.items())
+
+
+BOMB = '''
+"""A shape whose gap kills the worker process that computes it (fuse > 0): a worker dying mid-point."""
+import os
+from dataclasses import dataclass
+
+from tengsim.geometry import Paraboloid
+from tengsim.registry import SHAPES
+
+
+@SHAPES.register("bomb", summary="a paraboloid; fuse > 0 ends its worker process")
+@dataclass(frozen=True)
+class Bomb(Paraboloid):
+    fuse: float = 0.0
+
+    def gap(self, grid):
+        if self.fuse > 0:
+            os._exit(9)
+        return super().gap(grid)
+'''
+
+
+def test_worker_dying_mid_point_is_a_failed_point_others_finish(tmp_path, monkeypatch):
+    """A worker process that dies during a point (here: the point's own shape ends it) is recorded as a
+    failed point with the scheduler's message; the nanny restarts the worker and the other points
+    finish; --resume does not rerun the failed one, --retry-failed does.  The plugin module reaches
+    the workers through the client's TENGSIM_PLUGINS."""
+    import dask
+    import distributed  # noqa: F401 - its config defaults, before the setting below
+
+    from tengsim import registry
+    from tengsim.study.execute import connect
+
+    name = "tengsim_bomb_" + tmp_path.name.replace("-", "_")
+    (tmp_path / f"{name}.py").write_text(BOMB)
+    monkeypatch.syspath_prepend(str(tmp_path))
+    monkeypatch.setenv("PYTHONPATH", os.pathsep.join([str(tmp_path), os.environ.get("PYTHONPATH", "")]))
+    monkeypatch.setenv("TENGSIM_PLUGINS", name)
+    monkeypatch.setattr(registry, "_PLUGINS_LOADED", False)
+    try:
+        study = parse_study({"base": {"contact": {"shape": "bomb", "radius": 1.0, "cell": 4.0, "dx": 0.4,
+                                                  "d_min": -0.5, "d_max": 0.5, "d_step": 0.5}},
+                             "axes": {"contact.fuse": [0.0, 1.0], "contact.tabor": [0.5, 1.0]}}, source="bomb")
+        with dask.config.set({"distributed.scheduler.allowed-failures": 0}):  # no retries on other workers
+            c, cluster = connect(workers=1)
+        try:
+            s = run_study(study, tmp_path / "s", client=c, quiet=True)
+            assert (s["ok"], s["failed"]) == (2, 2)
+            failed = [json.loads(p.read_text()) for p in (tmp_path / "s" / "points").glob("*.failed.json")]
+            assert all(f["contact"]["fuse"] == 1.0 and "KilledWorker" in f["message"] for f in failed)
+            s2 = run_study(study, tmp_path / "s", client=c, quiet=True, resume=True)
+            assert s2["computed"] == []
+            s3 = run_study(study, tmp_path / "s", client=c, quiet=True, resume=True, retry_failed=True)
+            assert len(s3["computed"]) == 2 and (s3["ok"], s3["failed"]) == (2, 2)
+        finally:
+            c.close()
+            cluster.close()
+    finally:
+        registry.SHAPES.unregister("bomb")

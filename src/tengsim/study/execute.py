@@ -45,23 +45,37 @@ starts; a cluster behind ``--scheduler`` keeps its own configuration."""
 
 # ---- the task that runs on a worker --------------------------------------------------------------
 
-def compute_point(contact: dict, pid: str) -> dict:
+def _worker_setup(plugins: str = "") -> None:
+    """Pin threads and import the client's plugin modules (``TENGSIM_PLUGINS``) on a worker."""
+    for k, v in WORKER_ENV.items():  # for workers of an external scheduler (LocalCluster sets them already)
+        os.environ.setdefault(k, v)
+    if plugins and not os.environ.get("TENGSIM_PLUGINS"):
+        os.environ["TENGSIM_PLUGINS"] = plugins
+    from tengsim.registry import load_plugins
+
+    load_plugins()
+
+
+def compute_point(contact: dict, pid: str, plugins: str = "") -> dict:
     """Run one point (exactly what ``tengsim run`` runs for the same [contact] table) on a worker.
 
+    ``plugins``: the client's ``TENGSIM_PLUGINS`` (modules a worker imports before the point, so a
+    study of user shapes or laws runs on workers that only have the modules installed).
     Never raises: returns {'status': 'ok' | 'unconverged' | 'failed', 'message', 'data' (the result's
     xarray Dataset with its attrs; the client writes it), 'seconds', 'host', 'pid', 'started', 'finished'}.
     """
-    for k, v in WORKER_ENV.items():  # for workers of an external scheduler (LocalCluster sets them already)
-        os.environ.setdefault(k, v)
     import traceback
 
     from tengsim import __version__
-    from tengsim.config import run_contact
 
     t0 = time.time()
     c0 = time.perf_counter()
     info = {"host": socket.gethostname(), "pid": os.getpid(), "started": t0}
     try:
+        _worker_setup(plugins)
+        from tengsim.config import run_contact
+
+        c0 = time.perf_counter()
         res = run_contact(dict(contact))
     except Exception as exc:  # noqa: BLE001 - recorded as a failed point, the others go on
         msg = str(exc) if isinstance(exc, TengsimError) else \
@@ -80,10 +94,12 @@ def compute_point(contact: dict, pid: str) -> dict:
             "data": ds}
 
 
-def warm_up() -> int:
-    """Import the solver stack on a worker (before the first point, so that no point pays for it)."""
-    for k, v in WORKER_ENV.items():
-        os.environ.setdefault(k, v)
+def warm_up(plugins: str = "") -> int:
+    """Import the solver stack (and the client's plugins) on a worker, before the first point."""
+    try:
+        _worker_setup(plugins)
+    except TengsimError:
+        pass  # the points report it, each as a failed point with the message
     import tengsim.config  # noqa: F401
     import tengsim.contact  # noqa: F401
     import xarray  # noqa: F401
@@ -296,7 +312,9 @@ def run_study(study, out, *, workers=None, scheduler=None, client=None, resume=F
     Nothing is written if validation, the directory check or the connection fails.
     """
     from tengsim.io import write_json
+    from tengsim.registry import load_plugins
 
+    load_plugins()  # the client plans the points with the same registries as its workers
     stream = stream or sys.stderr
     say = (lambda m: None) if quiet else (lambda m: print(m, file=stream, flush=True))
     if workers is not None and scheduler is not None:
@@ -333,10 +351,11 @@ def run_study(study, out, *, workers=None, scheduler=None, client=None, resume=F
         if len(todo) < len(valid):
             say(f"sweep: {len(valid) - len(todo)} point(s) already in {sd.points}, {len(todo)} to compute")
         _append_log(sd, {"event": "start", "time": time.time(), "todo": todo})
+        plugins = os.environ.get("TENGSIM_PLUGINS", "")
         if todo:
-            client.run(warm_up)
+            client.run(warm_up, plugins)
         t0, t0_unix = time.perf_counter(), time.time()
-        computed = _compute(client, valid, todo, sd, bar)
+        computed = _compute(client, valid, todo, sd, bar, plugins)
         t_compute = time.perf_counter() - t0
         bar.close()
     finally:
@@ -369,14 +388,14 @@ def _append_log(sd, entry):
         fh.flush()
 
 
-def _compute(client, valid, todo, sd, bar) -> list:
+def _compute(client, valid, todo, sd, bar, plugins="") -> list:
     """Submit ``todo``; write each result as it completes.  Returns the ids computed here."""
     import dask
     from dask.distributed import as_completed
 
     from tengsim.io import write_dataset, write_json
 
-    futures = {client.submit(compute_point, valid[pid], pid, key=f"tengsim-point-{pid}", pure=False,
+    futures = {client.submit(compute_point, valid[pid], pid, plugins, key=f"tengsim-point-{pid}", pure=False,
                              priority=len(todo) - k): pid
                for k, pid in enumerate(todo)}  # todo is longest first (validate); keep that order
     computed = []

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import sys
 import time
 from pathlib import Path
@@ -87,6 +88,9 @@ def optimize_study(study, out, *, workers=None, scheduler=None, client=None, res
     from tengsim.study.execute import StudyDir, SweepProgress, _close, _compute, connect, warm_up
     from tengsim.study.observe import observe
 
+    from tengsim.registry import load_plugins
+
+    load_plugins()
     stream = stream or sys.stderr
     obj = parse_objective(study)
     say = (lambda m: None) if quiet else (lambda m: print(m, file=stream, flush=True))
@@ -109,7 +113,8 @@ def optimize_study(study, out, *, workers=None, scheduler=None, client=None, res
         say(f"optimize: {obj['goal']} {obj['name']} over {', '.join(a.name for a in study.axes)}; "
             f"dashboard {client.dashboard_link}")
         sd.points.mkdir(parents=True, exist_ok=True)
-        client.run(warm_up)
+        plugins = os.environ.get("TENGSIM_PLUGINS", "")
+        client.run(warm_up, plugins)
 
         def save_spec():
             spec = study.resolved()
@@ -158,7 +163,7 @@ def optimize_study(study, out, *, workers=None, scheduler=None, client=None, res
                 todo.append(p.id)
             save_spec()
             bar = SweepProgress(len(todo), quiet=True)
-            _compute(client, valid, todo, sd, bar)
+            _compute(client, valid, todo, sd, bar, plugins)
             vals = [value(p) for p in pts]
             history.append(min(vals))
             say(f"optimize: generation {len(history)}: {len(todo)} new point(s), {len(evaluated)} evaluated, "
