@@ -185,3 +185,12 @@ def test_a_law_key_clashing_with_another_key_is_a_schema_error(clashing_law):
     with pytest.raises(TengsimError, match="law clash_radius field 'radius' clashes with the key of that name of "
                                            "shape sphere"):
         plan_contact(dict(RUN))
+
+
+def test_docs_name_every_built_in_law_key():
+    from pathlib import Path
+
+    text = (Path(__file__).parents[1] / "docs" / "validation.md").read_text(encoding="utf-8")
+    for name in ("lj93", "repulsive", "md", "exp"):
+        for f in law_fields(name):
+            assert f"`{f.name}`" in text, f"docs/validation.md does not name law {name}'s key {f.name}"
