@@ -28,7 +28,7 @@ class Law:
 
     g_safe: float
     internal_fields = ("g_safe",)
-    field_help: dict = {}
+    field_help = {}
 
     def _raw(self, g, need_dp=True):  # pragma: no cover - abstract
         raise NotImplementedError
@@ -193,7 +193,7 @@ class MaugisDugdale(Law):
     wall_stiffness: float = 1000.0
     smoothing: float = 0.2
     g_safe: float = 0.6
-    field_help = {"tension": "Dugdale tension σ0, in W/ε (default the LJ93 peak 16/(9√3))",
+    field_help = {"tension": "Dugdale tension σ0, in W/ε (default: the LJ93 peak 16/(9√3))",
                   "wall_stiffness": "stiffness k of the wall g < 1, in W/ε²",
                   "smoothing": "width of the smoothstep ramp at the range's end g = 1 + h0, in ε"}
 
@@ -245,7 +245,7 @@ class Exponential(Law):
     range: float = 1.0 / LJ_PEAK_TENSION - LJ_PEAK_TENSION / 2000.0
     wall_stiffness: float = 1000.0
     g_safe: float = 0.6
-    field_help = {"range": "decay length ρ of the attraction, in ε (default: the LJ93 peak tension)",
+    field_help = {"range": "decay length ρ of the attraction, in ε (default: peak tension A/ρ = LJ93's)",
                   "wall_stiffness": "stiffness k of the wall g < 1, in W/ε²"}
 
     def __post_init__(self):
