@@ -160,11 +160,13 @@ from tengsim.registry import LAWS, OBSERVERS, SHAPES
 @LAWS.register("half_lj", summary="the paper's law at half strength")
 @dataclass(frozen=True)
 class HalfLJ(Law):
+    factor: float = 0.5
     g_safe: float = 0.6
 
     def _raw(self, g, need_dp=True):
         phi, p, dp = LJ93()._raw(g, need_dp)
-        return 0.5 * phi, 0.5 * p, None if dp is None else 0.5 * dp
+        f = self.factor
+        return f * phi, f * p, None if dp is None else f * dp
 
 
 @SHAPES.register("tent", summary="square tent with a flat tip")
@@ -247,6 +249,27 @@ out = "{out2}"
     # a key the new shape does not have is refused with its name
     assert main(["contact", "tent", "--radius", "2", "--quiet", "--out", str(tmp_path / "x.csv")]) == 2
     assert "radius" in capsys.readouterr().err
+
+    # the new law's own field is a key of the CLI, TOML and help, with the law's default
+    HalfLJ = LAWS.get("half_lj")
+    api = ts.simulate(Tent(slope=1.5, tip=0.3), 0.5, 0.3, ts.PathSpec(-0.5, 0.5, 0.5), law=HalfLJ(factor=0.25))
+    assert not np.allclose(api.table["F"], res.table["F"])
+    out3 = tmp_path / "factor.csv"
+    assert main(["contact", "tent", "--slope", "1.5", "--tip", "0.3", "--law", "half_lj", "--factor", "0.25",
+                 "--dx", "0.3", "--d-min", "-0.5", "--d-max", "0.5", "--d-step", "0.5", "--quiet",
+                 "--out", str(out3)]) == 0, capsys.readouterr().err
+    rows = list(csv.DictReader(l for l in open(out3) if not l.startswith("#")))
+    np.testing.assert_allclose([float(r["F"]) for r in rows], api.table["F"], rtol=1e-12)
+    assert "# factor: 0.25" in "".join(l for l in open(out3) if l.startswith("#"))
+    cfg.write_text(cfg.read_text().replace('law = "half_lj"', 'law = "half_lj"\nfactor = 0.25'))
+    assert main(["run", str(cfg), "--quiet"]) == 0, capsys.readouterr().err
+    np.testing.assert_allclose(xr.load_dataset(out2)["F"].values, api.table["F"], rtol=1e-12)
+    assert main(["contact", "tent", "--factor", "0.25", "--quiet", "--out", str(tmp_path / "y.csv")]) == 2
+    assert "law lj93 has no key 'factor' (its keys: none)" in capsys.readouterr().err
+    with pytest.raises(SystemExit):
+        main(["contact", "--help"])
+    assert "--factor FACTOR parameter of law half_lj, in units of W and ε [law half_lj: default 0.5]" in " ".join(
+        capsys.readouterr().out.split())
 
 
 def test_broken_plugin_is_one_line(tmp_path, monkeypatch, capsys):

@@ -3,8 +3,9 @@
 The table's keys come from the registries and the schema, never from a list kept here: the shape's
 dimensionless fields (its dataclass fields, plain numbers) *or* its physical fields (numbers in SI
 or unit strings such as '2um') with ``E_star``, ``W`` and ``eps`` or ``tabor``; then the grid, the
-path, and the boundary, solver, law and observers by registered name.  A physical run builds the
-shape's :class:`tengsim.units.Scaling`; the core stays dimensionless.
+path, and the boundary, solver, law and observers by registered name, with the chosen law's own
+parameters (its fields, :func:`law_fields`: plain numbers in units of W and ε).  A physical run builds
+the shape's :class:`tengsim.units.Scaling`; the core stays dimensionless.
 """
 from __future__ import annotations
 
@@ -165,22 +166,93 @@ def dimensionless_fields(cls) -> tuple:
         return tuple(cls.dimensionless_fields())
     if dataclasses.is_dataclass(cls):
         return tuple(Shape.dimensionless_fields.__func__(cls))
+    return _signature_fields(cls)
+
+
+def _kind(annotation) -> str:
+    return {"int": "int", "bool": "bool"}.get(getattr(annotation, "__name__", annotation), "float")
+
+
+def _signature_fields(cls, skip=(), helps=None) -> tuple:
     out = []
     for p in inspect.signature(cls).parameters.values():
-        if p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY):
-            out.append(Field(p.name, "float", REQUIRED if p.default is p.empty else p.default))
+        if p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY) and p.name not in skip:
+            out.append(Field(p.name, "float" if p.annotation is p.empty else _kind(p.annotation),
+                             REQUIRED if p.default is p.empty else p.default, help=(helps or {}).get(p.name, "")))
     return tuple(out)
+
+
+def law_fields(law) -> tuple:
+    """A law's [contact] keys: its dataclass fields (or constructor arguments) less the numerical guards it
+    names in ``internal_fields`` (g_safe); plain numbers in units of W and ε (help from ``field_help``).
+
+    ``law`` is a registered name or the registered class (factory); the defaults are the law's own.
+    """
+    ensure_builtins()
+    cls = LAWS.get(law) if isinstance(law, str) else law
+    skip = tuple(getattr(cls, "internal_fields", ()) or ())
+    helps = getattr(cls, "field_help", None) or {}
+    if not dataclasses.is_dataclass(cls):
+        return _signature_fields(cls, skip, helps)
+    out = []
+    for f in dataclasses.fields(cls):
+        if not f.init or f.name in skip:
+            continue
+        if f.default is not dataclasses.MISSING:
+            default = f.default
+        elif f.default_factory is not dataclasses.MISSING:  # pragma: no cover
+            default = f.default_factory()
+        else:
+            default = REQUIRED
+        out.append(Field(f.name, _kind(f.type), default, help=helps.get(f.name, "")))
+    return tuple(out)
+
+
+def _default_text(f) -> str:
+    if f.required:
+        return "required"
+    return f"default {f.default:.6g}" if isinstance(f.default, float) else f"default {f.default!r}"
+
+
+def _field_help(name, f) -> str:
+    return f.help or f"parameter of law {name}, in units of W and ε"
+
+
+def law_keys() -> dict:
+    """{key: [(law name, Field), ...]}: every registered law's [contact] keys, and the laws having each.
+
+    A law key may not be a common [contact] key (a TengsimError names the clash); several laws may share
+    one (md and exp: wall_stiffness)."""
+    ensure_builtins()
+    common = {f.name for f in common_fields()}
+    out = {}
+    for name in LAWS.names():
+        for f in law_fields(name):
+            if f.name in common:
+                raise TengsimError(f"law {name} field {f.name!r} clashes with the [contact] key of that name")
+            out.setdefault(f.name, []).append((name, f))
+    return out
+
+
+def law_key_help(entries) -> str:
+    """One help text for a law key shared by ``entries`` [(law, Field)]: its text, the laws and defaults."""
+    groups = {}
+    for name, f in entries:
+        groups.setdefault(_field_help(name, f), []).append(f"{name}: {_default_text(f)}")
+    return "; ".join(f"{h} [law {', '.join(laws)}]" for h, laws in groups.items())
 
 
 def physical_fields(cls) -> tuple:
     return tuple(getattr(cls, "physical_fields", ()) or ())
 
 
-def contact_table(shape: str = "pyramid", mode: str | None = None) -> Table:
-    """The schema of a [contact] table for ``shape``.
+def contact_table(shape: str = "pyramid", mode: str | None = None, law: str | None = None) -> Table:
+    """The schema of a [contact] table for ``shape`` (and ``law``).
 
     ``mode`` 'dimensionless' or 'physical' gives the table a run of that kind is parsed with; None
-    (default) every key the shape accepts in either (for docs, the sweep and the CLI).
+    (default) every key the shape accepts in either (for docs, the sweep and the CLI).  ``law`` (a
+    registered name) adds that law's keys with its defaults; None the keys of every registered law
+    (no defaults: each law has its own).  A shape or law key named like another key is an error.
     """
     name, cls = _shape_cls(shape)
     common = common_fields()
@@ -189,10 +261,20 @@ def contact_table(shape: str = "pyramid", mode: str | None = None) -> Table:
     for f in (*dims, *phys):
         if f.name in taken:
             raise TengsimError(f"shape {name} field {f.name!r} clashes with the [contact] key of that name")
+    keys = law_keys()  # every law's: a clash with a shape key is an error whichever law a run picks
+    for f in (*dims, *phys):
+        if f.name in keys:
+            raise TengsimError(f"law {keys[f.name][0][0]} field {f.name!r} clashes with the key of that name "
+                               f"of shape {name}")
+    if law is None:
+        laws = [Field(k, entries[0][1].kind, None, help=law_key_help(entries)) for k, entries in keys.items()]
+    else:
+        lname = LAWS.canonical(law)
+        laws = [dataclasses.replace(f, help=_field_help(lname, f) + f" [law {lname}]") for f in law_fields(lname)]
     if mode == "dimensionless":
-        fields = [*common, *dims]
+        fields = [*common, *dims, *laws]
     elif mode == "physical":
-        fields = [*common, *phys]
+        fields = [*common, *phys, *laws]
     elif mode is None:
         merged = {f.name: dataclasses.replace(f, default=None) if f.required else f for f in dims}
         for f in phys:
@@ -204,14 +286,14 @@ def contact_table(shape: str = "pyramid", mode: str | None = None) -> Table:
             else:  # same name in both: a plain number, or a quantity in a physical run
                 h = d.help if d.help == f.help or not f.dim else f"{d.help} (dimensionless) / {f.help} (physical)"
                 merged[f.name] = Field(f.name, "float", None, dim=f.dim, help=h)
-        fields = [*common, *merged.values()]
+        fields = [*common, *merged.values(), *laws]
     else:
         raise TengsimError(f"mode must be 'dimensionless', 'physical' or None, got {mode!r}")
     return Table("contact", fields, doc=f"shape {name}")
 
 
 def contact_keys() -> tuple:
-    """Every key a [contact] table may hold for some registered shape (the CLI's option set)."""
+    """Every key a [contact] table may hold for some registered shape and law (the CLI's option set)."""
     ensure_builtins()
     keys = [f.name for f in common_fields()]
     for s in SHAPES.names():
@@ -281,23 +363,38 @@ def _build(cls, name, kw):
         raise TengsimError(f"shape {name}: {exc}") from None
 
 
+def _build_law(name, kw):
+    """The law ``name`` with the given keys (the rest: its own defaults); its own check of the values."""
+    try:
+        return make_law(name, **kw)
+    except (TypeError, ValueError) as exc:
+        raise TengsimError(f"law {name}: {exc}") from None
+
+
 def plan_contact(cfg: dict) -> ContactPlan:
     """Validate a [contact] table and build its pieces (no solving)."""
     if not isinstance(cfg, dict):
         raise TengsimError(f"[contact] must be a table, got {cfg!r}")
     name, cls = _shape_cls(cfg.get("shape") or "pyramid")
     full = contact_table(name)
+    all_law_keys = law_keys()
     unknown = [k for k in cfg if k not in full]
     if unknown:
         others = [k for k in unknown if k in contact_keys()]
         if others:
-            raise TengsimError(f"shape {name} has no key {', '.join(map(repr, others))} "
-                               f"(its keys: {', '.join(k for k in full.keys() if k not in _common_names())})")
+            own = [k for k in full.keys() if k not in _common_names() and k not in all_law_keys]
+            raise TengsimError(f"shape {name} has no key {', '.join(map(repr, others))} (its keys: {', '.join(own)})")
         raise TengsimError(f"[contact] unknown key(s) {', '.join(map(repr, unknown))} "
                            f"(known: {', '.join(full.keys())})")
     dims, phys = dimensionless_fields(cls), physical_fields(cls)
     dim_names, phys_names = [f.name for f in dims], [f.name for f in phys]
     given = {k for k, v in cfg.items() if v is not None and v != ""}
+    law_name = full.fields["law"].parse(cfg.get("law") or "lj93", "[contact] ")
+    lfields = law_fields(law_name)
+    wrong = [k for k in cfg if k in given and k in all_law_keys and k not in {f.name for f in lfields}]
+    if wrong:
+        raise TengsimError(f"law {law_name} has no key {', '.join(map(repr, wrong))} "
+                           f"(its keys: {', '.join(f.name for f in lfields) or 'none'})")
     triggers = sorted(given & (set(PHYSICAL_KEYS) | (set(phys_names) - set(dim_names))))
     extra, scaling, lateral = {}, None, None
     if triggers:
@@ -313,7 +410,7 @@ def plan_contact(cfg: dict) -> ContactPlan:
         missing += [f.name for f in phys if f.required and f.name not in given]
         if missing:
             raise TengsimError(f"physical {name} input needs {', '.join(missing)}")
-        vals = contact_table(name, "physical").parse(cfg)
+        vals = contact_table(name, "physical", law_name).parse(cfg)
         E, W = positive("E_star", vals["E_star"]), positive("W", vals["W"])
         p = {f.name: vals[f.name] for f in phys}
         if vals["eps"] is not None and vals["tabor"] is not None:
@@ -345,7 +442,7 @@ def plan_contact(cfg: dict) -> ContactPlan:
             raise TengsimError(f"{name} needs {', '.join(missing)} (dimensionless)"
                                + (f" or {', '.join(phys_names)} with E_star, W and eps or tabor (physical)"
                                   if phys_names else ""))
-        vals = contact_table(name, "dimensionless").parse(cfg)
+        vals = contact_table(name, "dimensionless", law_name).parse(cfg)
         tabor = positive("tabor", 0.5 if vals["tabor"] is None else vals["tabor"])
         shape = _build(cls, name, {f.name: vals[f.name] for f in dims if vals[f.name] is not None})
     raw_dx = cfg.get("dx")  # not given: the shape's own pixel (a height map's) or 0.1
@@ -353,7 +450,7 @@ def plan_contact(cfg: dict) -> ContactPlan:
     kernel_params = _film(cfg, vals, lateral, extra)
     path = _path_spec(vals, given, scaling)
     tol = positive("tol", vals["tol"])
-    law = make_law(vals["law"])
+    law = _build_law(law_name, {f.name: vals[f.name] for f in lfields if f.name in given})
     grid = shape.grid(dx)  # validates dx against the cell
     from tengsim.resources import check_memory
 

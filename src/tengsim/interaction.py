@@ -19,9 +19,16 @@ from tengsim.registry import LAWS
 
 
 class Law:
-    """Base class: subclasses give the raw law for g >= g_safe via ``_raw(g) -> (Φ, P, dP/dg)``."""
+    """Base class: subclasses give the raw law for g >= g_safe via ``_raw(g) -> (Φ, P, dP/dg)``.
+
+    A law's fields (its dataclass fields, or constructor arguments) are ``[contact]`` keys of a run
+    with that law (:func:`tengsim.config.law_fields`), except the numerical guards named in
+    ``internal_fields``; ``field_help`` gives a key its help text (with its unit: W and ε).
+    """
 
     g_safe: float
+    internal_fields = ("g_safe",)
+    field_help = {}
 
     def _raw(self, g, need_dp=True):  # pragma: no cover - abstract
         raise NotImplementedError
@@ -129,6 +136,8 @@ class Repulsive(Law):
     scale: float = 8.0 / 3.0
     exponent: float = 9.0
     g_safe: float = 0.6
+    field_help = {"scale": "prefactor c of the wall P = c g^-k, in W/ε",
+                  "exponent": "power k > 1 of the wall P = c g^-k (pure number)"}
 
     def __post_init__(self):
         positive("scale", self.scale)
@@ -184,6 +193,9 @@ class MaugisDugdale(Law):
     wall_stiffness: float = 1000.0
     smoothing: float = 0.2
     g_safe: float = 0.6
+    field_help = {"tension": "Dugdale tension σ0, in W/ε (default: the LJ93 peak 16/(9√3))",
+                  "wall_stiffness": "stiffness k of the wall g < 1, in W/ε²",
+                  "smoothing": "width of the smoothstep ramp at the range's end g = 1 + h0, in ε"}
 
     def __post_init__(self):
         positive("tension", self.tension)
@@ -233,6 +245,8 @@ class Exponential(Law):
     range: float = 1.0 / LJ_PEAK_TENSION - LJ_PEAK_TENSION / 2000.0
     wall_stiffness: float = 1000.0
     g_safe: float = 0.6
+    field_help = {"range": "decay length ρ of the attraction, in ε (default: peak tension A/ρ = LJ93's)",
+                  "wall_stiffness": "stiffness k of the wall g < 1, in W/ε²"}
 
     def __post_init__(self):
         positive("range", self.range)

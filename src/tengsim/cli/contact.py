@@ -12,15 +12,17 @@ _ALIASES = {"maps_at": ("--maps",)}
 
 
 def _option_help():
-    """Common keys, and per shape key its help text(s) and the shapes using it, from the [contact] schema."""
-    from tengsim.config import common_fields, contact_table
+    """Common keys, per shape key its help text(s) and the shapes using it, and per law key its help text,
+    laws and defaults, from the [contact] schema."""
+    from tengsim.config import common_fields, contact_table, law_key_help, law_keys
     from tengsim.registry import SHAPES
 
     common = {f.name: f for f in common_fields()}
+    laws = law_keys()
     per_key = {}
     for s in SHAPES.names():
         for k, f in contact_table(s).fields.items():
-            if k not in common:
+            if k not in common and k not in laws:
                 per_key.setdefault(k, {}).setdefault(f.help or k, []).append(s)
     helps = {}
     for k, groups in per_key.items():
@@ -29,6 +31,8 @@ def _option_help():
             helps[k] = f"{h} [{', '.join(users)}]"
         else:
             helps[k] = "; ".join(f"{', '.join(users)}: {h}" for h, users in groups.items())
+    for k, entries in laws.items():
+        helps[k] = law_key_help(entries) + " (a plain number, no unit)"
     return common, helps
 
 
