@@ -373,21 +373,19 @@ def convergence_tables(rows, runs) -> list[str]:
         ratio = _ms([_at(rows, k, 150.0) / _at(rows, k, 10.0) for k in ks])
         L.append(f"| {dx:g} | {K} | {s:.0%} | {len(ks)} | " + " | ".join(a) + f" | {ratio} |")
     dxs = sorted({k[0] for k in keys})
-    pairs = [(k, (dxs[0],) + k[1:]) for k in keys if k[0] != dxs[0] and (dxs[0],) + k[1:] in keys]
-    if pairs:
-        fine, coarse = dxs[0], pairs[0][0][0]
-        L += ["", f"## Grid: dx = {fine:g} vs dx = {coarse:g} (same K, s, seed)", "",
-              "Each cell: A/S at dx = " + f"{fine:g} / at dx = {coarse:g} (difference fine − coarse).", "",
-              "| K | s | seed | " + " | ".join(f"A/S @ {p:g} kPa" for p in PS_REPORT)
-              + " | V_OC(150)/V_OC(10) |", "|" + "---|" * (4 + len(PS_REPORT))]
-        for kc, kf in pairs:
-            cells = []
-            for p in PS_REPORT:
-                f, c = _at(rows, kf, p), _at(rows, kc, p)
-                cells.append(f"{f:.3f} / {c:.3f} ({f - c:+.3f})")
-            rf, rc = _at(rows, kf, 150.0) / _at(rows, kf, 10.0), _at(rows, kc, 150.0) / _at(rows, kc, 10.0)
-            L.append(f"| {kc[1]} | {kc[2]:.0%} | {kc[3]} | " + " | ".join(cells)
-                     + f" | {rf:.3f} / {rc:.3f} ({rf - rc:+.3f}) |")
+    multi = [k for k in sorted({k[1:] for k in keys}) if sum((d,) + k in keys for d in dxs) > 1]
+    if multi:
+        L += ["", "## Grid: the same K, s, seed at each dx", "",
+              "Δ: the row's V_OC(150)/V_OC(10) minus that at the finest dx of the group.", "",
+              "| K | s | seed | dx | " + " | ".join(f"A/S @ {p:g} kPa" for p in PS_REPORT)
+              + " | V_OC(150)/V_OC(10) | Δ |", "|" + "---|" * (6 + len(PS_REPORT))]
+        for K, s, seed in multi:
+            ks = [(d, K, s, seed) for d in dxs if (d, K, s, seed) in keys]
+            ref = _at(rows, ks[0], 150.0) / _at(rows, ks[0], 10.0)
+            for k in ks:
+                r = _at(rows, k, 150.0) / _at(rows, k, 10.0)
+                L.append(f"| {K} | {s:.0%} | {seed} | {k[0]:g} | "
+                         + " | ".join(f"{_at(rows, k, p):.3f}" for p in PS_REPORT) + f" | {r:.3f} | {r - ref:+.3f} |")
     for dx in dxs:
         Ks = sorted({k[1] for k in keys if k[0] == dx})
         if len(Ks) < 2:

@@ -64,7 +64,8 @@ def test_runs_append_skip_and_tables(mod, tmp_path, capsys):
     assert text.endswith("## Findings\n\nhand-written\n")  # the hand-written section survives a rewrite
     a = {(r["dx"], float(r["P_target_kPa"])): float(r["A_S_greenwood"]) for r in rows}
     fine, coarse = a["0.3", 150.0] / a["0.3", 10.0], a["0.4", 150.0] / a["0.4", 10.0]
-    assert "## Grid: dx = 0.3 vs dx = 0.4" in text
-    pair = next(ln for ln in text.splitlines() if ln.startswith("| 2 | 0% | 0 | "))
-    assert pair.endswith(f"| {fine:.3f} / {coarse:.3f} ({fine - coarse:+.3f}) |")
-    assert f"{a['0.3', 50.0]:.3f} / {a['0.4', 50.0]:.3f} ({a['0.3', 50.0] - a['0.4', 50.0]:+.3f})" in pair
+    assert "## Grid: the same K, s, seed at each dx" in text
+    line = {d: next(ln for ln in text.splitlines() if ln.startswith(f"| 2 | 0% | 0 | {d} | ")) for d in ("0.3", "0.4")}
+    assert line["0.3"].endswith(f"| {fine:.3f} | +0.000 |")
+    assert line["0.4"].endswith(f"| {coarse:.3f} | {coarse - fine:+.3f} |")
+    assert f"| {a['0.4', 50.0]:.3f} | {a['0.4', 100.0]:.3f} |" in line["0.4"]
