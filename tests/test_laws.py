@@ -168,3 +168,66 @@ def test_md_sphere_converged_mu1():
     p, _, a0 = md_sphere(1.0, 0.05, 6.0, -1.2, d_max=4.0)
     assert p == pytest.approx(m.pull_off, rel=1e-2)
     assert a0 == pytest.approx(m.a_zero_load, rel=1e-2)
+
+
+# ---- the contact branch walked in D, sub-pixel radius, pull-off as the vertex of F(a) ------------------
+
+def md_branch(mu, dx, cell, Ds, k=1e4, tol=1e-7):
+    """2-D engine, MD law (wall stiffness ``k``), sphere R = 1 in a free cell: the contact branch at the
+    D values ``Ds`` walked in order from the zero state (so Ds[0] must already be in contact, e.g. 0).
+    Returns (D, −∬P/π, edge radius (tengsim.analysis.edge_radius), sqrt(area(H <= 0)/π))."""
+    from tengsim.analysis import apex_index, edge_radius
+    from tengsim.geometry import Paraboloid
+    from tengsim.kernels import FreeKernel
+    from tengsim.path import walk_states
+    from tengsim.solvers import FastSolver
+    shape = Paraboloid(1.0, cell)
+    grid = shape.grid(dx)
+    U0 = shape.gap(grid)
+    apex = apex_index(U0)
+    out = []
+    for D, eq in walk_states(U0, MaugisDugdale(wall_stiffness=k), FreeKernel(grid, mu ** 1.5), FastSolver(tol), Ds):
+        assert eq.converged, (D, eq.residual)
+        out.append((D, -eq.P.sum() * grid.area / np.pi, edge_radius(eq.H, grid, apex),
+                    np.sqrt((eq.H <= 0).sum() * grid.area / np.pi)))
+    return tuple(np.array(c) for c in zip(*out))
+
+
+def md_paths(D_pull, D_zero, fine=0.01, half=0.12):
+    """D lists for :func:`md_branch`: down from 0 to D_pull + half in 0.05 steps, then in ``fine``
+    steps to D_pull − half (the window of the F(a) fit); up from 0 in 0.1 steps to D_zero + 0.3
+    (the zero-load row).  D_pull, D_zero: where to refine (Maugis' values serve as the guess)."""
+    down = np.concatenate([np.arange(0.0, D_pull + half, -0.05), np.arange(D_pull + half, D_pull - half - 1e-9, -fine)])
+    up = np.arange(0.0, D_zero + 0.3, 0.1)
+    return down, up
+
+
+def md_measure(mu, dx, cell, k=1e4, n_fit=7, down=True, up=True):
+    """Pull-off P̄* and radius a* (vertex of the parabola F(a) on the descending walk), pull-off from
+    the fine rows' least F, and the zero-load radius (quadratic a(F) through the 3 rows around F = 0
+    on the ascending walk)."""
+    from tengsim.analysis import quadratic_vertex
+    m = maugis_sphere(mu)
+    dn, upD = md_paths(m.D_pull_off, m.D_pull_off if not up else ref_zero_load_D(mu))
+    res = {}
+    if down:
+        D, P, a, a_area = md_branch(mu, dx, cell, dn, k)
+        ok = a > 0
+        a_star, F_star = quadratic_vertex(a[ok], -P[ok], n_fit)
+        res.update(pull_off=-F_star, a_pull_off=a_star, pull_off_rows=P.max(), D_rows=D[np.argmax(P)],
+                   a_area_rows=a_area[np.argmax(P)])
+    if up:
+        D, P, a, _ = md_branch(mu, dx, cell, upD, k)
+        j = int(np.flatnonzero(P[:-1] * P[1:] <= 0)[0])
+        s = slice(max(j - 1, 0), j + 2)
+        res["a_zero_load"] = float(np.polyval(np.polyfit(-P[s], a[s], 2), 0.0))
+    return res
+
+
+def ref_zero_load_D(mu):
+    """D at zero load on Maugis' curve (where the ascending walk must reach)."""
+    lam = ref.md_lambda_from_tabor(mu)
+    sc = ref.md_scales(**sphere_md_units(mu))
+    c = ref.maugis_dugdale_curve(lam, A_max=4.0, n=4000, A_min=1e-3)
+    i = int(np.argmin(c.P))
+    return float(np.interp(0.0, c.P[i:], c.D[i:]) * sc.indentation)
