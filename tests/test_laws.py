@@ -323,3 +323,22 @@ def test_md_sphere_dmt_end_mu01():
     r = md_measure(0.1, 0.035, 3.8, n_fit=0, fine=0.005, half=0.05)
     assert r["pull_off_rows"] == pytest.approx(m.pull_off, rel=3e-3)
     assert r["a_zero_load"] == pytest.approx(m.a_zero_load, rel=1e-2)
+
+
+def test_walk_states_matches_run_path():
+    """tengsim.path.walk_states (the walks above) gives run_path's approach rows (LJ93 sphere, μ = 0.5,
+    dx 0.25, cell 4, D −0.6 … 0.4 in 0.2 steps) to the solver tolerance (F within 1e-5); it also walks down."""
+    from tengsim.analysis import force
+    from tengsim.geometry import Paraboloid
+    from tengsim.kernels import FreeKernel
+    from tengsim.path import PathSpec, run_path, walk_states
+    from tengsim.solvers import FastSolver
+    shape = Paraboloid(1.0, 4.0)
+    grid = shape.grid(0.25)
+    U0, kernel, solver = shape.gap(grid), FreeKernel(grid, 0.5 ** 1.5), FastSolver(1e-8)
+    res = run_path(U0, LJ93(), kernel, solver, PathSpec(-0.6, 0.4, 0.2, retract=False))
+    Ds = np.linspace(-0.6, 0.4, 6)
+    up = [force(eq.P, grid) for _, eq in walk_states(U0, LJ93(), kernel, solver, Ds)]
+    assert np.allclose(up, res.branch("approach")["F"], atol=1e-5)
+    down = [force(eq.P, grid) for _, eq in walk_states(U0, LJ93(), kernel, solver, Ds[::-1])]
+    assert np.allclose(down[::-1], up, atol=1e-5)
