@@ -172,7 +172,7 @@ def test_md_sphere_converged_mu1():
 
 # ---- the contact branch walked in D, sub-pixel radius, pull-off as the vertex of F(a) ------------------
 
-def md_branch(mu, dx, cell, Ds, k=1e4, tol=1e-7, pre=()):
+def md_branch(mu, dx, cell, Ds, k=1e4, tol=1e-7, pre=(), smoothing=0.2):
     """2-D engine, MD law (wall stiffness ``k``), sphere R = 1 in a free cell: the contact branch at the
     D values ``Ds`` walked in order from the zero state (so Ds[0] must already be in contact, e.g. 0),
     or from the last of a walk over ``pre`` (not recorded) with the softer wall k = 1000, tol 1e-5 and up
@@ -189,10 +189,10 @@ def md_branch(mu, dx, cell, Ds, k=1e4, tol=1e-7, pre=()):
     apex = apex_index(U0)
     out = []
     kernel, solver, start = FreeKernel(grid, mu ** 1.5), FastSolver(tol, max_iter=20000), None
-    for D, eq in walk_states(U0, MaugisDugdale(), kernel, FastSolver(1e-5, max_iter=50000), pre):
+    for D, eq in walk_states(U0, MaugisDugdale(smoothing=smoothing), kernel, FastSolver(1e-5, max_iter=50000), pre):
         assert eq.converged, (D, eq.residual)
         start = eq.state
-    for D, eq in walk_states(U0, MaugisDugdale(wall_stiffness=k), kernel, solver, Ds, start):
+    for D, eq in walk_states(U0, MaugisDugdale(wall_stiffness=k, smoothing=smoothing), kernel, solver, Ds, start):
         assert eq.converged, (D, eq.residual)
         out.append((D, -eq.P.sum() * grid.area / np.pi, edge_radius(eq.H, grid, apex),
                     np.sqrt((eq.H <= 0).sum() * grid.area / np.pi)))
@@ -210,7 +210,8 @@ def md_paths(D_pull, D_zero, fine=0.01, half=0.12, d_start=0.0):
     return down, up, (pre if d_start < 0 else ())
 
 
-def md_measure(mu, dx, cell, k=1e4, n_fit=7, down=True, up=True, d_start=0.0, fine=0.01, half=0.12, tol=1e-7):
+def md_measure(mu, dx, cell, k=1e4, n_fit=7, down=True, up=True, d_start=0.0, fine=0.01, half=0.12, tol=1e-7,
+               smoothing=0.2):
     """Pull-off P̄* and radius a* (vertex of the parabola F(a) through ``n_fit`` rows of the descending
     walk; none if n_fit = 0), the fine rows' least F (``pull_off_rows``), and the zero-load radius
     (quadratic a(F) through the 3 rows around F = 0 on the ascending walk)."""
@@ -219,14 +220,14 @@ def md_measure(mu, dx, cell, k=1e4, n_fit=7, down=True, up=True, d_start=0.0, fi
     dn, upD, pre = md_paths(m.D_pull_off, m.D_pull_off if not up else ref_zero_load_D(mu), fine, half, d_start)
     res = {}
     if down:
-        D, P, a, a_area = md_branch(mu, dx, cell, dn, k, tol, pre)
+        D, P, a, a_area = md_branch(mu, dx, cell, dn, k, tol, pre, smoothing)
         res.update(pull_off_rows=P.max(), D_rows=D[np.argmax(P)], a_rows=a[np.argmax(P)],
                    a_area_rows=a_area[np.argmax(P)], rows=np.c_[D, P, a, a_area])
         if n_fit:
             a_star, F_star = quadratic_vertex(a, -P, n_fit)
             res.update(pull_off=-F_star, a_pull_off=a_star)
     if up:
-        D, P, a, _ = md_branch(mu, dx, cell, upD, k, tol, pre)
+        D, P, a, _ = md_branch(mu, dx, cell, upD, k, tol, pre, smoothing)
         j = int(np.flatnonzero(P[:-1] * P[1:] <= 0)[0])
         s = slice(max(j - 1, 0), j + 2)
         res["a_zero_load"] = float(np.polyval(np.polyfit(-P[s], a[s], 2), 0.0))
@@ -295,8 +296,9 @@ def test_quadratic_vertex_pull_off():
 @pytest.mark.slow
 def test_md_sphere_radius_at_pull_off_mu03():
     """μ = 0.3 (λ = 0.347), wall k = 10⁴ (Maugis' wall is rigid; k = 1000 adds +0.9 % to a*), dx 0.05,
-    cell 4.4: pull-off P̄* MEAS_P03, radius at pull-off a* (vertex of F(a)) MEAS_A03, zero-load radius
-    MEAS_Z03 from Maugis; asserted 1 % (pull-off 0.3 %)."""
+    cell 4.4: pull-off P̄* +0.010 %, radius at pull-off a* (vertex of F(a)) +0.013 %, zero-load radius
+    +0.010 % from Maugis (dx 0.1: +0.13 / +2.4 / −0.12 %; dx 0.035: +0.012 / −0.35 / −0.012 %; the
+    least-F row's radius: −0.28 % edge, +1.6 % sqrt(area/π)); asserted 1 % (pull-off 0.3 %); 6–7 s."""
     m = maugis_sphere(0.3)
     r = md_measure(0.3, 0.05, 4.4)
     assert r["pull_off"] == pytest.approx(m.pull_off, rel=3e-3)
@@ -306,8 +308,9 @@ def test_md_sphere_radius_at_pull_off_mu03():
 
 @pytest.mark.slow
 def test_md_sphere_radius_at_pull_off_mu1():
-    """μ = 1 (λ = 1.157), k = 10⁴, dx 0.05, cell 5.9, the descending walk only: pull-off MEAS_P1,
-    radius at pull-off MEAS_A1 from Maugis (dx 0.1: +1.09 / +1.47 %); asserted 1 %."""
+    """μ = 1 (λ = 1.157), k = 10⁴, dx 0.05, cell 5.9, the descending walk only: pull-off +0.27 %,
+    radius at pull-off +0.52 % from Maugis (dx 0.1: +1.09 / +1.47 %; dx 0.035: +0.07 / +0.29 %;
+    sqrt(area/π) of the least-F row: +1.03 %); asserted 1 %; 92–117 s."""
     m = maugis_sphere(1.0)
     r = md_measure(1.0, 0.05, 5.9, up=False)
     assert r["pull_off"] == pytest.approx(m.pull_off, rel=1e-2)
@@ -317,8 +320,8 @@ def test_md_sphere_radius_at_pull_off_mu1():
 @pytest.mark.slow
 def test_md_sphere_dmt_end_mu01():
     """μ = 0.1 (λ = 0.116, DMT-like), k = 10⁴, dx 0.035, cell 3.8: pull-off (least F of the fine rows;
-    a* = 0.096 is under 3 pixels, so no radius at pull-off is claimed) MEAS_P01, zero-load radius
-    MEAS_Z01 from Maugis; asserted 0.3 % and 1 %."""
+    a* = 0.096 is under 3 pixels, so no radius at pull-off is claimed) +0.009 %, zero-load radius
+    +0.24 % from Maugis (dx 0.05: +0.002 %, +0.05 %); asserted 0.3 % and 1 %; 2 s."""
     m = maugis_sphere(0.1)
     r = md_measure(0.1, 0.035, 3.8, n_fit=0, fine=0.005, half=0.05)
     assert r["pull_off_rows"] == pytest.approx(m.pull_off, rel=3e-3)
