@@ -297,7 +297,7 @@ def test_quadratic_vertex_pull_off():
 def test_md_sphere_radius_at_pull_off_mu03():
     """μ = 0.3 (λ = 0.347), wall k = 10⁴ (Maugis' wall is rigid; k = 1000 adds +0.9 % to a*), dx 0.05,
     cell 4.4: pull-off P̄* +0.010 %, radius at pull-off a* (vertex of F(a)) +0.013 %, zero-load radius
-    +0.010 % from Maugis (dx 0.1: +0.13 / +2.4 / −0.12 %; dx 0.035: +0.012 / −0.35 / −0.012 %; the
+    +0.010 % from Maugis (dx 0.1: +0.13 / +2.4 / +0.01 %; dx 0.035: +0.012 / −0.35 / −0.012 %; the
     least-F row's radius: −0.28 % edge, +1.6 % sqrt(area/π)); asserted 1 % (pull-off 0.3 %); 6–7 s."""
     m = maugis_sphere(0.3)
     r = md_measure(0.3, 0.05, 4.4)
