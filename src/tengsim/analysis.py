@@ -87,3 +87,51 @@ def summarize(P: np.ndarray, H: np.ndarray, grid: Grid, apex: tuple[int, int]) -
         max_pressure=float(P.max()),
         min_pressure=float(P.min()),
     )
+
+
+def edge_radius(H: np.ndarray, grid: Grid, apex: tuple[int, int], window: float = 2.5) -> float:
+    """Radius a of the closed zone H <= 0 (g <= 1, Maugis' contact) around ``apex``, sub-pixel.
+
+    At the edge of an adhesive (Dugdale-like) contact the stress intensity vanishes and the gap opens
+    as H ≈ β (r − a)^{3/2}; so y = H^{2/3} is linear in r just outside the edge.  The pixels with
+    H > 0 whose centre radius r lies within ``window``·dx outside the outermost closed pixel give a
+    least-squares line y = β^{2/3}(r − a), and a is its root.  Unlike sqrt(area/π), a moves
+    continuously with the state (the pixel lattice only adds scatter).  0 if the apex pixel is open;
+    NaN if fewer than 3 open pixels lie in the window (the zone reaches the cell's edge).
+    """
+    i0, j0 = apex
+    if H[i0, j0] > 0:
+        return 0.0
+    x = (np.arange(grid.nx) - i0) * grid.dx
+    y = (np.arange(grid.ny) - j0) * grid.dy
+    r = np.hypot(x[:, None], y[None, :])
+    r_in = float(r[H <= 0].max())
+    sel = (H > 0) & (r <= r_in + window * max(grid.dx, grid.dy))
+    if np.count_nonzero(sel) < 3:
+        return float("nan")
+    slope, icpt = np.polyfit(r[sel], H[sel] ** (2.0 / 3.0), 1)
+    return float(-icpt / slope) if slope > 0 else float("nan")
+
+
+def quadratic_vertex(x, F, n: int = 7) -> tuple[float, float]:
+    """(x*, F*) at the minimum of F(x): vertex of the least-squares parabola through the ``n`` samples
+    nearest (in sample order) to the smallest F.  For the sphere's pull-off with x the contact radius
+    a this is Maugis' condition dF/da = 0, well posed where the row with the least F is not (dF/dD = 0
+    there too).  Raises TengsimError if the parabola opens downwards or its vertex lies outside the
+    samples used."""
+    from tengsim.errors import TengsimError
+
+    x = np.asarray(x, dtype=float)
+    F = np.asarray(F, dtype=float)
+    if x.shape != F.shape or len(x) < 3 or n < 3:
+        raise TengsimError(f"need at least 3 samples of x and F (got {len(x)}) and n >= 3 (got {n})")
+    i = int(np.argmin(F))
+    lo = max(0, min(i - n // 2, len(F) - n))
+    xs, Fs = x[lo:lo + n], F[lo:lo + n]
+    c2, c1, c0 = np.polyfit(xs, Fs, 2)
+    if not c2 > 0:
+        raise TengsimError("quadratic_vertex: the parabola through the samples has no minimum")
+    xv = -c1 / (2 * c2)
+    if not xs.min() <= xv <= xs.max():
+        raise TengsimError(f"quadratic_vertex: vertex x = {xv:.6g} outside the samples [{xs.min():.6g}, {xs.max():.6g}]")
+    return float(xv), float(c0 - c1 * c1 / (4 * c2))

@@ -465,3 +465,24 @@ def compare_paths(ref, other, interp: str = "pchip") -> dict:
         dj = float("nan")
     return {"max_rel_dF": worst, "where": where, "max_rel_dF_same_D": worst_same, "n_compared": n_cmp,
             "n_skipped": n_skip, "jumps_ref": ja, "jumps_other": jb, "max_jump_dD": dj}
+
+
+def walk_states(U0, law, kernel, solver, Ds, start: State | None = None):
+    """Equilibria of Eq. (9) at the displacements ``Ds``, in the order given (up or down), each solved
+    from the secant extrapolation of the two before (the first from ``start``, default zero).
+
+    One branch only: no jump detection or step refinement (use :func:`run_path` for that); meant for
+    short, finely stepped walks along a branch from a state already on it.  Yields (D, Equilibrium).
+    """
+    prev = []
+    state = start if start is not None else State.zero(kernel.grid.shape)
+    for D in Ds:
+        D = float(D)
+        if len(prev) == 2 and prev[1][0] != prev[0][0]:
+            (D0, s0), (D1, s1) = prev
+            c = (D - D1) / (D1 - D0)
+            state = State(s1.q + c * (s1.q - s0.q), s1.w + c * (s1.w - s0.w))
+        eq = solver.solve(Problem(U0 - D + 1.0, law, kernel), state)
+        prev = (prev + [(D, eq.state)])[-2:]
+        state = eq.state
+        yield D, eq
