@@ -18,7 +18,7 @@ from tengsim.errors import TengsimError, finite, positive
 from tengsim.interaction import make_law
 from tengsim.path import PathSpec
 from tengsim.registry import KERNELS, LAWS, OBSERVERS, SHAPES, SOLVERS, ensure_builtins
-from tengsim.schema import REQUIRED, Field, Table, read_config
+from tengsim.schema import REQUIRED, Field, Table, dataclass_fields, field_kind, read_config
 from tengsim.units import PaperScaling, Scaling, parse_quantity
 
 PHYSICAL_KEYS = ("E_star", "W", "eps")
@@ -169,15 +169,11 @@ def dimensionless_fields(cls) -> tuple:
     return _signature_fields(cls)
 
 
-def _kind(annotation) -> str:
-    return {"int": "int", "bool": "bool"}.get(getattr(annotation, "__name__", annotation), "float")
-
-
 def _signature_fields(cls, skip=(), helps=None) -> tuple:
     out = []
     for p in inspect.signature(cls).parameters.values():
         if p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY) and p.name not in skip:
-            out.append(Field(p.name, "float" if p.annotation is p.empty else _kind(p.annotation),
+            out.append(Field(p.name, "float" if p.annotation is p.empty else field_kind(p.annotation),
                              REQUIRED if p.default is p.empty else p.default, help=(helps or {}).get(p.name, "")))
     return tuple(out)
 
@@ -194,18 +190,7 @@ def law_fields(law) -> tuple:
     helps = getattr(cls, "field_help", None) or {}
     if not dataclasses.is_dataclass(cls):
         return _signature_fields(cls, skip, helps)
-    out = []
-    for f in dataclasses.fields(cls):
-        if not f.init or f.name in skip:
-            continue
-        if f.default is not dataclasses.MISSING:
-            default = f.default
-        elif f.default_factory is not dataclasses.MISSING:  # pragma: no cover
-            default = f.default_factory()
-        else:
-            default = REQUIRED
-        out.append(Field(f.name, _kind(f.type), default, help=helps.get(f.name, "")))
-    return tuple(out)
+    return dataclass_fields(cls, skip, helps)
 
 
 def _default_text(f) -> str:

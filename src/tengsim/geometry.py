@@ -11,7 +11,6 @@ from SI input with the lateral scale ``lateral_scale(values, eps)`` (then κ = W
 """
 from __future__ import annotations
 
-import dataclasses
 import math
 from dataclasses import asdict, dataclass
 
@@ -20,7 +19,7 @@ import numpy as np
 from tengsim.errors import TengsimError, positive
 from tengsim.grid import Grid
 from tengsim.registry import SHAPES
-from tengsim.schema import REQUIRED, Field
+from tengsim.schema import REQUIRED, Field, dataclass_fields
 
 
 def _length(name, help, default=REQUIRED):
@@ -59,19 +58,7 @@ class Shape:
     @classmethod
     def dimensionless_fields(cls) -> tuple:
         """Schema fields of the dimensionless input: the dataclass fields (plain numbers, no units)."""
-        out = []
-        for f in dataclasses.fields(cls):
-            if not f.init:
-                continue
-            if f.default is not dataclasses.MISSING:
-                default = f.default
-            elif f.default_factory is not dataclasses.MISSING:  # pragma: no cover
-                default = f.default_factory()
-            else:
-                default = REQUIRED
-            kind = "int" if f.type in ("int", int) else "float"
-            out.append(Field(f.name, kind, default, help=cls.field_help.get(f.name, "")))
-        return tuple(out)
+        return dataclass_fields(cls, helps=cls.field_help)
 
     @classmethod
     def lateral_scale(cls, values: dict, eps: float) -> float:

@@ -218,3 +218,27 @@ def check_tables(cfg: dict, allowed, where: str = "config") -> None:
     for k, v in cfg.items():
         if not isinstance(v, dict):
             raise TengsimError(f"{where}: [{k}] must be a table, got {v!r}")
+
+
+def field_kind(annotation) -> str:
+    """Schema kind of a dataclass/argument annotation: 'int', 'bool' or (anything else) 'float'."""
+    return {"int": "int", "bool": "bool"}.get(getattr(annotation, "__name__", annotation), "float")
+
+
+def dataclass_fields(cls, skip=(), helps=None) -> tuple:
+    """Fields of a dataclass's init arguments (defaults kept, REQUIRED where none), minus ``skip``;
+    help texts from ``helps`` (name → text).  Shapes' and laws' input schemas are built with it."""
+    import dataclasses
+
+    out = []
+    for f in dataclasses.fields(cls):
+        if not f.init or f.name in skip:
+            continue
+        if f.default is not dataclasses.MISSING:
+            default = f.default
+        elif f.default_factory is not dataclasses.MISSING:  # pragma: no cover
+            default = f.default_factory()
+        else:
+            default = REQUIRED
+        out.append(Field(f.name, field_kind(f.type), default, help=(helps or {}).get(f.name, "")))
+    return tuple(out)
