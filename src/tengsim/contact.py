@@ -73,7 +73,7 @@ def simulate(shape: Shape, tabor: float, dx: float, path: PathSpec, boundary: st
         for k, v in scaling.params().items():
             res.params.setdefault(k, v)
         res.add_physical(scaling)
-    status.attach(res, law, kernel.coupling)  # per-row 'status' column, params['status'] (tengsim.status)
+    status.attach(res, law, kernel.coupling, kernel)  # per-row 'status' column, params['status'] (tengsim.status)
     if (getattr(kernel, "film", False) and getattr(kernel, "pinned_mean", False)
             and not res.table["in_law_range"].all()):
         res.params["warning"] = res.params.get("warning", "") + (

@@ -25,6 +25,16 @@ criterion reads "the Maugis–Dugdale zone is narrower than about one pixel".  M
 grid-converged LJ value is +4.9 %).  Resolved runs lie within 1.8 % of the finest grid; the full table
 is in docs/validation.md.
 
+Pixel snap (a second, a-priori cause of under-resolution).  A law that softens beyond its tensile
+peak faster than one pixel is stiff — s = max_g dP/dg × c_pix > 1, with c_pix the gap change of a pixel
+under unit pressure on that pixel alone (one convolution of the run's kernel) — has no stable state
+in that band of gaps: pixels snap in and out one at a time and the contact edge is pinned to the
+lattice, whatever the process zone.  Every judged row of such a run is under-resolved.  Measured
+(docs/validation.md, MD sphere): MD law at μ = 3, smoothing 0.2, dx 0.05, s = 2.0, pull-off +8.2 %
+over Maugis with the edge stuck for 0.6 ε of D; smoothing 0.6 (s = 0.67 / 0.52 at dx 0.05 / 0.035)
++0.72 / +0.21 %; μ = 1, smoothing 0.2, s = 0.79 / 0.38 at dx 0.1 / 0.05: +1.1 / +0.27 %.  LJ 9-3 has
+s = 0.66 at μ = 3, dx 0.1.  s grows about as μ^{3/2} dx.
+
 A-priori estimate (stated with every run, ``params['process_zone_estimate']``): at a crack-like
 contact edge (JKR limit) the Dugdale zone is ℓ_D = (π/4) E* W/σ0², i.e. π/(4 κ σ0²) in units of the
 lateral length with κ = μ^{3/2} (E* = 1/κ, W = 1); it exceeds the MD c − a at pull-off by
@@ -114,6 +124,32 @@ def _cohesive_window(law) -> CohesiveWindow | None:
     return CohesiveWindow(g_peak, g0, sigma0, work)
 
 
+def law_softening(law) -> float:
+    """Steepest softening of a law beyond its tensile peak, max dP/dg over g* ≤ g ≤ g0 + 2 h0 (W/ε²
+    units); 0 for a law without tension."""
+    w = cohesive_window(law)
+    if w is None:
+        return 0.0
+    g = np.linspace(w.g_peak, w.g0 + 2.0 * w.h0, 200001)
+    p = np.asarray(law.evaluate(g)[1], dtype=float)
+    return float(max(np.max(np.diff(p) / np.diff(g)), 0.0))
+
+
+def pixel_compliance(kernel) -> float:
+    """Gap change of the centre pixel under unit pressure on it alone (one convolution)."""
+    g = kernel.grid
+    p = np.zeros((g.nx, g.ny))
+    c = (g.nx // 2, g.ny // 2)
+    p[c] = 1.0
+    return float(abs(np.asarray(kernel.apply(p))[c]))
+
+
+def pixel_snap_number(law, kernel) -> float:
+    """s = (steepest softening of the law) × (pixel compliance); s > 1: pixels snap one at a time."""
+    soft = law_softening(law)
+    return soft * pixel_compliance(kernel) if soft > 0 else 0.0
+
+
 def process_zone_estimate(law, coupling: float) -> float:
     """A-priori Dugdale zone ℓ_D = (π/4) E* W/σ0² = π W/(4 κ σ0²) (lateral units, κ the coupling); NaN
     for a law without tension.  Johnson & Greenwood (1997); equals MD c − a at the sphere's pull-off
@@ -166,20 +202,31 @@ def process_zone_width(H: np.ndarray, dx: float, apex: tuple[int, int], law) -> 
 
 # ---- classification -----------------------------------------------------------------------------
 
-def flags(table: dict, dx: float) -> dict:
-    """Boolean arrays, one per problem kind, over the rows of a result table."""
+def snapping(table: dict, snap: float | None) -> np.ndarray:
+    """Rows judged (an opening contact edge on the apex row) in a run whose pixel snap number > 1."""
+    n = len(table["D"])
+    if not (snap is not None and snap > 1.0):
+        return np.zeros(n, bool)
+    pz = np.asarray(table.get("process_zone", np.full(n, np.nan)), dtype=float)
+    with np.errstate(invalid="ignore"):
+        return np.isfinite(pz) & (pz > 0)
+
+
+def flags(table: dict, dx: float, snap: float | None = None) -> dict:
+    """Boolean arrays, one per problem kind, over the rows of a result table (``snap``: the run's
+    pixel snap number, :func:`pixel_snap_number`)."""
     n = len(table["D"])
     conv = np.asarray(table["converged"]).astype(bool)
     in_range = np.asarray(table.get("in_law_range", np.ones(n))).astype(bool)
     pz = np.asarray(table.get("process_zone", np.full(n, np.nan)), dtype=float)
     with np.errstate(invalid="ignore"):
         coarse = np.isfinite(pz) & (pz > 0) & (pz < RESOLUTION * dx)  # 0: not measured (older files)
-    return {NOT_CONVERGED: ~conv, OUT_OF_LAW_RANGE: ~in_range, UNDER_RESOLVED: coarse}
+    return {NOT_CONVERGED: ~conv, OUT_OF_LAW_RANGE: ~in_range, UNDER_RESOLVED: coarse | snapping(table, snap)}
 
 
-def classify(table: dict, dx: float) -> np.ndarray:
+def classify(table: dict, dx: float, snap: float | None = None) -> np.ndarray:
     """Per-row status strings: the worst problem of each row (SEVERITY order), 'ok' if none."""
-    f = flags(table, dx)
+    f = flags(table, dx, snap)
     out = np.full(len(table["D"]), OK, dtype=object)
     for kind in SEVERITY[1:]:
         out[f[kind]] = kind
@@ -205,7 +252,8 @@ def _where(table: dict, mask: np.ndarray) -> str:
 def problems(result) -> list[tuple[str, str]]:
     """(kind, one-line description naming where) for each problem kind present, worst first."""
     t, dx, p = result.table, result.grid.dx, result.params
-    f = flags(t, dx)
+    snap = p.get("pixel_snap_number")
+    f = flags(t, dx, snap)
     n = len(t["D"])
     out = []
     for kind in reversed(SEVERITY[1:]):
@@ -221,11 +269,22 @@ def problems(result) -> list[tuple[str, str]]:
                     "beyond the physical law; with the periodic kernel this happens once the whole cell is "
                     "flattened)")
         else:
-            pz = float(np.nanmin(np.asarray(t["process_zone"], dtype=float)[m]))
-            est = p.get("process_zone_estimate", float("nan"))
-            text = (f"process zone {pz:.3g} < {RESOLUTION:g} dx = {RESOLUTION * dx:.3g} (dx = {dx:.3g}; "
-                    f"cohesive window g* → g0 + h0 on the apex row; a-priori Dugdale estimate {est:.3g}; "
-                    f"resolved for dx <= {pz / RESOLUTION:.3g}) {where}")
+            parts = []
+            pzs = np.asarray(t["process_zone"], dtype=float)
+            with np.errstate(invalid="ignore"):
+                narrow = m & (pzs < RESOLUTION * dx)
+            if narrow.any():
+                pz = float(np.nanmin(pzs[narrow]))
+                est = p.get("process_zone_estimate", float("nan"))
+                parts.append(f"process zone {pz:.3g} < {RESOLUTION:g} dx = {RESOLUTION * dx:.3g} (dx = {dx:.3g}; "
+                             f"cohesive window g* → g0 + h0 on the apex row; a-priori Dugdale estimate {est:.3g}; "
+                             f"resolved for dx <= {pz / RESOLUTION:.3g})")
+            if snapping(t, snap).any():
+                parts.append(f"the law softens faster than one pixel is stiff (max dP/dg × pixel compliance = "
+                             f"{snap:.3g} > 1): pixels snap one at a time and the contact edge is pinned to the "
+                             f"grid; refine dx to about {dx / snap:.3g} or below, or soften the law (md: a larger "
+                             "smoothing)")
+            text = "; ".join(parts) + f" {where}"
         out.append((kind, f"{_LABEL[kind]}: {text}"))
     return out
 
@@ -235,12 +294,16 @@ def warning_lines(result) -> list[str]:
     return [text for _, text in problems(result)]
 
 
-def attach(result, law, coupling: float) -> None:
-    """Set the status column, the a-priori process-zone estimate and the overall status on ``result``
-    (``params['warning']`` keeps the joined lines for older readers)."""
+def attach(result, law, coupling: float, kernel=None) -> None:
+    """Set the status column, the a-priori process-zone estimate, the pixel snap number (with
+    ``kernel``) and the overall status on ``result`` (``params['warning']`` keeps the joined lines
+    for older readers)."""
     result.params["process_zone_estimate"] = process_zone_estimate(law, coupling)
-    result.params["resolution_criterion"] = f"process_zone >= {RESOLUTION:g} dx"
-    result.table["status"] = classify(result.table, result.grid.dx)
+    result.params["resolution_criterion"] = f"process_zone >= {RESOLUTION:g} dx and pixel_snap_number <= 1"
+    snap = pixel_snap_number(law, kernel) if kernel is not None else None
+    if snap is not None:
+        result.params["pixel_snap_number"] = snap
+    result.table["status"] = classify(result.table, result.grid.dx, snap)
     result.params["status"] = overall(result.table["status"])
     lines = warning_lines(result)
     if lines:
