@@ -204,6 +204,21 @@ def test_cli_unit_on_dimensionless_key(tmp_path, capsys):
     assert not (tmp_path / "out").exists()
 
 
+@pytest.mark.parametrize("axis, bad", [('"contact.tabor" = [0.5, "0.3MPa"]', "0.3MPa"),
+                                        ('"contact.boundary" = ["free", "perodic"]', "perodic"),
+                                        ('"contact.d_step" = [0.25, "fine"]', "fine")])
+def test_cli_one_malformed_axis_value_refuses_the_study(tmp_path, capsys, axis, bad):
+    """A value of the wrong kind in one point (a unit on a dimensionless key, a choice not offered, text
+    for a number) is an error in the file: one line naming it and the point, exit 2, nothing written
+    (unlike a point that is well-formed but impossible, which is recorded as failed)."""
+    f = tmp_path / "s.toml"
+    f.write_text(MINIMAL.split("[axes]")[0] + "[axes]\n" + axis + "\n")
+    rc = main(["sweep", str(f), "--out", str(tmp_path / "out"), "--quiet"])
+    err = capsys.readouterr().err.strip()
+    assert rc == 2 and len(err.splitlines()) == 1 and bad in err and "(at contact." in err, err
+    assert not (tmp_path / "out").exists()
+
+
 def test_cli_workers_and_scheduler_exclusive(tmp_path, capsys):
     f = tmp_path / "s.toml"
     f.write_text(MINIMAL)

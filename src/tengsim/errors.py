@@ -5,6 +5,11 @@ class TengsimError(ValueError):
     """Bad input or an unusable configuration; the message names the bad value."""
 
 
+class ConfigValueError(TengsimError):
+    """A value of the wrong kind for its key (a unit on a dimensionless key, text for a number, a
+    choice not offered): an error in the file, never a property of one point of a study."""
+
+
 def require(condition: bool, message: str) -> None:
     """Raise :class:`TengsimError` with ``message`` unless ``condition`` holds."""
     if not condition:

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable
 
-from tengsim.errors import TengsimError
+from tengsim.errors import ConfigValueError, TengsimError
 
 REQUIRED = object()
 """Marker default of a field that must be given."""
@@ -57,27 +57,27 @@ class Field:
             elif isinstance(value, str) and value.lower() in ("true", "false", "1", "0", "yes", "no"):
                 v = value.lower() in ("true", "1", "yes")
             else:
-                raise TengsimError(f"{label} must be true or false, got {value!r}")
+                raise ConfigValueError(f"{label} must be true or false, got {value!r}")
         elif k == "str":
             if not isinstance(value, str):
-                raise TengsimError(f"{label} must be a string, got {value!r}")
+                raise ConfigValueError(f"{label} must be a string, got {value!r}")
             v = value
             ch = self._choices()
             if ch:
                 key = value.strip().lower().replace("-", "_")
                 norm = {c.lower().replace("-", "_"): c for c in ch}
                 if key not in norm:
-                    raise TengsimError(f"{label} = {value!r} is not one of {', '.join(ch)}")
+                    raise ConfigValueError(f"{label} = {value!r} is not one of {', '.join(ch)}")
                 v = norm[key]
         elif k == "int":
             if isinstance(value, bool) or not isinstance(value, (int, float, str)):
-                raise TengsimError(f"{label} must be an integer, got {value!r}")
+                raise ConfigValueError(f"{label} must be an integer, got {value!r}")
             try:
                 f = float(value)
             except ValueError:
-                raise TengsimError(f"{label} must be an integer, got {value!r}") from None
+                raise ConfigValueError(f"{label} must be an integer, got {value!r}") from None
             if not math.isfinite(f) or f != int(f):
-                raise TengsimError(f"{label} must be an integer, got {value!r}")
+                raise ConfigValueError(f"{label} must be an integer, got {value!r}")
             v = int(f)
         elif k == "float":
             v = self._number(value, label)
@@ -88,7 +88,7 @@ class Field:
             elif isinstance(value, (int, float)) and not isinstance(value, bool):
                 items = [value]
             if not isinstance(items, (list, tuple)):
-                raise TengsimError(f"{label} must be a list of numbers, got {value!r}")
+                raise ConfigValueError(f"{label} must be a list of numbers, got {value!r}")
             v = tuple(self._number(x, label) for x in items)
         else:  # pragma: no cover - a schema bug
             raise TypeError(f"unknown field kind {k!r}")
@@ -100,21 +100,21 @@ class Field:
         from tengsim.units import parse_quantity
 
         if isinstance(value, bool):
-            raise TengsimError(f"{label} must be a number, got {value!r}")
+            raise ConfigValueError(f"{label} must be a number, got {value!r}")
         if isinstance(value, str):
             s = value.strip()
             try:
                 x = float(s)
             except ValueError:
                 if self.dim is None:
-                    raise TengsimError(f"{label} is dimensionless: give a plain number, got {value!r}") from None
+                    raise ConfigValueError(f"{label} is dimensionless: give a plain number, got {value!r}") from None
                 x = parse_quantity(s, self.dim, name=label)
         elif isinstance(value, (int, float)):
             x = float(value)
         else:
-            raise TengsimError(f"{label} must be a number, got {value!r}")
+            raise ConfigValueError(f"{label} must be a number, got {value!r}")
         if not math.isfinite(x):
-            raise TengsimError(f"{label} must be finite, got {value!r}")
+            raise ConfigValueError(f"{label} must be finite, got {value!r}")
         return x
 
     def describe(self) -> str:

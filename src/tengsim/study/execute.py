@@ -23,7 +23,7 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
-from tengsim.errors import TengsimError
+from tengsim.errors import ConfigValueError, TengsimError
 
 WORKER_ENV = {"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1",
               "TENGSIM_THREADS": "1", "TENGSIM_FFT_WORKERS": "1"}
@@ -145,6 +145,9 @@ def validate(study) -> tuple[dict, dict]:
             continue
         try:
             plan = plan_contact(dict(p.contact))
+        except ConfigValueError as exc:  # a malformed value in the file: the whole study is refused
+            where = ", ".join(f"{k} = {v!r}" for k, v in p.axes.items())
+            raise TengsimError(f"{study.source or 'study'}: {exc}" + (f" (at {where})" if where else "")) from None
         except TengsimError as exc:
             invalid[pid] = str(exc)
             if first is None:
