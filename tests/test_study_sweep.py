@@ -484,8 +484,11 @@ def test_ctrl_c_keeps_points_and_resume_completes(tmp_path):
     f.write_text(KILL_STUDY)
     out = tmp_path / "interrupted"
     env = dict(os.environ, PYTHONPATH=str(Path(__file__).resolve().parents[1] / "src"))
+    # a terminal's Ctrl-C: SIGINT with its default disposition (a CI runner may start us with SIGINT
+    # ignored, as a shell does for background jobs; Python then keeps ignoring it, and so would the sweep)
     proc = subprocess.Popen(_sweep_cmd(f, out), env=env, start_new_session=True, stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True)
+                            stderr=subprocess.PIPE, text=True,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     t0 = time.time()
     while not list((out / "points").glob("*.nc")):
         assert proc.poll() is None, "the sweep ended before writing a point"

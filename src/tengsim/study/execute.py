@@ -301,10 +301,21 @@ def connect(workers=None, scheduler=None, timeout: float = 3.0):
     import dask
 
     n = workers or os.cpu_count() or 1
-    with dask.config.set(LOCAL_CLUSTER_CONFIG):
-        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, env=dict(WORKER_ENV),
-                               dashboard_address=":0", silence_logs=logging.ERROR)
-        return Client(cluster), cluster
+    import signal
+    import threading
+
+    # the worker processes start with SIGINT ignored: a terminal's Ctrl-C reaches the whole process
+    # group, and the client alone answers it (one line, the cluster closed), not a traceback per worker
+    old = signal.signal(signal.SIGINT, signal.SIG_IGN) if threading.current_thread() is threading.main_thread() \
+        else None
+    try:
+        with dask.config.set(LOCAL_CLUSTER_CONFIG):
+            cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, env=dict(WORKER_ENV),
+                                   dashboard_address=":0", silence_logs=logging.ERROR)
+    finally:
+        if old is not None:
+            signal.signal(signal.SIGINT, old)
+    return Client(cluster), cluster
 
 
 def run_study(study, out, *, workers=None, scheduler=None, client=None, resume=False, retry_failed=False,
