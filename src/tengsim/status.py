@@ -218,10 +218,15 @@ def flags(table: dict, dx: float, snap: float | None = None) -> dict:
     n = len(table["D"])
     conv = np.asarray(table["converged"]).astype(bool)
     in_range = np.asarray(table.get("in_law_range", np.ones(n))).astype(bool)
-    pz = np.asarray(table.get("process_zone", np.full(n, np.nan)), dtype=float)
+    return {NOT_CONVERGED: ~conv, OUT_OF_LAW_RANGE: ~in_range,
+            UNDER_RESOLVED: narrow_zone(table, dx) | snapping(table, snap)}
+
+
+def narrow_zone(table: dict, dx: float) -> np.ndarray:
+    """Rows whose measured process zone is below RESOLUTION · dx (0: not measured, older files)."""
+    pz = np.asarray(table.get("process_zone", np.full(len(table["D"]), np.nan)), dtype=float)
     with np.errstate(invalid="ignore"):
-        coarse = np.isfinite(pz) & (pz > 0) & (pz < RESOLUTION * dx)  # 0: not measured (older files)
-    return {NOT_CONVERGED: ~conv, OUT_OF_LAW_RANGE: ~in_range, UNDER_RESOLVED: coarse | snapping(table, snap)}
+        return np.isfinite(pz) & (pz > 0) & (pz < RESOLUTION * dx)
 
 
 def classify(table: dict, dx: float, snap: float | None = None) -> np.ndarray:
@@ -270,11 +275,9 @@ def problems(result) -> list[tuple[str, str]]:
                     "flattened)")
         else:
             parts = []
-            pzs = np.asarray(t["process_zone"], dtype=float)
-            with np.errstate(invalid="ignore"):
-                narrow = m & (pzs < RESOLUTION * dx)
+            narrow = m & narrow_zone(t, dx)
             if narrow.any():
-                pz = float(np.nanmin(pzs[narrow]))
+                pz = float(np.nanmin(np.asarray(t["process_zone"], dtype=float)[narrow]))
                 est = p.get("process_zone_estimate", float("nan"))
                 parts.append(f"process zone {pz:.3g} < {RESOLUTION:g} dx = {RESOLUTION * dx:.3g} (dx = {dx:.3g}; "
                              f"cohesive window g* → g0 + h0 on the apex row; a-priori Dugdale estimate {est:.3g}; "
