@@ -128,24 +128,39 @@ def test_csv_same_format_and_exact_round_trip(tmp_path):
     assert (back["converged"] == cols["converged"]).all() and (back["branch"] == cols["branch"]).all()
 
 
-def test_csv_100k_rows_fast(tmp_path):
-    """100 000 rows × 6 mixed columns: well under a second of CPU, and the per-cell Python loop's
-    overhead is gone (one float repr per value is the floor: up to 1.5 µs for 17-digit values with
-    3-digit exponents on the 2-core test machine), and the file reads back exactly."""
-    cols = _table(100_000, seed=1)
-    t_new = []
-    for _ in range(2):
-        t = time.process_time()
-        io.write_csv(tmp_path / "big.csv", cols)
-        t_new.append(time.process_time() - t)
-    t = time.process_time()
-    _per_cell_csv(cols, {})
-    t_old = time.process_time() - t
-    # measured on the 2-core test machine: 0.31-0.39 s CPU against 0.63 s for the per-cell loop
-    assert min(t_new) < 1.0, t_new
-    assert min(t_new) < 0.75 * t_old, (t_new, t_old)
+def _python_calls(fn):
+    """Function calls made from Python code while running ``fn``: Python functions and builtins called
+    from Python (a builtin that ``map`` applies inside C is not counted)."""
+    import sys
+
+    n = 0
+
+    def prof(frame, event, arg):
+        nonlocal n
+        n += event in ("call", "c_call")
+
+    sys.setprofile(prof)
+    try:
+        fn()
+    finally:
+        sys.setprofile(None)
+    return n
+
+
+def test_csv_100k_rows_no_per_row_python(tmp_path):
+    """The writer runs no Python code per row: 1 000 and 100 000 rows × 6 mixed columns cost the same
+    few hundred calls from Python code, give or take a few inside NumPy (the per-cell loop it replaced
+    made several per cell), and the big file reads
+    back exactly. Its speed against the per-cell loop is measured, not gated: benchmarks/csv_write.py."""
+    small, big = _table(1_000, seed=1), _table(100_000, seed=1)
+    n_small = _python_calls(lambda: io.write_csv(tmp_path / "small.csv", small))
+    n_big = _python_calls(lambda: io.write_csv(tmp_path / "big.csv", big))
+    n_loop = _python_calls(lambda: _per_cell_csv(small, {}))
+    assert abs(n_big - n_small) < 0.2 * n_small and n_big < 1_000, (n_small, n_big)
+    assert n_loop > 1_000 > n_small, (n_loop, n_small)  # the check can fail: the old loop trips it
     _, back = _read_csv(tmp_path / "big.csv")
-    np.testing.assert_array_equal(back["F"], cols["F"])
+    np.testing.assert_array_equal(back["F"], big["F"])
+    assert (back["branch"] == big["branch"]).all()
 
 
 def test_csv_unequal_columns_refused(tmp_path):
