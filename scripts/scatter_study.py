@@ -108,10 +108,9 @@ def main(argv=None):
         print(f"scatter_study.py: error: {bad}", file=sys.stderr)
         return 2
     out = Path(args.out)
-    if is_convergence(args):
-        out.mkdir(parents=True, exist_ok=True)
-        return convergence_part(out, args)
     out.mkdir(parents=True, exist_ok=True)
+    if is_convergence(args):
+        return convergence_part(out, args)
     if args.waviness:
         return waviness_part(out)
     scatters = (0.0, 0.01, 0.02, 0.05, 0.10, 0.20, 0.30)

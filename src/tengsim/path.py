@@ -99,6 +99,11 @@ class _Row:
     eq: object
 
 
+def _secant(s0: State, s1: State, c: float) -> State:
+    """The state c steps of (s0 → s1) beyond s1: the secant predictor of a continuation step."""
+    return State(s1.q + c * (s1.q - s0.q), s1.w + c * (s1.w - s0.w))
+
+
 class _Branch:
     """Walks one branch, refining steps and predicting starts."""
 
@@ -117,7 +122,7 @@ class _Branch:
             if D1 != D0:
                 c = (D - D1) / (D1 - D0)
                 if 0 < c <= 1.5:
-                    return State(s1.q + c * (s1.q - s0.q), s1.w + c * (s1.w - s0.w)), True
+                    return _secant(s0, s1, c), True
         return s1, False
 
     def _jumped(self, eqa, eqb, dD):
@@ -166,7 +171,7 @@ class _Adaptive(_Branch):
             D0, s0 = self.hist[-2]
             c = (D - D1) / (D1 - D0)
             if 0 < c <= 2.0:
-                return State(s1.q + c * (s1.q - s0.q), s1.w + c * (s1.w - s0.w)), True
+                return _secant(s0, s1, c), True
         return s1, False
 
     def _error(self, Db, eqb):
@@ -481,7 +486,7 @@ def walk_states(U0, law, kernel, solver, Ds, start: State | None = None):
         if len(prev) == 2 and prev[1][0] != prev[0][0]:
             (D0, s0), (D1, s1) = prev
             c = (D - D1) / (D1 - D0)
-            state = State(s1.q + c * (s1.q - s0.q), s1.w + c * (s1.w - s0.w))
+            state = _secant(s0, s1, c)
         eq = solver.solve(Problem(U0 - D + 1.0, law, kernel), state)
         prev = (prev + [(D, eq.state)])[-2:]
         state = eq.state

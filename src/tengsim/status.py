@@ -202,14 +202,19 @@ def process_zone_width(H: np.ndarray, dx: float, apex: tuple[int, int], law) -> 
 
 # ---- classification -----------------------------------------------------------------------------
 
+def _zone(table: dict) -> tuple[np.ndarray, np.ndarray]:
+    """(process zone per row, rows where it was measured: an opening edge on the apex row; 0 or NaN:
+    none, or an older file)."""
+    pz = np.asarray(table.get("process_zone", np.full(len(table["D"]), np.nan)), dtype=float)
+    with np.errstate(invalid="ignore"):
+        return pz, np.isfinite(pz) & (pz > 0)
+
+
 def snapping(table: dict, snap: float | None) -> np.ndarray:
     """Rows judged (an opening contact edge on the apex row) in a run whose pixel snap number > 1."""
-    n = len(table["D"])
     if not (snap is not None and snap > 1.0):
-        return np.zeros(n, bool)
-    pz = np.asarray(table.get("process_zone", np.full(n, np.nan)), dtype=float)
-    with np.errstate(invalid="ignore"):
-        return np.isfinite(pz) & (pz > 0)
+        return np.zeros(len(table["D"]), bool)
+    return _zone(table)[1]
 
 
 def flags(table: dict, dx: float, snap: float | None = None) -> dict:
@@ -224,9 +229,8 @@ def flags(table: dict, dx: float, snap: float | None = None) -> dict:
 
 def narrow_zone(table: dict, dx: float) -> np.ndarray:
     """Rows whose measured process zone is below RESOLUTION · dx (0: not measured, older files)."""
-    pz = np.asarray(table.get("process_zone", np.full(len(table["D"]), np.nan)), dtype=float)
-    with np.errstate(invalid="ignore"):
-        return np.isfinite(pz) & (pz > 0) & (pz < RESOLUTION * dx)
+    pz, measured = _zone(table)
+    return measured & (pz < RESOLUTION * dx)
 
 
 def classify(table: dict, dx: float, snap: float | None = None) -> np.ndarray:

@@ -297,13 +297,12 @@ def connect(workers=None, scheduler=None, timeout: float = 3.0):
     if workers is not None and (not isinstance(workers, int) or workers < 1):
         raise TengsimError(f"--workers must be a positive integer, got {workers!r}")
     import logging
+    import signal
+    import threading
 
     import dask
 
     n = workers or os.cpu_count() or 1
-    import signal
-    import threading
-
     # the worker processes start with SIGINT ignored: a terminal's Ctrl-C reaches the whole process
     # group, and the client alone answers it (one line, the cluster closed), not a traceback per worker
     old = signal.signal(signal.SIGINT, signal.SIG_IGN) if threading.current_thread() is threading.main_thread() \
