@@ -457,6 +457,9 @@ def test_local_cluster_runs_quiet_monitors(client):
         assert cfg == LOCAL_CLUSTER_CONFIG
         assert blas == "1"
     assert dask.config.get("distributed.worker.profile.enabled") is True  # the caller's config untouched
+    # the scheduler hands a worker its next point only when the last is done (a dying worker takes
+    # one point with it, not a queued one too)
+    assert client.run_on_scheduler(lambda dask_scheduler: dask_scheduler.WORKER_SATURATION) == 1.0
 
 
 def test_points_submitted_longest_first():

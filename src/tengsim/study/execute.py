@@ -36,10 +36,15 @@ LOCAL_CLUSTER_CONFIG = {
     "distributed.admin.system-monitor.disk": False,
     "distributed.worker.profile.enabled": False,  # the 10 ms stack sampler of every running task
     "distributed.worker.memory.monitor-interval": "1s",
+    # a worker holds only the point it runs (default 1.1: a second one queued per thread), so a worker
+    # that dies (out of memory, killed) takes no other point down with it; a point lasts seconds, the
+    # hand-over milliseconds
+    "distributed.scheduler.worker-saturation": 1.0,
 }
 """Dask settings of the LocalCluster a sweep starts.  With the defaults an idle 2-worker cluster burns
 about 3 CPU-seconds per 20 s (15 % of a core) in monitors, taken from the points it runs on a
-2-core machine; with these, 0.4 s (benchmarks/results/sweep_scaling.md).  Read when the cluster
+2-core machine; with these, 0.4 s (benchmarks/results/sweep_scaling.md).  A worker is handed its
+next point only when it has finished the last.  Read when the cluster
 starts; a cluster behind ``--scheduler`` keeps its own configuration."""
 
 
