@@ -183,3 +183,50 @@ def test_package_data_entries_exist():
     for pkg, patterns in pkg_data.items():
         for pat in patterns:
             assert list((root / "src" / pkg.replace(".", "/")).glob(pat)), f"{pkg}: {pat} matches nothing"
+
+
+def test_ctrl_c_waits_for_a_netcdf_write_then_arrives(tmp_path):
+    """SIGINT during write_dataset: the write finishes (the file is whole, no .part left), then
+    KeyboardInterrupt is raised; the caller's handler is back in place afterwards."""
+    import signal
+
+    import xarray as xr
+
+    ds = xr.Dataset({"F": ("D", np.linspace(0.0, 1.0, 50))})
+
+    class Interrupted:  # a dataset whose write is hit by Ctrl-C half-way
+        def to_netcdf(self, path, engine):
+            signal.raise_signal(signal.SIGINT)
+            ds.to_netcdf(path, engine=engine)
+
+    before = signal.getsignal(signal.SIGINT)
+    with pytest.raises(KeyboardInterrupt):
+        io.write_dataset(Interrupted(), tmp_path / "r.nc")
+    assert signal.getsignal(signal.SIGINT) is before
+    assert xr.load_dataset(tmp_path / "r.nc", engine="h5netcdf").identical(ds)
+    assert not list(tmp_path.glob(".*.part"))
+
+
+def test_interrupts_held_nests_and_respects_an_ignored_sigint():
+    """A nested hold delivers to the outer one (one KeyboardInterrupt, after the outer block); with
+    SIGINT ignored by the caller nothing is raised; without a signal nothing changes."""
+    import signal
+
+    steps = []
+    with pytest.raises(KeyboardInterrupt):
+        with io.interrupts_held():
+            with io.interrupts_held():
+                signal.raise_signal(signal.SIGINT)
+                steps.append("inner")
+            steps.append("outer")
+    assert steps == ["inner", "outer"]
+    old = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        with io.interrupts_held():
+            signal.raise_signal(signal.SIGINT)
+        assert signal.getsignal(signal.SIGINT) is signal.SIG_IGN
+    finally:
+        signal.signal(signal.SIGINT, old)
+    with io.interrupts_held():
+        steps.append("quiet")
+    assert steps[-1] == "quiet"

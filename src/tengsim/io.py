@@ -9,8 +9,10 @@ import contextlib
 import json
 import math
 import os
+import signal
 import stat
 import tempfile
+import threading
 from pathlib import Path
 
 
@@ -34,6 +36,26 @@ def _mode_for(path: Path) -> int:
         return stat.S_IMODE(os.stat(path).st_mode)
     except OSError:
         return 0o666 & ~_umask()
+
+
+@contextlib.contextmanager
+def interrupts_held():
+    """Hold Ctrl-C (SIGINT) until the block ends, then deliver it to the handler that was in place.
+
+    For short writes and reads of result files: an interrupted ``h5netcdf.File`` constructor leaves an
+    object whose ``__del__`` prints a traceback at exit.  Outside the main thread (where no handler can
+    be set) it holds nothing.  Nested blocks deliver to the outer one."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    got = []
+    old = signal.signal(signal.SIGINT, lambda signum, frame: got.append(signum))
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, old)
+        if got:
+            signal.raise_signal(signal.SIGINT)
 
 
 @contextlib.contextmanager
@@ -112,8 +134,8 @@ def write_json(path, obj) -> None:
 
 
 def write_dataset(ds, path) -> None:
-    """Write an xarray Dataset to NetCDF (h5netcdf engine) atomically."""
-    with atomic_path(path) as tmp:
+    """Write an xarray Dataset to NetCDF (h5netcdf engine) atomically; Ctrl-C waits for the write."""
+    with interrupts_held(), atomic_path(path) as tmp:
         ds.to_netcdf(tmp, engine="h5netcdf")
 
 

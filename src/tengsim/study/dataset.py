@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from tengsim.errors import TengsimError
+from tengsim.io import interrupts_held
 from tengsim.study.observe import SCALARS, observe, pressure_grid
 
 STATUSES = ("ok", "unconverged", "failed", "pending")
@@ -28,7 +29,8 @@ def _read_point(sd, pid):
     nc = sd.nc(pid)
     if nc.exists():
         try:
-            res, a = _light_result(nc)
+            with interrupts_held():
+                res, a = _light_result(nc)
         except (OSError, KeyError, ValueError) as exc:
             return "failed", f"unreadable point file {nc.name}: {exc}", None, math.nan
         return a.get("status", "ok"), str(a.get("message", "")), res, float(a.get("compute_seconds", math.nan))

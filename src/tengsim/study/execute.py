@@ -411,7 +411,7 @@ def _compute(client, valid, todo, sd, bar, plugins="") -> list:
     import dask
     from dask.distributed import as_completed
 
-    from tengsim.io import write_dataset, write_json
+    from tengsim.io import interrupts_held, write_dataset, write_json
 
     futures = {client.submit(compute_point, valid[pid], pid, plugins, key=f"tengsim-point-{pid}", pure=False,
                              priority=len(todo) - k): pid
@@ -425,20 +425,22 @@ def _compute(client, valid, todo, sd, bar, plugins="") -> list:
             except Exception as exc:  # noqa: BLE001 - a worker died (KilledWorker) or the task was lost
                 r = {"status": "failed", "message": f"{type(exc).__name__}: {exc}", "seconds": None,
                      "data": None}
-            if r["status"] == "failed":
-                write_json(sd.failed(pid), {"id": pid, "status": "failed", "stage": "compute",
-                                            "message": r["message"], "contact": valid[pid],
-                                            **{k: r.get(k) for k in ("seconds", "host", "pid")}})
-            else:
-                with dask.config.set(scheduler="synchronous"):  # a local file: no distributed write lock
-                    write_dataset(r["data"], sd.nc(pid))
-                try:
-                    sd.failed(pid).unlink()
-                except FileNotFoundError:
-                    pass
-            computed.append(pid)
-            _append_log(sd, {"event": "point", "id": pid, "status": r["status"], "seconds": r.get("seconds"),
-                             "host": r.get("host"), "worker_pid": r.get("pid"), "time": time.time()})
+            with interrupts_held():  # a point's files and log line are written whole
+                if r["status"] == "failed":
+                    write_json(sd.failed(pid), {"id": pid, "status": "failed", "stage": "compute",
+                                                "message": r["message"], "contact": valid[pid],
+                                                **{k: r.get(k) for k in ("seconds", "host", "pid")}})
+                else:
+                    with dask.config.set(scheduler="synchronous"):  # local file: no distributed write lock
+                        write_dataset(r["data"], sd.nc(pid))
+                    try:
+                        sd.failed(pid).unlink()
+                    except FileNotFoundError:
+                        pass
+                computed.append(pid)
+                _append_log(sd, {"event": "point", "id": pid, "status": r["status"],
+                                 "seconds": r.get("seconds"), "host": r.get("host"),
+                                 "worker_pid": r.get("pid"), "time": time.time()})
             bar.update(r["status"])
             fut.release()
     except BaseException:
