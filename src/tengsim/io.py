@@ -139,6 +139,14 @@ def write_dataset(ds, path) -> None:
         ds.to_netcdf(tmp, engine="h5netcdf")
 
 
+def read_dataset(path):
+    """Load a NetCDF file (h5netcdf engine) whole into memory; Ctrl-C waits for the read."""
+    import xarray as xr
+
+    with interrupts_held():
+        return xr.load_dataset(path, engine="h5netcdf")
+
+
 def _column_text(a) -> list[str]:
     """One column as strings: floats by ``repr`` (shortest exact round-trip), bools as 0/1, else str."""
     import numpy as np

@@ -116,10 +116,10 @@ def load_result(path) -> tuple[str, object]:
             return "sweep", {**cols, "header": header}
         raise TengsimError(f"{path}: not a tengsim result (no 'branch'/'D', 't' or 'R' columns)")
     if suffix == ".nc":
-        import xarray as xr
+        from tengsim.io import read_dataset
 
         try:
-            ds = xr.load_dataset(path, engine="h5netcdf")
+            ds = read_dataset(path)
         except Exception as exc:  # noqa: BLE001 - any reader failure is a bad input file
             raise TengsimError(f"cannot read {path} as NetCDF: {exc}") from None
         if "branch" in ds and "D" in ds:

@@ -7,6 +7,7 @@ from pathlib import Path
 import numpy as np
 
 from tengsim.errors import TengsimError
+from tengsim.io import read_dataset
 
 MAP_VARS = ("S_V_per_kPa", "linear_range_Pa", "P_sat_Pa", "pull_off_F", "area_fraction_0", "V_sat")
 _LABEL = {"S_V_per_kPa": "sensitivity S (V/kPa)", "linear_range_Pa": "linear range (kPa)",
@@ -35,13 +36,12 @@ def plot_study(root, out, vars=MAP_VARS) -> list:
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    import xarray as xr
 
     root, out = Path(root), Path(out)
     nc = root / "study.nc"
     if not nc.exists():
         raise TengsimError(f"{root} holds no study.nc (run tengsim sweep first)")
-    ds = xr.load_dataset(nc, engine="h5netcdf")
+    ds = read_dataset(nc)
     dims = [d for d in ds["pull_off_F"].dims]
     vars = [v for v in vars if v in ds and np.isfinite(ds[v].values.astype(float)).any()] or ["pull_off_F"]
     n = len(vars)
