@@ -185,7 +185,17 @@ def test_package_data_entries_exist():
             assert list((root / "src" / pkg.replace(".", "/")).glob(pat)), f"{pkg}: {pat} matches nothing"
 
 
-def test_ctrl_c_waits_for_a_netcdf_write_then_arrives(tmp_path):
+@pytest.fixture
+def python_sigint():
+    """SIGINT raising KeyboardInterrupt, as in an interactive run (CI may start us with it ignored)."""
+    import signal
+
+    old = signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
+    signal.signal(signal.SIGINT, old)
+
+
+def test_ctrl_c_waits_for_a_netcdf_write_then_arrives(tmp_path, python_sigint):
     """SIGINT during write_dataset: the write finishes (the file is whole, no .part left), then
     KeyboardInterrupt is raised; the caller's handler is back in place afterwards."""
     import signal
@@ -207,7 +217,7 @@ def test_ctrl_c_waits_for_a_netcdf_write_then_arrives(tmp_path):
     assert not list(tmp_path.glob(".*.part"))
 
 
-def test_interrupts_held_nests_and_respects_an_ignored_sigint():
+def test_interrupts_held_nests_and_respects_an_ignored_sigint(python_sigint):
     """A nested hold delivers to the outer one (one KeyboardInterrupt, after the outer block); with
     SIGINT ignored by the caller nothing is raised; without a signal nothing changes."""
     import signal
