@@ -52,7 +52,7 @@ def run_group(group, dx, fixed_step, factor, tol, adapt_h, refine):
     import tengsim as ts
     from tengsim.kernels import FreeKernel
     from tengsim.path import PathSpec, compare_paths, run_path
-    from tengsim.units import paper_scaling
+    from tengsim.cases.paper.units import paper_scaling
 
     sc = paper_scaling(group)
     shape = ts.Pyramid(sc.N, sc.cell)

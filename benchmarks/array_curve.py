@@ -1,6 +1,6 @@
 """Benchmark (issue 15, "Speed"): the whole A/S(P) approach curve of a 16 × 16 array of group-A cells.
 
-The array: ``tengsim.arrays.Array`` of the paper's group-A pyramid (N = 0.946, L̄ = 3.78, μ = 0.5),
+The array: ``tengsim.shapes.arrays.Array`` of the paper's group-A pyramid (N = 0.946, L̄ = 3.78, μ = 0.5),
 K × K cells (default 16), rms height scatter ``--scatter`` (default 2 %, normal, ``--seed``), on the
 paper's 400 µm bonded film (ν = 0.49, thickness 400 µm / ℓ in X units; periodic film kernel, so the
 flat array has the film's finite mean stiffness and every state stays in the LJ law's range); ``--px``
@@ -33,7 +33,8 @@ from pathlib import Path
 import numpy as np
 
 import tengsim
-from tengsim.arrays import Array, ArrayGrid
+from tengsim.cases.paper.units import paper_scaling
+from tengsim.shapes.arrays import Array, ArrayGrid
 
 T_FILM, NU = 400e-6, 0.49
 TARGETS_KPA = np.arange(10, 151, 10)
@@ -64,7 +65,7 @@ def run(K=16, px=40, scatter=0.02, seed=0, d_step=0.1, d_max=23.5, adaptive=Fals
     from tengsim.path import PathSpec, run_path
     from tengsim.solvers import make_solver
 
-    sc = tengsim.paper_scaling("A")
+    sc = paper_scaling("A")
     arr = Array("pyramid", K=K, scatter_height=scatter, seed=seed, N=sc.N, cell=sc.cell)
     dx = sc.cell / px
     grid = ArrayGrid(K * px, K * px, dx, dx, cells=K)

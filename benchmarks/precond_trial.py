@@ -27,7 +27,7 @@ from scipy.optimize import line_search
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from scaling import rough_surface  # noqa: E402
 
-from tengsim.interaction import LJ93  # noqa: E402
+from tengsim.laws import LJ93  # noqa: E402
 
 
 def trial(n, sbar, dx=0.25, mu=0.5, overlap=0.05, memory=10, tol=1e-6, max_iter=4000, history=None):

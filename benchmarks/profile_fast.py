@@ -39,7 +39,7 @@ def main(argv=None):
 
     from tengsim import kernels
     from tengsim.contact import simulate_pyramid
-    from tengsim.geometry import Pyramid
+    from tengsim.shapes import Pyramid
 
     g = GROUPS[a.group]
     d_max = a.d_max if a.d_max is not None else g["d_max"]

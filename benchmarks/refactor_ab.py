@@ -29,7 +29,7 @@ from run_benchmarks import ConvCounter  # noqa: E402
 
 
 def a_path(S):
-    from tengsim.interaction import LJ93
+    from tengsim.laws import LJ93
     from tengsim.path import PathSpec, run_path
 
     _, U0, K = _group_a(0.1)

@@ -35,7 +35,7 @@ def solver_class(which):
 
 
 def _group_a(dx):
-    from tengsim.geometry import Pyramid
+    from tengsim.shapes import Pyramid
     from tengsim.kernels import FreeKernel
 
     shape = Pyramid(0.946, 3.78)
@@ -44,8 +44,8 @@ def _group_a(dx):
 
 
 def _rough(n, seed=3):
-    from tengsim.geometry import random_rough
-    from tengsim.interaction import LJ93
+    from tengsim.shapes import random_rough
+    from tengsim.laws import LJ93
     from tengsim.kernels import PeriodicKernel
     from tengsim.solvers import Problem
 
@@ -61,7 +61,7 @@ def _rec(eq):
 
 
 def case_a_path(S):
-    from tengsim.interaction import LJ93
+    from tengsim.laws import LJ93
     from tengsim.path import PathSpec, run_path
 
     _, U0, K = _group_a(0.1)
@@ -73,7 +73,7 @@ def case_a_path(S):
 
 
 def case_a_sequence(S):
-    from tengsim.interaction import LJ93
+    from tengsim.laws import LJ93
     from tengsim.solvers import Problem, State
 
     grid, U0, K = _group_a(0.2)
@@ -89,7 +89,7 @@ def case_a_blocks(S):
     import os
 
     import tengsim._sweep as sweep
-    from tengsim.interaction import LJ93
+    from tengsim.laws import LJ93
     from tengsim.solvers import Problem, State
 
     grid, U0, K = _group_a(0.1)
@@ -115,8 +115,8 @@ def _rough_case(n, tol):
 
 
 def case_hertz(S):
-    from tengsim.geometry import Paraboloid
-    from tengsim.interaction import Repulsive
+    from tengsim.shapes import Paraboloid
+    from tengsim.laws import Repulsive
     from tengsim.kernels import FreeKernel
     from tengsim.solvers import Problem, State
 

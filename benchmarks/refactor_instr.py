@@ -19,7 +19,7 @@ sys.path.insert(0, str(HERE))
 
 from _fast_before import FastSolver as Old  # noqa: E402
 from refactor_check import _group_a, _rough  # noqa: E402
-from tengsim.interaction import LJ93  # noqa: E402
+from tengsim.laws import LJ93  # noqa: E402
 from tengsim.solvers import FastSolver as New, Problem, State  # noqa: E402
 
 which, k, case = sys.argv[1], int(sys.argv[2]), sys.argv[3]

@@ -136,8 +136,8 @@ def run_group(name, args, log):
     from tengsim.analysis import apex_index
     from tengsim.analysis import contact_length as ts_contact_length
     from tengsim.contact import simulate_pyramid
-    from tengsim.geometry import Pyramid
-    from tengsim.interaction import LJ93
+    from tengsim.shapes import Pyramid
+    from tengsim.laws import LJ93
     from tengsim.solvers import Problem, State, make_solver
 
     g = GROUPS[name]

@@ -69,7 +69,7 @@ def pyramid_array(n, px=128, group="C", jitter=0.02, seed=0):
     normal, fixed seed: fabrication scatter, so that no two cells are the same problem).
     Returns U0 (the undeformed gap, 0 at the highest tip), the pixel dx and μ."""
     from tengsim.grid import Grid
-    from tengsim.units import paper_scaling
+    from tengsim.cases.paper.units import paper_scaling
 
     if n % px:
         raise ValueError(f"n = {n} is not a multiple of the pixels per pyramid cell ({px})")
@@ -88,7 +88,7 @@ def pyramid_array(n, px=128, group="C", jitter=0.02, seed=0):
 def one_size(n, dx, mu, tol, overlap, dD, seed, cold=True, nested=True, min_size=128, warm=True, max_dx=0.5,
              max_iter=3000, coarse_max_iter=1000, surface="rough", px=128, jitter=0.02, D=6.0):
     from tengsim.grid import Grid
-    from tengsim.interaction import LJ93
+    from tengsim.laws import LJ93
     from tengsim.kernels import make_kernel
     from tengsim.solvers import Problem, State, make_solver
 
@@ -255,7 +255,7 @@ def main(argv=None):
                 f"(cell grows with n), seed {a.seed}; μ = {a.mu}, LJ 8-2, periodic kernel, tol = {a.tol:g}; "
                 f"D0 such that {100 * a.overlap:g} % overlaps rigidly")
     else:
-        from tengsim.units import paper_scaling
+        from tengsim.cases.paper.units import paper_scaling
 
         sc = paper_scaling("C")
         title = "periodic array of the paper's group-C pyramids"

@@ -25,7 +25,8 @@ from pathlib import Path
 import numpy as np
 
 import tengsim
-from tengsim.arrays import Array
+from tengsim.cases.paper.units import paper_scaling
+from tengsim.shapes.arrays import Array
 from tengsim.device import voc_polymer
 
 SIGMA, EPS_R, T = 5.84e-6, 2.40, 400e-6
@@ -65,7 +66,7 @@ def approach(shape, mu, dx, p_of_F, p_max_kpa=150.0, coarse=0.025, fine=0.0025, 
 
 
 def run_case(K, s, seed, dx=0.2, waviness=0.0, wavelength=1.0):
-    sc = tengsim.paper_scaling("A")
+    sc = paper_scaling("A")
     arr = Array("pyramid", K=K, scatter_height=s, seed=seed, N=sc.N, cell=sc.cell, waviness_amplitude=waviness,
                 waviness_wavelength=wavelength)
     t = approach(arr, sc.mu, dx, lambda F: sc.pressure(F / K**2) / 1e3)
@@ -145,7 +146,7 @@ def main(argv=None):
 def waviness_part(out, K=4, cells=4, amplitudes=(0.25, 0.5, 1.0, 2.0)):
     """Plate/film waviness a·½[cos 2πX/λ + cos 2πY/λ] (λ = ``cells`` cells), no scatter; the section
     '## Waviness' of scatter_study.md is written (replaced) with A/S and V_OC at 10 … 150 kPa."""
-    sc = tengsim.paper_scaling("A")
+    sc = paper_scaling("A")
     lam_m = cells * sc.L
     L = ["## Waviness", "",
          f"K = {K}, waviness wavelength λ = {cells} cells = {lam_m * 1e6:g} µm, no height scatter, amplitude a in ε "

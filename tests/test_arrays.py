@@ -5,9 +5,10 @@ import numpy as np
 import pytest
 
 import tengsim
-from tengsim.arrays import Array
+from tengsim.shapes.arrays import Array
 from tengsim.cli.main import main
-from tengsim.config import plan_contact, run_contact
+from tengsim.config import plan_contact
+from tengsim.contact import run_contact
 from tengsim.errors import TengsimError
 
 A = dict(N=0.946, cell=3.78)

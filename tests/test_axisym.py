@@ -16,8 +16,8 @@ import pytest
 from scipy.integrate import quad
 
 from tengsim.axisym import AxisymSphere, disc_integral, walk
-from tengsim.geometry import Paraboloid
-from tengsim.interaction import LJ93
+from tengsim.shapes import Paraboloid
+from tengsim.laws import LJ93
 from tengsim.kernels import FreeKernel
 from tengsim.path import PathSpec, run_path
 from tengsim.solvers import FastSolver
@@ -106,7 +106,7 @@ def test_engine_lj_sphere_jumps_vs_axisym():
 
 @lru_cache(maxsize=None)
 def axisym_md(mu, dr, smoothing=0.2):
-    from tengsim.interaction import MaugisDugdale
+    from tengsim.laws import MaugisDugdale
     s = AxisymSphere(mu, MaugisDugdale(smoothing=smoothing), dr=dr, r_fine=3 + 2 * mu, r_max=4 + 2 * mu)
     return s.trace(d_end=2.0)
 
@@ -155,7 +155,7 @@ def test_axisym_md_vs_maugis_mu3():
     snaps on its own at this coupling (κ = 5.2): dr 0.04 takes 15152 steps and gives +23 %, dr 0.02 with
     smoothing 0.4 +2.3 % (why the default did not finish in 500 s at dr 0.02)."""
     from tengsim.axisym import maugis_sphere, pull_off_state
-    from tengsim.interaction import MaugisDugdale
+    from tengsim.laws import MaugisDugdale
     m = maugis_sphere(3.0)
     c = AxisymSphere(3.0, MaugisDugdale(smoothing=0.6), dr=0.02, r_fine=4.7, r_max=9.0).trace(d_end=6.3)
     f, _, a = pull_off_state(c)

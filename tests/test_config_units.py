@@ -9,10 +9,11 @@ import xarray as xr
 from tengsim.cli.main import main
 from tengsim.config import contact_table, plan_contact
 from tengsim.errors import TengsimError
-from tengsim.geometry import Cone, Cube, HeightMap, Hemisphere, Paraboloid, Pyramid
+from tengsim.shapes import Cone, Cube, HeightMap, Hemisphere, Paraboloid, Pyramid
 from tengsim.grid import Grid
 from tengsim.registry import SHAPES
-from tengsim.units import PaperScaling, Scaling, eps_for_tabor, paper_scaling
+from tengsim.cases.paper.units import paper_scaling
+from tengsim.units import Scaling, eps_for_tabor
 
 E, W = 1e6, 0.05  # Pa, J/m²
 
@@ -243,7 +244,7 @@ def test_plot_curves_uses_physical_axes(tmp_path, monkeypatch):
     monkeypatch.setattr(plots, "save", lambda fig, path: figs.append(fig))
     plan_cfg = dict(shape="cube", half_width="0.3um", height="0.2um", pitch="1um", E_star="1MPa",
                     W="50mJ/m2", eps="20nm", dx=2, d_min=-0.5, d_max=0.5, d_step=0.5)
-    from tengsim.config import run_contact
+    from tengsim.contact import run_contact
 
     res = run_contact(plan_cfg)
     plots.plot_curves(res, tmp_path / "p.png")
@@ -271,7 +272,10 @@ def test_paper_scaling_pyramid_plan_is_unchanged():
     plan = plan_contact(dict(shape="pyramid", pitch="2um", base="1um", height="0.7um", E_star="0.59MPa",
                              W="54mJ/m2", tabor=0.5))
     sc = paper_scaling("A")
-    assert isinstance(plan.scaling, PaperScaling)
+    # the core builds the generic Scaling (no paper special case); its numbers are the paper's
+    assert type(plan.scaling) is Scaling and plan.scaling == sc.to_scaling()
+    for F in (-0.3, 1.0, 7.5):
+        assert plan.scaling.pressure(F) == pytest.approx(sc.pressure(F), rel=1e-12)
     assert plan.shape == Pyramid(sc.N, sc.cell) or plan.shape.N == pytest.approx(sc.N, rel=1e-12)
     assert plan.extra["pitch_m"] == pytest.approx(2e-6) and plan.extra["eps_m"] == pytest.approx(sc.eps)
 

@@ -8,7 +8,7 @@ from tengsim.cli.main import main
 from tengsim.config import plan_contact
 from tengsim.loadpath import LoadPathSpec
 from tengsim.path import PathSpec
-from tengsim.units import paper_scaling
+from tengsim.cases.paper.units import paper_scaling
 
 GROUP_A = ["contact", "pyramid", "--N", "0.946", "--cell", "3.78", "--tabor", "0.5", "--dx", "0.3", "--quiet"]
 PHYS_A = ["contact", "pyramid", "--pitch", "2um", "--base", "1um", "--height", "0.7um", "--E-star", "0.59MPa",

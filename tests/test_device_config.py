@@ -1,4 +1,5 @@
 """Device config through the one schema, `tengsim run` with [device], the paper as a layer, strict JSON."""
+import importlib
 import dataclasses
 import json
 import math
@@ -365,10 +366,10 @@ def test_old_names_say_where_they_moved():
 
     with pytest.raises(AttributeError, match="tengsim.cases.paper"):
         tengsim.device.run_fig7  # noqa: B018
-    from tengsim.paper import area_table_from_result  # thin re-export, old path
-    from tengsim.cases.paper import area_table_from_result as new
-
-    assert area_table_from_result is new
+    # the re-export shims tengsim.paper and tengsim.reproduce are gone: one import path each
+    for old in ("tengsim.paper", "tengsim.reproduce", "tengsim.geometry", "tengsim.interaction"):
+        with pytest.raises(ModuleNotFoundError):
+            importlib.import_module(old)
 
 
 def test_device_takes_any_area_model():

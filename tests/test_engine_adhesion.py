@@ -20,8 +20,8 @@ import numpy as np
 import pytest
 
 from tengsim import references as ref
-from tengsim.geometry import Paraboloid
-from tengsim.interaction import LJ93
+from tengsim.shapes import Paraboloid
+from tengsim.laws import LJ93
 from tengsim.kernels import FreeKernel
 from tengsim.path import PathSpec, run_path
 from tengsim.solvers import FastSolver

@@ -16,9 +16,9 @@ import numpy as np
 import pytest
 
 from tengsim import references as ref
-from tengsim.geometry import Cone, FlatPunch, Paraboloid, Sinusoid1D
+from tengsim.shapes import Cone, FlatPunch, Paraboloid, Sinusoid1D
 from tengsim.grid import Grid
-from tengsim.interaction import Repulsive
+from tengsim.laws import Repulsive
 from tengsim.kernels import FreeKernel, PeriodicKernel
 from tengsim.solvers import FastSolver, Problem, State
 

@@ -11,7 +11,7 @@ import pytest
 
 from tengsim import references as ref
 from tengsim.grid import Grid
-from tengsim.interaction import LJ93, Repulsive
+from tengsim.laws import LJ93, Repulsive
 from tengsim.kernels import FreeKernel, PeriodicKernel, pixel_influence
 
 LAWS = [LJ93(), Repulsive(), Repulsive(scale=2.0, exponent=4.0, g_safe=0.5)]

@@ -76,9 +76,9 @@ def test_periodic_array_of_identical_cells_is_its_one_cell():
     """A 2 × 2 periodic array of the same group-A cell solves as the cell itself: the periodic kernel
     is 2κ/|q| at the physical wavenumber, so the array's state stays 2 × 2-periodic and every cell
     carries the single cell's pressure and force (the scaling study's pyramid array rests on this)."""
-    from tengsim.geometry import Pyramid
+    from tengsim.shapes import Pyramid
     from tengsim.grid import Grid
-    from tengsim.interaction import LJ93
+    from tengsim.laws import LJ93
     from tengsim.kernels import PeriodicKernel
     from tengsim.solvers import FastSolver, Problem, State
 

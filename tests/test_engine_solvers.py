@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 
 from tengsim.analysis import apex_index, contact_length, force
-from tengsim.geometry import Paraboloid, Pyramid
-from tengsim.interaction import LJ93, Repulsive
+from tengsim.shapes import Paraboloid, Pyramid
+from tengsim.laws import LJ93, Repulsive
 from tengsim.kernels import FreeKernel, pixel_influence
 from tengsim.solvers import FastSolver, Problem, State, VSRSolver
 
@@ -258,7 +258,7 @@ def test_fast_solver_monitor_reports_progress():
 
 
 def _rough_periodic(n, seed=3):
-    from tengsim.geometry import random_rough
+    from tengsim.shapes import random_rough
     from tengsim.kernels import PeriodicKernel
 
     surf = random_rough(n, n * 0.25, hurst=0.8, rms_height=1.0, short_cutoff=2.0, seed=seed)

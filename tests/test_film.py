@@ -1,4 +1,4 @@
-"""Finite-thickness film on a rigid substrate (tengsim.film, the film options of the kernels, [contact]).
+"""Finite-thickness film on a rigid substrate (tengsim.kernels.film, the film options of the kernels, [contact]).
 
 References and tolerances:
 * thickness → ∞: the half-space kernels to 1e-6 (relative, zero-mean load for the periodic one);
@@ -19,8 +19,9 @@ from scipy.integrate import quad
 from scipy.sparse.linalg import LinearOperator, cg
 from scipy.special import j0
 
-from tengsim import film
-from tengsim.config import plan_contact, run_contact
+from tengsim.kernels import film
+from tengsim.config import plan_contact
+from tengsim.contact import run_contact
 from tengsim.errors import TengsimError
 from tengsim.grid import Grid
 from tengsim.kernels import FreeKernel, PeriodicKernel, make_kernel
@@ -284,8 +285,8 @@ def test_nested_solve_keeps_the_film_on_coarse_levels(monkeypatch):
     """multilevel's coarse grids get the same film; the nested result is an equilibrium of the film problem
     and the same state as a cold start on the fine grid (energy to 1e-9)."""
     from tengsim import multilevel
-    from tengsim.geometry import random_rough
-    from tengsim.interaction import LJ93
+    from tengsim.shapes import random_rough
+    from tengsim.laws import LJ93
     from tengsim.multilevel import nested_solve
     from tengsim.solvers import FastSolver, Problem, State
 

@@ -11,8 +11,8 @@ import tengsim as ts
 from tengsim.cli.main import main
 from tengsim.config import contact_table, law_fields, law_keys, plan_contact
 from tengsim.errors import TengsimError
-from tengsim.geometry import Paraboloid
-from tengsim.interaction import LJ93, Exponential, Law, MaugisDugdale
+from tengsim.shapes import Paraboloid
+from tengsim.laws import LJ93, Exponential, Law, MaugisDugdale
 from tengsim.registry import LAWS, SHAPES
 from tengsim.study.execute import validate
 from tengsim.study.spec import parse_study

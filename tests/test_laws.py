@@ -14,7 +14,7 @@ from tengsim import references as ref
 from tengsim.axisym import maugis_sphere
 from tengsim.cli.main import main
 from tengsim.errors import TengsimError
-from tengsim.interaction import LJ93, LJ_PEAK_TENSION, Exponential, MaugisDugdale, make_law
+from tengsim.laws import LJ93, LJ_PEAK_TENSION, Exponential, MaugisDugdale, make_law
 from tengsim.registry import LAWS
 
 LAWS_UNDER_TEST = [MaugisDugdale(), MaugisDugdale(smoothing=0.1, wall_stiffness=30.0),
@@ -179,7 +179,7 @@ def md_branch(mu, dx, cell, Ds, k=1e4, tol=1e-7, pre=(), smoothing=0.2):
     to 50000 iterations (at μ = 3 the snap into contact takes thousands; against k = 10⁴ it stalls).
     Returns (D, −∬P/π, edge radius (tengsim.analysis.edge_radius), sqrt(area(H <= 0)/π))."""
     from tengsim.analysis import apex_index, edge_radius
-    from tengsim.geometry import Paraboloid
+    from tengsim.shapes import Paraboloid
     from tengsim.kernels import FreeKernel
     from tengsim.path import walk_states
     from tengsim.solvers import FastSolver
@@ -332,7 +332,7 @@ def test_walk_states_matches_run_path():
     """tengsim.path.walk_states (the walks above) gives run_path's approach rows (LJ93 sphere, μ = 0.5,
     dx 0.25, cell 4, D −0.6 … 0.4 in 0.2 steps) to the solver tolerance (F within 1e-5); it also walks down."""
     from tengsim.analysis import force
-    from tengsim.geometry import Paraboloid
+    from tengsim.shapes import Paraboloid
     from tengsim.kernels import FreeKernel
     from tengsim.path import PathSpec, run_path, walk_states
     from tengsim.solvers import FastSolver

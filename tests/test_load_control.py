@@ -12,7 +12,7 @@ from tengsim.kernels import FreeKernel
 from tengsim.loadpath import LoadPathSpec, run_load_path
 from tengsim.path import PathSpec, run_path
 from tengsim.solvers import Problem, State
-from tengsim.units import paper_scaling
+from tengsim.cases.paper.units import paper_scaling
 
 TOL = 1e-7
 F_TARGETS = (-0.75, -0.5, 0.0, 0.5, 1.0)

@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 
 from tengsim.errors import TengsimError
-from tengsim.geometry import random_rough
+from tengsim.shapes import random_rough
 from tengsim.grid import Grid
-from tengsim.interaction import LJ93
+from tengsim.laws import LJ93
 from tengsim.kernels import FreeKernel, PeriodicKernel
 from tengsim.multilevel import coarse_levels, fourier_resample, nested_solve
 from tengsim.solvers import FastSolver, Problem, State

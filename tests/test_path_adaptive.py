@@ -15,7 +15,7 @@ import pytest
 import tengsim as ts
 from tengsim.kernels import FreeKernel
 from tengsim.path import PathSpec, compare_paths, run_path
-from tengsim.units import paper_scaling
+from tengsim.cases.paper.units import paper_scaling
 
 
 class Counting:

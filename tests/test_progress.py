@@ -64,7 +64,7 @@ def test_simulate_reports_inside_long_solves(monkeypatch):
     """contact.simulate hands the progress's monitor to the fast solver on large grids (threshold
     lowered here so that a small grid counts as large)."""
     from tengsim import contact
-    from tengsim.geometry import Paraboloid
+    from tengsim.shapes import Paraboloid
     from tengsim.path import PathSpec
 
     monkeypatch.setattr(contact, "MONITOR_MIN_POINTS", 0)

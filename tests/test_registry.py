@@ -11,9 +11,10 @@ import xarray as xr
 
 import tengsim as ts
 from tengsim import registry
+from tengsim import plugins
 from tengsim.cli.main import main
 from tengsim.errors import TengsimError
-from tengsim.interaction import LJ93, Repulsive, make_law
+from tengsim.laws import LJ93, Repulsive, make_law
 from tengsim.kernels import FreeKernel, PeriodicKernel, make_kernel
 from tengsim.registry import KERNELS, LAWS, OBSERVERS, SHAPES, SOLVERS
 from tengsim.solvers import FastSolver, VSRSolver, make_solver
@@ -152,8 +153,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tengsim.geometry import Shape
-from tengsim.interaction import LJ93, Law
+from tengsim.shapes import Shape
+from tengsim.laws import LJ93, Law
 from tengsim.registry import LAWS, OBSERVERS, SHAPES
 
 
@@ -196,7 +197,7 @@ def plugin(tmp_path, monkeypatch):
     (tmp_path / f"{name}.py").write_text(textwrap.dedent(PLUGIN))
     monkeypatch.syspath_prepend(str(tmp_path))
     monkeypatch.setenv("TENGSIM_PLUGINS", name)
-    monkeypatch.setattr(registry, "_PLUGINS_LOADED", False)
+    monkeypatch.setattr(plugins, "_LOADED", set())
     yield name
     for reg, key in ((LAWS, "half_lj"), (SHAPES, "tent"), (OBSERVERS, "p_apex")):
         if key in reg:
@@ -274,7 +275,7 @@ out = "{out2}"
 
 def test_broken_plugin_is_one_line(tmp_path, monkeypatch, capsys):
     monkeypatch.setenv("TENGSIM_PLUGINS", "no_such_tengsim_plugin_module")
-    monkeypatch.setattr(registry, "_PLUGINS_LOADED", False)
+    monkeypatch.setattr(plugins, "_LOADED", set())
     assert main(["contact", "--help"]) == 2
     err = capsys.readouterr().err
     assert "no_such_tengsim_plugin_module" in err and len(err.strip().splitlines()) == 1

@@ -13,7 +13,7 @@ from tengsim.errors import TengsimError
 _PEAK = r"""
 import json, resource, sys
 from tengsim.contact import simulate
-from tengsim.geometry import Pyramid
+from tengsim.shapes import Pyramid
 from tengsim.path import PathSpec
 def rss():
     # peak RSS of this process image: VmHWM (getrusage's ru_maxrss also counts the parent's RSS at

@@ -18,7 +18,7 @@ from tengsim import references as ref
 from tengsim import status as st
 from tengsim.cli.contact import write_contact
 from tengsim.grid import Grid
-from tengsim.interaction import LJ93, Law, Repulsive
+from tengsim.laws import LJ93, Law, Repulsive
 from tengsim.load import load_result
 from tengsim.results import CURVE_COLUMNS, ContactResult
 
@@ -267,7 +267,7 @@ def test_pixel_snap_number_values():
     """s = max dP/dg × pixel compliance: MD (smoothing 0.2) at μ = 3, dx 0.05 is 2.0 (the run that pinned
     its edge, +8.2 % pull-off, docs/validation.md); smoothing 0.6 0.67; LJ93 at μ = 0.5, dx 0.1 0.05;
     no tension, no snap; s grows about as dx (pixel compliance of the half-space ∝ κ dx)."""
-    from tengsim.interaction import MaugisDugdale
+    from tengsim.laws import MaugisDugdale
     from tengsim.kernels import make_kernel
 
     def s(law, mu, dx):
@@ -290,7 +290,7 @@ def test_snapping_run_is_under_resolved_with_its_own_line(tmp_path):
     process zone (≥ 0.13) is wider than 0.75 dx; the line names the snap and a dx; the status and the
     line survive a NetCDF round trip.  μ = 1 with the same law and grid (s = 0.82; its pull-off within
     1.1 % of Maugis, docs/validation.md) is ok."""
-    from tengsim.interaction import MaugisDugdale
+    from tengsim.laws import MaugisDugdale
 
     res = ts.simulate(ts.Paraboloid(1.0, 5.0), 3.0, 0.15, ts.PathSpec(-1.0, 0.5, 0.25), law=MaugisDugdale())
     assert res.params["pixel_snap_number"] > 4

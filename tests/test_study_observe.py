@@ -7,7 +7,7 @@ import pytest
 from tengsim.grid import Grid
 from tengsim.results import CURVE_COLUMNS, ContactResult
 from tengsim.study.observe import observe, parse_observables
-from tengsim.units import paper_scaling
+from tengsim.cases.paper.units import paper_scaling
 
 EPS_0 = 8.8541878128e-12
 SC = paper_scaling("A")
@@ -115,7 +115,7 @@ def test_area_fraction_per_shape_family():
 
 def test_physical_scale_of_any_shape_from_its_columns():
     """Any physical run: Pa per unit F from pressure_Pa (or F_N / cell area), metres per unit D = eps_m."""
-    from tengsim.config import run_contact
+    from tengsim.contact import run_contact
     from tengsim.study.observe import physical_scale
 
     res = run_contact({"shape": "cone", "slope": 1.0, "pitch": "2um", "height": "0.4um", "E_star": "1MPa",

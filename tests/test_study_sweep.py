@@ -12,7 +12,9 @@ import pytest
 import xarray as xr
 
 from tengsim.cli.main import main
-from tengsim.config import plan_contact, run_contact
+from tengsim import plugins
+from tengsim.config import plan_contact
+from tengsim.contact import run_contact
 from tengsim.errors import TengsimError
 from tengsim.study import parse_study, run_study
 
@@ -102,13 +104,13 @@ def test_bad_point_fails_with_message_others_finish(tmp_path, client):
 
 def test_failure_at_compute_is_recorded(monkeypatch):
     """An exception inside a run becomes a failed point with its message (compute_point never raises)."""
-    import tengsim.config
+    import tengsim.contact
     from tengsim.study.execute import compute_point
 
     def boom(cfg, progress=None):
         raise FloatingPointError("overflow in the solver")
 
-    monkeypatch.setattr(tengsim.config, "run_contact", boom)
+    monkeypatch.setattr(tengsim.contact, "run_contact", boom)
     r = compute_point(dict(TINY), "abc")
     assert r["status"] == "failed" and "FloatingPointError: overflow in the solver" in r["message"]
     assert r["data"] is None
@@ -141,7 +143,7 @@ def test_physical_study_has_pressure_observables(tmp_path, client):
                          "observables": {"pressures": ["5kPa"], "fit_range": ["0kPa", "10kPa"]}})
     run_study(study, tmp_path / "out", client=client, quiet=True)
     ds = xr.load_dataset(tmp_path / "out" / "study.nc")
-    from tengsim.units import PaperScaling
+    from tengsim.cases.paper.units import PaperScaling
 
     for e in ("0.59MPa", "2MPa"):
         row = ds.sel({"contact.E_star": e})
@@ -516,7 +518,7 @@ BOMB = '''
 import os
 from dataclasses import dataclass
 
-from tengsim.geometry import Paraboloid
+from tengsim.shapes import Paraboloid
 from tengsim.registry import SHAPES
 
 
@@ -548,7 +550,7 @@ def test_worker_dying_mid_point_is_a_failed_point_others_finish(tmp_path, monkey
     monkeypatch.syspath_prepend(str(tmp_path))
     monkeypatch.setenv("PYTHONPATH", os.pathsep.join([str(tmp_path), os.environ.get("PYTHONPATH", "")]))
     monkeypatch.setenv("TENGSIM_PLUGINS", name)
-    monkeypatch.setattr(registry, "_PLUGINS_LOADED", False)
+    monkeypatch.setattr(plugins, "_LOADED", set())
     try:
         study = parse_study({"base": {"contact": {"shape": "bomb", "radius": 1.0, "cell": 4.0, "dx": 0.4,
                                                   "d_min": -0.5, "d_max": 0.5, "d_step": 0.5}},

@@ -9,7 +9,7 @@ import tengsim
 from tengsim.cli.main import main
 from tengsim.config import plan_contact
 from tengsim.errors import TengsimError
-from tengsim.topography import Topography, read
+from tengsim.shapes.topography import Topography, read
 
 
 def _bump(path, n=9, amp=30e-9, tilt=0.0):

@@ -7,7 +7,8 @@ import pytest
 from tengsim.analysis import tensile_peak_offset
 from tengsim.errors import TengsimError
 from tengsim.path import PathSpec
-from tengsim.units import PaperScaling, paper_scaling, parse_quantity
+from tengsim.cases.paper.units import PaperScaling, paper_scaling
+from tengsim.units import parse_quantity
 
 
 @pytest.mark.parametrize("text, kind, value", [

@@ -1,36 +1,35 @@
 """tengsim: adhesive contact of micro-structured TENG interfaces and the device output.
 
-Public API (re-exported by hand; internals may move):
-shapes (geometry), laws (interaction), kernels, solvers, observers, the continuation path, results,
-units, and the registries through which each of those is extended (tengsim.registry).
+The public API, gathered from the layers below (see the README's layout section): shapes
+(:mod:`tengsim.shapes`), laws (:mod:`tengsim.laws`), kernels (:mod:`tengsim.kernels`), solvers,
+observers, the continuation paths, results, units, and the registries through which each of those
+is extended (:mod:`tengsim.registry`, filled by :mod:`tengsim.plugins`).  No tengsim module imports
+this one: it is the user's entry point only.
 """
-__version__ = "0.1.0"
-
-from tengsim.analysis import contact_length, force, repulsive_area  # noqa: E402
-from tengsim.contact import simulate, simulate_pyramid  # noqa: E402
-from tengsim.errors import TengsimError  # noqa: E402
-from tengsim.geometry import (Cone, Cube, FlatPunch, HeightMap, Hemisphere, Line, Paraboloid,  # noqa: E402
-                              Pyramid, Sinusoid1D, random_rough)
-from tengsim.grid import Grid  # noqa: E402
-from tengsim.arrays import Array  # noqa: E402
-from tengsim.interaction import LJ93, Exponential, MaugisDugdale, Repulsive  # noqa: E402
-from tengsim.kernels import FreeKernel, PeriodicKernel  # noqa: E402
-from tengsim.observers import Summary  # noqa: E402
-from tengsim.loadpath import LoadPathSpec, run_load_path  # noqa: E402
-from tengsim.path import PathSpec, run_path  # noqa: E402
-from tengsim.registry import KERNELS, LAWS, OBSERVERS, SHAPES, SOLVERS  # noqa: E402
-from tengsim.results import ContactResult, Jump  # noqa: E402
-from tengsim.solvers import Equilibrium, FastSolver, Problem, State, VSRSolver  # noqa: E402
-from tengsim.status import ResultStatusError  # noqa: E402
-from tengsim.topography import Topography  # noqa: E402
-from tengsim.units import PaperScaling, Scaling, paper_scaling, parse_quantity  # noqa: E402
+from tengsim._version import __version__
+from tengsim.analysis import contact_length, force, repulsive_area
+from tengsim.contact import simulate, simulate_pyramid
+from tengsim.errors import TengsimError
+from tengsim.grid import Grid
+from tengsim.kernels import FreeKernel, PeriodicKernel
+from tengsim.laws import LJ93, Exponential, MaugisDugdale, Repulsive
+from tengsim.loadpath import LoadPathSpec, run_load_path
+from tengsim.observers import Summary
+from tengsim.path import PathSpec, run_path
+from tengsim.plugins import KERNELS, LAWS, OBSERVERS, SHAPES, SOLVERS
+from tengsim.results import ContactResult, Jump
+from tengsim.shapes import (Array, Cone, Cube, FlatPunch, HeightMap, Hemisphere, Line, Paraboloid, Pyramid,
+                            Sinusoid1D, Topography, random_rough)
+from tengsim.solvers import Equilibrium, FastSolver, Problem, State, VSRSolver
+from tengsim.status import ResultStatusError
+from tengsim.units import Scaling, parse_quantity
 
 __all__ = [
     "KERNELS", "LAWS", "OBSERVERS", "SHAPES", "SOLVERS", "Scaling", "Summary",
     "Array", "Exponential", "LoadPathSpec", "MaugisDugdale", "ResultStatusError", "Topography", "run_load_path",
     "Cone", "ContactResult", "Cube", "Equilibrium", "FastSolver", "FlatPunch", "FreeKernel", "Grid",
-    "HeightMap", "Hemisphere", "Jump", "LJ93", "Line", "PaperScaling", "Paraboloid", "PathSpec",
+    "HeightMap", "Hemisphere", "Jump", "LJ93", "Line", "Paraboloid", "PathSpec",
     "PeriodicKernel", "Problem", "Pyramid", "Repulsive", "Sinusoid1D", "State", "TengsimError",
-    "VSRSolver", "contact_length", "force", "paper_scaling", "parse_quantity", "random_rough",
+    "VSRSolver", "contact_length", "force", "parse_quantity", "random_rough",
     "repulsive_area", "run_path", "simulate", "simulate_pyramid", "__version__",
 ]

@@ -320,7 +320,7 @@ def maugis_sphere(mu: float, sigma0: float | None = None) -> MaugisSphere:
     W R (so P̄ = |F|/(πWR) = −∬P/π), lengths in ℓ = sqrt(Rε) = 1, indentation in ε.  λ from the
     Dugdale stress ``sigma0`` (default the LJ93 peak 16/(9√3), giving λ = 1.157 μ)."""
     from tengsim import references as ref
-    from tengsim.interaction import LJ_PEAK_TENSION
+    from tengsim.laws import LJ_PEAK_TENSION
 
     R, E_star, W = 1.0, positive("mu", mu) ** -1.5, 1.0
     lam = ref.md_lambda(R, E_star, W, LJ_PEAK_TENSION if sigma0 is None else sigma0)

@@ -13,13 +13,14 @@ import dataclasses
 import inspect
 from dataclasses import dataclass, field
 
-from tengsim import film
+from tengsim.kernels import film
 from tengsim.errors import TengsimError, finite, positive
-from tengsim.interaction import make_law
+from tengsim.laws import make_law
 from tengsim.path import PathSpec
-from tengsim.registry import KERNELS, LAWS, OBSERVERS, SHAPES, SOLVERS, ensure_builtins
-from tengsim.schema import REQUIRED, Field, Table, dataclass_fields, field_kind, read_config
-from tengsim.units import PaperScaling, Scaling, parse_quantity
+from tengsim.plugins import KERNELS, LAWS, OBSERVERS, SHAPES, SOLVERS
+from tengsim.schema import Field, Table, dataclass_fields, read_config, signature_fields
+from tengsim.shapes.base import dimensionless_fields, physical_fields
+from tengsim.units import Scaling, parse_quantity
 
 PHYSICAL_KEYS = ("E_star", "W", "eps")
 """Keys that make a [contact] table a physical run (with any physical-only key of the shape)."""
@@ -105,7 +106,6 @@ def _path_spec(vals, given, scaling):
 
 def common_fields() -> list:
     """The [contact] keys every shape has (choices and help read from the registries)."""
-    ensure_builtins()
     return [
         Field("shape", "str", "pyramid", check=lambda v: SHAPES.canonical(v),
               help="registered shape: " + SHAPES.help()),
@@ -152,30 +152,9 @@ def common_fields() -> list:
 
 
 def _shape_cls(name):
-    ensure_builtins()
     if not isinstance(name, str):
         raise TengsimError(f"shape must be a name, got {name!r}")
     return SHAPES.canonical(name), SHAPES.get(name)
-
-
-def dimensionless_fields(cls) -> tuple:
-    """A shape's dimensionless input fields (its dataclass fields, or its constructor's arguments)."""
-    from tengsim.geometry import Shape
-
-    if hasattr(cls, "dimensionless_fields"):
-        return tuple(cls.dimensionless_fields())
-    if dataclasses.is_dataclass(cls):
-        return tuple(Shape.dimensionless_fields.__func__(cls))
-    return _signature_fields(cls)
-
-
-def _signature_fields(cls, skip=(), helps=None) -> tuple:
-    out = []
-    for p in inspect.signature(cls).parameters.values():
-        if p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY) and p.name not in skip:
-            out.append(Field(p.name, "float" if p.annotation is p.empty else field_kind(p.annotation),
-                             REQUIRED if p.default is p.empty else p.default, help=(helps or {}).get(p.name, "")))
-    return tuple(out)
 
 
 def law_fields(law) -> tuple:
@@ -184,12 +163,11 @@ def law_fields(law) -> tuple:
 
     ``law`` is a registered name or the registered class (factory); the defaults are the law's own.
     """
-    ensure_builtins()
     cls = LAWS.get(law) if isinstance(law, str) else law
     skip = tuple(getattr(cls, "internal_fields", ()) or ())
     helps = getattr(cls, "field_help", None) or {}
     if not dataclasses.is_dataclass(cls):
-        return _signature_fields(cls, skip, helps)
+        return signature_fields(cls, skip, helps)
     return dataclass_fields(cls, skip, helps)
 
 
@@ -208,7 +186,6 @@ def law_keys() -> dict:
 
     A law key may not be a common [contact] key (a TengsimError names the clash); several laws may share
     one (md and exp: wall_stiffness)."""
-    ensure_builtins()
     common = {f.name for f in common_fields()}
     out = {}
     for name in LAWS.names():
@@ -225,10 +202,6 @@ def law_key_help(entries) -> str:
     for name, f in entries:
         groups.setdefault(_field_help(name, f), []).append(f"{name}: {_default_text(f)}")
     return "; ".join(f"{h} [law {', '.join(laws)}]" for h, laws in groups.items())
-
-
-def physical_fields(cls) -> tuple:
-    return tuple(getattr(cls, "physical_fields", ()) or ())
 
 
 def contact_table(shape: str = "pyramid", mode: str | None = None, law: str | None = None) -> Table:
@@ -279,7 +252,6 @@ def contact_table(shape: str = "pyramid", mode: str | None = None, law: str | No
 
 def contact_keys() -> tuple:
     """Every key a [contact] table may hold for some registered shape and law (the CLI's option set)."""
-    ensure_builtins()
     keys = [f.name for f in common_fields()]
     for s in SHAPES.names():
         for k in contact_table(s).keys():
@@ -301,7 +273,7 @@ class ContactPlan:
     tol: float
     law: object
     extra: dict = field(default_factory=dict)
-    scaling: Scaling | PaperScaling | None = None
+    scaling: Scaling | None = None
     observers: tuple = ()
     kernel_params: dict = field(default_factory=dict)
 
@@ -356,6 +328,15 @@ def _build_law(name, kw):
         raise TengsimError(f"law {name}: {exc}") from None
 
 
+def _cell_area_m2(cls, p, shape, lateral) -> float:
+    """The cell's area in m²: the shape's own (``cell_area_si``, exact from its SI input) or its
+    dimensionless cell area times ℓ²."""
+    own = getattr(cls, "cell_area_si", None)
+    if own is not None:
+        return own(p)
+    return getattr(shape, "cell_area", shape.cell**2) * lateral**2
+
+
 def plan_contact(cfg: dict) -> ContactPlan:
     """Validate a [contact] table and build its pieces (no solving)."""
     if not isinstance(cfg, dict):
@@ -408,10 +389,7 @@ def plan_contact(cfg: dict) -> ContactPlan:
             raise TengsimError(f"physical {name} input needs eps or tabor (tabor has no default in a physical run)")
         lateral = positive("lateral scale", cls.lateral_scale(p, eps))
         shape = cls.from_si(p, eps)
-        if name == "pyramid" and cls.__name__ == "Pyramid":
-            scaling = PaperScaling(E, W, p["base"], p["height"], p["pitch"], eps)
-        else:
-            scaling = Scaling(E, W, eps, lateral, getattr(shape, "cell_area", shape.cell**2) * lateral**2)
+        scaling = Scaling(E, W, eps, lateral, _cell_area_m2(cls, p, shape, lateral))
         tabor = scaling.mu
         if vals["tabor"] is not None and abs(tabor - vals["tabor"]) > 1e-8 * vals["tabor"]:
             raise TengsimError(f"could not solve eps for tabor = {vals['tabor']:g} (got μ = {tabor:g})")
@@ -446,16 +424,3 @@ def plan_contact(cfg: dict) -> ContactPlan:
 
 def _common_names():
     return {f.name for f in common_fields()}
-
-
-def run_contact(cfg: dict, progress=None):
-    """Plan and run a [contact] table; returns a ContactResult with the config in params."""
-    from tengsim.contact import simulate
-
-    plan = plan_contact(cfg)
-    res = simulate(plan.shape, plan.tabor, plan.dx, plan.path, boundary=plan.boundary,
-                   solver=plan.solver, tol=plan.tol, law=plan.law, progress=progress,
-                   extra_params=plan.extra, observers=plan.observers, scaling=plan.scaling,
-                   kernel_params=plan.kernel_params)
-    res.params["config"] = {k: v for k, v in cfg.items() if k not in ("out", "plot")}
-    return res

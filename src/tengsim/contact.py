@@ -3,10 +3,12 @@ from __future__ import annotations
 
 from dataclasses import is_dataclass, replace
 
-from tengsim import __version__, status
+from tengsim import status
+from tengsim._version import __version__
+from tengsim.config import plan_contact
 from tengsim.errors import TengsimError, positive
-from tengsim.geometry import Pyramid, Shape
-from tengsim.interaction import LJ93, Law, make_law
+from tengsim.shapes import Pyramid, Shape
+from tengsim.laws import LJ93, Law, make_law
 from tengsim.kernels import make_kernel
 from tengsim.path import PathSpec, run_path
 from tengsim.registry import KERNELS
@@ -92,3 +94,14 @@ def simulate_pyramid(N: float, cell: float, tabor: float = 0.5, dx: float = 0.05
     shape = Pyramid(N, cell)
     spec = PathSpec(d_min, d_max, d_step, maps_at=tuple(maps_at), **path_kw)
     return simulate(shape, tabor, dx, spec, boundary=boundary, solver=solver, tol=tol, progress=progress)
+
+
+def run_contact(cfg: dict, progress=None):
+    """Plan and run a [contact] table; returns a ContactResult with the config in params."""
+    plan = plan_contact(cfg)
+    res = simulate(plan.shape, plan.tabor, plan.dx, plan.path, boundary=plan.boundary,
+                   solver=plan.solver, tol=plan.tol, law=plan.law, progress=progress,
+                   extra_params=plan.extra, observers=plan.observers, scaling=plan.scaling,
+                   kernel_params=plan.kernel_params)
+    res.params["config"] = {k: v for k, v in cfg.items() if k not in ("out", "plot")}
+    return res

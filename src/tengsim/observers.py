@@ -93,7 +93,7 @@ def observe(o, eq, ctx) -> dict:
 
 @OBSERVERS.register("array_area")
 class ArrayArea:
-    """Charged area over a K × K array (``tengsim.arrays``; a plain grid is one cell).
+    """Charged area over a K × K array (``tengsim.shapes.arrays``; a plain grid is one cell).
 
     ``area_fraction_greenwood`` = Σ_cells Λc,k² / (K L̄)²: the paper's A/S of Eq. (12), λc²/L², summed
     over the cells, with Λc,k the Greenwood contact length of cell k (twice the distance from the

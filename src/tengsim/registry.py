@@ -6,16 +6,16 @@ them from here; no other module keeps its own list.  A user extends tengsim from
     from tengsim.registry import LAWS
 
     @LAWS.register("mylaw", summary="my interaction law")
-    class MyLaw(tengsim.interaction.Law): ...
+    class MyLaw(tengsim.laws.Law): ...
 
 and ``law = "mylaw"`` then works in :func:`tengsim.simulate`, TOML runs and ``tengsim contact --law``.
-Plugins named in the environment variable ``TENGSIM_PLUGINS`` (comma-separated module names) or under
-the ``tengsim.plugins`` entry-point group are imported before the command line is built.
+This module imports nothing of tengsim's but :mod:`tengsim.errors`: the built-in pieces register
+themselves here on import exactly as a plugin's do, and :mod:`tengsim.plugins` imports both (the
+built-in packages, then the modules named in ``TENGSIM_PLUGINS`` and the ``tengsim.plugins`` entry
+points).
 """
 from __future__ import annotations
 
-import importlib
-import os
 from typing import Any, Callable, Generic, Iterator, Protocol, TypeVar, runtime_checkable
 
 import numpy as np
@@ -173,37 +173,5 @@ LAWS: Registry = Registry("law", LawLike)
 KERNELS: Registry = Registry("boundary", KernelLike)
 SOLVERS: Registry = Registry("solver", SolverLike)
 OBSERVERS: Registry = Registry("observer", ObserverLike)
-
-_PLUGINS_LOADED = False
-
-
-def load_plugins() -> None:
-    """Import the modules named in ``TENGSIM_PLUGINS`` and the ``tengsim.plugins`` entry points (once)."""
-    global _PLUGINS_LOADED
-    if _PLUGINS_LOADED:
-        return
-    _PLUGINS_LOADED = True
-    for mod in filter(None, (m.strip() for m in os.environ.get("TENGSIM_PLUGINS", "").split(","))):
-        try:
-            importlib.import_module(mod)
-        except ImportError as exc:
-            raise TengsimError(f"TENGSIM_PLUGINS: cannot import {mod!r}: {exc}") from None
-    try:
-        from importlib.metadata import entry_points
-
-        for ep in entry_points(group="tengsim.plugins"):
-            ep.load()
-    except Exception as exc:  # noqa: BLE001 - a broken plugin is reported, not a traceback
-        raise TengsimError(f"tengsim.plugins entry point failed: {exc}") from None
-
-
-def ensure_builtins() -> None:
-    """Import the modules that register the built-in pieces."""
-    import tengsim.geometry  # noqa: F401
-    import tengsim.interaction  # noqa: F401
-    import tengsim.kernels  # noqa: F401
-    import tengsim.observers  # noqa: F401
-    import tengsim.solvers  # noqa: F401
-
 
 Factory = Callable[..., Any]

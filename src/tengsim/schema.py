@@ -242,3 +242,13 @@ def dataclass_fields(cls, skip=(), helps=None) -> tuple:
             default = REQUIRED
         out.append(Field(f.name, field_kind(f.type), default, help=(helps or {}).get(f.name, "")))
     return tuple(out)
+
+
+def signature_fields(cls, skip=(), helps=None) -> tuple:
+    """Input fields from a constructor's signature (for shapes and laws that are not dataclasses)."""
+    out = []
+    for p in inspect.signature(cls).parameters.values():
+        if p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY) and p.name not in skip:
+            out.append(Field(p.name, "float" if p.annotation is p.empty else field_kind(p.annotation),
+                             REQUIRED if p.default is p.empty else p.default, help=(helps or {}).get(p.name, "")))
+    return tuple(out)

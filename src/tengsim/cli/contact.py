@@ -1,4 +1,4 @@
-"""``tengsim contact``: one approach–retraction run (thin shell over tengsim.config.run_contact)."""
+"""``tengsim contact``: one approach–retraction run (thin shell over tengsim.contact.run_contact)."""
 from __future__ import annotations
 
 import sys
@@ -71,7 +71,8 @@ def register(sub):
 
 
 def run(args) -> int:
-    from tengsim.config import contact_keys, plan_contact, run_contact
+    from tengsim.config import contact_keys, plan_contact
+    from tengsim.contact import run_contact
     from tengsim.progress import Progress
 
     keys = [k for k in contact_keys() if k not in _CLI_ONLY]

@@ -15,7 +15,7 @@ SUBCOMMANDS = ["contact", "device", "reproduce", "run", "plot", "sweep", "optimi
 
 
 def build_parser() -> argparse.ArgumentParser:
-    from tengsim import __version__
+    from tengsim._version import __version__
 
     p = argparse.ArgumentParser(
         prog="tengsim",
@@ -35,10 +35,9 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv=None) -> int:
-    from tengsim.registry import ensure_builtins, load_plugins
+    from tengsim.plugins import load_plugins
 
     try:
-        ensure_builtins()
         load_plugins()  # user shapes, laws, kernels, solvers, observers: before the parser lists them
     except TengsimError as exc:
         print(f"tengsim: error: {exc}", file=sys.stderr)

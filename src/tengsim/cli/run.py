@@ -39,7 +39,7 @@ def run(args) -> int:
     if kind == "contact":
         return _contact(section, args)
     if kind == "reproduce":
-        from tengsim.reproduce import reproduce
+        from tengsim.cases.paper.reproduce import reproduce
         from tengsim.schema import Field, Table
 
         vals = Table("reproduce", [Field("out", "str", "tengsim-paper", help="output folder"),
@@ -51,7 +51,8 @@ def run(args) -> int:
 
 def _contact(section, args) -> int:
     from tengsim.cli.contact import write_contact
-    from tengsim.config import plan_contact, run_contact
+    from tengsim.config import plan_contact
+    from tengsim.contact import run_contact
     from tengsim.progress import Progress
 
     plan_contact(section)  # every key checked before anything is written

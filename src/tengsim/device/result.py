@@ -144,7 +144,7 @@ class DeviceResult:
 
     # --- output ---
     def header(self) -> dict:
-        from tengsim import __version__
+        from tengsim._version import __version__
 
         return {"model": "tengsim.device (paper Eqs. 13-24)", "tengsim_version": __version__,
                 "params": self.params.to_dict(),

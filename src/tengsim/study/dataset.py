@@ -196,7 +196,7 @@ def build_study(root) -> dict:
     ds["seconds"].attrs["units"] = "s"
     ds["run_status"].attrs["long_name"] = ("worst status of the run's equilibria (tengsim.status): ok, "
                                            "under_resolved, out_of_law_range, not_converged")
-    from tengsim import __version__
+    from tengsim._version import __version__
 
     ds.attrs.update({"study": json.dumps({k: spec[k] for k in ("source", "sampling", "n", "seed", "base")},
                                          default=str),

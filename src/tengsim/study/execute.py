@@ -55,7 +55,7 @@ def _worker_setup(plugins: str = "") -> None:
         os.environ.setdefault(k, v)
     if plugins and not os.environ.get("TENGSIM_PLUGINS"):
         os.environ["TENGSIM_PLUGINS"] = plugins
-    from tengsim.registry import load_plugins
+    from tengsim.plugins import load_plugins
 
     load_plugins()
 
@@ -70,14 +70,14 @@ def compute_point(contact: dict, pid: str, plugins: str = "") -> dict:
     """
     import traceback
 
-    from tengsim import __version__
+    from tengsim._version import __version__
 
     t0 = time.time()
     c0 = time.perf_counter()
     info = {"host": socket.gethostname(), "pid": os.getpid(), "started": t0}
     try:
         _worker_setup(plugins)
-        from tengsim.config import run_contact
+        from tengsim.contact import run_contact
 
         c0 = time.perf_counter()
         res = run_contact(dict(contact))
@@ -329,7 +329,7 @@ def run_study(study, out, *, workers=None, scheduler=None, client=None, resume=F
     Nothing is written if validation, the directory check or the connection fails.
     """
     from tengsim.io import write_json
-    from tengsim.registry import load_plugins
+    from tengsim.plugins import load_plugins
 
     load_plugins()  # the client plans the points with the same registries as its workers
     stream = stream or sys.stderr

@@ -93,7 +93,7 @@ def physical_scale(res) -> tuple[float, float] | None:
 
     Every physical run (any shape, :class:`tengsim.units.Scaling`) carries ``pressure_Pa`` (or ``F_N``
     with ``cell_area_m2``) and ``eps_m``: the ratio to F is one constant.  Older pyramid files without
-    those columns: the paper's scaling (Eq. 7, :class:`tengsim.units.PaperScaling`) from their parameters.
+    those columns: the paper's scaling (Eq. 7, ℓ = ε m/n) from their parameters.
     """
     p = res.params
     t = res.table
@@ -109,10 +109,9 @@ def physical_scale(res) -> tuple[float, float] | None:
             return float(np.median(fn[ok] / F[ok])) / float(p["cell_area_m2"]), float(eps)
     need = ("E_star_Pa", "W_J_m2", "base_m", "height_m", "pitch_m", "eps_m")
     if shape_name(p) == "pyramid" and all(p.get(k) for k in need):
-        from tengsim.units import PaperScaling
-
-        sc = PaperScaling(p["E_star_Pa"], p["W_J_m2"], p["base_m"], p["height_m"], p["pitch_m"], p["eps_m"])
-        return sc.pressure(1.0), sc.eps
+        m, n, L, eps = p["base_m"], p["height_m"], p["pitch_m"], p["eps_m"]
+        # the pyramid's force unit 3π W ℓ²/ε with ℓ = ε m/n (Eqs. 7, 10), over the cell's area L²
+        return 3 * math.pi * m**2 * p["W_J_m2"] * eps / n**2 / L**2, float(eps)
     return None
 
 

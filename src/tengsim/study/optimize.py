@@ -88,7 +88,7 @@ def optimize_study(study, out, *, workers=None, scheduler=None, client=None, res
     from tengsim.study.execute import StudyDir, SweepProgress, _close, _compute, connect, warm_up
     from tengsim.study.observe import observe
 
-    from tengsim.registry import load_plugins
+    from tengsim.plugins import load_plugins
 
     load_plugins()
     stream = stream or sys.stderr

@@ -235,9 +235,8 @@ def parse_study(cfg: dict, source: str = "") -> Study:
 
 def _parse_shapes(tables, where) -> dict:
     """[base.shapes.<name>] tables, keyed by canonical shape name."""
-    from tengsim.registry import SHAPES, ensure_builtins
+    from tengsim.plugins import SHAPES
 
-    ensure_builtins()
     if not isinstance(tables, dict):
         raise TengsimError(f"{where}: [base.shapes] must hold one table per shape, got {tables!r}")
     out = {}

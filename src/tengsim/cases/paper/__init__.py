@@ -12,11 +12,11 @@ from tengsim.cases.paper.device import (FIG7_FORCE_N, FIG7_FREQUENCY_HZ, FIG8_FR
                                         fig7_params, fig7_summary, fig7_waveform, fig8_area_table, fig8_params,
                                         fig8_summary, fig8_waveform, run_fig7, run_fig8)
 from tengsim.cases.paper.reproduce import FIG5_EPS_R, FIG5_SIGMA, FIG5_T, reproduce, summary_text
-from tengsim.units import PAPER_GROUPS, paper_scaling
+from tengsim.cases.paper.units import PAPER_GROUPS, PaperScaling, paper_scaling
 
 __all__ = ["FIG3_D", "GROUPS", "PAPER_GROUPS", "PAPER_TRANSITION_D", "RunSettings", "area_table",
            "area_table_from_result", "area_table_from_load_result", "area_table_load_controlled",
-           "compare_area_tables", "contact_summary", "group_shape", "run_group", "run_group_load", "paper_scaling",
+           "compare_area_tables", "contact_summary", "group_shape", "run_group", "run_group_load", "paper_scaling", "PaperScaling",
            "FIG7_FORCE_N", "FIG7_FREQUENCY_HZ", "FIG8_FREQUENCY_HZ", "FIG8_PRESSURES_PA", "fig7_params",
            "fig7_summary", "fig7_waveform", "fig8_area_table", "fig8_params", "fig8_summary", "fig8_waveform",
            "run_fig7", "run_fig8", "FIG5_EPS_R", "FIG5_SIGMA", "FIG5_T", "reproduce", "summary_text"]

@@ -13,10 +13,10 @@ from tengsim.cases._json import json_safe
 from tengsim.contact import simulate
 from tengsim.device.params import AreaTable
 from tengsim.errors import TengsimError
-from tengsim.geometry import Pyramid
+from tengsim.shapes import Pyramid
 from tengsim.loadpath import LoadPathSpec
 from tengsim.path import PathSpec
-from tengsim.units import PAPER_GROUPS, paper_scaling
+from tengsim.cases.paper.units import PAPER_GROUPS, PaperScaling, paper_scaling
 
 # The paper's reported partial-to-full contact transitions (Fig. 4a), for comparison only.
 PAPER_TRANSITION_D = {"A": 1.75, "B": 5.20, "C": 10.95}

@@ -14,7 +14,8 @@ from pathlib import Path
 
 import numpy as np
 
-from tengsim import __version__, io
+from tengsim import io
+from tengsim._version import __version__
 from tengsim.cases._json import json_safe
 from tengsim.cases.paper.contact import (FIG3_D, GROUPS, PAPER_TRANSITION_D, RunSettings,
                                          area_table_from_load_result, area_table_from_result, compare_area_tables,

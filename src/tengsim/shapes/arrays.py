@@ -29,6 +29,7 @@ from tengsim.errors import TengsimError, positive
 from tengsim.grid import Grid
 from tengsim.registry import SHAPES
 from tengsim.schema import Field
+from tengsim.shapes.base import dimensionless_fields, physical_fields
 
 DISTRIBUTIONS = ("normal", "uniform")
 
@@ -68,8 +69,6 @@ def _phys_only_fields():
 
 def _union(kind):
     """The fields of every pattern shape (physical or dimensionless), each name once, none required."""
-    from tengsim.config import dimensionless_fields, physical_fields
-
     out = {}
     for n in _pattern_shapes():
         cls = SHAPES.get(n)
@@ -158,8 +157,6 @@ class Array:
         pcls = SHAPES.get(pname)
         if not getattr(pcls, "is_pattern", True):
             raise TengsimError(f"array pattern {pname!r} cannot be a cell pattern")
-        from tengsim.config import physical_fields
-
         mine = {f.name for f in physical_fields(pcls)}
         extra = [k for k, v in values.items() if k not in own and k not in mine and v is not None]
         if extra:

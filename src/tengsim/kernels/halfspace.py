@@ -10,7 +10,7 @@ A kernel's ``apply`` is one convolution (a forward and an inverse real FFT): the
   displacement (q = 0) held at zero, so D is measured from the mean surface.
 
 Both take an optional film (``thickness`` T in X units, ``substrate`` 'bonded' or 'frictionless',
-``poisson`` ν; :mod:`tengsim.film`): a layer of thickness T on a rigid substrate instead of the
+``poisson`` ν; :mod:`tengsim.kernels.film`): a layer of thickness T on a rigid substrate instead of the
 half-space, E* keeping its meaning.  The periodic multiplier becomes (2κ/|q|) C(|q| T, ν) with the
 finite mean compliance κT(1 − 2ν)/(1 − ν)² at q = 0; the free kernel adds to the exact half-space
 pixel coefficients the layer's smooth correction (κ/π)(1/T) h(r/T), pixel-averaged by Gauss points
@@ -24,78 +24,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from tengsim import _fft, film
+from tengsim import _fft
 from tengsim.errors import positive
 from tengsim.grid import Grid
+from tengsim.kernels import film
+from tengsim.kernels.base import pixel_influence
+from tengsim.kernels.film import _Film, film_pixel_correction
 from tengsim.registry import KERNELS
-
-
-def _F(x, y):
-    """Antiderivative of 1/sqrt(x² + y²) in x and y: x asinh(y/|x|) + y asinh(x/|y|).
-
-    (= x ln(y + r) + y ln(x + r) up to terms in x or y alone, which cancel in a double difference.)
-    """
-    ax, ay = np.abs(x), np.abs(y)
-    a = x * np.arcsinh(y / np.where(ax > 0, ax, 1.0))
-    b = y * np.arcsinh(x / np.where(ay > 0, ay, 1.0))
-    return a + b
-
-
-def pixel_influence(x, y, dx: float, dy: float) -> np.ndarray:
-    """∬ over the pixel [−dx/2, dx/2]×[−dy/2, dy/2] of 1/|r − r'|, at offsets (x, y)."""
-    a, b = dx / 2, dy / 2
-    return _F(x + a, y + b) - _F(x + a, y - b) - _F(x - a, y + b) + _F(x - a, y - b)
-
-
-def _gauss3():
-    x, w = np.polynomial.legendre.leggauss(3)
-    return 0.5 * x, 0.5 * w  # nodes and weights on [−1/2, 1/2]
-
-
-def film_pixel_correction(X, Y, dx: float, dy: float, thickness: float, poisson: float,
-                          substrate: str) -> np.ndarray:
-    """∬ over the pixel at offsets (X, Y) of (1/T) h(|r|/T): the layer-minus-half-space influence per κ/π.
-
-    A pixel wholly beyond ``film.RHO_FAR`` thicknesses gets −pixel_influence exactly (there h = −1/ρ:
-    the layer's influence vanishes); a nearer one is split into k × k sub-pixels, k = ⌈max(dx, dy)/T⌉,
-    with 3 × 3 Gauss points each (h is smooth on the scale T, so a film thinner than a pixel still
-    has its correction resolved)."""
-    X, Y = np.broadcast_arrays(np.asarray(X, float), np.asarray(Y, float))
-    out = -pixel_influence(X, Y, dx, dy)
-    gap = np.hypot(np.maximum(np.abs(X) - dx / 2, 0.0), np.maximum(np.abs(Y) - dy / 2, 0.0))
-    near = gap < film.RHO_FAR * thickness
-    if not near.any():
-        return out
-    Xn, Yn = X[near], Y[near]
-    k = int(np.ceil(max(dx, dy) / thickness))
-    xg, wg = _gauss3()
-    sub = (np.arange(k) + 0.5) / k - 0.5  # sub-pixel centres on [−1/2, 1/2]
-    nodes = [(c + x / k, w / k) for c in sub for x, w in zip(xg, wg)]
-    acc = np.zeros(Xn.shape)
-    for xi, wi in nodes:
-        for yj, wj in nodes:
-            r = np.hypot(Xn + xi * dx, Yn + yj * dy)
-            acc += (wi * wj) * film.correction_profile(r / thickness, poisson, substrate)
-    out[near] = acc * (dx * dy / thickness)
-    return out
-
-
-class _Film:
-    """The optional film fields shared by both kernels (validated; all None for the half-space)."""
-
-    def _init_film(self):
-        if self.thickness is None:
-            self.film = False
-            return
-        self.thickness, self.substrate, self.poisson = film.check_film(self.thickness, self.substrate,
-                                                                       self.poisson)
-        self.film = True
-
-    def film_params(self) -> dict:
-        """thickness, substrate, poisson of the film ({} for the half-space): rebuilds the same body."""
-        if not self.film:
-            return {}
-        return {"thickness": self.thickness, "substrate": self.substrate, "poisson": self.poisson}
 
 
 @dataclass
@@ -173,13 +108,6 @@ class PeriodicKernel(_Film):
 
     def params(self) -> dict:
         return {"boundary": "periodic", "coupling": self.coupling, **self.film_params()}
-
-
-def make_kernel(boundary: str, grid: Grid, coupling: float, **params):
-    """Kernel by registered name (see ``tengsim.registry.KERNELS``): 'free' (isolated cell, Eq. 9 as
-    printed) or 'periodic' (array of cells); both take ``thickness``, ``substrate``, ``poisson`` for a
-    film on a rigid substrate.  A registered kernel is a factory ``(grid, coupling, **params) -> kernel``."""
-    return KERNELS.get(boundary)(grid, coupling, **params)
 
 
 KERNELS.register("free", FreeKernel, summary="isolated cell on a half-space, Eq. (9), or on a film")

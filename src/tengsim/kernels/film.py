@@ -28,6 +28,7 @@ from functools import lru_cache
 import numpy as np
 
 from tengsim.errors import TengsimError, positive
+from tengsim.kernels.base import pixel_influence
 
 SUBSTRATES = ("bonded", "frictionless")
 _SERIES_S = 0.02  # below this s the closed forms lose digits to cancellation: Taylor series instead
@@ -144,3 +145,53 @@ def correction_profile(rho, poisson: float = 0.5, substrate: str = "bonded") -> 
     out[near] = -1 / np.sqrt(x2) + (c1 - 1) / (x2 * np.sqrt(x2)) + _spline(float(poisson), substrate)(r)
     out[~near] = -1 / rho[~near]
     return out
+
+def _gauss3():
+    x, w = np.polynomial.legendre.leggauss(3)
+    return 0.5 * x, 0.5 * w  # nodes and weights on [−1/2, 1/2]
+
+
+def film_pixel_correction(X, Y, dx: float, dy: float, thickness: float, poisson: float,
+                          substrate: str) -> np.ndarray:
+    """∬ over the pixel at offsets (X, Y) of (1/T) h(|r|/T): the layer-minus-half-space influence per κ/π.
+
+    A pixel wholly beyond ``RHO_FAR`` thicknesses gets −pixel_influence exactly (there h = −1/ρ:
+    the layer's influence vanishes); a nearer one is split into k × k sub-pixels, k = ⌈max(dx, dy)/T⌉,
+    with 3 × 3 Gauss points each (h is smooth on the scale T, so a film thinner than a pixel still
+    has its correction resolved)."""
+    X, Y = np.broadcast_arrays(np.asarray(X, float), np.asarray(Y, float))
+    out = -pixel_influence(X, Y, dx, dy)
+    gap = np.hypot(np.maximum(np.abs(X) - dx / 2, 0.0), np.maximum(np.abs(Y) - dy / 2, 0.0))
+    near = gap < RHO_FAR * thickness
+    if not near.any():
+        return out
+    Xn, Yn = X[near], Y[near]
+    k = int(np.ceil(max(dx, dy) / thickness))
+    xg, wg = _gauss3()
+    sub = (np.arange(k) + 0.5) / k - 0.5  # sub-pixel centres on [−1/2, 1/2]
+    nodes = [(c + x / k, w / k) for c in sub for x, w in zip(xg, wg)]
+    acc = np.zeros(Xn.shape)
+    for xi, wi in nodes:
+        for yj, wj in nodes:
+            r = np.hypot(Xn + xi * dx, Yn + yj * dy)
+            acc += (wi * wj) * correction_profile(r / thickness, poisson, substrate)
+    out[near] = acc * (dx * dy / thickness)
+    return out
+
+
+class _Film:
+    """The optional film fields shared by both kernels (validated; all None for the half-space)."""
+
+    def _init_film(self):
+        if self.thickness is None:
+            self.film = False
+            return
+        self.thickness, self.substrate, self.poisson = check_film(self.thickness, self.substrate,
+                                                                       self.poisson)
+        self.film = True
+
+    def film_params(self) -> dict:
+        """thickness, substrate, poisson of the film ({} for the half-space): rebuilds the same body."""
+        if not self.film:
+            return {}
+        return {"thickness": self.thickness, "substrate": self.substrate, "poisson": self.poisson}

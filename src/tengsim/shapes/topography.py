@@ -174,7 +174,7 @@ class Topography:
     )
     lateral_unit = "ε"
     positional = "file"  # tengsim contact topography FILE
-    is_pattern = False  # not a cell pattern of tengsim.arrays
+    is_pattern = False  # not a cell pattern of tengsim.shapes.arrays
 
     def __post_init__(self):
         z = np.asarray(self.heights, dtype=float)

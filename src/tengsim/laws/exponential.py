@@ -1,0 +1,55 @@
+"""Exponential attraction with a stiff wall (the contact-mechanics challenge's kind)."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from tengsim.errors import positive
+from tengsim.laws.base import LJ_PEAK_TENSION, Law, _check_common, _wall
+from tengsim.registry import LAWS
+
+
+@dataclass(frozen=True)
+class Exponential(Law):
+    """Exponential attraction with a wall (the contact-mechanics challenge's kind, Müser et al. 2017).
+
+    g >= 1: Φ = −A exp(−(g − 1)/ρ), P = −(A/ρ) exp(−(g − 1)/ρ), range ρ = ``range`` (ε); peak
+    tension A/ρ at g = 1.  Wall (g < 1): P = −A/ρ + k(1 − g), k = ``wall_stiffness`` (W/ε²), as in
+    :class:`MaugisDugdale`.  A = 2/(1 + sqrt(1 + 2/(kρ²))) makes the work of adhesion exactly 1 (= W).
+    The default ρ = 1/σ − σ/(2k) with σ = 16/(9√3) gives the LJ93 peak tension, so ``tabor``
+    means the same as for LJ93.  Φ in W, P in W/ε.
+    """
+
+    range: float = 1.0 / LJ_PEAK_TENSION - LJ_PEAK_TENSION / 2000.0
+    wall_stiffness: float = 1000.0
+    g_safe: float = 0.6
+    field_help = {"range": "decay length ρ of the attraction, in ε (default: peak tension A/ρ = LJ93's)",
+                  "wall_stiffness": "stiffness k of the wall g < 1, in W/ε²"}
+
+    def __post_init__(self):
+        positive("range", self.range)
+        _check_common(self)
+
+    @property
+    def amplitude(self) -> float:
+        """The depth A = −Φ(1) of the attraction, in units of W, from A + (A/ρ)²/(2k) = 1."""
+        return 2.0 / (1.0 + np.sqrt(1.0 + 2.0 / (self.wall_stiffness * self.range**2)))
+
+    @property
+    def tension(self) -> float:
+        """Peak tension A/ρ (W/ε), at g = 1."""
+        return self.amplitude / self.range
+
+    def _raw(self, g, need_dp=True):
+        A, rho, k = self.amplitude, self.range, self.wall_stiffness
+        e = np.exp(-np.maximum(g - 1.0, 0.0) / rho)
+        phi_w, p_w, dp_w = _wall(g, A / rho, k, -A)
+        wall = g < 1.0
+        phi = np.where(wall, phi_w, -A * e)
+        p = np.where(wall, p_w, -(A / rho) * e)
+        dp = np.where(wall, dp_w, (A / rho**2) * e) if need_dp else None
+        return phi, p, dp
+
+
+LAWS.register("exp", Exponential, aliases=("exponential",), summary="exponential attraction, stiff wall")

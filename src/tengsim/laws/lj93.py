@@ -1,0 +1,57 @@
+"""The paper's Lennard-Jones 9-3 surface law (Derjaguin), Eq. (2)/(8)."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from tengsim.errors import TengsimError
+from tengsim.laws.base import Law
+from tengsim.registry import LAWS
+
+
+@dataclass(frozen=True)
+class LJ93(Law):
+    """The paper's law, Eq. (2)/(8): P = (8/3)[g⁻⁹ − g⁻³], Φ = (1/3)g⁻⁸ − (4/3)g⁻².
+
+    A 9-3 law in pressure (8-2 in energy, Derjaguin): Φ(1) = −1 (the work of adhesion W),
+    P(1) = 0, tensile peak P_min = −16/(9√3) ≈ −1.026 at g = 3^{1/6}.
+    """
+
+    g_safe: float = 0.6
+
+    def __post_init__(self):
+        if not 0 < self.g_safe < 1:
+            raise TengsimError(f"g_safe must lie in (0, 1), got {self.g_safe!r}")
+
+    def _raw(self, g, need_dp=True):
+        inv = 1.0 / g
+        i2 = inv * inv
+        i3 = i2 * inv
+        i8 = i2 * i2
+        i8 *= i8
+        i9 = i8 * inv
+        phi = i8 / 3.0 - (4.0 / 3.0) * i2
+        p = (8.0 / 3.0) * (i9 - i3)
+        dp = (8.0 / 3.0) * (-9.0 * i9 + 3.0 * i3) * inv if need_dp else None
+        return phi, p, dp
+
+    def energy_pressure(self, g, out, work):
+        """In place, no temporaries (same values as ``evaluate``); falls back below g_safe."""
+        if float(g.min()) < self.g_safe:
+            return super().energy_pressure(g, out, work)
+        a, b = work
+        np.reciprocal(g, out=a)      # g⁻¹
+        np.multiply(a, a, out=b)     # g⁻²
+        s2 = float(b.sum())
+        np.multiply(b, b, out=out)   # g⁻⁴
+        out *= out                   # g⁻⁸
+        s8 = float(out.sum())
+        out *= a                     # g⁻⁹
+        b *= a                       # g⁻³
+        out -= b
+        out *= 8.0 / 3.0
+        return s8 / 3.0 - (4.0 / 3.0) * s2
+
+
+LAWS.register("lj93", LJ93, aliases=("lj", "paper", "lj82"), summary="the paper's 9-3 law, Eq. (2)/(8)")

@@ -1,0 +1,42 @@
+"""A non-adhesive power-law wall (Hertz-type checks)."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from tengsim.errors import TengsimError, positive
+from tengsim.laws.base import Law
+from tengsim.registry import LAWS
+
+
+@dataclass(frozen=True)
+class Repulsive(Law):
+    """Non-adhesive wall: P = c g^{−k}, Φ = c g^{1−k}/(k − 1) (k > 1); for Hertz-type checks.
+
+    With c = 8/3, k = 9 it is the repulsive half of the paper's law; the wall sits near g ≈ 1.
+    """
+
+    scale: float = 8.0 / 3.0
+    exponent: float = 9.0
+    g_safe: float = 0.6
+    field_help = {"scale": "prefactor c of the wall P = c g^-k, in W/ε",
+                  "exponent": "power k > 1 of the wall P = c g^-k (pure number)"}
+
+    def __post_init__(self):
+        positive("scale", self.scale)
+        if not self.exponent > 1:
+            raise TengsimError(f"exponent must be > 1, got {self.exponent!r}")
+        if not 0 < self.g_safe < 1:
+            raise TengsimError(f"g_safe must lie in (0, 1), got {self.g_safe!r}")
+
+    def _raw(self, g, need_dp=True):
+        k, c = self.exponent, self.scale
+        gk = g ** (-k)
+        p = c * gk
+        phi = c * gk * g / (k - 1)
+        dp = -k * p / g
+        return phi, p, dp
+
+
+LAWS.register("repulsive", Repulsive, aliases=("hertz", "nonadhesive"), summary="non-adhesive wall")
