@@ -8,7 +8,7 @@ from tengsim.cases.paper import fig7_params, fig7_summary, fig7_waveform, fig8_p
 from tengsim.device import (EPS0, AreaTable, ConstantArea, DeviceParams, Sine, SolverOptions, SquareWave, Staircase,
                             TableWaveform, cmeo_cycle, eq20_force, field_force, figure_of_merit, fom_structural,
                             isc_apart, resistance_sweep, simulate, voc_apart, voc_from_area, voc_from_contact_length,
-                            voc_polymer, vq_cycle, waveform_from_dict)
+                            voc_polymer, vq_cycle, parse_waveform)
 from tengsim.errors import TengsimError
 
 P7 = fig7_params()
@@ -248,7 +248,7 @@ def test_waveforms():
     assert st(0.6) == pytest.approx(2e4) and st(0.8) == 0 and st(100.0) == 0
     tw = TableWaveform([0, 1, 2], [0, 10, 0], interp="step")
     assert tw(1.5) == 10 and tw(0.5) == 0
-    assert waveform_from_dict({"kind": "sine", "amplitude_Pa": 1, "frequency_Hz": 2}).period == 0.5
+    assert parse_waveform({"kind": "sine", "amplitude_Pa": 1, "frequency_Hz": 2}).period == 0.5
     with pytest.raises(TengsimError, match="frequency_Hz"):
         SquareWave(1.0, -1.0)
     with pytest.raises(TengsimError, match="strictly increasing"):

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from tengsim.cli.main import main
-from tengsim.device import WAVEFORMS, DeviceParams, SolverOptions, Staircase, simulate, waveform_from_dict
+from tengsim.device import WAVEFORMS, DeviceParams, SolverOptions, Staircase, simulate
 from tengsim.device.config import (DEVICE_TABLE, RUN_TABLE, SOLVER_TABLE, SWEEP_TABLE, fields_help, parse_waveform,
                                    waveform_table)
 from tengsim.errors import TengsimError
@@ -175,17 +175,17 @@ def test_waveform_registry_and_derived_fields():
 ])
 def test_waveform_table_errors_are_one_clear_line(table, message):
     with pytest.raises(TengsimError) as exc:
-        waveform_from_dict(table)
+        parse_waveform(table)
     text = str(exc.value)
     assert message in text and "\n" not in text and "keyword" not in text
 
 
 def test_unit_strings_on_dimensional_fields():
-    wf = waveform_from_dict({"kind": "square", "amplitude_Pa": "2.5kPa", "frequency_Hz": "5Hz"})
+    wf = parse_waveform({"kind": "square", "amplitude_Pa": "2.5kPa", "frequency_Hz": "5Hz"})
     assert wf.amplitude_Pa == 2500.0 and wf.frequency_Hz == 5.0
-    st = waveform_from_dict({"kind": "staircase", "amplitudes_Pa": ["10kPa", 2e4], "frequency_Hz": 2})
+    st = parse_waveform({"kind": "staircase", "amplitudes_Pa": ["10kPa", 2e4], "frequency_Hz": 2})
     assert st.amplitudes_Pa == (1e4, 2e4)
-    tw = waveform_from_dict({"kind": "table", "t_s": ["0ms", "10ms", "20ms"], "pressure_Pa": [0, 1, 0],
+    tw = parse_waveform({"kind": "table", "t_s": ["0ms", "10ms", "20ms"], "pressure_Pa": [0, 1, 0],
                              "interp": "step", "periodic": True})
     assert tw.period == pytest.approx(0.02) and tw.interp == "step"
 

@@ -10,7 +10,6 @@ the shape's :class:`tengsim.units.Scaling`; the core stays dimensionless.
 from __future__ import annotations
 
 import dataclasses
-import inspect
 from dataclasses import dataclass, field
 
 from tengsim.kernels import film

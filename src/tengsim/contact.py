@@ -10,8 +10,9 @@ from tengsim.errors import TengsimError, positive
 from tengsim.shapes import Pyramid, Shape
 from tengsim.laws import LJ93, Law, make_law
 from tengsim.kernels import make_kernel
+from tengsim.loadpath import LoadPathSpec, run_load_path
 from tengsim.path import PathSpec, run_path
-from tengsim.registry import KERNELS
+from tengsim.plugins import KERNELS
 from tengsim.resources import check_memory
 from tengsim.solvers import make_solver
 
@@ -49,7 +50,8 @@ def simulate(shape: Shape, tabor: float, dx: float, path: PathSpec, boundary: st
             and getattr(solver_obj, "monitor", 0) is None):  # long solves report as they go
         solver_obj = replace(solver_obj, monitor=progress.monitor(), monitor_every=10)
     kernel = make_kernel(boundary, grid, tabor**1.5, **(kernel_params or {}))
-    res = run_path(shape.gap(grid), law, kernel, solver_obj, path, progress=progress, observers=observers)
+    walk = run_load_path if isinstance(path, LoadPathSpec) else run_path  # load or rigid-approach control
+    res = walk(shape.gap(grid), law, kernel, solver_obj, path, progress=progress, observers=observers)
     res.params = {
         "tengsim_version": __version__,
         **shape.params(),

@@ -1,11 +1,14 @@
 """Atomic result writing: a file appears whole or not at all, with the permissions of an ordinary write.
 
-JSON is strict (RFC 8259): NaN and ±inf are written as ``null``.  CSV columns are written vectorised,
-floats as Python's shortest round-trip ``repr``, booleans as 0/1.
+JSON is strict (RFC 8259): NaN and ±inf are written as ``null`` (:func:`jsonable` is the one converter).
+CSV goes through the standard :mod:`csv` module (a field holding a comma, quote or newline is quoted), its
+columns formatted vectorised: floats as Python's shortest round-trip ``repr``, booleans as 0/1.
 """
 from __future__ import annotations
 
 import contextlib
+import csv
+import io as _stdio
 import json
 import math
 import os
@@ -103,23 +106,21 @@ def write_text(path, text: str) -> None:
 
 
 def jsonable(x):
-    """``x`` as plain JSON types: numpy scalars and arrays to Python, NaN and ±inf to None, tuples to
-    lists, other objects to ``str``."""
-    if isinstance(x, float):
-        return x if math.isfinite(x) else None
+    """``x`` as plain JSON types, so that it is strict JSON: every float that is not finite (NaN, ±inf;
+    Python or numpy) to None, other numpy scalars and arrays to Python numbers, bools and lists, tuples to
+    lists, non-str dict keys to ``str``, any other object (a Path, ...) to ``str``."""
+    if isinstance(x, float):  # numpy float64 too (a float subclass): a plain float
+        return float(x) if math.isfinite(x) else None
     if x is None or isinstance(x, (str, bool, int)):
         return x
     if isinstance(x, dict):
         return {k if isinstance(k, str) else str(k): jsonable(v) for k, v in x.items()}
     if isinstance(x, (list, tuple)):
         return [jsonable(v) for v in x]
-    try:
-        import numpy as np
+    import numpy as np
 
-        if isinstance(x, (np.generic, np.ndarray)):
-            return jsonable(x.tolist())
-    except ImportError:  # pragma: no cover
-        pass
+    if isinstance(x, (np.generic, np.ndarray)):
+        return jsonable(x.tolist())
     return str(x)
 
 

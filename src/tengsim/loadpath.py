@@ -7,7 +7,7 @@ path has at that D (the same warm starts, the same branch):
 
 1. walk in D from the current state, in the direction the load moves the body (D up when the
    target is above the current F, down when below), in steps of ``d_step`` with the D path's own
-   jump bisection (:class:`tengsim.path._Branch`), until F crosses the target;
+   jump bisection (:class:`tengsim.continuation.Branch`), until F crosses the target;
 2. solve F(D) = F_target in that bracket by regula falsi (Illinois), each trial D warm-started
    from the bracket's states interpolated, until |F − F_target| <= ``f_tol``.
 
@@ -35,7 +35,8 @@ import numpy as np
 
 from tengsim.analysis import force
 from tengsim.errors import TengsimError, finite, positive
-from tengsim.path import PathSpec, _Branch
+from tengsim.continuation import Branch, Recorder
+from tengsim.path import PathSpec
 from tengsim.solvers import State
 
 
@@ -108,7 +109,7 @@ class _LoadBranch:
     def __init__(self, U0, law, kernel, solver, spec: LoadPathSpec, emit):
         self.spec, self.emit, self.grid = spec, emit, kernel.grid
         self.trail: list = []
-        self.walker = _Branch(U0, law, kernel, solver, spec.d_spec(),
+        self.walker = Branch(U0, law, kernel, solver, spec.d_spec(),
                               lambda D, eq, on_grid, jump: self.trail.append((D, eq, jump)))
         self.h_min = spec.d_step / 2 ** int(spec.refine_levels)
 
@@ -247,7 +248,6 @@ def run_load_path(U0, law, kernel, solver, spec: LoadPathSpec, start: State | No
                   progress=None, keep_states: bool = False, observers=()):
     """Solve the load-controlled approach–retraction path; returns a ContactResult (same columns as
     :func:`tengsim.path.run_path`: D is an output, F the control).  ``progress(branch, F, done, total)``."""
-    from tengsim.path import Recorder
 
     targets = spec.targets()
     rec = Recorder(U0, law, kernel, observers, progress, len(targets) * (2 if spec.retract else 1),

@@ -11,15 +11,14 @@ With ``PathSpec(adaptive=True)`` the step also adapts where the path is smooth (
 """
 from __future__ import annotations
 
-import time
 from dataclasses import dataclass
 
 import numpy as np
 
-from tengsim.analysis import apex_index, force
+from tengsim.analysis import force
+from tengsim.continuation import Branch, Recorder, StateOnly, secant
 from tengsim.errors import TengsimError, finite, positive
 from tengsim.solvers import Problem, State
-from tengsim.status import process_zone_width
 
 
 @dataclass(frozen=True)
@@ -90,72 +89,7 @@ class PathSpec:
         return self.d_min + self.d_step * np.arange(k + 1)
 
 
-@dataclass
-class _Row:
-    branch: str
-    D: float
-    on_grid: bool
-    jump: bool
-    eq: object
-
-
-def _secant(s0: State, s1: State, c: float) -> State:
-    """The state c steps of (s0 → s1) beyond s1: the secant predictor of a continuation step."""
-    return State(s1.q + c * (s1.q - s0.q), s1.w + c * (s1.w - s0.w))
-
-
-class _Branch:
-    """Walks one branch, refining steps and predicting starts."""
-
-    def __init__(self, U0, law, kernel, solver, spec, on_row):
-        self.U0, self.law, self.kernel, self.solver, self.spec = U0, law, kernel, solver, spec
-        self.on_row = on_row
-        self.hist: list = []  # accepted (D, state) on this branch, newest last
-
-    def solve(self, D, start):
-        return self.solver.solve(Problem(self.U0 - D + 1.0, self.law, self.kernel), start)
-
-    def _start(self, D):
-        (D1, s1) = self.hist[-1]
-        if self.spec.predictor and len(self.hist) >= 2:
-            D0, s0 = self.hist[-2]
-            if D1 != D0:
-                c = (D - D1) / (D1 - D0)
-                if 0 < c <= 1.5:
-                    return _secant(s0, s1, c), True
-        return s1, False
-
-    def _jumped(self, eqa, eqb, dD):
-        return float(np.max(np.abs(eqb.H - eqa.H))) - abs(dD) > self.spec.jump_h
-
-    def advance(self, Da, eqa, Db, level, on_grid):
-        start, predicted = self._start(Db)
-        eqb = self.solve(Db, start)
-        if predicted and self._jumped(eqa, eqb, Db - Da):
-            eqb = self.solve(Db, eqa.state)  # confirm without the predictor
-        if self._jumped(eqa, eqb, Db - Da):
-            if level < self.spec.refine_levels:
-                mid = 0.5 * (Da + Db)
-                eqm = self.advance(Da, eqa, mid, level + 1, False)
-                return self.advance(mid, eqm, Db, level + 1, on_grid)
-            jump = True
-        else:
-            jump = False
-        self.hist = (self.hist + [(Db, eqb.state)])[-2:]
-        if jump:
-            self.hist = self.hist[-1:]
-        self.on_row(Db, eqb, on_grid, jump)
-        return eqb
-
-
-@dataclass
-class _S:
-    """A bare state holder (``.state``) for rows kept only as states."""
-
-    state: State
-
-
-class _Adaptive(_Branch):
+class _Adaptive(Branch):
     """Walks one branch with adaptive steps on the dyadic lattice of ``d_step`` (see PathSpec)."""
 
     def __init__(self, U0, law, kernel, solver, spec, on_row, f_scale):
@@ -171,7 +105,7 @@ class _Adaptive(_Branch):
             D0, s0 = self.hist[-2]
             c = (D - D1) / (D1 - D0)
             if 0 < c <= 2.0:
-                return _secant(s0, s1, c), True
+                return secant(s0, s1, c), True
         return s1, False
 
     def _error(self, Db, eqb):
@@ -267,7 +201,7 @@ class _Adaptive(_Branch):
                 else:
                     c = (Db - D1) / (D1 - D0)
                     ratio = err / c**2
-                back = self._insert(D0, _S(s0), self.hist_F[0], D1, _S(s1), self.hist_F[1], ratio, kp + 1)
+                back = self._insert(D0, StateOnly(s0), self.hist_F[0], D1, StateOnly(s1), self.hist_F[1], ratio, kp + 1)
             for Dm, eqm, Fm in back:
                 self.on_row(Dm, eqm, self._on_grid(Dm), False)
             if pending is not None:
@@ -291,86 +225,17 @@ class _Adaptive(_Branch):
         return eq
 
 
-class Recorder:
-    """Collects what one path produces: a row per equilibrium (the built-in summary, the status inputs
-    and the observers' columns), the maps asked for, and progress.  Shared by every kind of path.
-
-    ``control`` names the path's control variable ('D' or 'F'); maps are kept at the rows whose
-    control value is within ``map_tol`` of an entry of ``maps_at``.
-    """
-
-    def __init__(self, U0, law, kernel, observers=(), progress=None, total=0, maps_at=(), control="D",
-                 map_tol=1e-9):
-        from tengsim import observers as obs
-        from tengsim.results import CURVE_COLUMNS, PHYSICAL_COLUMNS
-
-        grid = kernel.grid
-        U0 = np.asarray(U0, dtype=float)
-        if U0.shape != grid.shape:
-            raise TengsimError(f"U0 shape {U0.shape} does not match the grid {grid.shape}")
-        if not np.all(np.isfinite(U0)):
-            raise TengsimError("the initial gap U0 contains NaN or infinite values")
-        self.U0, self.law, self.grid = U0, law, grid
-        self.apex = apex_index(U0)
-        self.summary = obs.Summary()
-        self.extra = obs.resolve(observers)
-        self.extra_cols = obs.check_columns(self.extra, CURVE_COLUMNS + PHYSICAL_COLUMNS)
-        self.ctx = obs.Context(grid, self.apex, U0, law, kernel)
-        self._observe = obs.observe
-        self.progress, self.total, self.maps_at = progress, total, tuple(maps_at)
-        self.control, self.map_tol = control, map_tol
-        self.rows, self.maps, self.done, self._map_keys = [], [], 0, set()
-        self.t_start = time.perf_counter()
-
-    def on_row(self, branch):
-        """The callback ``(D, eq, on_grid, jump)`` that records a row of ``branch``."""
-        def record(D, eq, on_grid, jump):
-            s = self.summary(eq, self.ctx)
-            # a state whose gap enters the law's safe extension (g < g_safe) is outside the physical law
-            in_range = bool(s["min_gap"] + 1.0 >= getattr(self.law, "g_safe", -np.inf))
-            more = {}
-            for o in self.extra:
-                more.update(self._observe(o, eq, self.ctx))
-            self.rows.append(dict(branch=branch, D=D, on_grid=on_grid, jump=jump, converged=eq.converged,
-                                  in_law_range=in_range,
-                                  process_zone=process_zone_width(eq.H, self.grid.dx, self.apex, self.law),
-                                  residual=eq.residual, iterations=eq.iterations, n_conv=eq.n_conv,
-                                  seconds=eq.seconds, energy=eq.energy, **s, **more))
-            value = D if self.control == "D" else s["F"]
-            for m in self.maps_at:
-                tol = self.map_tol * (max(1.0, abs(m)) if self.control == "D" else 1.0) + 1e-9
-                if on_grid and abs(value - m) <= tol and (branch, m) not in self._map_keys:
-                    self._map_keys.add((branch, m))
-                    self.maps.append(dict(branch=branch, D=D, P=eq.P.copy(), H=eq.H.copy()))
-            if on_grid:
-                self.done += 1
-                if self.progress:
-                    self.progress(branch, value, self.done, self.total)
-        return record
-
-    def result(self, final_state=None):
-        """The :class:`tengsim.results.ContactResult` of the recorded rows."""
-        from tengsim.results import ContactResult
-
-        res = ContactResult.from_rows(self.rows, self.maps, self.grid, seconds=time.perf_counter() - self.t_start,
-                                      final_state=final_state, extra_columns=self.extra_cols)
-        for o in self.extra:
-            res.units.update(getattr(o, "units", None) or {})
-        return res
-
-
 def run_path(U0, law, kernel, solver, spec: PathSpec, start: State | None = None,
              progress=None, keep_states: bool = False, observers=()):
     """Solve the approach–retraction path; returns a :class:`tengsim.results.ContactResult`.
 
     ``progress(branch, D, done, total)`` is called after each row on the D grid.  ``observers``
     (registered names or objects, see :mod:`tengsim.observers`) add their columns to every row.  A
-    :class:`tengsim.loadpath.LoadPathSpec` runs the load-controlled path instead.
+    load-controlled path is :func:`tengsim.loadpath.run_load_path`.
     """
-    if not isinstance(spec, PathSpec):  # a load-controlled path (tengsim.loadpath.LoadPathSpec)
-        from tengsim.loadpath import run_load_path
-        return run_load_path(U0, law, kernel, solver, spec, start=start, progress=progress,
-                             keep_states=keep_states, observers=observers)
+    if not isinstance(spec, PathSpec):
+        raise TengsimError(f"run_path walks a PathSpec (rigid approach D); got {type(spec).__name__} "
+                           "(a LoadPathSpec runs with tengsim.loadpath.run_load_path)")
     targets = spec.targets()
     rec = Recorder(U0, law, kernel, observers, progress, len(targets) * (2 if spec.retract else 1),
                    spec.maps_at, "D")
@@ -379,14 +244,14 @@ def run_path(U0, law, kernel, solver, spec: PathSpec, start: State | None = None
     if spec.adaptive:
         eq = _run_adaptive(U0, law, kernel, solver, spec, state, targets, rec.on_row)
         return rec.result(eq.state if keep_states else None)
-    walker = _Branch(U0, law, kernel, solver, spec, rec.on_row("approach"))
+    walker = Branch(U0, law, kernel, solver, spec, rec.on_row("approach"))
     eq = walker.solve(targets[0], state)
     walker.hist = [(targets[0], eq.state)]
     walker.on_row(targets[0], eq, True, False)
     for Da, Db in zip(targets[:-1], targets[1:]):
         eq = walker.advance(Da, eq, Db, 0, True)
     if spec.retract:
-        back = _Branch(U0, law, kernel, solver, spec, rec.on_row("retraction"))
+        back = Branch(U0, law, kernel, solver, spec, rec.on_row("retraction"))
         back.hist = [(targets[-1], eq.state)]
         back.on_row(targets[-1], eq, True, False)
         rev = targets[::-1]
@@ -486,7 +351,7 @@ def walk_states(U0, law, kernel, solver, Ds, start: State | None = None):
         if len(prev) == 2 and prev[1][0] != prev[0][0]:
             (D0, s0), (D1, s1) = prev
             c = (D - D1) / (D1 - D0)
-            state = _secant(s0, s1, c)
+            state = secant(s0, s1, c)
         eq = solver.solve(Problem(U0 - D + 1.0, law, kernel), state)
         prev = (prev + [(D, eq.state)])[-2:]
         state = eq.state

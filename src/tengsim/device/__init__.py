@@ -8,19 +8,24 @@ from tengsim.device.dynamics import simulate
 from tengsim.device.params import (EPS0, AreaFunction, AreaTable, ConstantArea, DeviceParams, SolverOptions,
                                    area_model)
 from tengsim.device.result import DeviceResult
-from tengsim.device.waveforms import WAVEFORMS, Sine, SquareWave, Staircase, TableWaveform, waveform_from_dict
+from tengsim.device.waveforms import WAVEFORMS, Sine, SquareWave, Staircase, TableWaveform
+from tengsim.device.config import parse_device, parse_waveform
 from tengsim.device.formulas import (CMEOCycle, cmeo_cycle, eq20_force, electrostatic_energy, field_force,
-                                     fom_structural, isc_apart, qsc_apart, trapezoid, voc_apart,
+                                     fom_structural, isc_apart, qsc_apart, voc_apart,
                                      voc_from_contact_length, voc_polymer, voltage)
 from tengsim.device.analysis import (FigureOfMerit, ResistanceSweep, StaticVoltageCurve, VQCycle, figure_of_merit,
                                      resistance_sweep, staircase_summary, steady_charge, voc_from_area, vq_cycle)
 
 _MOVED = {"fig7_params", "fig7_summary", "fig7_waveform", "fig8_params", "fig8_summary", "fig8_waveform",
           "run_fig7", "run_fig8"}
+_RENAMED = {"waveform_from_dict": "tengsim.device.parse_waveform (tengsim.device.config, the one parser)",
+            "trapezoid": "scipy.integrate.trapezoid"}
 
 
 def __getattr__(name):
     if name in _MOVED:
         raise AttributeError(f"tengsim.device.{name} moved to tengsim.cases.paper (the paper's cases are a layer "
                              f"on top of the device model): from tengsim.cases.paper import {name}")
+    if name in _RENAMED:
+        raise AttributeError(f"tengsim.device.{name} was removed: use {_RENAMED[name]}")
     raise AttributeError(f"module 'tengsim.device' has no attribute {name!r}")

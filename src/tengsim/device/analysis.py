@@ -6,6 +6,7 @@ import sys
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.integrate import trapezoid
 
 from tengsim.device import formulas as fm
 from tengsim.device.dynamics import simulate
@@ -165,7 +166,7 @@ def vq_cycle(result: DeviceResult, cycle: int = -1) -> VQCycle:
     x_max = float(np.max(result.gap[m]))
     area = float(np.max(result.area[m]))
     cm = fm.cmeo_cycle(p.sigma_C_per_m2, p.area_m2, p.thickness_m, p.eps_r, x_max, area=area)
-    return VQCycle(q, v, fm.trapezoid(v, q), x_max, cm)
+    return VQCycle(q, v, float(trapezoid(v, q)), x_max, cm)
 
 
 @dataclass(frozen=True)

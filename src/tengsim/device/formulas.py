@@ -15,15 +15,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.integrate import trapezoid
 
 from tengsim.device.params import EPS0
-
-
-def trapezoid(y, x) -> float:
-    """Trapezoidal integral of y dx (numpy.trapezoid is NumPy 2 only, numpy.trapz is gone from 2.4)."""
-    y = np.asarray(y, dtype=float)
-    x = np.asarray(x, dtype=float)
-    return float(0.5 * np.sum((y[1:] + y[:-1]) * np.diff(x))) if y.size > 1 else 0.0
 
 
 def voc_polymer(area_fraction, sigma, eps_r, thickness):
@@ -124,5 +118,5 @@ def cmeo_cycle(sigma, plate_area, thickness, eps_r, x_max, area=None, n: int = 2
     legs_v = [v(0.0, xs), v(qs, x_max), v(qm, xs[::-1]), v(qs[::-1], 0.0)]
     q = np.concatenate(legs_q)
     vv = np.concatenate(legs_v)
-    energy = trapezoid(vv, q)  # only the two discharge legs move Q
+    energy = float(trapezoid(vv, q))  # only the two discharge legs move Q
     return CMEOCycle(q, vv, energy, qm, float(v(0.0, x_max)), float(-v(qm, 0.0)), float(x_max))

@@ -12,6 +12,7 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from tengsim.errors import TengsimError, finite, positive, require
+from tengsim.schema import REQUIRED
 
 EPS0 = 8.8541878128e-12
 """Vacuum permittivity (F/m, CODATA 2018); the paper rounds it to 8.85e-12."""
@@ -22,13 +23,11 @@ AREA_MEMORIES = ("max", "release")
 INITIAL_CHARGES = ("zero", "rest")
 
 
-_NO_DEFAULT = object()
-
-
-def _f(help_text: str, default=_NO_DEFAULT, **meta):
-    """A dataclass field whose help (and optional ``dim``, ``choices``) the config schema reads."""
+def _f(help_text: str, default=REQUIRED, **meta):
+    """A dataclass field whose help (and optional ``dim``, ``choices``) the config schema reads;
+    without ``default`` (:data:`tengsim.schema.REQUIRED`) the field is required."""
     meta = {"help": help_text, **meta}
-    if default is _NO_DEFAULT:
+    if default is REQUIRED:
         return field(metadata=meta)
     if callable(default) and not isinstance(default, (int, float, str)):
         return field(default_factory=default, metadata=meta)
@@ -262,13 +261,6 @@ class DeviceParams:
         if math.isinf(self.load_ohm):
             d["load_ohm"] = "inf"
         return d
-
-    @classmethod
-    def from_dict(cls, d: dict, base: "DeviceParams | None" = None) -> "DeviceParams":
-        """Build from a [device] mapping through the config schema; keys missing there come from ``base``."""
-        from tengsim.device.config import parse_device
-
-        return parse_device(d, base)
 
 
 @dataclass(frozen=True)

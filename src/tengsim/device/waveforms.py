@@ -13,18 +13,17 @@ import numpy as np
 
 from tengsim.errors import TengsimError, finite, positive, require
 from tengsim.registry import Registry
+from tengsim.schema import REQUIRED
 
 WAVEFORMS: Registry = Registry("waveform")
 """Waveform kinds by name (``kind`` in a [waveform] table); the config fields are the dataclass fields."""
 
 
-_NO_DEFAULT = object()
-
-
-def _f(help_text: str, default=_NO_DEFAULT, **meta):
-    """A dataclass field whose help (and optional ``dim``, ``choices``) the config schema reads."""
+def _f(help_text: str, default=REQUIRED, **meta):
+    """A dataclass field whose help (and optional ``dim``, ``choices``) the config schema reads;
+    without ``default`` (:data:`tengsim.schema.REQUIRED`) the field is required."""
     meta = {"help": help_text, **meta}
-    return field(metadata=meta) if default is _NO_DEFAULT else field(default=default, metadata=meta)
+    return field(metadata=meta) if default is REQUIRED else field(default=default, metadata=meta)
 
 
 def _duty(duty):
@@ -215,14 +214,3 @@ class TableWaveform(_Waveform):
         else:
             b = self.t_s
         return np.unique(b[(b > t0) & (b < t1)])
-
-
-
-def waveform_from_dict(d: dict):
-    """Build a waveform from a config mapping: ``kind`` (a :data:`WAVEFORMS` name) plus that kind's fields.
-
-    Keys, types and units are checked by the one config schema (:mod:`tengsim.device.config`).
-    """
-    from tengsim.device.config import parse_waveform
-
-    return parse_waveform(d)

@@ -3,8 +3,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-import numpy as np
-
 from tengsim.errors import TengsimError, positive
 from tengsim.laws.base import Law
 from tengsim.registry import LAWS

@@ -12,7 +12,6 @@ from SI input with the lateral scale ``lateral_scale(values, eps)`` (then κ = W
 from __future__ import annotations
 
 import dataclasses
-import inspect
 from dataclasses import asdict
 
 import numpy as np

@@ -1,0 +1,136 @@
+"""Continuation machinery shared by every path (D-controlled :mod:`tengsim.path`, load-controlled
+:mod:`tengsim.loadpath`): the secant predictor, the branch walker with jump bisection, and the
+recorder that turns each equilibrium into a row of the result table.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from tengsim import observers as obs
+from tengsim.analysis import apex_index
+from tengsim.errors import TengsimError
+from tengsim.results import CURVE_COLUMNS, PHYSICAL_COLUMNS, ContactResult
+from tengsim.solvers import Problem, State
+from tengsim.status import process_zone_width
+
+
+def secant(s0: State, s1: State, c: float) -> State:
+    """The state c steps of (s0 → s1) beyond s1: the secant predictor of a continuation step."""
+    return State(s1.q + c * (s1.q - s0.q), s1.w + c * (s1.w - s0.w))
+
+
+class Branch:
+    """Walks one branch, refining steps and predicting starts."""
+
+    def __init__(self, U0, law, kernel, solver, spec, on_row):
+        self.U0, self.law, self.kernel, self.solver, self.spec = U0, law, kernel, solver, spec
+        self.on_row = on_row
+        self.hist: list = []  # accepted (D, state) on this branch, newest last
+
+    def solve(self, D, start):
+        return self.solver.solve(Problem(self.U0 - D + 1.0, self.law, self.kernel), start)
+
+    def _start(self, D):
+        (D1, s1) = self.hist[-1]
+        if self.spec.predictor and len(self.hist) >= 2:
+            D0, s0 = self.hist[-2]
+            if D1 != D0:
+                c = (D - D1) / (D1 - D0)
+                if 0 < c <= 1.5:
+                    return secant(s0, s1, c), True
+        return s1, False
+
+    def _jumped(self, eqa, eqb, dD):
+        return float(np.max(np.abs(eqb.H - eqa.H))) - abs(dD) > self.spec.jump_h
+
+    def advance(self, Da, eqa, Db, level, on_grid):
+        start, predicted = self._start(Db)
+        eqb = self.solve(Db, start)
+        if predicted and self._jumped(eqa, eqb, Db - Da):
+            eqb = self.solve(Db, eqa.state)  # confirm without the predictor
+        if self._jumped(eqa, eqb, Db - Da):
+            if level < self.spec.refine_levels:
+                mid = 0.5 * (Da + Db)
+                eqm = self.advance(Da, eqa, mid, level + 1, False)
+                return self.advance(mid, eqm, Db, level + 1, on_grid)
+            jump = True
+        else:
+            jump = False
+        self.hist = (self.hist + [(Db, eqb.state)])[-2:]
+        if jump:
+            self.hist = self.hist[-1:]
+        self.on_row(Db, eqb, on_grid, jump)
+        return eqb
+
+
+@dataclass
+class StateOnly:
+    """A bare state holder (``.state``) for rows kept only as states."""
+
+    state: State
+
+
+class Recorder:
+    """Collects what one path produces: a row per equilibrium (the built-in summary, the status inputs
+    and the observers' columns), the maps asked for, and progress.  Shared by every kind of path.
+
+    ``control`` names the path's control variable ('D' or 'F'); maps are kept at the rows whose
+    control value is within ``map_tol`` of an entry of ``maps_at``.
+    """
+
+    def __init__(self, U0, law, kernel, observers=(), progress=None, total=0, maps_at=(), control="D",
+                 map_tol=1e-9):
+        grid = kernel.grid
+        U0 = np.asarray(U0, dtype=float)
+        if U0.shape != grid.shape:
+            raise TengsimError(f"U0 shape {U0.shape} does not match the grid {grid.shape}")
+        if not np.all(np.isfinite(U0)):
+            raise TengsimError("the initial gap U0 contains NaN or infinite values")
+        self.U0, self.law, self.grid = U0, law, grid
+        self.apex = apex_index(U0)
+        self.summary = obs.Summary()
+        self.extra = obs.resolve(observers)
+        self.extra_cols = obs.check_columns(self.extra, CURVE_COLUMNS + PHYSICAL_COLUMNS)
+        self.ctx = obs.Context(grid, self.apex, U0, law, kernel)
+        self._observe = obs.observe
+        self.progress, self.total, self.maps_at = progress, total, tuple(maps_at)
+        self.control, self.map_tol = control, map_tol
+        self.rows, self.maps, self.done, self._map_keys = [], [], 0, set()
+        self.t_start = time.perf_counter()
+
+    def on_row(self, branch):
+        """The callback ``(D, eq, on_grid, jump)`` that records a row of ``branch``."""
+        def record(D, eq, on_grid, jump):
+            s = self.summary(eq, self.ctx)
+            # a state whose gap enters the law's safe extension (g < g_safe) is outside the physical law
+            in_range = bool(s["min_gap"] + 1.0 >= getattr(self.law, "g_safe", -np.inf))
+            more = {}
+            for o in self.extra:
+                more.update(self._observe(o, eq, self.ctx))
+            self.rows.append(dict(branch=branch, D=D, on_grid=on_grid, jump=jump, converged=eq.converged,
+                                  in_law_range=in_range,
+                                  process_zone=process_zone_width(eq.H, self.grid.dx, self.apex, self.law),
+                                  residual=eq.residual, iterations=eq.iterations, n_conv=eq.n_conv,
+                                  seconds=eq.seconds, energy=eq.energy, **s, **more))
+            value = D if self.control == "D" else s["F"]
+            for m in self.maps_at:
+                tol = self.map_tol * (max(1.0, abs(m)) if self.control == "D" else 1.0) + 1e-9
+                if on_grid and abs(value - m) <= tol and (branch, m) not in self._map_keys:
+                    self._map_keys.add((branch, m))
+                    self.maps.append(dict(branch=branch, D=D, P=eq.P.copy(), H=eq.H.copy()))
+            if on_grid:
+                self.done += 1
+                if self.progress:
+                    self.progress(branch, value, self.done, self.total)
+        return record
+
+    def result(self, final_state=None):
+        """The :class:`tengsim.results.ContactResult` of the recorded rows."""
+        res = ContactResult.from_rows(self.rows, self.maps, self.grid, seconds=time.perf_counter() - self.t_start,
+                                      final_state=final_state, extra_columns=self.extra_cols)
+        for o in self.extra:
+            res.units.update(getattr(o, "units", None) or {})
+        return res
