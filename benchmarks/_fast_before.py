@@ -15,8 +15,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tengsim._lbfgs import KMetricLBFGS
-from tengsim._sweep import Sweeper
+from tengsim.solvers._lbfgs import KMetricLBFGS
+from tengsim.solvers._sweep import Sweeper
 from tengsim.errors import TengsimError
 from tengsim.solvers import Equilibrium, Problem, State
 
@@ -33,7 +33,7 @@ class FastSolver:
 
     Each iteration spends one convolution, K P(g) at the new state (plus one every ``resync``
     iterations to re-anchor w = K q): the direction's image K d is assembled from stored images
-    (K s = Δw, K y = Δr, K G = r) by the compact L-BFGS form (tengsim._lbfgs), and the line search
+    (K s = Δw, K y = Δr, K G = r) by the compact L-BFGS form (tengsim.solvers._lbfgs), and the line search
     along d needs only element-wise work, since g(α) = g + α K d.  Converged when max|r| <= ``tol``.
     ``monitor(iteration, max|r|, energy)``, if given, is called every ``monitor_every`` iterations
     (progress on long solves).

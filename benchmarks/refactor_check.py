@@ -88,7 +88,7 @@ def case_a_sequence(S):
 def case_a_blocks(S):
     import os
 
-    import tengsim._sweep as sweep
+    import tengsim.solvers._sweep as sweep
     from tengsim.laws import LJ93
     from tengsim.solvers import Problem, State
 

@@ -391,13 +391,13 @@ def test_device_takes_any_area_model():
 
 # --- defect 7: strict JSON summaries ---
 
-def test_json_safe_and_summaries_are_strict_json():
-    from tengsim.cases._json import json_safe
+def test_jsonable_and_summaries_are_strict_json():
     from tengsim.cases.paper import fig7_summary, fig8_params, fig8_summary, run_fig7
     from tengsim.cases.paper.reproduce import summary_text
+    from tengsim.io import jsonable
 
-    d = json_safe({"a": float("nan"), "b": [1.0, float("inf"), np.float64("nan")], "c": {"d": np.array([np.nan])},
-                   "e": np.int64(3), "f": np.bool_(True)})
+    d = jsonable({"a": float("nan"), "b": [1.0, float("inf"), np.float64("nan")], "c": {"d": np.array([np.nan])},
+                  "e": np.int64(3), "f": np.bool_(True)})
     assert _strict(json.dumps(d)) == {"a": None, "b": [1.0, None, None], "c": {"d": [None]}, "e": 3, "f": True}
     r = run_fig7(1, dt_out=1e-3)  # no settled cycle after dropping the first: energy etc. are missing
     s = fig7_summary(r)

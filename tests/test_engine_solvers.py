@@ -180,7 +180,7 @@ def test_vsr_and_fast_agree_on_whole_path():
 def test_sweeps_give_the_same_iterates(monkeypatch, block, threads):
     """Element-wise work runs block by block on large grids, and the blocks split over threads;
     forced here on a small grid (many uneven blocks): that changes nothing but round-off."""
-    import tengsim._sweep as S
+    import tengsim.solvers._sweep as S
 
     grid, U0, K = _group_a(dx=0.1)
     prob = Problem(U0 - 1.5 + 1.0, LJ93(), K)
@@ -201,7 +201,7 @@ def test_sweep_pool_survives_fork(monkeypatch):
     """A forked child (multiprocessing, Dask processes) gets a fresh sweep pool, not the parent's dead one."""
     import multiprocessing as mp
 
-    import tengsim._sweep as S
+    import tengsim.solvers._sweep as S
 
     monkeypatch.setenv("TENGSIM_THREADS", "2")
     sw = S.Sweeper(4 * S.BLOCK + 10)
@@ -217,7 +217,7 @@ def test_sweep_pool_survives_fork(monkeypatch):
 
 
 def _sweep_in_child(n):
-    import tengsim._sweep as S
+    import tengsim.solvers._sweep as S
 
     def count(sl, m, sc, acc):
         acc[0] += m
@@ -357,7 +357,7 @@ def test_fast_solver_workspace_is_reused_and_never_aliased():
 
 def test_fast_solver_gives_back_large_workspaces(monkeypatch):
     """Grids above KEEP_MAX_SIZE points do not keep their workspace (memory goes back with the solve)."""
-    import tengsim._workspace as W
+    import tengsim.solvers._workspace as W
 
     grid, U0, K = _group_a(dx=0.2)
     monkeypatch.setattr(W, "KEEP_MAX_SIZE", grid.nx * grid.ny - 1)
@@ -384,7 +384,7 @@ def test_line_search_accepts_a_wolfe_point_and_leaves_it_in_its_buffers():
     """The line search object on a solver's first direction: the accepted α satisfies the (strong or
     approximate) Wolfe conditions of its docstring, E(α) equals the energy recomputed from scratch
     at q + α d, and the trial buffers hold g + α K d and P(g + α K d)."""
-    from tengsim._workspace import Workspace
+    from tengsim.solvers._workspace import Workspace
     from tengsim.solvers import _Descent
 
     grid, U0, K = _group_a(dx=0.2)

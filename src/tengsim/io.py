@@ -148,15 +148,24 @@ def read_dataset(path):
         return xr.load_dataset(path, engine="h5netcdf")
 
 
-def _column_text(a) -> list[str]:
-    """One column as strings: floats by ``repr`` (shortest exact round-trip), bools as 0/1, else str."""
+def _column_text(a, missing: str | None = None) -> list[str]:
+    """One column as strings: floats by ``repr`` (shortest exact round-trip), bools as 0/1, else str.
+
+    With ``missing`` given, None and non-finite floats are written as it ('' for an empty cell)."""
     import numpy as np
 
     kind = a.dtype.kind
     if kind == "b":
         return np.where(a, "1", "0").tolist()
     if kind == "f":
-        return list(map(float.__repr__, a.astype(float, copy=False).tolist()))
+        a = a.astype(float, copy=False)
+        text = list(map(float.__repr__, a.tolist()))
+        bad = np.flatnonzero(~np.isfinite(a)) if missing is not None else ()
+        if len(bad):
+            out = np.array(text, dtype=object)
+            out[bad] = missing
+            text = out.tolist()
+        return text
     if kind in "iuUS":
         return list(map(str, a.tolist()))
     out = []  # object or mixed columns: element by element
@@ -164,14 +173,19 @@ def _column_text(a) -> list[str]:
         if isinstance(x, (bool, np.bool_)):
             out.append(str(int(x)))
         elif isinstance(x, (float, np.floating)):
-            out.append(repr(float(x)))
+            out.append(missing if missing is not None and not math.isfinite(x) else repr(float(x)))
+        elif x is None and missing is not None:
+            out.append(missing)
         else:
             out.append(str(x))
     return out
 
 
-def write_csv(path, columns: dict, header: dict | None = None) -> None:
-    """Write equal-length columns as CSV; ``header`` goes in as '# key: json' lines (strict JSON)."""
+def csv_text(columns: dict, header: dict | None = None, missing: str | None = None) -> str:
+    """Equal-length columns as CSV text: ``header`` first as '# key: json' lines (strict JSON), then the
+    column names and one row per index, through :func:`csv.writer` (a field holding a comma, quote or
+    newline is quoted, ``\n`` ends a line).  Columns are formatted whole (:func:`_column_text`, with
+    ``missing`` for None and non-finite floats when given), so no Python code runs per row."""
     import numpy as np
 
     from tengsim.errors import TengsimError
@@ -182,8 +196,16 @@ def write_csv(path, columns: dict, header: dict | None = None) -> None:
     if len(lengths) > 1:
         raise TengsimError(f"CSV columns of unequal length: "
                            f"{', '.join(f'{k}={len(a)}' for k, a in zip(names, arrays))}")
-    lines = [f"# {k}: {dumps(v)}" for k, v in (header or {}).items()]
-    lines.append(",".join(names))
+    buf = _stdio.StringIO()
+    buf.writelines([f"# {k}: {dumps(v)}\n" for k, v in (header or {}).items()])
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow(names)
     if arrays and len(arrays[0]):
-        lines.append("\n".join(map(",".join, zip(*map(_column_text, arrays)))))
-    write_text(path, "\n".join(lines) + "\n")
+        w.writerows(zip(*[_column_text(a, missing) for a in arrays]))
+    return buf.getvalue()
+
+
+def write_csv(path, columns: dict, header: dict | None = None) -> None:
+    """Write equal-length columns as CSV (:func:`csv_text`) atomically; ``header`` goes in as
+    '# key: json' lines (strict JSON)."""
+    write_text(path, csv_text(columns, header))

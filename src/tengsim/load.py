@@ -5,6 +5,8 @@ CSV without its grid in the header gives a result with ``grid=None`` (curves nee
 """
 from __future__ import annotations
 
+import csv
+import itertools
 import json
 from pathlib import Path
 
@@ -22,23 +24,30 @@ SWEEP_COLUMNS = ("R", "energy_per_cycle", "average_power")
 
 
 def _read_csv(path: Path):
-    header, lines, names = {}, [], None
-    with open(path) as fh:
+    """('# key: json' header lines as a dict, {column: array}) of a CSV written by
+    :func:`tengsim.io.write_csv`: quoted fields are read by :mod:`csv`; a column of numbers is a float
+    array, any other a str array."""
+    header, rows, names = {}, [], None
+    with open(path, newline="") as fh:
         for line in fh:
-            line = line.rstrip("\n")
-            if line.startswith("#"):
-                k, _, v = line[1:].partition(":")
-                try:
-                    header[k.strip()] = json.loads(v)
-                except json.JSONDecodeError:
-                    header[k.strip()] = v.strip()
-            elif names is None:
-                names = line.split(",")
-            elif line:
-                lines.append(line)
+            if not line.startswith("#"):
+                break
+            k, _, v = line[1:].rstrip("\r\n").partition(":")
+            try:
+                header[k.strip()] = json.loads(v)
+            except json.JSONDecodeError:
+                header[k.strip()] = v.strip()
+        else:
+            line = ""
+        for row in csv.reader(itertools.chain([line], fh)):
+            if not row:
+                continue
+            if names is None:
+                names = row
+            else:
+                rows.append(row)
     if names is None:
         raise TengsimError(f"{path}: no column header found")
-    rows = [r.split(",") for r in lines]
     bad = next((i for i, r in enumerate(rows) if len(r) != len(names)), None)
     if bad is not None:
         raise TengsimError(f"{path}: data row {bad + 1} has {len(rows[bad])} fields, the header has {len(names)}")

@@ -12,8 +12,9 @@ Resolution criterion (measured per equilibrium).  Along the X row through the ap
 the apex on each side, the *cohesive window* ℓ is the distance over which the gap opens from the law's
 tensile-peak gap g* (P(g*) = −σ0, the most tensile stress; LJ 9-3: g* = 3^{1/6}) to g0 + h0, where g0
 is the contact gap (P(g0) = 0; LJ 9-3: 1) and h0 = W/σ0 the Dugdale range of the law (W = −Φ(g0);
-LJ 9-3: h0 = 9√3/16 = 0.974).  Positions are interpolated linearly in the gap between pixels; ℓ is
-the smaller of the two sides.  An equilibrium is **under-resolved when ℓ < 0.75 dx**.  Rows without
+LJ 9-3: h0 = 9√3/16 = 0.974), all as the law declares them (:class:`tengsim.laws.Law`: ``g_peak``,
+``max_tension``, ``g_zero``, ``work``, ``cohesive_range``).  Positions are interpolated linearly in
+the gap between pixels; ℓ is the smaller of the two sides.  An equilibrium is **under-resolved when ℓ < 0.75 dx**.  Rows without
 such an opening edge on the row (no contact, or contact up to the cell border) are not judged.
 
 Calibration (LJ 9-3 sphere, free kernel, docs/validation.md): ℓ is 0.65–0.73 of the Maugis–Dugdale
@@ -26,7 +27,7 @@ grid-converged LJ value is +4.9 %).  Resolved runs lie within 1.8 % of the fines
 is in docs/validation.md.
 
 Pixel snap (a second, a-priori cause of under-resolution).  A law that softens beyond its tensile
-peak faster than one pixel is stiff — s = max_g dP/dg × c_pix > 1, with c_pix the gap change of a pixel
+peak faster than one pixel is stiff — s = max_g dP/dg × c_pix > 1 (the law's declared ``max_softening``), with c_pix the gap change of a pixel
 under unit pressure on that pixel alone (one convolution of the run's kernel) — has no stable state
 in that band of gaps: pixels snap in and out one at a time and the contact edge is pinned to the
 lattice, whatever the process zone.  Every judged row of such a run is under-resolved.  Measured
@@ -90,49 +91,50 @@ class CohesiveWindow:
         return self.g0 + self.h0
 
 
+_MISSING = object()
+
+
+def _declared(law) -> tuple:
+    """(σ0, g_peak, g0, W, max dP/dg) as the law declares them (``tengsim.laws.Law``: closed forms in the
+    built-in laws, a cached numerical search otherwise); a duck-typed law declaring none gets the laws'
+    numerical search (cached where the law is hashable)."""
+    s0 = getattr(law, "max_tension", _MISSING)
+    if s0 is _MISSING:
+        try:
+            return _undeclared(law)
+        except TypeError:  # an unhashable duck-typed law: compute without the cache
+            return _undeclared.__wrapped__(law)
+    if s0 is None or not float(s0) > 0:
+        return 0.0, None, None, 0.0, 0.0
+    return float(s0), law.g_peak, law.g_zero, float(law.work or 0.0), law.max_softening
+
+
+@lru_cache(maxsize=16)
+def _undeclared(law) -> tuple:
+    from tengsim.laws.base import numeric_softening, numeric_window  # only for a law that is no Law
+
+    w = numeric_window(law)
+    if w is None:
+        return 0.0, None, None, 0.0, 0.0
+    g_peak, s0, g0, work = w
+    return s0, g_peak, g0, work, numeric_softening(law, g_peak, g0 + 2.0 * work / s0)
+
+
 def cohesive_window(law) -> CohesiveWindow | None:
-    """The law's cohesive window (None for a law without tension, e.g. ``Repulsive``); found numerically
-    from ``law.evaluate`` (cached for hashable laws)."""
-    try:
-        return _cohesive_window(law)
-    except TypeError:  # an unhashable user law: compute without the cache
-        return _cohesive_window.__wrapped__(law)
-
-
-@lru_cache(maxsize=64)
-def _cohesive_window(law) -> CohesiveWindow | None:
-    from scipy.optimize import brentq, minimize_scalar
-
-    def P(x):
-        return float(law.evaluate(np.array([x]))[1][0])
-
-    g = np.geomspace(max(float(law.g_safe), 1e-3), 100.0, 4001)
-    p = np.asarray(law.evaluate(g)[1], dtype=float)
-    i = int(np.argmin(p))
-    if not p[i] < 0 or i == 0 or i == len(g) - 1:
+    """The law's cohesive window from its declared numbers (``max_tension``, ``g_peak``, ``g_zero``,
+    ``work``; :class:`tengsim.laws.Law`); None for a law without tension, e.g. ``Repulsive``."""
+    s0, g_peak, g0, work, _ = _declared(law)
+    if not (s0 > 0 and work > 0):
         return None
-    r = minimize_scalar(P, bounds=(g[i - 1], g[i + 1]), method="bounded", options={"xatol": 1e-12})
-    g_peak, sigma0 = float(r.x), -float(r.fun)
-    pos = np.flatnonzero(p[:i] > 0)
-    if len(pos) == 0:
-        return None
-    j = int(pos[-1])
-    g0 = float(brentq(P, g[j], g[j + 1], xtol=1e-14))
-    work = -float(law.evaluate(np.array([g0]))[0][0])
-    if not work > 0:
-        return None
-    return CohesiveWindow(g_peak, g0, sigma0, work)
+    return CohesiveWindow(float(g_peak), float(g0), s0, work)
 
 
 def law_softening(law) -> float:
     """Steepest softening of a law beyond its tensile peak, max dP/dg over g* ≤ g ≤ g0 + 2 h0 (W/ε²
-    units); 0 for a law without tension."""
-    w = cohesive_window(law)
-    if w is None:
+    units), as the law declares it (``max_softening``); 0 for a law without tension."""
+    if cohesive_window(law) is None:
         return 0.0
-    g = np.linspace(w.g_peak, w.g0 + 2.0 * w.h0, 200001)
-    p = np.asarray(law.evaluate(g)[1], dtype=float)
-    return float(max(np.max(np.diff(p) / np.diff(g)), 0.0))
+    return float(max(_declared(law)[4] or 0.0, 0.0))
 
 
 def pixel_compliance(kernel) -> float:

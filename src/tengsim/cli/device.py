@@ -166,9 +166,9 @@ def execute(case: str, cfg: dict, cli: dict | None = None, quiet: bool = False, 
 
             summary = fig7_summary(res, skip)
         else:
-            from tengsim.cases._json import json_safe
+            from tengsim.io import jsonable
 
-            summary = json_safe(res.summary(skip))
+            summary = jsonable(res.summary(skip))
     return _write(res, out, summary, quiet, {"case": case, "config": cfg, "config_file": source})
 
 
@@ -245,11 +245,11 @@ def _sweep(cfg, cli, run, dev_cli, solver, out, quiet, source) -> int:
     check_writable(out)
     sw = resistance_sweep(params, wf, loads, cycles=cycles, steady=sw_cfg["steady"], dt_out=run.get("dt_out"),
                           options=solver, progress=not quiet)
-    from tengsim.cases._json import json_safe
+    from tengsim.io import jsonable
 
-    head = json_safe({"params": params.to_dict(), "waveform": wf.to_dict(), "optimum_ohm": sw.optimum_ohm,
-                      "optimum_power_W": sw.optimum_power_W, "optimum_at_edge": sw.optimum_at_edge,
-                      "run": {"case": "sweep", "cycles": cycles, "config": cfg, "config_file": source}})
+    head = jsonable({"params": params.to_dict(), "waveform": wf.to_dict(), "optimum_ohm": sw.optimum_ohm,
+                    "optimum_power_W": sw.optimum_power_W, "optimum_at_edge": sw.optimum_at_edge,
+                    "run": {"case": "sweep", "cycles": cycles, "config": cfg, "config_file": source}})
     write_csv(out, {"R": sw.load_ohm, "energy_per_cycle": sw.energy_per_cycle_J, "average_power": sw.average_power_W,
                     "peak_voltage": sw.peak_voltage_V, "peak_current": sw.peak_current_A}, head)
     side = out.with_suffix(".json")

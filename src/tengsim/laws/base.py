@@ -5,6 +5,11 @@ Positive P is repulsive and P = −dΦ/dg.  Units: P in W/ε, Φ in W (paper Eq.
 Every law is made safe for any trial gap (a solver's line search may try g <= 0): below ``g_safe``
 the pressure continues linearly with the slope it has there (Φ quadratic), so P and Φ stay finite and
 C¹; physical equilibria never reach g_safe.  States are always judged by the residual of Eq. (9).
+
+Every law also declares its own numbers (:class:`Law`, "declared numbers"): its maximum tension, the
+gaps of that peak and of zero load, its work of adhesion, its cohesive range and its steepest
+softening.  The built-in laws give them in closed form; the base class finds them numerically, once
+per law, for a law that does not.
 """
 from __future__ import annotations
 
@@ -23,6 +28,16 @@ class Law:
     A law's fields (its dataclass fields, or constructor arguments) are ``[contact]`` keys of a run
     with that law (:func:`tengsim.config.law_fields`), except the numerical guards named in
     ``internal_fields``; ``field_help`` gives a key its help text (with its unit: W and ε).
+
+    Declared numbers (units W and ε; what :mod:`tengsim.status` reads): ``max_tension`` σ0 = −min P
+    (W/ε), ``g_peak`` (the smallest gap where P = −σ0), ``g_zero`` g0 (P(g0) = 0, the last zero below
+    g_peak: the contact gap), ``work`` W = −Φ(g0) (W), ``cohesive_range`` h0 = W/σ0 (ε),
+    ``max_softening`` max dP/dg over g_peak <= g <= g0 + 2 h0 (W/ε², the stiffest softening beyond the
+    peak) and ``g_safe`` (below it the safe extension).  A law without tension has ``max_tension`` =
+    ``work`` = ``max_softening`` = 0 and ``g_peak`` = ``g_zero`` = ``cohesive_range`` = None.  A
+    subclass overrides them with closed forms where it knows them; otherwise the base class finds them
+    numerically from ``evaluate`` and ``_raw``'s dP/dg, once per law (:func:`numeric_window`,
+    :func:`numeric_softening`).
     """
 
     g_safe: float
@@ -71,6 +86,55 @@ class Law:
         gg = np.maximum(g, self.g_safe)
         return -self._raw(gg)[2]
 
+    # ---- declared numbers: closed forms in the built-in laws, a cached numerical search here ----------
+
+    @cached_property
+    def _numeric_window(self):
+        return numeric_window(self)
+
+    @cached_property
+    def _numeric_softening(self) -> float:
+        if not self.max_tension > 0:
+            return 0.0
+        return numeric_softening(self, self.g_peak, self.g_zero + 2.0 * self.cohesive_range)
+
+    @property
+    def max_tension(self) -> float:
+        """σ0 = −min P, the most tensile pressure (W/ε); 0 for a law without tension."""
+        w = self._numeric_window
+        return 0.0 if w is None else w[1]
+
+    @property
+    def g_peak(self) -> float | None:
+        """The smallest gap where P = −σ0 (the tensile peak; the start of a plateau); None without tension."""
+        w = self._numeric_window
+        return None if w is None else w[0]
+
+    @property
+    def g_zero(self) -> float | None:
+        """The contact gap g0: P(g0) = 0, the last zero of P below ``g_peak``; None without tension."""
+        w = self._numeric_window
+        return None if w is None else w[2]
+
+    @property
+    def work(self) -> float:
+        """The work of adhesion −Φ(g0) (W; 1 for the built-in laws); 0 for a law without tension."""
+        w = self._numeric_window
+        return 0.0 if w is None else w[3]
+
+    @property
+    def cohesive_range(self) -> float | None:
+        """The Dugdale range h0 = W/σ0 of the law (ε); None without tension.  (Not the ``range`` field of
+        :class:`~tengsim.laws.Exponential` or the property of :class:`~tengsim.laws.MaugisDugdale`.)"""
+        s0 = self.max_tension
+        return self.work / s0 if s0 > 0 else None
+
+    @property
+    def max_softening(self) -> float:
+        """The stiffest softening beyond the tensile peak, max dP/dg over g_peak <= g <= g0 + 2 h0 (W/ε²);
+        0 for a law without tension."""
+        return self._numeric_softening
+
     def params(self) -> dict:
         """The law's parameters (its dataclass fields; public attributes otherwise) and its class name."""
         if dataclasses.is_dataclass(self):
@@ -99,6 +163,55 @@ def _wall(g, sigma, k, phi1):
     """
     t = 1.0 - g
     return phi1 - sigma * t + 0.5 * k * t * t, -sigma + k * t, np.full_like(g, -k)
+
+
+def numeric_window(law):
+    """(g_peak, σ0, g0, W) of a law found numerically from ``law.evaluate`` and ``law.g_safe`` (None for a
+    law without tension): the fallback for a law that declares no closed forms.  The most tensile of
+    4001 geometric samples of [g_safe, 100] refined by a bounded search (on a plateau: a point near its
+    start), the last sign change of P below it by root finding, W = −Φ(g0)."""
+    from scipy.optimize import brentq, minimize_scalar
+
+    def P(x):
+        return float(law.evaluate(np.array([x]))[1][0])
+
+    g = np.geomspace(max(float(law.g_safe), 1e-3), 100.0, 4001)
+    p = np.asarray(law.evaluate(g)[1], dtype=float)
+    i = int(np.argmin(p))
+    if not p[i] < 0 or i == 0 or i == len(g) - 1:
+        return None
+    r = minimize_scalar(P, bounds=(g[i - 1], g[i + 1]), method="bounded", options={"xatol": 1e-12})
+    g_peak, sigma0 = float(r.x), -float(r.fun)
+    pos = np.flatnonzero(p[:i] > 0)
+    if len(pos) == 0:
+        return None
+    j = int(pos[-1])
+    g0 = float(brentq(P, g[j], g[j + 1], xtol=1e-14))
+    work = -float(law.evaluate(np.array([g0]))[0][0])
+    if not work > 0:
+        return None
+    return g_peak, sigma0, g0, work
+
+
+def numeric_softening(law, g_lo: float, g_hi: float) -> float:
+    """max dP/dg over [g_lo, g_hi], >= 0, found numerically: the fallback for a law that declares no
+    closed form.  dP/dg is the law's own (−``law.stiffness``, from ``_raw``) where it has one, else a
+    central difference of ``evaluate``; 20001 samples, the largest refined by a bounded search."""
+    from scipy.optimize import minimize_scalar
+
+    stiffness = getattr(law, "stiffness", None)
+    if stiffness is None:
+        def stiffness(x, h=1e-7):
+            x = np.asarray(x, dtype=float)
+            return -(law.evaluate(x + h)[1] - law.evaluate(x - h)[1]) / (2.0 * h)
+
+    g = np.linspace(g_lo, g_hi, 20001)
+    d = -np.asarray(stiffness(g), dtype=float)
+    i = int(np.argmax(d))
+    lo, hi = g[max(i - 1, 0)], g[min(i + 1, len(g) - 1)]
+    r = minimize_scalar(lambda x: float(np.asarray(stiffness(np.array([x])))[0]), bounds=(lo, hi),
+                        method="bounded", options={"xatol": 1e-12})
+    return float(max(d[i], -float(r.fun), 0.0))
 
 
 def make_law(name: str, **params) -> Law:

@@ -19,6 +19,9 @@ class Exponential(Law):
     :class:`MaugisDugdale`.  A = 2/(1 + sqrt(1 + 2/(kρ²))) makes the work of adhesion exactly 1 (= W).
     The default ρ = 1/σ − σ/(2k) with σ = 16/(9√3) gives the LJ93 peak tension, so ``tabor``
     means the same as for LJ93.  Φ in W, P in W/ε.
+
+    Declared numbers (closed forms): peak tension σ0 = A/ρ at g = 1 (the wall's edge), zero load at
+    g0 = 1 − σ0/k, W = A + σ0²/(2k) = 1, and the steepest softening is at g = 1⁺, dP/dg = A/ρ².
     """
 
     range: float = 1.0 / LJ_PEAK_TENSION - LJ_PEAK_TENSION / 2000.0
@@ -40,6 +43,27 @@ class Exponential(Law):
     def tension(self) -> float:
         """Peak tension A/ρ (W/ε), at g = 1."""
         return self.amplitude / self.range
+
+    # declared numbers (Law): closed forms
+    @property
+    def max_tension(self) -> float:
+        return self.tension
+
+    @property
+    def g_peak(self) -> float:
+        return 1.0
+
+    @property
+    def g_zero(self) -> float:
+        return 1.0 - self.tension / self.wall_stiffness
+
+    @property
+    def work(self) -> float:
+        return self.amplitude + self.tension**2 / (2.0 * self.wall_stiffness)
+
+    @property
+    def max_softening(self) -> float:
+        return self.amplitude / self.range**2
 
     def _raw(self, g, need_dp=True):
         A, rho, k = self.amplitude, self.range, self.wall_stiffness

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from tengsim.errors import TengsimError
-from tengsim.laws.base import Law
+from tengsim.laws.base import LJ_PEAK_TENSION, Law
 from tengsim.registry import LAWS
 
 
@@ -15,7 +15,9 @@ class LJ93(Law):
     """The paper's law, Eq. (2)/(8): P = (8/3)[g⁻⁹ − g⁻³], Φ = (1/3)g⁻⁸ − (4/3)g⁻².
 
     A 9-3 law in pressure (8-2 in energy, Derjaguin): Φ(1) = −1 (the work of adhesion W),
-    P(1) = 0, tensile peak P_min = −16/(9√3) ≈ −1.026 at g = 3^{1/6}.
+    P(1) = 0, tensile peak P_min = −16/(9√3) ≈ −1.026 at g = 3^{1/6}.  Declared numbers (closed
+    forms): dP/dg = (8/3)(3g⁻⁴ − 9g⁻¹⁰) vanishes at g⁶ = 3 (the peak); d²P/dg² = (8/3)(90g⁻¹¹ − 12g⁻⁵)
+    vanishes at g⁶ = 15/2, where the softening is steepest, dP/dg = (24/5)(15/2)^{−2/3} ≈ 1.253.
     """
 
     g_safe: float = 0.6
@@ -23,6 +25,27 @@ class LJ93(Law):
     def __post_init__(self):
         if not 0 < self.g_safe < 1:
             raise TengsimError(f"g_safe must lie in (0, 1), got {self.g_safe!r}")
+
+    # declared numbers (Law): closed forms
+    @property
+    def max_tension(self) -> float:
+        return LJ_PEAK_TENSION                          # 16/(9√3) = −P(3^{1/6})
+
+    @property
+    def g_peak(self) -> float:
+        return 3.0 ** (1.0 / 6.0)
+
+    @property
+    def g_zero(self) -> float:
+        return 1.0
+
+    @property
+    def work(self) -> float:
+        return 1.0                                      # −Φ(1) = −(1/3 − 4/3)
+
+    @property
+    def max_softening(self) -> float:
+        return 4.8 * 7.5 ** (-2.0 / 3.0)                # at the inflection g = 7.5^{1/6} ≈ 1.399
 
     def _raw(self, g, need_dp=True):
         inv = 1.0 / g

@@ -22,6 +22,10 @@ class MaugisDugdale(Law):
     (Greenwood 1997), so ``tabor`` means the same as for LJ93.  The step at g = 1 + h0 is a smoothstep
     ramp 3t² − 2t³ of width ``smoothing`` centred on it (area, hence W, unchanged), so P and dP/dg are
     continuous for the solvers.  Φ is in W, P in W/ε.
+
+    Declared numbers (closed forms): the tension σ0 is reached at g = 1 (the plateau's start, the wall's
+    edge), zero load at g0 = 1 − σ0/k, W = σ0 h0 + σ0²/(2k) = 1, and the steepest softening is the
+    ramp's centre g = 1 + h0, dP/dg = 6σ0 t(1 − t)/smoothing at t = 1/2: 1.5 σ0/smoothing.
     """
 
     tension: float = LJ_PEAK_TENSION
@@ -48,6 +52,27 @@ class MaugisDugdale(Law):
     def range(self) -> float:
         """h0 = 1/σ0 − σ0/(2k) in ε (W = σ0 h0 + σ0²/(2k) = 1)."""
         return 1.0 / self.tension - self.tension / (2.0 * self.wall_stiffness)
+
+    # declared numbers (Law): closed forms
+    @property
+    def max_tension(self) -> float:
+        return self.tension
+
+    @property
+    def g_peak(self) -> float:
+        return 1.0
+
+    @property
+    def g_zero(self) -> float:
+        return 1.0 - self.tension / self.wall_stiffness
+
+    @property
+    def work(self) -> float:
+        return self.tension * self.range + self.tension**2 / (2.0 * self.wall_stiffness)
+
+    @property
+    def max_softening(self) -> float:
+        return 1.5 * self.tension / self.smoothing
 
     def _raw(self, g, need_dp=True):
         s0, k, s = self.tension, self.wall_stiffness, self.smoothing

@@ -12,7 +12,10 @@ from tengsim.registry import LAWS
 class Repulsive(Law):
     """Non-adhesive wall: P = c g^{−k}, Φ = c g^{1−k}/(k − 1) (k > 1); for Hertz-type checks.
 
-    With c = 8/3, k = 9 it is the repulsive half of the paper's law; the wall sits near g ≈ 1.
+    With c = 8/3, k = 9 it is the repulsive half of the paper's law; the wall sits near g ≈ 1.  No
+    tension (P > 0 everywhere): its declared numbers say so (``max_tension`` = ``work`` =
+    ``max_softening`` = 0, ``g_peak`` = ``g_zero`` = ``cohesive_range`` = None), so it has no cohesive
+    window.
     """
 
     scale: float = 8.0 / 3.0
@@ -27,6 +30,27 @@ class Repulsive(Law):
             raise TengsimError(f"exponent must be > 1, got {self.exponent!r}")
         if not 0 < self.g_safe < 1:
             raise TengsimError(f"g_safe must lie in (0, 1), got {self.g_safe!r}")
+
+    # declared numbers (Law): no tension
+    @property
+    def max_tension(self) -> float:
+        return 0.0
+
+    @property
+    def g_peak(self) -> None:
+        return None
+
+    @property
+    def g_zero(self) -> None:
+        return None
+
+    @property
+    def work(self) -> float:
+        return 0.0
+
+    @property
+    def max_softening(self) -> float:
+        return 0.0
 
     def _raw(self, g, need_dp=True):
         k, c = self.exponent, self.scale

@@ -19,6 +19,7 @@ import numpy as np
 
 from tengsim.errors import TengsimError
 from tengsim.io import interrupts_held
+from tengsim.study.layout import StudyDir
 from tengsim.study.observe import SCALARS, observe, pressure_grid
 
 STATUSES = ("ok", "unconverged", "failed", "pending")
@@ -84,8 +85,6 @@ def _run_status(res) -> str:
 
 def collect(root) -> dict:
     """Per study point (in study.json order): axes, id, status, message, scalars, curves."""
-    from tengsim.study.execute import StudyDir
-
     sd = StudyDir(Path(root))
     try:
         spec = json.loads(sd.spec.read_text())
@@ -208,32 +207,21 @@ def build_study(root) -> dict:
     return {**counts, "points": n}
 
 
-def _cell(v):
-    if v is None:
-        return ""
-    if isinstance(v, (float, np.floating)):
-        return "" if not math.isfinite(v) else repr(float(v))
-    return str(v)
-
-
 def _csv(spec, rows, per_point, vat, labels) -> str:
-    cols = []
+    """study.csv text (tengsim.io.csv_text): an empty cell for a missing or non-finite value."""
+    from tengsim.io import csv_text
+
+    cols = {}
     for a in spec["axes"]:
-        if len(a["members"]) > 1:
-            cols.append(a["name"])
-        cols.extend(a["members"])
-    buf = io.StringIO()
-    w = csv.writer(buf, lineterminator="\n")
-    scal = list(SCALARS)
-    w.writerow(cols + ["id", "status", "run_status"] + scal + [f"V_OC_{lab}" for lab in labels]
-               + ["seconds", "message"])
-    for i, r in enumerate(rows):
-        vals = []
-        for a in spec["axes"]:
-            if len(a["members"]) > 1:
-                vals.append(r["axes"].get(a["name"], ""))
-            vals.extend(r["axes"][m] for m in a["members"])
-        w.writerow([_cell(v) for v in vals] + [r["id"], r["status"], r["run_status"]]
-                   + [_cell(per_point[k][i]) for k in scal] + [_cell(x) for x in vat[i]]
-                   + [_cell(per_point["seconds"][i]), r["message"]])
-    return buf.getvalue()
+        names = ([a["name"]] if len(a["members"]) > 1 else []) + list(a["members"])
+        for m in names:
+            vals = [r["axes"].get(m, "") if m == a["name"] else r["axes"][m] for r in rows]
+            # each value formatted by its own type (a bool as True/False, as in study.nc)
+            cols[m] = np.array([str(v) if isinstance(v, bool) else v for v in vals], dtype=object)
+    for k in ("id", "status", "run_status"):
+        cols[k] = [r[k] for r in rows]
+    cols.update({k: per_point[k] for k in SCALARS})
+    cols.update({f"V_OC_{lab}": vat[:, j] for j, lab in enumerate(labels)})
+    cols["seconds"] = per_point["seconds"]
+    cols["message"] = [r["message"] for r in rows]
+    return csv_text(cols, missing="")

@@ -1,17 +1,13 @@
 """Running a study on Dask: validate every point, submit, write each finished point atomically, resume.
 
-Layout of a study directory::
-
-    DIR/study.json            resolved points of the study (checked on --resume)
-    DIR/points/<id>.nc        one finished contact computation (result + params, timings, status, version)
-    DIR/points/<id>.failed.json   a point that raised (its message); rerun only with --retry-failed
-    DIR/log.jsonl             one line per finished or failed point, in completion order
-    DIR/study.nc, study.csv   the assembled dataset (tengsim.study.dataset), rebuilt at the end
+The files of a study directory are named by :class:`tengsim.study.layout.StudyDir`.
 
 Points are computed on a ``dask.distributed`` client: a LocalCluster (one single-threaded worker
 process per core, BLAS/FFT threads pinned to 1) or an existing scheduler.  The client writes each
 result the moment it arrives (``as_completed``), through a temporary file and an atomic rename, so a
 sweep killed at any moment keeps every finished point and never holds a half-written one.
+:class:`PointRunner` is that machinery (client, warm-up, compute a batch, close), shared by
+:func:`run_study` and :func:`tengsim.study.optimize.optimize_study`.
 """
 from __future__ import annotations
 
@@ -20,10 +16,11 @@ import os
 import socket
 import sys
 import time
-from dataclasses import dataclass
 from pathlib import Path
 
 from tengsim.errors import ConfigValueError, TengsimError
+from tengsim.progress import Progress
+from tengsim.study.layout import StudyDir
 
 WORKER_ENV = {"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1",
               "TENGSIM_THREADS": "1", "TENGSIM_FFT_WORKERS": "1"}
@@ -170,48 +167,7 @@ def validate(study) -> tuple[dict, dict]:
     return {pid: valid[pid] for pid in order}, invalid
 
 
-# ---- directory state ----------------------------------------------------------------------------
-
-@dataclass
-class StudyDir:
-    root: Path
-
-    @property
-    def points(self) -> Path:
-        return self.root / "points"
-
-    def nc(self, pid) -> Path:
-        return self.points / f"{pid}.nc"
-
-    def failed(self, pid) -> Path:
-        return self.points / f"{pid}.failed.json"
-
-    def drop_partial(self) -> int:
-        """Remove the temporary files of writes a kill interrupted (``.<name>.part``; never a finished
-        point, which only appears under its final name by an atomic rename); returns how many."""
-        stale = list(self.points.glob(".*.part")) if self.points.is_dir() else []
-        for f in stale:
-            f.unlink(missing_ok=True)
-        return len(stale)
-
-    @property
-    def spec(self) -> Path:
-        return self.root / "study.json"
-
-    @property
-    def log(self) -> Path:
-        return self.root / "log.jsonl"
-
-    def done(self) -> set:
-        if not self.points.is_dir():
-            return set()
-        return {f.name[:-3] for f in self.points.glob("*.nc")}
-
-    def failures(self) -> set:
-        if not self.points.is_dir():
-            return set()
-        return {f.name[: -len(".failed.json")] for f in self.points.glob("*.failed.json")}
-
+# ---- directory state (the layout: tengsim.study.layout) --------------------------------------------
 
 def check_resume(study, sd: StudyDir, resume: bool) -> None:
     """Refuse to mix two studies in one directory; on --resume the new study may only add points."""
@@ -238,43 +194,42 @@ def check_resume(study, sd: StudyDir, resume: bool) -> None:
 
 # ---- progress -----------------------------------------------------------------------------------
 
-class SweepProgress:
-    """done/total, failed, rate and ETA on stderr: one updating line on a TTY, plain lines otherwise."""
+class SweepProgress(Progress):
+    """A sweep's :class:`tengsim.progress.Progress`: done/total, failed, rate and ETA, updated per point.
+
+    Only the text is the sweep's; stream, terminal detection, writing and :meth:`close` are Progress's:
+    one updating line on a TTY, a plain line per finished point otherwise."""
 
     def __init__(self, total, done=0, failed=0, quiet=False, stream=None):
+        super().__init__(quiet=quiet, stream=stream)
         self.total, self.done, self.failed = total, done, failed
         self.start_done = done + failed
-        self.quiet = quiet
-        self.stream = stream or sys.stderr
-        self.tty = bool(getattr(self.stream, "isatty", lambda: False)())
-        self.t0 = time.perf_counter()
+
+    def text(self) -> str:
+        """``sweep: N/total points (k failed), R points/h, ETA h:mm:ss``."""
+        n = self.done + self.failed - self.start_done
+        dt = time.perf_counter() - self.t0
+        rate = n / dt * 3600 if dt > 0 and n else 0.0
+        left = self.total - self.done - self.failed
+        eta = _hms(left / rate * 3600) if rate > 0 else "?"
+        return (f"sweep: {self.done + self.failed}/{self.total} points ({self.failed} failed), "
+                f"{rate:.4g} points/h, ETA {eta}")
 
     def update(self, status=None):
+        """Count one finished point (``status``: 'failed' or another) and report; ``None`` only reports."""
         if status == "failed":
             self.failed += 1
         elif status is not None:
             self.done += 1
         if self.quiet:
             return
-        n = self.done + self.failed - self.start_done
-        dt = time.perf_counter() - self.t0
-        rate = n / dt * 3600 if dt > 0 and n else 0.0
-        left = self.total - self.done - self.failed
-        eta = _hms(left / rate * 3600) if rate > 0 else "?"
-        line = (f"sweep: {self.done + self.failed}/{self.total} points ({self.failed} failed), "
-                f"{rate:.4g} points/h, ETA {eta}")
         if self.tty:
-            self.stream.write("\r" + line + " ")
-            if left == 0:
-                self.stream.write("\n")
+            self._write(f"\r{self.text():<78}")
+            self.active = True
+            if self.done + self.failed >= self.total:
+                self.close()
         else:
-            self.stream.write(line + "\n")
-        self.stream.flush()
-
-    def close(self):
-        if self.tty and not self.quiet:
-            self.stream.write("\n")
-            self.stream.flush()
+            self._write(self.text() + "\n")
 
 
 def _hms(s):
@@ -284,8 +239,16 @@ def _hms(s):
 
 # ---- the client ---------------------------------------------------------------------------------
 
-def connect(workers=None, scheduler=None, timeout: float = 3.0):
-    """A dask Client: on ``scheduler`` (an address) or on a new LocalCluster; returns (client, cluster)."""
+CONNECT_TIMEOUT_S = 3.0
+"""How long :func:`connect` tries to reach a ``--scheduler`` address before it gives up (seconds)."""
+
+
+def connect(workers=None, scheduler=None, timeout: float | None = None):
+    """A dask Client: on ``scheduler`` (an address) or on a new LocalCluster; returns (client, cluster).
+
+    An unreachable scheduler is a TengsimError naming the address after ``timeout`` seconds (default
+    :data:`CONNECT_TIMEOUT_S`)."""
+    timeout = CONNECT_TIMEOUT_S if timeout is None else timeout
     if workers is not None and scheduler is not None:
         raise TengsimError("give either --workers or --scheduler, not both")
     try:
@@ -321,6 +284,58 @@ def connect(workers=None, scheduler=None, timeout: float = 3.0):
     return Client(cluster), cluster
 
 
+class PointRunner:
+    """Computes planned points into a study directory on Dask: the one runner of ``tengsim sweep`` and
+    ``tengsim optimize``.
+
+    Used as a context manager: entering connects (a new LocalCluster of ``workers`` processes, or the
+    scheduler at ``scheduler``) unless ``client`` (an existing dask Client) is given; leaving closes
+    only what it started.  :meth:`compute` submits a batch of points and writes each result the moment
+    it arrives (``DIR/points/<id>.nc`` or ``<id>.failed.json``, one ``log.jsonl`` line), atomically.
+    The workers import the client's ``TENGSIM_PLUGINS`` (read on entering).
+    """
+
+    def __init__(self, sd: StudyDir, *, workers=None, scheduler=None, client=None):
+        self.sd = sd if isinstance(sd, StudyDir) else StudyDir(Path(sd))
+        self.workers, self.scheduler = workers, scheduler
+        self.client = client
+        self._own = None
+        self.plugins = ""
+
+    def __enter__(self) -> "PointRunner":
+        if self.client is None:
+            client, cluster = connect(self.workers, self.scheduler)
+            self.client, self._own = client, (client, cluster)
+        self.plugins = os.environ.get("TENGSIM_PLUGINS", "")
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    def close(self) -> None:
+        """Close the client and cluster this runner started (a given client stays open)."""
+        if self._own is not None:
+            own, self._own = self._own, None
+            _close(*own)
+            self.client = None
+
+    @property
+    def n_workers(self) -> int:
+        return len(self.client.scheduler_info().get("workers", {}))
+
+    def warm_up(self) -> None:
+        """Import the solver stack and the plugins on every worker, before the first point."""
+        self.client.run(warm_up, self.plugins)
+
+    def compute(self, contacts: dict, todo, progress: SweepProgress | None = None) -> list:
+        """Compute the points ``todo`` (ids; submitted in this order, first with the highest priority),
+        ``contacts`` mapping each id to its [contact] table; write each as it finishes and report it to
+        ``progress``.  Returns the ids computed (in completion order).  An interrupt cancels the rest."""
+        todo = list(todo)
+        progress = progress if progress is not None else SweepProgress(len(todo), quiet=True)
+        return _compute(self.client, contacts, todo, self.sd, progress, self.plugins)
+
+
 def run_study(study, out, *, workers=None, scheduler=None, client=None, resume=False, retry_failed=False,
               quiet=False, stream=None) -> dict:
     """Validate, then compute the study's missing points on Dask and assemble DIR/study.nc and study.csv.
@@ -341,16 +356,12 @@ def run_study(study, out, *, workers=None, scheduler=None, client=None, resume=F
     if sd.root.exists() and not sd.root.is_dir():
         raise TengsimError(f"--out {sd.root} is a file, not a directory")
     check_resume(study, sd, resume)
-    own = None
-    if client is None:
-        client, own = connect(workers, scheduler)
-        own = (client, own)
-    try:
+    with PointRunner(sd, workers=workers, scheduler=scheduler, client=client) as runner:
         from tengsim.io import check_writable
 
-        check_writable(sd.root / "study.json")
+        check_writable(sd.spec)
         say(f"sweep: {len(study.points)} points ({len(valid) + len(invalid)} distinct computations) on "
-            f"{len(client.scheduler_info().get('workers', {}))} worker(s); dashboard {client.dashboard_link}")
+            f"{runner.n_workers} worker(s); dashboard {runner.client.dashboard_link}")
         sd.points.mkdir(parents=True, exist_ok=True)
         if sd.drop_partial():
             say("sweep: removed the temporary files of point writes a kill interrupted")
@@ -368,16 +379,12 @@ def run_study(study, out, *, workers=None, scheduler=None, client=None, resume=F
         if len(todo) < len(valid):
             say(f"sweep: {len(valid) - len(todo)} point(s) already in {sd.points}, {len(todo)} to compute")
         _append_log(sd, {"event": "start", "time": time.time(), "todo": todo})
-        plugins = os.environ.get("TENGSIM_PLUGINS", "")
         if todo:
-            client.run(warm_up, plugins)
+            runner.warm_up()
         t0, t0_unix = time.perf_counter(), time.time()
-        computed = _compute(client, valid, todo, sd, bar, plugins)
+        computed = runner.compute(valid, todo, bar)
         t_compute = time.perf_counter() - t0
         bar.close()
-    finally:
-        if own is not None:
-            _close(*own)
     from tengsim.study.dataset import build_study
 
     import dask
@@ -387,7 +394,7 @@ def run_study(study, out, *, workers=None, scheduler=None, client=None, resume=F
         summary = build_study(sd.root)
     summary.update(computed=computed, compute_phase_s=t_compute, compute_phase_start_unix=t0_unix,
                    assemble_s=time.perf_counter() - t0)
-    say(f"sweep: wrote {sd.root / 'study.nc'} and {sd.root / 'study.csv'}: {summary['ok']} ok, "
+    say(f"sweep: wrote {sd.dataset_nc} and {sd.dataset_csv}: {summary['ok']} ok, "
         f"{summary['failed']} failed, {summary['unconverged']} unconverged, {summary['pending']} pending")
     return summary
 

@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import json
 import math
-import os
 import sys
 import time
 from pathlib import Path
@@ -67,13 +66,9 @@ def parse_objective(study) -> dict:
 
 
 def _point(study, x):
-    from tengsim.study.spec import Point, _resolve, _with_unit
+    from tengsim.study.spec import point_at
 
-    assign = {}
-    for a, v in zip(study.axes, x):
-        lo, hi, scale, unit = a.continuous
-        assign[a.members[0]] = _with_unit(10**v if scale == "log" else v, unit)
-    return Point(assign, _resolve(study.base, assign), ())
+    return point_at(study, x)
 
 
 def optimize_study(study, out, *, workers=None, scheduler=None, client=None, resume=False, quiet=False,
@@ -85,7 +80,8 @@ def optimize_study(study, out, *, workers=None, scheduler=None, client=None, res
     from tengsim.io import write_json
     from tengsim.load import load_result
     from tengsim.study.dataset import build_study
-    from tengsim.study.execute import StudyDir, SweepProgress, _close, _compute, connect, warm_up
+    from tengsim.study.execute import PointRunner
+    from tengsim.study.layout import StudyDir
     from tengsim.study.observe import observe
 
     from tengsim.plugins import load_plugins
@@ -103,18 +99,13 @@ def optimize_study(study, out, *, workers=None, scheduler=None, client=None, res
             plan_contact(dict(_point(study, corner).contact))
         except TengsimError as exc:
             raise TengsimError(f"{study.source or 'study'}: {exc}") from None
-    own = None
-    if client is None:
-        client, cluster = connect(workers, scheduler)
-        own = (client, cluster)
     evaluated: dict = {}
     history = []
-    try:
+    with PointRunner(sd, workers=workers, scheduler=scheduler, client=client) as runner:
         say(f"optimize: {obj['goal']} {obj['name']} over {', '.join(a.name for a in study.axes)}; "
-            f"dashboard {client.dashboard_link}")
+            f"dashboard {runner.client.dashboard_link}")
         sd.points.mkdir(parents=True, exist_ok=True)
-        plugins = os.environ.get("TENGSIM_PLUGINS", "")
-        client.run(warm_up, plugins)
+        runner.warm_up()
 
         def save_spec():
             spec = study.resolved()
@@ -162,8 +153,7 @@ def optimize_study(study, out, *, workers=None, scheduler=None, client=None, res
                 valid[p.id] = p.contact
                 todo.append(p.id)
             save_spec()
-            bar = SweepProgress(len(todo), quiet=True)
-            _compute(client, valid, todo, sd, bar, plugins)
+            runner.compute(valid, todo)
             vals = [value(p) for p in pts]
             history.append(min(vals))
             say(f"optimize: generation {len(history)}: {len(todo)} new point(s), {len(evaluated)} evaluated, "
@@ -176,9 +166,6 @@ def optimize_study(study, out, *, workers=None, scheduler=None, client=None, res
                                    maxiter=obj["maxiter"], popsize=obj["popsize"], seed=obj["seed"],
                                    tol=obj["tol"], polish=False, init="sobol")
         seconds = time.perf_counter() - t0
-    finally:
-        if own is not None:
-            _close(*own)
     import dask
 
     with dask.config.set(scheduler="synchronous"):
@@ -188,7 +175,7 @@ def optimize_study(study, out, *, workers=None, scheduler=None, client=None, res
               "value": float(obj["sign"] * r.fun) if r.fun < PENALTY / 2 else math.nan,
               "feasible": bool(r.fun < PENALTY / 2), "evaluations": len(evaluated),
               "generations": len(history), "seconds": seconds, "message": str(r.message)}
-    write_json(sd.root / "optimum.json", result)
+    write_json(sd.optimum, result)
     say(f"optimize: best {obj['name']} = {result['value']:.5g} at "
-        + ", ".join(f"{k} = {v}" for k, v in best.axes.items()) + f"; wrote {sd.root / 'optimum.json'}")
+        + ", ".join(f"{k} = {v}" for k, v in best.axes.items()) + f"; wrote {sd.optimum}")
     return result

@@ -511,6 +511,16 @@ def expand(study: Study) -> list:
     return pts
 
 
+def point_at(study: Study, x) -> Point:
+    """The point of a study of range axes at ``x``: one value per axis, log10 of the value on a log axis
+    (the search space of ``tengsim optimize``); values are written as :func:`expand` writes them."""
+    assign = {}
+    for a, v in zip(study.axes, x):
+        lo, hi, scale, unit = a.continuous
+        assign[a.members[0]] = _with_unit(10**v if scale == "log" else v, unit)
+    return Point(assign, _resolve(study.base, assign), ())
+
+
 def numeric(v) -> float:
     """An axis value as a number in SI (unit strings parsed); NaN if it is not a quantity."""
     from tengsim.units import parse_quantity

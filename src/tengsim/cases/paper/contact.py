@@ -9,10 +9,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tengsim.cases._json import json_safe
 from tengsim.contact import simulate
 from tengsim.device.params import AreaTable
 from tengsim.errors import TengsimError
+from tengsim.io import jsonable
 from tengsim.shapes import Pyramid
 from tengsim.loadpath import LoadPathSpec
 from tengsim.path import PathSpec
@@ -164,7 +164,7 @@ def contact_summary(res, group: str) -> dict:
     full = 2 * sc.N
     tD = res.transition_D(full)
     pull = res.pull_off_force
-    return json_safe({
+    return jsonable({
         "N": sc.N,
         "cell": sc.cell,
         "transition_D": tD,

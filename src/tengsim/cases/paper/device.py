@@ -5,13 +5,13 @@ paper's group-A contact run (:func:`tengsim.cases.paper.contact.area_table`), bu
 """
 from __future__ import annotations
 
-from tengsim.cases._json import json_safe
 from tengsim.device.analysis import staircase_summary
 from tengsim.device.dynamics import simulate
 from tengsim.device.params import ConstantArea, DeviceParams, SolverOptions, area_model
 from tengsim.device.result import DeviceResult
 from tengsim.device.waveforms import SquareWave, Staircase
 from tengsim.errors import positive, require
+from tengsim.io import jsonable
 
 FIG7_FORCE_N = 10.0
 FIG7_FREQUENCY_HZ = 5.0
@@ -82,12 +82,12 @@ def fig7_summary(result: DeviceResult, skip_cycles: int = 1) -> dict:
     s = result.summary(skip_cycles)
     keys = ("peak_voltage_V", "peak_current_A", "voc_V", "isc_A", "energy_per_cycle_J", "average_power_W",
             "net_charge_per_cycle_C", "settled_cycles")
-    return json_safe({k: s[k] for k in keys})
+    return jsonable({k: s[k] for k in keys})
 
 
 def fig8_summary(result: DeviceResult) -> dict:
     """V_OC per pressure step: the largest Eq. (17) voltage after that step's release (Fig. 8b)."""
-    return json_safe(staircase_summary(result))
+    return jsonable(staircase_summary(result))
 
 
 __all__ = ["FIG7_FORCE_N", "FIG7_FREQUENCY_HZ", "FIG8_FREQUENCY_HZ", "FIG8_PRESSURES_PA", "fig7_params",

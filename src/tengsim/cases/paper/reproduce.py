@@ -16,7 +16,6 @@ import numpy as np
 
 from tengsim import io
 from tengsim._version import __version__
-from tengsim.cases._json import json_safe
 from tengsim.cases.paper.contact import (FIG3_D, GROUPS, PAPER_TRANSITION_D, RunSettings,
                                          area_table_from_load_result, area_table_from_result, compare_area_tables,
                                          contact_summary, run_group, run_group_load)
@@ -127,7 +126,7 @@ def reproduce(out_dir, quick: bool = False, progress_factory=None, log=None,
             dplots.plot_fig8(r8, stage / "fig8.pdf")
             summary["fig8"] = fig8_summary(r8)
         summary["seconds"] = time.perf_counter() - t0
-        summary = json_safe(summary)
+        summary = io.jsonable(summary)
         io.write_json(stage / "summary.json", summary)
         out_dir.mkdir(parents=True, exist_ok=True)
         for f in sorted(stage.iterdir()):

@@ -11,7 +11,7 @@ pass each) and no convolution.
 
 Memory traffic is the cost here, not arithmetic, so this class keeps only the small matrices and
 the rows; the solver reads the rows itself, block by block together with its other element-wise
-work (tengsim._sweep):
+work (tengsim.solvers._sweep):
 
 * the 2m stored rows are read twice for H v and K H v and once for the update, and nothing else
   touches them (float32 rows halve the bytes, but measured on rough surfaces they cost up to

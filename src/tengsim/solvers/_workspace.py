@@ -2,7 +2,7 @@
 
 An iteration allocates nothing: the current and trial gap and pressure, the direction and its image,
 residual, gradient and their next values, the new pair (y, K y), the convolution's output, the
-sweeper with its per-thread scratch (tengsim._sweep) and the L-BFGS rows (tengsim._lbfgs).  A
+sweeper with its per-thread scratch (tengsim.solvers._sweep) and the L-BFGS rows (tengsim.solvers._lbfgs).  A
 workspace holds no result: the state a solve returns (q, w, P) lives in arrays of its own, so one
 workspace serves the equilibria of a path one after the other (``FastSolver`` keeps a spare one per
 solver, see :class:`Spare`).
@@ -11,9 +11,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from tengsim import _sweep
-from tengsim._lbfgs import KMetricLBFGS
-from tengsim._sweep import Sweeper
+from tengsim.solvers import _sweep
+from tengsim.solvers._lbfgs import KMetricLBFGS
+from tengsim.solvers._sweep import Sweeper
 
 #: grids up to this many points keep their workspace between solves (the allocation matters only
 #: there; a large grid's workspace, ~(13 + 4 m) arrays, is given back with its solve)

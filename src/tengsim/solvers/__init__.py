@@ -22,8 +22,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tengsim._linesearch import Ray, Trial, WolfeLineSearch
-from tengsim._workspace import Spare
+from tengsim.solvers._linesearch import Ray, Trial, WolfeLineSearch
+from tengsim.solvers._workspace import Spare
 from tengsim.errors import TengsimError
 from tengsim.registry import SOLVERS
 
@@ -90,12 +90,12 @@ class FastSolver:
     start state), one per iteration (K P(g) at the new state), and one more every ``resync``
     iterations to re-anchor w = K q; one solve of k iterations spends 1 + k + ⌊k / resync⌋.  Nothing
     else convolves: the direction's image K d is assembled from stored images (K s = Δw, K y = Δr,
-    K G = r) by the compact L-BFGS form (tengsim._lbfgs), and the line search along d needs only
-    element-wise work, since g(α) = g + α K d (tengsim._linesearch).  Converged when max|r| <= ``tol``.
+    K G = r) by the compact L-BFGS form (tengsim.solvers._lbfgs), and the line search along d needs only
+    element-wise work, since g(α) = g + α K d (tengsim.solvers._linesearch).  Converged when max|r| <= ``tol``.
     ``monitor(iteration, max|r|, energy)``, if given, is called every ``monitor_every`` iterations
     (progress on long solves).
 
-    The arrays of an iteration live in a workspace (tengsim._workspace), allocated once per grid and,
+    The arrays of an iteration live in a workspace (tengsim.solvers._workspace), allocated once per grid and,
     on grids up to 512² points, kept by the solver for its next solve (a path's equilibria share one).
     """
 

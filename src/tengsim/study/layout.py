@@ -1,0 +1,84 @@
+"""Layout of a study directory: where each file of a sweep or an optimisation lives (paths only).
+
+::
+
+    DIR/study.json            resolved points of the study (checked on --resume)
+    DIR/points/<id>.nc        one finished contact computation (result + params, timings, status, version)
+    DIR/points/<id>.failed.json   a point that raised (its message); rerun only with --retry-failed
+    DIR/points/.<name>.part   a write in progress (an atomic rename gives it its final name)
+    DIR/log.jsonl             one line per finished or failed point, in completion order
+    DIR/study.nc, study.csv   the assembled dataset (tengsim.study.dataset), rebuilt at the end
+    DIR/optimum.json          the best point found by ``tengsim optimize``
+
+Both the runner (:mod:`tengsim.study.execute`, :mod:`tengsim.study.optimize`) and the assembler
+(:mod:`tengsim.study.dataset`) read the directory through :class:`StudyDir`; neither imports the other
+for it.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+
+@dataclass
+class StudyDir:
+    """The files of the study directory ``root`` (nothing is created or read on construction)."""
+
+    root: Path
+
+    def __post_init__(self):
+        self.root = Path(self.root)
+
+    @property
+    def points(self) -> Path:
+        return self.root / "points"
+
+    def nc(self, pid) -> Path:
+        return self.points / f"{pid}.nc"
+
+    def failed(self, pid) -> Path:
+        return self.points / f"{pid}.failed.json"
+
+    def drop_partial(self) -> int:
+        """Remove the temporary files of writes a kill interrupted (``.<name>.part``; never a finished
+        point, which only appears under its final name by an atomic rename); returns how many."""
+        stale = list(self.points.glob(".*.part")) if self.points.is_dir() else []
+        for f in stale:
+            f.unlink(missing_ok=True)
+        return len(stale)
+
+    @property
+    def spec(self) -> Path:
+        return self.root / "study.json"
+
+    @property
+    def log(self) -> Path:
+        return self.root / "log.jsonl"
+
+    @property
+    def dataset_nc(self) -> Path:
+        return self.root / "study.nc"
+
+    @property
+    def dataset_csv(self) -> Path:
+        return self.root / "study.csv"
+
+    @property
+    def optimum(self) -> Path:
+        """The best point of ``tengsim optimize``."""
+        return self.root / "optimum.json"
+
+    def done(self) -> set:
+        """Ids of the finished points (a ``<id>.nc`` under points/)."""
+        if not self.points.is_dir():
+            return set()
+        return {f.name[:-3] for f in self.points.glob("*.nc")}
+
+    def failures(self) -> set:
+        """Ids of the failed points (a ``<id>.failed.json`` under points/)."""
+        if not self.points.is_dir():
+            return set()
+        return {f.name[: -len(".failed.json")] for f in self.points.glob("*.failed.json")}
+
+
+__all__ = ["StudyDir"]
