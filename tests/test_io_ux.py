@@ -1,7 +1,6 @@
 """Result files as users meet them: strict JSON, ordinary permissions, a fast exact CSV writer."""
 import json
 import os
-import time
 from pathlib import Path
 
 import numpy as np
@@ -161,6 +160,31 @@ def test_csv_100k_rows_no_per_row_python(tmp_path):
     _, back = _read_csv(tmp_path / "big.csv")
     np.testing.assert_array_equal(back["F"], big["F"])
     assert (back["branch"] == big["branch"]).all()
+
+
+def test_csv_text_with_commas_quotes_and_newlines_round_trips(tmp_path):
+    """Text cells and names holding a comma, a quote or a newline are quoted (csv module, minimal quoting:
+    plain cells stay bare) and read back whole; a cell starting with '#' is data, not a header line."""
+    p = tmp_path / "q.csv"
+    notes = ["plain", 'a, "b"', 'say "hi"', "two\nlines", "", "#not a header"]
+    io.write_csv(p, {"label": ["#x", "y", "z", "w", "v", "u"], "D": np.arange(6.0), "note": notes,
+                     'n, "count"': np.arange(6)}, header={"title": 'a, "b"'})
+    text = p.read_text()
+    assert '"a, ""b"""' in text and '"say ""hi"""' in text and "\n#x,0.0,plain,0\n" in text
+    header, back = _read_csv(p)
+    assert header == {"title": 'a, "b"'}
+    assert list(back) == ["label", "D", "note", 'n, "count"']
+    assert back["note"].tolist() == notes and back["label"][0] == "#x"
+    np.testing.assert_array_equal(back["D"], np.arange(6.0))
+    np.testing.assert_array_equal(back['n, "count"'], np.arange(6))
+
+
+def test_csv_text_missing_cells_left_empty():
+    """``missing``: None and non-finite floats (float and object columns) become that text; others as ever."""
+    cols = {"x": [1.5, np.nan, np.inf], "o": np.array([None, 2.0, float("-inf")], dtype=object),
+            "b": [True, False, True], "s": ["a", "b,c", "d"]}
+    assert io.csv_text(cols, missing="") == 'x,o,b,s\n1.5,,1,a\n,2.0,0,"b,c"\n,,1,d\n'
+    assert io.csv_text(cols).splitlines()[1:] == ["1.5,None,1,a", "nan,2.0,0,\"b,c\"", "inf,-inf,1,d"]
 
 
 def test_csv_unequal_columns_refused(tmp_path):

@@ -70,14 +70,20 @@ def test_law_params_are_its_fields_not_its_caches():
     assert set(r.params()) == {"scale", "exponent", "g_safe", "law"}
 
 
-def test_trapezoid_helper_needs_no_numpy_name(monkeypatch):
-    from tengsim.results import trapezoid
+def test_hysteresis_needs_no_numpy_trapezoid_name(monkeypatch):
+    """ContactResult.hysteresis integrates with scipy: NumPy 1.x has no np.trapezoid, NumPy 2.4 no np.trapz."""
+    from tengsim.grid import Grid
+    from tengsim.results import ContactResult
 
     monkeypatch.delattr(np, "trapezoid", raising=False)
     monkeypatch.delattr(np, "trapz", raising=False)
     x = np.linspace(0, 1, 101)
-    assert trapezoid(x**2, x) == pytest.approx(1 / 3, abs=2e-5)
-    assert trapezoid([1.0], [0.0]) == 0.0
+    res = ContactResult(table={"branch": np.array(["approach"] * 101 + ["retraction"] * 101),
+                               "D": np.r_[x, x[::-1]], "F": np.r_[x**2, 0 * x]}, grid=Grid(3, 3, 1.0, 1.0))
+    assert res.hysteresis == pytest.approx(1 / 3, abs=2e-5) and isinstance(res.hysteresis, float)
+    one = ContactResult(table={"branch": np.array(["approach", "retraction"]), "D": np.r_[0.0, 0.0],
+                               "F": np.r_[1.0, 1.0]}, grid=Grid(3, 3, 1.0, 1.0))
+    assert one.hysteresis == 0.0
 
 
 class PApex:

@@ -52,15 +52,42 @@ def test_cohesive_window_of_lj93():
     assert w.h0 == pytest.approx(9 * np.sqrt(3) / 16, rel=1e-10)
     assert st.cohesive_window(Repulsive()) is None
 
-    class Unhashable(Law):  # a user's law need not be hashable
+    class Unhashable(Law):  # a user's law need not be hashable, nor declare its numbers
         g_safe = 0.6
         __hash__ = None
 
         def _raw(self, g, need_dp=True):
             return LJ93()._raw(g, need_dp)
 
-    assert st.cohesive_window(Unhashable()) == w
+    u = st.cohesive_window(Unhashable())  # the base class's numerical search, vs LJ93's closed forms
+    for name in ("g_peak", "g0", "sigma0", "work"):
+        assert getattr(u, name) == pytest.approx(getattr(w, name), rel=1e-9), name
+    assert st.law_softening(Unhashable()) == pytest.approx(st.law_softening(LJ93()), rel=1e-9)
+
+    class DuckLaw:  # no Law at all: only g_safe and evaluate (the LawLike protocol)
+        g_safe = 0.6
+
+        def evaluate(self, g):
+            return LJ93().evaluate(g)
+
+    d = st.cohesive_window(DuckLaw())
+    for name in ("g_peak", "g0", "sigma0", "work"):
+        assert getattr(d, name) == pytest.approx(getattr(w, name), rel=1e-9), name
+    assert st.law_softening(DuckLaw()) == pytest.approx(st.law_softening(LJ93()), rel=1e-6)
     assert np.isnan(st.process_zone_estimate(Repulsive(), 1.0))
+
+
+def test_status_reads_the_laws_declared_numbers():
+    """The window and the softening are the law's own declarations (tengsim.laws.Law), not a search."""
+    from tengsim.laws import Exponential, MaugisDugdale
+
+    for law in (LJ93(), MaugisDugdale(smoothing=0.4, wall_stiffness=1e4), Exponential(range=0.5)):
+        w = st.cohesive_window(law)
+        assert (w.g_peak, w.g0, w.sigma0, w.work) == (law.g_peak, law.g_zero, law.max_tension, law.work)
+        assert w.h0 == pytest.approx(law.cohesive_range, rel=1e-15)
+        assert st.law_softening(law) == law.max_softening
+    assert st.law_softening(Repulsive()) == 0.0
+    assert st.law_softening(LJ93()) == pytest.approx(4.8 * 7.5 ** (-2 / 3), rel=1e-15)
 
 
 @pytest.mark.parametrize("mu", [3.0, 5.0, 8.0])

@@ -40,12 +40,17 @@ TINY = {"shape": "pyramid", "N": 0.946, "cell": 3.78, "tabor": 0.5, "dx": 0.4, "
 
 @pytest.fixture(scope="module")
 def client():
+    """A 2-worker LocalCluster for this module's tests, closed when they are done (never shared further)."""
     from tengsim.study.execute import connect
 
     c, cluster = connect(workers=2)  # the LocalCluster `tengsim sweep --workers 2` starts
-    yield c
-    c.close()
-    cluster.close()
+    try:
+        yield c
+    finally:
+        try:
+            c.close()
+        finally:
+            cluster.close()
 
 
 def tiny_study(axes, **extra):
@@ -230,15 +235,41 @@ def test_cli_workers_and_scheduler_exclusive(tmp_path, capsys):
     assert not (tmp_path / "out").exists()
 
 
-def test_cli_unreachable_scheduler(tmp_path, capsys):
+def test_cli_unreachable_scheduler(tmp_path, capsys, monkeypatch):
+    """Nothing listens at the address: exit 2, one line naming it, nothing written.  (How long the
+    attempt lasts is not timed here: test_connect_gives_dask_its_timeout checks the bound handed to dask.)"""
+    from tengsim.study import execute
+
+    monkeypatch.setattr(execute, "CONNECT_TIMEOUT_S", 0.5)  # a short attempt keeps the test quick
     f = tmp_path / "s.toml"
     f.write_text(MINIMAL)
-    t0 = time.perf_counter()
     rc = main(["sweep", str(f), "--out", str(tmp_path / "out"), "--scheduler", "tcp://127.0.0.1:9"])
     err = capsys.readouterr().err.strip()
-    assert rc == 2 and len(err.splitlines()) == 1 and "cannot reach the dask scheduler" in err, err
-    assert time.perf_counter() - t0 < 20
+    assert rc == 2 and len(err.splitlines()) == 1, err
+    assert "cannot reach the dask scheduler at 'tcp://127.0.0.1:9'" in err, err
     assert not (tmp_path / "out").exists()
+
+
+def test_connect_gives_dask_its_timeout(monkeypatch):
+    """connect() bounds the attempt on a --scheduler by CONNECT_TIMEOUT_S (or its ``timeout``), handed to
+    dask's Client, and turns dask's refusal into one TengsimError naming the address."""
+    import dask.distributed
+
+    from tengsim.study import execute
+
+    seen = []
+
+    class Unreachable:
+        def __init__(self, address, timeout=None, **kw):
+            seen.append((address, timeout))
+            raise OSError(f"Timed out trying to connect to {address} after {timeout}")
+
+    monkeypatch.setattr(dask.distributed, "Client", Unreachable)
+    for kw, expect in [({}, f"{execute.CONNECT_TIMEOUT_S}s"), ({"timeout": 0.25}, "0.25s")]:
+        with pytest.raises(TengsimError, match=r"cannot reach the dask scheduler at 'tcp://10\.0\.0\.1:8786'"):
+            execute.connect(scheduler="tcp://10.0.0.1:8786", **kw)
+        assert seen.pop() == ("tcp://10.0.0.1:8786", expect)
+    assert 0 < execute.CONNECT_TIMEOUT_S <= 10  # a typo'd address fails in seconds, not dask's 30 s default
 
 
 KILL_STUDY = """
@@ -434,7 +465,7 @@ def test_shape_axis_invalid_points(tmp_path, capsys, client):
 def test_stale_temporary_files_of_a_killed_write_are_removed(tmp_path):
     """A SIGKILL during a point's atomic write leaves '.<id>.nc.<random>.part'; the next run removes it and
     leaves the finished points (final names) alone."""
-    from tengsim.study.execute import StudyDir
+    from tengsim.study.layout import StudyDir
 
     sd = StudyDir(tmp_path)
     sd.points.mkdir()
@@ -571,3 +602,35 @@ def test_worker_dying_mid_point_is_a_failed_point_others_finish(tmp_path, monkey
             cluster.close()
     finally:
         registry.SHAPES.unregister("bomb")
+
+
+def test_sweep_progress_is_a_progress_line_per_point():
+    """The sweep's reporter is tengsim.progress.Progress with the sweep's text: a plain line per point on
+    a log stream, one updating line (closed by one newline) on a terminal, nothing when quiet."""
+    import io
+
+    from tengsim.progress import Progress
+    from tengsim.study.execute import SweepProgress
+
+    s = io.StringIO()
+    bar = SweepProgress(3, done=1, stream=s)
+    assert isinstance(bar, Progress) and not bar.tty
+    bar.update("ok")
+    bar.update("failed")
+    bar.close()
+    lines = s.getvalue().splitlines()
+    assert "\r" not in s.getvalue() and len(lines) == 2
+    assert lines[0].startswith("sweep: 2/3 points (0 failed), ") and "points/h, ETA" in lines[0]
+    assert lines[1].startswith("sweep: 3/3 points (1 failed), ") and lines[1].endswith("ETA 0:00:00")
+    t = io.StringIO()
+    bar = SweepProgress(2, stream=t)
+    bar.tty = True
+    bar.update("ok")
+    bar.update("unconverged")
+    bar.close()
+    assert t.getvalue().count("\r") == 2 and t.getvalue().count("\n") == 1 and t.getvalue().endswith("\n")
+    q = io.StringIO()
+    bar = SweepProgress(1, quiet=True, stream=q)
+    bar.update("ok")
+    bar.close()
+    assert q.getvalue() == "" and (bar.done, bar.failed) == (1, 0)

@@ -17,7 +17,7 @@ from tengsim.errors import TengsimError, finite, positive
 from tengsim.laws import make_law
 from tengsim.path import PathSpec
 from tengsim.plugins import KERNELS, LAWS, OBSERVERS, SHAPES, SOLVERS
-from tengsim.schema import Field, Table, dataclass_fields, read_config, signature_fields
+from tengsim.schema import Field, Table, dataclass_fields, signature_fields
 from tengsim.shapes.base import dimensionless_fields, physical_fields
 from tengsim.units import Scaling, parse_quantity
 
@@ -25,11 +25,6 @@ PHYSICAL_KEYS = ("E_star", "W", "eps")
 """Keys that make a [contact] table a physical run (with any physical-only key of the shape)."""
 
 _SUFFIX = {"length": "_m", "pressure": "_Pa", "energy/area": "_J_m2"}
-
-
-def load_toml(path) -> dict:
-    """Read a config file (TOML or JSON) through :func:`tengsim.schema.read_config`."""
-    return read_config(path)
 
 
 def _observer_names(v):
@@ -106,7 +101,7 @@ def _path_spec(vals, given, scaling):
 def common_fields() -> list:
     """The [contact] keys every shape has (choices and help read from the registries)."""
     return [
-        Field("shape", "str", "pyramid", check=lambda v: SHAPES.canonical(v),
+        Field("shape", "str", "pyramid", check=SHAPES.canonical,
               help="registered shape: " + SHAPES.help()),
         Field("tabor", help="Tabor parameter μ (coupling μ^{3/2}); dimensionless runs: default 0.5; "
               "physical runs: no default, give tabor or eps"),
@@ -140,7 +135,7 @@ def common_fields() -> list:
               "E = E*(1 - ν²) (needs thickness)"),
         Field("solver", "str", "fast", choices=SOLVERS.names, help="solver: " + SOLVERS.help()),
         Field("tol", default=1e-6, help="max residual of Eq. (9) in ε"),
-        Field("law", "str", "lj93", check=lambda v: LAWS.canonical(v), help="interaction law: " + LAWS.help()),
+        Field("law", "str", "lj93", check=LAWS.canonical, help="interaction law: " + LAWS.help()),
         Field("observers", "any", (), check=_observer_names,
               help="extra observers adding columns: "
               + ("; ".join(f"{n}: {OBSERVERS.summary(n)}" for n in OBSERVERS.names() if n != "summary")

@@ -22,7 +22,7 @@ MONITOR_MIN_POINTS = 1024**2  # grids from this size on report progress inside e
 def simulate(shape: Shape, tabor: float, dx: float, path: PathSpec, boundary: str = "free",
              solver="fast", tol: float = 1e-6, law: Law | str | None = None, progress=None,
              grid=None, extra_params: dict | None = None, observers=(), scaling=None,
-             kernel_params: dict | None = None, throw: bool = False):
+             kernel_params: dict | None = None, throw: bool = False, check_memory_first: bool = True):
     """Approach–retraction run of ``shape`` against a rigid flat plate (paper Eq. 9).
 
     ``tabor`` is μ (the elastic coupling is μ^{3/2}); ``dx`` the grid spacing in X units;
@@ -35,7 +35,8 @@ def simulate(shape: Shape, tabor: float, dx: float, path: PathSpec, boundary: st
     Returns a ContactResult whose ``status`` (and per-row ``status`` column) says ok /
     not_converged / out_of_law_range / under_resolved (:mod:`tengsim.status`); with ``throw=True``
     a status other than 'ok' raises :class:`tengsim.status.ResultStatusError`, which carries the
-    result.
+    result.  The grid's memory is checked once, before anything is built (``check_memory_first=False``:
+    the caller has checked it, as :func:`run_contact` does through :func:`tengsim.config.plan_contact`).
     """
     tabor = positive("tabor", tabor)
     if scaling is not None and abs(scaling.mu - tabor) > 1e-9 * tabor:
@@ -44,8 +45,9 @@ def simulate(shape: Shape, tabor: float, dx: float, path: PathSpec, boundary: st
     boundary = KERNELS.canonical(boundary)
     grid = grid or shape.grid(dx)
     solver_obj = make_solver(solver, tol=tol) if isinstance(solver, str) else solver
-    check_memory(grid.nx, grid.ny, boundary, getattr(solver_obj, "name", ""), getattr(solver_obj, "memory", 10),
-                 maps=2 * len(path.maps_at))  # before any large array: one clear error, needed vs available
+    if check_memory_first:  # before any large array: one clear error, needed vs available
+        check_memory(grid.nx, grid.ny, boundary, getattr(solver_obj, "name", ""), getattr(solver_obj, "memory", 10),
+                     maps=2 * len(path.maps_at))
     if (hasattr(progress, "monitor") and grid.nx * grid.ny >= MONITOR_MIN_POINTS and is_dataclass(solver_obj)
             and getattr(solver_obj, "monitor", 0) is None):  # long solves report as they go
         solver_obj = replace(solver_obj, monitor=progress.monitor(), monitor_every=10)
@@ -53,6 +55,7 @@ def simulate(shape: Shape, tabor: float, dx: float, path: PathSpec, boundary: st
     walk = run_load_path if isinstance(path, LoadPathSpec) else run_path  # load or rigid-approach control
     res = walk(shape.gap(grid), law, kernel, solver_obj, path, progress=progress, observers=observers)
     res.params = {
+        **res.params,  # what the path recorded (the pixel snap number)
         "tengsim_version": __version__,
         **shape.params(),
         "lateral_unit": getattr(shape, "lateral_unit", "ℓ"),
@@ -77,7 +80,7 @@ def simulate(shape: Shape, tabor: float, dx: float, path: PathSpec, boundary: st
         for k, v in scaling.params().items():
             res.params.setdefault(k, v)
         res.add_physical(scaling)
-    status.attach(res, law, kernel.coupling, kernel)  # per-row 'status' column, params['status'] (tengsim.status)
+    status.attach(res, law, kernel.coupling)  # per-row 'status' column, params['status'] (tengsim.status)
     if (getattr(kernel, "film", False) and getattr(kernel, "pinned_mean", False)
             and not res.table["in_law_range"].all()):
         res.params["warning"] = res.params.get("warning", "") + (
@@ -104,6 +107,6 @@ def run_contact(cfg: dict, progress=None):
     res = simulate(plan.shape, plan.tabor, plan.dx, plan.path, boundary=plan.boundary,
                    solver=plan.solver, tol=plan.tol, law=plan.law, progress=progress,
                    extra_params=plan.extra, observers=plan.observers, scaling=plan.scaling,
-                   kernel_params=plan.kernel_params)
+                   kernel_params=plan.kernel_params, check_memory_first=False)  # plan_contact checked it
     res.params["config"] = {k: v for k, v in cfg.items() if k not in ("out", "plot")}
     return res

@@ -14,7 +14,7 @@ from tengsim.analysis import apex_index
 from tengsim.errors import TengsimError
 from tengsim.results import CURVE_COLUMNS, PHYSICAL_COLUMNS, ContactResult
 from tengsim.solvers import Problem, State
-from tengsim.status import process_zone_width
+from tengsim.status import pixel_snap_number, process_zone_width, row_status
 
 
 def secant(s0: State, s1: State, c: float) -> State:
@@ -90,6 +90,8 @@ class Recorder:
         if not np.all(np.isfinite(U0)):
             raise TengsimError("the initial gap U0 contains NaN or infinite values")
         self.U0, self.law, self.grid = U0, law, grid
+        # the run's pixel snap number (one convolution), so that each row is classified once, as recorded
+        self.snap = pixel_snap_number(law, kernel)
         self.apex = apex_index(U0)
         self.summary = obs.Summary()
         self.extra = obs.resolve(observers)
@@ -110,9 +112,10 @@ class Recorder:
             more = {}
             for o in self.extra:
                 more.update(self._observe(o, eq, self.ctx))
+            pz = process_zone_width(eq.H, self.grid.dx, self.apex, self.law)
             self.rows.append(dict(branch=branch, D=D, on_grid=on_grid, jump=jump, converged=eq.converged,
-                                  in_law_range=in_range,
-                                  process_zone=process_zone_width(eq.H, self.grid.dx, self.apex, self.law),
+                                  in_law_range=in_range, process_zone=pz,
+                                  status=row_status(bool(eq.converged), in_range, pz, self.grid.dx, self.snap),
                                   residual=eq.residual, iterations=eq.iterations, n_conv=eq.n_conv,
                                   seconds=eq.seconds, energy=eq.energy, **s, **more))
             value = D if self.control == "D" else s["F"]
@@ -133,4 +136,5 @@ class Recorder:
                                       final_state=final_state, extra_columns=self.extra_cols)
         for o in self.extra:
             res.units.update(getattr(o, "units", None) or {})
+        res.params["pixel_snap_number"] = self.snap
         return res

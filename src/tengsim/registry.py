@@ -16,7 +16,7 @@ points).
 """
 from __future__ import annotations
 
-from typing import Any, Callable, Generic, Iterator, Protocol, TypeVar, runtime_checkable
+from typing import Any, Generic, Iterator, Protocol, TypeVar, runtime_checkable
 
 import numpy as np
 
@@ -42,7 +42,12 @@ class ShapeLike(Protocol):
 
 @runtime_checkable
 class LawLike(Protocol):
-    """Surface interaction: energy Φ(g) and pressure P(g) = −dΦ/dg of the gap g = h/ε (paper Eq. 2/8)."""
+    """Surface interaction: energy Φ(g) and pressure P(g) = −dΦ/dg of the gap g = h/ε (paper Eq. 2/8).
+
+    A law also declares its own numbers, read by the resolution status: ``max_tension`` (W/ε),
+    ``g_peak``, ``g_zero`` and ``cohesive_range`` (ε), ``work`` (W) and ``max_softening`` (W/ε²);
+    subclasses of :class:`tengsim.laws.Law` inherit a numerical fallback for any they do not give.
+    """
 
     g_safe: float
 
@@ -173,5 +178,3 @@ LAWS: Registry = Registry("law", LawLike)
 KERNELS: Registry = Registry("boundary", KernelLike)
 SOLVERS: Registry = Registry("solver", SolverLike)
 OBSERVERS: Registry = Registry("observer", ObserverLike)
-
-Factory = Callable[..., Any]

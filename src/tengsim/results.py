@@ -5,19 +5,10 @@ import json
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.integrate import trapezoid
 
 from tengsim import status as _status
 from tengsim.grid import Grid
-
-
-
-def trapezoid(y, x) -> float:
-    """∫ y dx by the trapezoidal rule (numpy >= 1.24: ``np.trapezoid`` is numpy 2's name for ``np.trapz``)."""
-    y, x = np.asarray(y, dtype=float), np.asarray(x, dtype=float)
-    if len(y) < 2:
-        return 0.0
-    return float(np.sum(0.5 * (y[1:] + y[:-1]) * np.diff(x)))
-
 
 CURVE_COLUMNS = ["branch", "D", "F", "contact_length", "area_repulsive", "converged", "residual",
                  "iterations", "n_conv", "on_grid", "jump", "min_gap", "max_pressure",
@@ -67,7 +58,10 @@ class ContactResult:
     def from_rows(cls, rows, maps, grid, seconds=0.0, final_state=None, extra_columns=()):
         table = {k: np.array([r.get(k, np.nan) for r in rows], dtype=float if k == "process_zone" else None)
                  for k in [*CURVE_COLUMNS, *extra_columns] if k != "status"}
-        table["status"] = _status.classify(table, grid.dx)
+        if rows and all("status" in r for r in rows):  # classified as recorded (tengsim.continuation)
+            table["status"] = np.array([r["status"] for r in rows]).astype(str)
+        else:
+            table["status"] = _status.classify(table, grid.dx)
         return cls(table=table, grid=grid, maps=maps, seconds=seconds, final_state=final_state)
 
     def add_physical(self, scaling) -> None:
@@ -150,7 +144,7 @@ class ContactResult:
             return 0.0
         ia = np.argsort(a["D"])
         ir = np.argsort(r["D"])
-        return trapezoid(a["F"][ia], a["D"][ia]) - trapezoid(r["F"][ir], r["D"][ir])
+        return float(trapezoid(a["F"][ia], a["D"][ia]) - trapezoid(r["F"][ir], r["D"][ir]))
 
     def transition_D(self, full_length: float, fraction: float = 0.95) -> float:
         """First approach D at which Λc reaches ``fraction`` × ``full_length`` (linear interpolation):

@@ -6,6 +6,7 @@ typed, and a unit string ('2um', '0.59MPa') is accepted only where the field has
 """
 from __future__ import annotations
 
+import inspect
 import json
 import math
 from dataclasses import dataclass
@@ -131,8 +132,6 @@ class Field:
 
 
 def _arity(fn) -> int:
-    import inspect
-
     try:
         return len(inspect.signature(fn).parameters)
     except (TypeError, ValueError):  # pragma: no cover

@@ -14,8 +14,9 @@ tensile-peak gap g* (P(g*) = −σ0, the most tensile stress; LJ 9-3: g* = 3^{1/
 is the contact gap (P(g0) = 0; LJ 9-3: 1) and h0 = W/σ0 the Dugdale range of the law (W = −Φ(g0);
 LJ 9-3: h0 = 9√3/16 = 0.974), all as the law declares them (:class:`tengsim.laws.Law`: ``g_peak``,
 ``max_tension``, ``g_zero``, ``work``, ``cohesive_range``).  Positions are interpolated linearly in
-the gap between pixels; ℓ is the smaller of the two sides.  An equilibrium is **under-resolved when ℓ < 0.75 dx**.  Rows without
-such an opening edge on the row (no contact, or contact up to the cell border) are not judged.
+the gap between pixels; ℓ is the smaller of the two sides.  An equilibrium is **under-resolved when
+ℓ < 0.75 dx**.  Rows without such an opening edge on the row (no contact, or contact up to the cell
+border) are not judged.
 
 Calibration (LJ 9-3 sphere, free kernel, docs/validation.md): ℓ is 0.65–0.73 of the Maugis–Dugdale
 cohesive zone c − a at pull-off (Maugis 1992, λ = 1.157 μ), and nearly independent of dx, so the
@@ -27,14 +28,15 @@ grid-converged LJ value is +4.9 %).  Resolved runs lie within 1.8 % of the fines
 is in docs/validation.md.
 
 Pixel snap (a second, a-priori cause of under-resolution).  A law that softens beyond its tensile
-peak faster than one pixel is stiff — s = max_g dP/dg × c_pix > 1 (the law's declared ``max_softening``), with c_pix the gap change of a pixel
-under unit pressure on that pixel alone (one convolution of the run's kernel) — has no stable state
-in that band of gaps: pixels snap in and out one at a time and the contact edge is pinned to the
-lattice, whatever the process zone.  Every judged row of such a run is under-resolved.  Measured
-(docs/validation.md, MD sphere): MD law at μ = 3, smoothing 0.2, dx 0.05, s = 2.0, pull-off +8.2 %
-over Maugis with the edge stuck for 0.6 ε of D; smoothing 0.6 (s = 0.67 / 0.52 at dx 0.05 / 0.035)
-+0.72 / +0.21 %; μ = 1, smoothing 0.2, s = 0.79 / 0.38 at dx 0.1 / 0.05: +1.1 / +0.27 %.  LJ 9-3 has
-s = 0.66 at μ = 3, dx 0.1.  s grows about as μ^{3/2} dx.
+peak faster than one pixel is stiff — s = max_g dP/dg × c_pix > 1 (the law's declared
+``max_softening``), with c_pix the gap change of a pixel under unit pressure on that pixel alone
+(one convolution of the run's kernel) — has no stable state in that band of gaps: pixels snap in and
+out one at a time and the contact edge is pinned to the lattice, whatever the process zone.  Every
+judged row of such a run is under-resolved.  Measured (docs/validation.md, MD sphere): MD law at
+μ = 3, smoothing 0.2, dx 0.05, s = 2.0, pull-off +8.2 % over Maugis with the edge stuck for 0.6 ε of
+D; smoothing 0.6 (s = 0.67 / 0.52 at dx 0.05 / 0.035) +0.72 / +0.21 %; μ = 1, smoothing 0.2,
+s = 0.79 / 0.38 at dx 0.1 / 0.05: +1.1 / +0.27 %.  LJ 9-3 has s = 0.66 at μ = 3, dx 0.1.  s grows
+about as μ^{3/2} dx.
 
 A-priori estimate (stated with every run, ``params['process_zone_estimate']``): at a crack-like
 contact edge (JKR limit) the Dugdale zone is ℓ_D = (π/4) E* W/σ0², i.e. π/(4 κ σ0²) in units of the
@@ -95,8 +97,8 @@ _MISSING = object()
 
 
 def _declared(law) -> tuple:
-    """(σ0, g_peak, g0, W, max dP/dg) as the law declares them (``tengsim.laws.Law``: closed forms in the
-    built-in laws, a cached numerical search otherwise); a duck-typed law declaring none gets the laws'
+    """(σ0, g_peak, g0, W) as the law declares them (``tengsim.laws.Law``: closed forms in the built-in
+    laws, a cached numerical search otherwise); a duck-typed law declaring none gets the laws'
     numerical search (cached where the law is hashable)."""
     s0 = getattr(law, "max_tension", _MISSING)
     if s0 is _MISSING:
@@ -105,25 +107,22 @@ def _declared(law) -> tuple:
         except TypeError:  # an unhashable duck-typed law: compute without the cache
             return _undeclared.__wrapped__(law)
     if s0 is None or not float(s0) > 0:
-        return 0.0, None, None, 0.0, 0.0
-    return float(s0), law.g_peak, law.g_zero, float(law.work or 0.0), law.max_softening
+        return 0.0, None, None, 0.0
+    return float(s0), law.g_peak, law.g_zero, float(law.work or 0.0)
 
 
 @lru_cache(maxsize=16)
 def _undeclared(law) -> tuple:
-    from tengsim.laws.base import numeric_softening, numeric_window  # only for a law that is no Law
+    from tengsim.laws.base import numeric_window  # only for a law that is no tengsim.laws.Law
 
     w = numeric_window(law)
-    if w is None:
-        return 0.0, None, None, 0.0, 0.0
-    g_peak, s0, g0, work = w
-    return s0, g_peak, g0, work, numeric_softening(law, g_peak, g0 + 2.0 * work / s0)
+    return (0.0, None, None, 0.0) if w is None else (w[1], w[0], w[2], w[3])
 
 
 def cohesive_window(law) -> CohesiveWindow | None:
     """The law's cohesive window from its declared numbers (``max_tension``, ``g_peak``, ``g_zero``,
     ``work``; :class:`tengsim.laws.Law`); None for a law without tension, e.g. ``Repulsive``."""
-    s0, g_peak, g0, work, _ = _declared(law)
+    s0, g_peak, g0, work = _declared(law)
     if not (s0 > 0 and work > 0):
         return None
     return CohesiveWindow(float(g_peak), float(g0), s0, work)
@@ -132,9 +131,15 @@ def cohesive_window(law) -> CohesiveWindow | None:
 def law_softening(law) -> float:
     """Steepest softening of a law beyond its tensile peak, max dP/dg over g* ≤ g ≤ g0 + 2 h0 (W/ε²
     units), as the law declares it (``max_softening``); 0 for a law without tension."""
-    if cohesive_window(law) is None:
+    w = cohesive_window(law)
+    if w is None:
         return 0.0
-    return float(max(_declared(law)[4] or 0.0, 0.0))
+    soft = getattr(law, "max_softening", _MISSING)
+    if soft is _MISSING:  # a duck-typed law declaring none: the laws' numerical search
+        from tengsim.laws.base import numeric_softening
+
+        soft = numeric_softening(law, w.g_peak, w.g_end + w.h0)
+    return float(max(soft or 0.0, 0.0))
 
 
 def pixel_compliance(kernel) -> float:
@@ -235,6 +240,18 @@ def narrow_zone(table: dict, dx: float) -> np.ndarray:
     return measured & (pz < RESOLUTION * dx)
 
 
+def row_status(converged: bool, in_range: bool, process_zone: float, dx: float, snap: float | None = None) -> str:
+    """The status of one equilibrium as it is recorded (the same rules as :func:`classify` on a table)."""
+    if not converged:
+        return NOT_CONVERGED
+    if not in_range:
+        return OUT_OF_LAW_RANGE
+    measured = process_zone == process_zone and process_zone > 0
+    if measured and (process_zone < RESOLUTION * dx or (snap is not None and snap > 1.0)):
+        return UNDER_RESOLVED
+    return OK
+
+
 def classify(table: dict, dx: float, snap: float | None = None) -> np.ndarray:
     """Per-row status strings: the worst problem of each row (SEVERITY order), 'ok' if none."""
     f = flags(table, dx, snap)
@@ -303,16 +320,14 @@ def warning_lines(result) -> list[str]:
     return [text for _, text in problems(result)]
 
 
-def attach(result, law, coupling: float, kernel=None) -> None:
-    """Set the status column, the a-priori process-zone estimate, the pixel snap number (with
-    ``kernel``) and the overall status on ``result`` (``params['warning']`` keeps the joined lines
-    for older readers)."""
+def attach(result, law, coupling: float) -> None:
+    """Add the run-level status to ``result``, whose rows were classified as they were recorded
+    (:class:`tengsim.continuation.Recorder`, :func:`row_status`): the a-priori process-zone estimate,
+    the criterion, the overall status and the warning lines (``params['warning']``, joined)."""
     result.params["process_zone_estimate"] = process_zone_estimate(law, coupling)
     result.params["resolution_criterion"] = f"process_zone >= {RESOLUTION:g} dx and pixel_snap_number <= 1"
-    snap = pixel_snap_number(law, kernel) if kernel is not None else None
-    if snap is not None:
-        result.params["pixel_snap_number"] = snap
-    result.table["status"] = classify(result.table, result.grid.dx, snap)
+    if "status" not in result.table:  # a table from elsewhere (an older file): classify it here, once
+        result.table["status"] = classify(result.table, result.grid.dx, result.params.get("pixel_snap_number"))
     result.params["status"] = overall(result.table["status"])
     lines = warning_lines(result)
     if lines:

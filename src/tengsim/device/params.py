@@ -248,10 +248,6 @@ class DeviceParams:
         """S sigma^2 / (eps0 d0 k_e): gamma4 of Eq. (23) with A = S."""
         return self.area_m2 * self.sigma_C_per_m2 ** 2 / (EPS0 * self.gap_m * self.stiffness_N_per_m)
 
-    @property
-    def damping_N_s_per_m(self) -> float:
-        return 2.0 * self.damping_ratio * math.sqrt(self.mass_kg * self.stiffness_N_per_m)
-
     def replace(self, **changes) -> "DeviceParams":
         return dataclasses.replace(self, **changes)
 

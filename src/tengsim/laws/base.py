@@ -106,7 +106,7 @@ class Law:
 
     @property
     def g_peak(self) -> float | None:
-        """The smallest gap where P = −σ0 (the tensile peak; the start of a plateau); None without tension."""
+        """The smallest gap where P = −σ0 (the tensile peak; a plateau's start); None without tension."""
         w = self._numeric_window
         return None if w is None else w[0]
 

@@ -71,10 +71,6 @@ class Equilibrium:
     seconds: float
     message: str = ""
 
-    @property
-    def force_sum(self) -> float:  # pragma: no cover - convenience
-        return float(self.P.sum())
-
 
 def _finish(problem, state, P, r, energy, converged, it, n_conv, t0, msg):
     H = problem.g0 + state.w - 1.0

@@ -9,8 +9,6 @@ named pressures, and an empty cell wherever there is no value.
 """
 from __future__ import annotations
 
-import csv
-import io
 import json
 import math
 from pathlib import Path

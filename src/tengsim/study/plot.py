@@ -38,7 +38,9 @@ def plot_study(root, out, vars=MAP_VARS) -> list:
     import matplotlib.pyplot as plt
 
     root, out = Path(root), Path(out)
-    nc = root / "study.nc"
+    from tengsim.study.layout import StudyDir
+
+    nc = StudyDir(root).dataset_nc
     if not nc.exists():
         raise TengsimError(f"{root} holds no study.nc (run tengsim sweep first)")
     ds = read_dataset(nc)

@@ -392,7 +392,6 @@ def _resolve(base: dict, assign: dict) -> dict:
     return tables
 
 
-_EXPR_NAME = re.compile(r"[A-Za-z_]\w*")
 
 
 def evaluate(contact: dict, var: dict) -> dict:

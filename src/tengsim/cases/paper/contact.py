@@ -16,7 +16,7 @@ from tengsim.io import jsonable
 from tengsim.shapes import Pyramid
 from tengsim.loadpath import LoadPathSpec
 from tengsim.path import PathSpec
-from tengsim.cases.paper.units import PAPER_GROUPS, PaperScaling, paper_scaling
+from tengsim.cases.paper.units import PAPER_GROUPS, paper_scaling
 
 # The paper's reported partial-to-full contact transitions (Fig. 4a), for comparison only.
 PAPER_TRANSITION_D = {"A": 1.75, "B": 5.20, "C": 10.95}

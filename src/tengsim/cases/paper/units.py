@@ -10,7 +10,7 @@ import math
 from dataclasses import dataclass
 
 from tengsim.errors import TengsimError, positive
-from tengsim.units import Scaling, _Units
+from tengsim.units import _Units
 
 
 @dataclass(frozen=True)
@@ -74,9 +74,6 @@ class PaperScaling(_Units):
     def pressure(self, F):
         """Nominal pressure on the array f/L² (Pa)."""
         return self.force(F) / self.L**2
-
-    def to_scaling(self) -> Scaling:
-        return Scaling(self.E_star, self.W, self.eps, self.lateral, self.cell_area)
 
     def params(self) -> dict:
         return {"E_star_Pa": self.E_star, "W_J_m2": self.W, "base_m": self.m, "height_m": self.n,
