@@ -93,19 +93,16 @@ class CohesiveWindow:
         return self.g0 + self.h0
 
 
-_MISSING = object()
-
-
 def _declared(law) -> tuple:
     """(σ0, g_peak, g0, W) as the law declares them (``tengsim.laws.Law``: closed forms in the built-in
     laws, a cached numerical search otherwise); a duck-typed law declaring none gets the laws'
     numerical search (cached where the law is hashable)."""
-    s0 = getattr(law, "max_tension", _MISSING)
-    if s0 is _MISSING:
+    if not hasattr(law, "max_tension"):
         try:
             return _undeclared(law)
         except TypeError:  # an unhashable duck-typed law: compute without the cache
             return _undeclared.__wrapped__(law)
+    s0 = law.max_tension
     if s0 is None or not float(s0) > 0:
         return 0.0, None, None, 0.0
     return float(s0), law.g_peak, law.g_zero, float(law.work or 0.0)
@@ -134,8 +131,9 @@ def law_softening(law) -> float:
     w = cohesive_window(law)
     if w is None:
         return 0.0
-    soft = getattr(law, "max_softening", _MISSING)
-    if soft is _MISSING:  # a duck-typed law declaring none: the laws' numerical search
+    if hasattr(law, "max_softening"):
+        soft = law.max_softening
+    else:  # a duck-typed law declaring none: the laws' numerical search
         from tengsim.laws.base import numeric_softening
 
         soft = numeric_softening(law, w.g_peak, w.g_end + w.h0)
