@@ -214,6 +214,24 @@ def numeric_softening(law, g_lo: float, g_hi: float) -> float:
     return float(max(d[i], -float(r.fun), 0.0))
 
 
+class WallLaw(Law):
+    """A law whose linear wall (:func:`_wall`, stiffness ``wall_stiffness``) starts at g = 1 with its peak
+    tension ``tension`` there (Maugis–Dugdale, exponential): the declared numbers these laws share."""
+
+    @property
+    def max_tension(self) -> float:
+        return self.tension
+
+    @property
+    def g_peak(self) -> float:
+        return 1.0
+
+    @property
+    def g_zero(self) -> float:
+        """Zero load on the wall: g0 = 1 − σ0/k."""
+        return 1.0 - self.tension / self.wall_stiffness
+
+
 def make_law(name: str, **params) -> Law:
     """Law by registered name or alias (see ``tengsim.registry.LAWS``): 'lj93' (the paper's), 'repulsive',
     'md' (Maugis–Dugdale) or 'exp' (exponential)."""

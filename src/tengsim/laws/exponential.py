@@ -6,12 +6,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from tengsim.errors import positive
-from tengsim.laws.base import LJ_PEAK_TENSION, Law, _check_common, _wall
+from tengsim.laws.base import LJ_PEAK_TENSION, WallLaw, _check_common, _wall
 from tengsim.registry import LAWS
 
 
 @dataclass(frozen=True)
-class Exponential(Law):
+class Exponential(WallLaw):
     """Exponential attraction with a wall (the contact-mechanics challenge's kind, Müser et al. 2017).
 
     g >= 1: Φ = −A exp(−(g − 1)/ρ), P = −(A/ρ) exp(−(g − 1)/ρ), range ρ = ``range`` (ε); peak
@@ -44,19 +44,7 @@ class Exponential(Law):
         """Peak tension A/ρ (W/ε), at g = 1."""
         return self.amplitude / self.range
 
-    # declared numbers (Law): closed forms
-    @property
-    def max_tension(self) -> float:
-        return self.tension
-
-    @property
-    def g_peak(self) -> float:
-        return 1.0
-
-    @property
-    def g_zero(self) -> float:
-        return 1.0 - self.tension / self.wall_stiffness
-
+    # declared numbers (Law): closed forms; max_tension, g_peak, g_zero from WallLaw
     @property
     def work(self) -> float:
         return self.amplitude + self.tension**2 / (2.0 * self.wall_stiffness)

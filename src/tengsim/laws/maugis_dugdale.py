@@ -6,12 +6,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from tengsim.errors import TengsimError, positive
-from tengsim.laws.base import LJ_PEAK_TENSION, Law, _check_common, _wall
+from tengsim.laws.base import LJ_PEAK_TENSION, WallLaw, _check_common, _wall
 from tengsim.registry import LAWS
 
 
 @dataclass(frozen=True)
-class MaugisDugdale(Law):
+class MaugisDugdale(WallLaw):
     """Dugdale law (Maugis 1992): constant tension σ0 = ``tension`` over 1 < g < 1 + h0, a wall below.
 
     Wall (g < 1): P = −σ0 + k(1 − g), k = ``wall_stiffness`` (W/ε²), so the contact zone g <= 1 carries
@@ -53,19 +53,7 @@ class MaugisDugdale(Law):
         """h0 = 1/σ0 − σ0/(2k) in ε (W = σ0 h0 + σ0²/(2k) = 1)."""
         return 1.0 / self.tension - self.tension / (2.0 * self.wall_stiffness)
 
-    # declared numbers (Law): closed forms
-    @property
-    def max_tension(self) -> float:
-        return self.tension
-
-    @property
-    def g_peak(self) -> float:
-        return 1.0
-
-    @property
-    def g_zero(self) -> float:
-        return 1.0 - self.tension / self.wall_stiffness
-
+    # declared numbers (Law): closed forms; max_tension, g_peak, g_zero from WallLaw
     @property
     def work(self) -> float:
         return self.tension * self.range + self.tension**2 / (2.0 * self.wall_stiffness)
