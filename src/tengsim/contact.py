@@ -54,8 +54,8 @@ def simulate(shape: Shape, tabor: float, dx: float, path: PathSpec, boundary: st
     kernel = make_kernel(boundary, grid, tabor**1.5, **(kernel_params or {}))
     walk = run_load_path if isinstance(path, LoadPathSpec) else run_path  # load or rigid-approach control
     res = walk(shape.gap(grid), law, kernel, solver_obj, path, progress=progress, observers=observers)
+    recorded = res.params  # what the path recorded (the pixel snap number)
     res.params = {
-        **res.params,  # what the path recorded (the pixel snap number)
         "tengsim_version": __version__,
         **shape.params(),
         "lateral_unit": getattr(shape, "lateral_unit", "ℓ"),
@@ -75,6 +75,7 @@ def simulate(shape: Shape, tabor: float, dx: float, path: PathSpec, boundary: st
         "jump_h": path.jump_h,
         **path.extra_params(),  # adaptive steps or load control (none for a fixed-step D path)
         **(extra_params or {}),
+        **recorded,
     }
     if scaling is not None:
         for k, v in scaling.params().items():
