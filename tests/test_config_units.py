@@ -212,9 +212,12 @@ def test_physical_run_has_si_columns_and_its_own_units(tmp_path):
     np.testing.assert_allclose(ds["F_N"].values, 3 * math.pi * W * lat**2 / eps * F, rtol=1e-9)
     np.testing.assert_allclose(ds["pressure_Pa"].values, ds["F_N"].values / (8 * lat) ** 2, rtol=1e-9)
     np.testing.assert_allclose(ds["contact_length_m"].values, ds["contact_length"].values * lat, rtol=1e-9)
-    assert ds["F_N"].attrs["units"].startswith("N") and ds["pressure_Pa"].attrs["units"].startswith("Pa")
-    assert "m/n" not in ds["F"].attrs["units"] and "N per cell" in ds["F"].attrs["units"]
-    assert f"{lat:.6g}" in ds["contact_length"].attrs["units"]
+    # CF units (tests/test_cf.py): SI columns in UDUNITS units, dimensionless ones "1" with their scale
+    assert ds["F_N"].attrs["units"] == "N" and ds["pressure_Pa"].attrs["units"] == "Pa"
+    assert ds["F"].attrs["units"] == "1" and "m/n" not in ds["F"].attrs["unit_scale_text"]
+    assert "per cell" in ds["F"].attrs["unit_scale_text"] and ds["F"].attrs["unit_scale_units"] == "N"
+    assert ds["F"].attrs["unit_scale"] == pytest.approx(3 * math.pi * W * lat**2 / eps, rel=1e-9)
+    assert ds["contact_length"].attrs["unit_scale"] == pytest.approx(lat, rel=1e-9)
     params = json.loads(ds.attrs["params"])
     assert params["tabor"] == pytest.approx(1.0) and params["eps_m"] == pytest.approx(eps, rel=1e-10)
     head = [line for line in open(csv) if line.startswith("#")]
@@ -228,12 +231,13 @@ def test_dimensionless_units_name_the_shape_not_the_pyramid(tmp_path):
     assert main(["contact", "cube", "--half-width", "1", "--height", "3", "--cell", "4", "--dx", "0.5",
                  "--d-max", "0.5", "--d-step", "0.5", "--quiet", "--out", str(nc)]) == 0
     ds = xr.load_dataset(nc)
-    assert "m/n" not in ds["F"].attrs["units"] and "m/n" not in ds["contact_length"].attrs["units"]
+    assert "m/n" not in ds["F"].attrs["unit_scale_text"] and "m/n" not in ds["contact_length"].attrs["unit_scale_text"]
+    assert "unit_scale" not in ds["F"].attrs  # a dimensionless run: the scale in words only
     assert "F_N" not in ds
     nc2 = tmp_path / "p.nc"
     assert main(["contact", "pyramid", "--N", "0.946", "--cell", "3.78", "--dx", "0.3", "--d-max", "0.5",
                  "--d-step", "0.5", "--quiet", "--out", str(nc2)]) == 0
-    assert "ε m/n" in xr.load_dataset(nc2)["contact_length"].attrs["units"]
+    assert "ε m/n" in xr.load_dataset(nc2)["contact_length"].attrs["unit_scale_text"]
 
 
 def test_plot_curves_uses_physical_axes(tmp_path, monkeypatch):

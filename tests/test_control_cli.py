@@ -112,3 +112,63 @@ def test_physical_pressure_needs_a_pressure(tmp_path, capsys):
     err = capsys.readouterr().err
     assert "f_max" in err and "pressure" in err
     assert list(tmp_path.iterdir()) == []
+
+
+# ---- issue 21: maps at a requested D or load, never dropped; a load not met is warned about -------------
+
+
+def test_cli_maps_at_off_the_d_step_lattice(tmp_path, capsys):
+    """`--maps-at 1.1` with `--d-step 0.25`: the maps at D = 1.1 on both branches (an extra row each)."""
+    import xarray as xr
+
+    out = tmp_path / "m.nc"
+    assert main([*GROUP_A, "--d-max", "2", "--d-step", "0.25", "--maps-at", "1.1", "--out", str(out)]) == 0
+    ds = xr.load_dataset(out)
+    assert sorted(zip(ds["map_branch"].values.astype(str), ds["map_D"].values.tolist())) == [
+        ("approach", 1.1), ("retraction", 1.1)]
+    at = np.flatnonzero(ds["D"].values == 1.1)
+    assert len(at) == 2 and not ds["on_grid"].values[at].astype(bool).any()
+
+
+def test_cli_load_maps_at_off_the_f_step_lattice(tmp_path):
+    import xarray as xr
+
+    out = tmp_path / "l.nc"
+    assert main([*GROUP_A, "--control", "load", "--f-max", "0.5", "--f-step", "0.25", "--maps-at", "0.1",
+                 "--out", str(out)]) == 0
+    ds = xr.load_dataset(out)
+    assert sorted(ds["map_branch"].values.astype(str)) == ["approach", "retraction"]
+    F = ds["F"].values
+    for D in ds["map_D"].values:  # the rows the maps were kept at hold the load 0.1
+        assert abs(F[np.flatnonzero(ds["D"].values == D)[0]] - 0.1) <= 1e-4 * 0.25
+
+
+@pytest.mark.parametrize("bad, words", [
+    (["--d-max", "2", "--d-step", "0.25", "--maps-at", "2.1"], "maps_at D = 2.1 is outside the path's D range [-1, 2]"),
+    (["--maps-at", "1.1"], "maps_at = 1.1 needs a .nc output: out = "),
+    (["--control", "load", "--f-max", "0.5", "--f-step", "0.25", "--maps-at", "-2"],
+     "maps_at load F = -2 is outside the path's load range [0, 0.5]"),
+])
+def test_cli_maps_at_refused_one_line_nothing_written(tmp_path, capsys, bad, words):
+    rc = main([*GROUP_A, *bad, "--out", str(tmp_path / "x.csv")])
+    err = capsys.readouterr().err
+    assert rc == 2 and words in err and len(err.strip().splitlines()) == 1, err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_cli_load_not_met_warns_with_where(tmp_path, capsys, monkeypatch):
+    """A load whose outer solve stops short of f_tol (regula falsi capped at one step here): exit 0, the
+    rows not_converged, and the warnings say which loads and where."""
+    from tengsim import loadpath
+
+    monkeypatch.setattr(loadpath._LoadBranch, "max_root_steps", 1)
+    out = tmp_path / "l.csv"
+    assert main([*GROUP_A, "--control", "load", "--f-max", "0.5", "--f-step", "0.25", "--out", str(out)]) == 0
+    err = capsys.readouterr().err
+    lines = [l for l in err.splitlines() if l.startswith("tengsim: warning:")]
+    assert any("not converged" in l and "load not met to f_tol" in l and "approach D" in l for l in lines), err
+    assert any("load(s) not met, first approach: load F = " in l and "D in [" in l for l in lines), err
+    rows = _rows(out)
+    assert any(r["status"] == "not_converged" for r in rows)
+    head = "".join(l for l in open(out) if l.startswith("#"))
+    assert "load_not_met" in head

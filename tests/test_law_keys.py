@@ -53,8 +53,9 @@ def test_toml_and_cli_law_keys_give_the_api_numbers(law, keys, obj, tmp_path, ca
     assert main(["run", str(toml), "--quiet"]) == 0, capsys.readouterr().err
     ds = xr.load_dataset(nc)
     np.testing.assert_allclose(ds["F"].values, api.table["F"], rtol=1e-12, atol=0)
-    for k, v in obj.params().items():  # the resolved law, defaults included, in the file's attributes
-        assert ds.attrs[k] == v, k
+    stored = json.loads(ds.attrs["params"])  # parameters stored once, as JSON (CF layout)
+    for k, v in obj.params().items():  # the resolved law, defaults included, in the file's parameters
+        assert stored[k] == v, k
 
     out = tmp_path / "cli.csv"
     argv = ["contact", "sphere", "--law", law, "--quiet", "--out", str(out)]

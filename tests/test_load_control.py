@@ -161,3 +161,86 @@ def test_paper_area_table_load_controlled_matches_d_picked():
     cmp = compare_area_tables(load, picked, "A", s.dx)
     assert cmp["n_compared"] >= 11
     assert cmp["max_excess"] == 0.0
+
+
+# ---- issue 21: loads off the lattice get their maps; a load not met is not_converged, with where -------
+
+
+@lru_cache(maxsize=None)
+def group_a_load(maps_at=(), steps=None):
+    """Group A at dx 0.4 under load −0.5 … 0.5 in steps of 0.25 (``steps``: the regula-falsi cap)."""
+    from tengsim import loadpath
+
+    sc = paper_scaling("A")
+    shape = ts.Pyramid(sc.N, sc.cell)
+    grid = shape.grid(0.4)
+    spec = LoadPathSpec(-0.5, 0.5, 0.25, d_max=3.0, d_step=0.1, maps_at=maps_at)
+    old = loadpath._LoadBranch.max_root_steps
+    loadpath._LoadBranch.max_root_steps = old if steps is None else steps
+    try:
+        res = ts.simulate(shape, sc.mu, 0.4, spec, tol=1e-7)
+    finally:
+        loadpath._LoadBranch.max_root_steps = old
+    return res, grid, spec
+
+
+def test_load_maps_at_off_the_lattice_are_extra_targets():
+    """A load between lattice loads is met (to f_tol) on both branches as an extra target, its row has
+    on_grid False and its map is that state; the lattice rows still meet their loads."""
+    ref_, _, spec = group_a_load()
+    res, grid, _ = group_a_load((0.1, 0.25))
+    assert res.status in ("ok", "under_resolved") and "load_not_met" not in res.params
+    got = sorted((m["branch"], round(float(ts.force(m["P"], grid)), 3)) for m in res.maps)
+    assert got == [("approach", 0.1), ("approach", 0.25), ("retraction", 0.1), ("retraction", 0.25)]
+    for m in res.maps:  # each map is the state at its load, to f_tol
+        assert min(abs(ts.force(m["P"], grid) - f) for f in (0.1, 0.25)) <= spec.tol_F
+    t = res.table
+    at = np.abs(t["F"] - 0.1) <= spec.tol_F
+    assert at.sum() == 2 and not t["on_grid"][at].astype(bool).any()
+    on = t["on_grid"].astype(bool)
+    np.testing.assert_allclose(t["F"][on], ref_.table["F"][ref_.table["on_grid"].astype(bool)], atol=2 * spec.tol_F)
+    assert len(t["F"]) == len(ref_.table["F"]) + 2
+
+
+def test_load_maps_at_outside_the_loads_refused():
+    with pytest.raises(ts.TengsimError, match=r"maps_at load F = 0.6 is outside the path's load range \[-0.5, 0.5\]"):
+        LoadPathSpec(-0.5, 0.5, 0.25, maps_at=(0.6,))
+    with pytest.raises(ts.TengsimError, match=r"below f_max = 0.6\)"):
+        LoadPathSpec(-0.5, 0.6, 0.25, maps_at=(0.55,))
+    LoadPathSpec(-0.5, 0.5, 0.25, maps_at=(-0.5, 0.1, 0.5))
+
+
+def test_a_load_not_met_is_not_converged_with_where():
+    """A regula falsi stopped before |F − target| <= f_tol (here capped at one step) records the row with
+    converged False: status not_converged, the warning line says so, and params['load_not_met'] names
+    each load missed, its branch and the D bracket the search ended in."""
+    from tengsim.status import warning_lines
+
+    res, _, spec = group_a_load((), 1)
+    t = res.table
+    miss = np.abs(t["F"] - np.round(t["F"] / 0.25) * 0.25) > spec.tol_F
+    on = t["on_grid"].astype(bool)
+    assert (miss & on).any()
+    # every on-grid row that misses its load is flagged, and no row that meets it
+    assert not t["converged"][miss & on].astype(bool).any()
+    assert t["converged"][~miss & on].astype(bool).all()
+    assert set(t["status"][miss & on]) == {"not_converged"} and res.status == "not_converged"
+    notes = res.params["load_not_met"].split("; ")
+    assert len(notes) >= (miss & on).sum() - 1  # the retraction's first row is the approach's last state
+    first = notes[0]
+    assert first.startswith("approach: load F = ") and "> f_tol = 2.5e-05" in first
+    assert "D in [" in first and "after 1 regula-falsi step)" in first
+    lines = warning_lines(res)
+    assert any(l.startswith("not converged:") and "load not met to f_tol" in l and "approach D" in l for l in lines)
+    # the same run uncapped meets every load
+    ok, _, _ = group_a_load()
+    assert "load_not_met" not in ok.params and ok.table["converged"].astype(bool).all()
+
+
+def test_a_map_whose_load_has_no_state_is_named_not_dropped():
+    """Group A at rest pulls with F ≈ −0.09, so the approach skips −0.25 (the body stays away): no map
+    there, and params['maps_not_made'] says so; the retraction (pull-off ≈ −0.93) has it."""
+    res, grid, spec = group_a_load((-0.25,))
+    assert [m["branch"] for m in res.maps] == ["retraction"]
+    assert abs(ts.force(res.maps[0]["P"], grid) + 0.25) <= spec.tol_F
+    assert res.params["maps_not_made"].startswith("approach F = -0.25 (no state at that load")

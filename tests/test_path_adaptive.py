@@ -81,3 +81,76 @@ def test_adaptive_spec_validation():
         PathSpec(-1, 1, 0.5, adaptive=True, adapt_tol=0)
     with pytest.raises(ts.TengsimError, match="adapt_h"):
         PathSpec(-1, 1, 0.5, adaptive=True, adapt_h=-1)
+
+
+# ---- maps at requested D off the walk's rows (issue 21: nothing silently dropped) -------------------------
+
+# a μ = 1 sphere jumps in between D = -1.625 and -1.609375 and out between -1.734375 and -1.75 (steps of
+# 0.25/16); the midpoints of those jump intervals, a D off every row, and a D on the lattice
+IN_JUMP_IN, IN_JUMP_OUT = -1.6171875, -1.7421875
+MAPS = (-1.3, 0.1, IN_JUMP_IN, IN_JUMP_OUT, 0.25)
+
+
+@lru_cache(maxsize=None)
+def sphere_mu1(maps_at=(), adaptive=False, d_step=0.25):
+    shape = ts.Paraboloid(1.0, 8.0)
+    grid = shape.grid(0.4)
+    spec = PathSpec(-2.0, 0.5, d_step, adaptive=adaptive, maps_at=maps_at)
+    return run_path(shape.gap(grid), ts.LJ93(), FreeKernel(grid, 1.0), ts.FastSolver(1e-8), spec), grid
+
+
+@pytest.mark.parametrize("adaptive", [False, True])
+def test_maps_at_off_the_rows_are_kept_exactly_at_their_D(adaptive):
+    """Every requested D gets its map on both branches, at exactly that D: off the rows the walk visits,
+    an extra row (on_grid False) there; every other row is the run's without maps_at, state for state;
+    the jumps stay one per branch, within the smallest step of where they were."""
+    ref, grid = sphere_mu1((), adaptive)
+    res, _ = sphere_mu1(MAPS, adaptive)
+    assert res.all_converged
+    assert sorted((m["branch"], float(m["D"])) for m in res.maps) == sorted(
+        (b, d) for b in ("approach", "retraction") for d in MAPS)
+    for m in res.maps:
+        row = res.branch(m["branch"])
+        i = int(np.flatnonzero(row["D"] == m["D"])[0])
+        assert ts.force(m["P"], grid) == row["F"][i]  # the map is the row's state
+    for br, sign in (("approach", 1), ("retraction", -1)):
+        a, b = ref.branch(br), res.branch(br)
+        extra = ~np.isin(b["D"], a["D"])
+        assert sorted(b["D"][extra]) == sorted(d for d in MAPS if d not in a["D"])
+        assert not b["on_grid"][extra].astype(bool).any()
+        np.testing.assert_array_equal(b["F"][~extra], a["F"])  # the continuation never saw the extra states
+        np.testing.assert_array_equal(b["on_grid"][~extra], a["on_grid"])
+        assert np.all(sign * np.diff(b["D"]) > 0)  # path order
+    assert [j.branch for j in res.jumps] == [j.branch for j in ref.jumps] == ["approach", "retraction"]
+    for ja, jb in zip(ref.jumps, res.jumps):  # an extra row inside a jump interval narrows it
+        lo, hi = sorted((ja.D_before, ja.D_after))
+        assert lo - 1e-12 <= min(jb.D_before, jb.D_after) < max(jb.D_before, jb.D_after) <= hi + 1e-12
+    assert {j.D_after for j in res.jumps} & {IN_JUMP_IN, IN_JUMP_OUT}  # (here it does)
+
+
+def test_extra_map_rows_are_the_d_controlled_equilibria_there():
+    """Away from the jumps, the state kept at a requested D off the lattice is the one a finer fixed run,
+    whose lattice holds that D, reaches by its own warm starts: F to 1e-6 of the pull-off scale."""
+    res, grid = sphere_mu1(MAPS, False)
+    fine, _ = sphere_mu1((), False, 0.05)
+    scale = abs(fine.pull_off_force)
+    for m in res.maps:
+        if m["D"] in (-1.3, 0.1):
+            f = fine.branch(m["branch"])
+            i = int(np.argmin(np.abs(f["D"] - m["D"])))
+            assert abs(f["D"][i] - m["D"]) < 1e-12
+            assert abs(ts.force(m["P"], grid) - f["F"][i]) < 1e-6 * scale
+
+
+@pytest.mark.parametrize("spec, words", [
+    (dict(d_min=-1.0, d_max=2.0, d_step=0.25, maps_at=(2.1,)), "maps_at D = 2.1 is outside the path's D range [-1, 2]"),
+    (dict(d_min=-1.0, d_max=2.1, d_step=0.25, maps_at=(2.05,)),
+     "maps_at D = 2.05 is outside the path's D range [-1, 2] (the last D of the d_step lattice below d_max = 2.1)"),
+    (dict(d_min=-1.0, d_max=2.0, d_step=0.25, maps_at=(-1.5,)), "maps_at D = -1.5 is outside"),
+    (dict(d_min=-1.0, d_max=2.0, d_step=0.25, maps_at=(float("nan"),)), "maps_at must be finite"),
+])
+def test_maps_at_outside_the_path_refused(spec, words):
+    with pytest.raises(ts.TengsimError) as e:
+        PathSpec(**spec)
+    assert words in str(e.value) and "\n" not in str(e.value)
+    PathSpec(-1.0, 2.0, 0.25, maps_at=(-1.0, 2.0, 1.1))  # the ends and a D between lattice points: accepted

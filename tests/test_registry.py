@@ -109,7 +109,8 @@ def test_observers_append_columns_to_table_csv_and_netcdf(tmp_path):
     assert [float(r["P_apex"]) for r in rows] == pytest.approx(list(t["P_apex"]))
     ds = xr.load_dataset(tmp_path / "o.nc")
     np.testing.assert_allclose(ds["H_apex"].values, t["H_apex"])
-    assert ds["P_apex"].attrs["units"] == "W/ε"
+    # CF: a dimensionless column has units "1"; the observer's unit is its scale (tests/test_cf.py)
+    assert ds["P_apex"].attrs["units"] == "1" and ds["P_apex"].attrs["unit_scale_text"] == "W/ε (Eq. 8)"
 
 
 def test_observer_errors_are_named():

@@ -13,7 +13,7 @@ import dataclasses
 from dataclasses import dataclass, field
 
 from tengsim.kernels import film
-from tengsim.errors import TengsimError, finite, positive
+from tengsim.errors import ConfigValueError, TengsimError, finite, positive
 from tengsim.laws import make_law
 from tengsim.path import PathSpec
 from tengsim.plugins import KERNELS, LAWS, OBSERVERS, SHAPES, SOLVERS
@@ -25,6 +25,66 @@ PHYSICAL_KEYS = ("E_star", "W", "eps")
 """Keys that make a [contact] table a physical run (with any physical-only key of the shape)."""
 
 _SUFFIX = {"length": "_m", "pressure": "_Pa", "energy/area": "_J_m2"}
+
+X_UNIT_KEYS = {"dx": "length", "thickness": "length", "f_min": "pressure", "f_max": "pressure", "f_step": "pressure"}
+"""Keys whose bare number is *not* SI (dx, thickness in X units; loads as F of Eq. 10), with the dimension a
+unit string gives them in a physical run."""
+_QUANTITY = {"E_star": "modulus"}
+"""The plausibility range (tengsim.units.PLAUSIBLE) of a key, where it is not its dimension's."""
+
+
+def _physical_triggers(given, dim_names, phys_names) -> list:
+    """The given keys that make a [contact] table a physical run."""
+    return sorted(set(given) & (set(PHYSICAL_KEYS) | (set(phys_names) - set(dim_names))))
+
+
+def key_dims(cfg: dict) -> dict:
+    """{key: (dimension, bare number is SI)} of the quantity keys of the run a [contact] table describes.
+
+    Empty for a dimensionless run (every number plain, lengths in X units) or an unknown shape (which
+    :func:`plan_contact` reports).  In a physical run: E_star, W, eps and the shape's physical fields
+    with a dimension (a bare number is SI), and dx, thickness, f_min, f_max, f_step (a bare number is in
+    X units or F: :data:`X_UNIT_KEYS`).  Study expressions read it to give their SI value its unit."""
+    try:
+        _, cls = _shape_cls(cfg.get("shape") or "pyramid")
+    except (TengsimError, KeyError, ValueError):
+        return {}
+    dims, phys = dimensionless_fields(cls), physical_fields(cls)
+    given = {k for k, v in cfg.items() if v is not None and v != ""}
+    if not phys or not _physical_triggers(given, [f.name for f in dims], [f.name for f in phys]):
+        return {}
+    out = {f.name: (f.dim, True) for f in common_fields() if f.dim}
+    out.update({k: (d, False) for k, d in X_UNIT_KEYS.items()})
+    out.update({f.name: (f.dim, True) for f in phys if f.dim})
+    return out
+
+
+def _bare(v) -> bool:
+    if isinstance(v, bool):
+        return False
+    if isinstance(v, (int, float)):
+        return True
+    if isinstance(v, str):
+        try:
+            float(v)
+        except ValueError:
+            return False
+        return True
+    return False
+
+
+def _check_bare_numbers(cfg, phys) -> None:
+    """Refuse a bare number (read as SI) outside the plausible range of its key's quantity (a physical run:
+    'E_star = 0.59' is 0.59 Pa); a ConfigValueError naming the likely unit (tengsim.units.PLAUSIBLE)."""
+    from tengsim.units import check_plausible
+
+    fields = [f for f in common_fields() if f.dim] + [f for f in phys if f.dim]
+    for f in fields:
+        raw = cfg.get(f.name)
+        items = raw if isinstance(raw, (list, tuple)) else [raw]
+        for v in items:
+            if _bare(v):
+                check_plausible(f.name, v, _QUANTITY.get(f.name, f.dim))
 
 
 def _observer_names(v):
@@ -98,6 +158,13 @@ def _path_spec(vals, given, scaling):
                     refine_levels=vals["refine_levels"], **kw)
 
 
+def _check_maps_out(maps_at, out) -> None:
+    """Refuse maps asked for with an output that cannot hold them (a .csv holds the curves only)."""
+    if maps_at and isinstance(out, str) and out.lower().endswith(".csv"):
+        raise TengsimError(f"maps_at = {', '.join(f'{m:g}' for m in maps_at)} needs a .nc output: out = {out!r} "
+                           "holds the curves only")
+
+
 def common_fields() -> list:
     """The [contact] keys every shape has (choices and help read from the registries)."""
     return [
@@ -105,16 +172,18 @@ def common_fields() -> list:
               help="registered shape: " + SHAPES.help()),
         Field("tabor", help="Tabor parameter μ (coupling μ^{3/2}); dimensionless runs: default 0.5; "
               "physical runs: no default, give tabor or eps"),
-        Field("E_star", dim="pressure", help="effective modulus E* (physical run)"),
-        Field("W", dim="energy/area", help="work of adhesion W (physical run)"),
-        Field("eps", dim="length", help="interaction range ε (physical run; or give tabor)"),
+        Field("E_star", dim="pressure", help="effective modulus E* (physical run; a bare number is Pa, 100 to 1e12)"),
+        Field("W", dim="energy/area", help="work of adhesion W (physical run; a bare number is J/m2, 1e-6 to 10)"),
+        Field("eps", dim="length",
+              help="interaction range ε (physical run; or give tabor; a bare number is m, 1e-12 to 1)"),
         Field("dx", "any", 0.1, help="grid spacing in X units; in a physical run also a length, e.g. '20nm'"),
         Field("d_min", default=-1.0, help="first rigid approach D of the path, in ε"),
         Field("d_max", default=4.0, help="last rigid approach D, in ε"),
         Field("d_step", default=0.05, help="step in D, in ε"),
         Field("refine_levels", "int", 4, help="step bisections before a change is called a jump"),
         Field("maps_at", "floats", (), help="D values (control = load: loads F) whose pressure and gap maps "
-              "are kept (.nc)"),
+              "are kept, on both branches, exactly there (a value between the path's rows gets a row of its "
+              "own; one outside the path is refused); needs a .nc out"),
         Field("control", "str", "approach", choices=CONTROLS,
               help="path control: approach (rigid approach D, Eq. 9) or load (total force F of Eq. 10, "
               "D an unknown)"),
@@ -282,11 +351,11 @@ def _dx(raw, lateral, name="dx"):
         if number is not None:
             return positive(name, number)
         if lateral is None:
-            raise TengsimError(f"{name} = {raw!r} has a unit, but this run is dimensionless: give {name} in X "
-                               "units (or the shape's physical sizes with E_star and W)")
+            raise ConfigValueError(f"{name} = {raw!r} has a unit, but this run is dimensionless: give {name} in X "
+                                   "units (or the shape's physical sizes with E_star and W)")
         return positive(name, parse_quantity(raw, "length", name=name) / lateral)
     if isinstance(raw, bool) or not isinstance(raw, (int, float)):
-        raise TengsimError(f"{name} must be a number, got {raw!r}")
+        raise ConfigValueError(f"{name} must be a number, got {raw!r}")
     return positive(name, raw)
 
 
@@ -355,7 +424,7 @@ def plan_contact(cfg: dict) -> ContactPlan:
     if wrong:
         raise TengsimError(f"law {law_name} has no key {', '.join(map(repr, wrong))} "
                            f"(its keys: {', '.join(f.name for f in lfields) or 'none'})")
-    triggers = sorted(given & (set(PHYSICAL_KEYS) | (set(phys_names) - set(dim_names))))
+    triggers = _physical_triggers(given, dim_names, phys_names)
     extra, scaling, lateral = {}, None, None
     if triggers:
         if not phys:
@@ -371,6 +440,7 @@ def plan_contact(cfg: dict) -> ContactPlan:
         if missing:
             raise TengsimError(f"physical {name} input needs {', '.join(missing)}")
         vals = contact_table(name, "physical", law_name).parse(cfg)
+        _check_bare_numbers(cfg, phys)
         E, W = positive("E_star", vals["E_star"]), positive("W", vals["W"])
         p = {f.name: vals[f.name] for f in phys}
         if vals["eps"] is not None and vals["tabor"] is not None:
@@ -405,7 +475,11 @@ def plan_contact(cfg: dict) -> ContactPlan:
     raw_dx = cfg.get("dx")  # not given: the shape's own pixel (a height map's) or 0.1
     dx = _dx(raw_dx, lateral) if raw_dx not in (None, "") else getattr(shape, "native_dx", 0.1)
     kernel_params = _film(cfg, vals, lateral, extra)
+    refuse_unused = getattr(cls, "refuse_unused", None)
+    if refuse_unused is not None:  # keys this variant of the shape does not use (an array without scatter: seed)
+        refuse_unused(vals, given)
     path = _path_spec(vals, given, scaling)
+    _check_maps_out(path.maps_at, cfg.get("out"))
     tol = positive("tol", vals["tol"])
     law = _build_law(law_name, {f.name: vals[f.name] for f in lfields if f.name in given})
     grid = shape.grid(dx)  # validates dx against the cell

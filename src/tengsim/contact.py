@@ -22,7 +22,8 @@ MONITOR_MIN_POINTS = 1024**2  # grids from this size on report progress inside e
 def simulate(shape: Shape, tabor: float, dx: float, path: PathSpec, boundary: str = "free",
              solver="fast", tol: float = 1e-6, law: Law | str | None = None, progress=None,
              grid=None, extra_params: dict | None = None, observers=(), scaling=None,
-             kernel_params: dict | None = None, throw: bool = False, check_memory_first: bool = True):
+             kernel_params: dict | None = None, throw: bool = False, check_memory_first: bool = True,
+             sink=None):
     """Approach–retraction run of ``shape`` against a rigid flat plate (paper Eq. 9).
 
     ``tabor`` is μ (the elastic coupling is μ^{3/2}); ``dx`` the grid spacing in X units;
@@ -37,6 +38,12 @@ def simulate(shape: Shape, tabor: float, dx: float, path: PathSpec, boundary: st
     a status other than 'ok' raises :class:`tengsim.status.ResultStatusError`, which carries the
     result.  The grid's memory is checked once, before anything is built (``check_memory_first=False``:
     the caller has checked it, as :func:`run_contact` does through :func:`tengsim.config.plan_contact`).
+
+    ``sink`` (a callable or None) receives each equilibrium as it is recorded, ``sink(row, maps)``
+    (:class:`tengsim.continuation.Recorder`); if it has a ``begin(params)`` method, that is called first,
+    before any solve, with the run's parameters known then (all but the recorded pixel snap number and
+    the status): :class:`tengsim.results.RowStream` writes them as its header, or refuses a file to
+    resume that another run wrote.
     """
     tabor = positive("tabor", tabor)
     if scaling is not None and abs(scaling.mu - tabor) > 1e-9 * tabor:
@@ -53,9 +60,7 @@ def simulate(shape: Shape, tabor: float, dx: float, path: PathSpec, boundary: st
         solver_obj = replace(solver_obj, monitor=progress.monitor(), monitor_every=10)
     kernel = make_kernel(boundary, grid, tabor**1.5, **(kernel_params or {}))
     walk = run_load_path if isinstance(path, LoadPathSpec) else run_path  # load or rigid-approach control
-    res = walk(shape.gap(grid), law, kernel, solver_obj, path, progress=progress, observers=observers)
-    recorded = res.params  # what the path recorded (the pixel snap number)
-    res.params = {
+    params = {
         "tengsim_version": __version__,
         **shape.params(),
         "lateral_unit": getattr(shape, "lateral_unit", "ℓ"),
@@ -75,11 +80,16 @@ def simulate(shape: Shape, tabor: float, dx: float, path: PathSpec, boundary: st
         "jump_h": path.jump_h,
         **path.extra_params(),  # adaptive steps or load control (none for a fixed-step D path)
         **(extra_params or {}),
-        **recorded,
     }
     if scaling is not None:
         for k, v in scaling.params().items():
-            res.params.setdefault(k, v)
+            params.setdefault(k, v)
+    if sink is not None and hasattr(sink, "begin"):
+        sink.begin(dict(params))
+    res = walk(shape.gap(grid), law, kernel, solver_obj, path, progress=progress, observers=observers, sink=sink)
+    recorded = res.params  # what the path recorded (the pixel snap number)
+    res.params = {**params, **recorded}
+    if scaling is not None:
         res.add_physical(scaling)
     status.attach(res, law, kernel.coupling)  # per-row 'status' column, params['status'] (tengsim.status)
     if (getattr(kernel, "film", False) and getattr(kernel, "pinned_mean", False)
@@ -102,12 +112,15 @@ def simulate_pyramid(N: float, cell: float, tabor: float = 0.5, dx: float = 0.05
     return simulate(shape, tabor, dx, spec, boundary=boundary, solver=solver, tol=tol, progress=progress)
 
 
-def run_contact(cfg: dict, progress=None):
-    """Plan and run a [contact] table; returns a ContactResult with the config in params."""
+def run_contact(cfg: dict, progress=None, sink=None):
+    """Plan and run a [contact] table; returns a ContactResult with the config in params.  ``sink``: as
+    for :func:`simulate` (the config is not among the parameters it is given: a CLI run and a TOML run
+    of the same settings spell it differently, and resume only cares about what is solved)."""
     plan = plan_contact(cfg)
     res = simulate(plan.shape, plan.tabor, plan.dx, plan.path, boundary=plan.boundary,
                    solver=plan.solver, tol=plan.tol, law=plan.law, progress=progress,
                    extra_params=plan.extra, observers=plan.observers, scaling=plan.scaling,
-                   kernel_params=plan.kernel_params, check_memory_first=False)  # plan_contact checked it
+                   kernel_params=plan.kernel_params, check_memory_first=False,  # plan_contact checked it
+                   sink=sink)
     res.params["config"] = {k: v for k, v in cfg.items() if k not in ("out", "plot")}
     return res

@@ -78,11 +78,17 @@ class Recorder:
     and the observers' columns), the maps asked for, and progress.  Shared by every kind of path.
 
     ``control`` names the path's control variable ('D' or 'F'); maps are kept at the rows whose
-    control value is within ``map_tol`` of an entry of ``maps_at``.
+    control value is within ``map_tol`` of an entry of ``maps_at`` (rows on the path's grid), and at a
+    row the path marks as the one for an entry (``map_at``: an extra row a path adds at that value, see
+    :func:`tengsim.path.run_path`); one map per entry and branch, the first such row.
+
+    ``sink`` (a plain callable or None) is called as ``sink(row, maps)`` once each equilibrium is
+    recorded, in path order: ``row`` the row's dict (the table's columns), ``maps`` the list of the maps
+    kept at it (usually empty).  It lets a caller write results as they are computed.
     """
 
     def __init__(self, U0, law, kernel, observers=(), progress=None, total=0, maps_at=(), control="D",
-                 map_tol=1e-9):
+                 map_tol=1e-9, sink=None):
         grid = kernel.grid
         U0 = np.asarray(U0, dtype=float)
         if U0.shape != grid.shape:
@@ -102,10 +108,12 @@ class Recorder:
         self.control, self.map_tol = control, map_tol
         self.rows, self.maps, self.done, self._map_keys = [], [], 0, set()
         self.t_start = time.perf_counter()
+        self.sink = sink
 
     def on_row(self, branch):
-        """The callback ``(D, eq, on_grid, jump)`` that records a row of ``branch``."""
-        def record(D, eq, on_grid, jump):
+        """The callback ``(D, eq, on_grid, jump, map_at=None)`` that records a row of ``branch``."""
+        def record(D, eq, on_grid, jump, map_at=None):
+            n_maps = len(self.maps)  # for the sink: the maps this row adds
             s = self.summary(eq, self.ctx)
             # a state whose gap enters the law's safe extension (g < g_safe) is outside the physical law
             in_range = bool(s["min_gap"] + 1.0 >= getattr(self.law, "g_safe", -np.inf))
@@ -121,14 +129,22 @@ class Recorder:
             value = D if self.control == "D" else s["F"]
             for m in self.maps_at:
                 tol = self.map_tol * (max(1.0, abs(m)) if self.control == "D" else 1.0) + 1e-9
-                if on_grid and abs(value - m) <= tol and (branch, m) not in self._map_keys:
+                hit = (map_at is not None and m == map_at) or (on_grid and abs(value - m) <= tol)
+                if hit and (branch, m) not in self._map_keys:
                     self._map_keys.add((branch, m))
                     self.maps.append(dict(branch=branch, D=D, P=eq.P.copy(), H=eq.H.copy()))
             if on_grid:
                 self.done += 1
                 if self.progress:
                     self.progress(branch, value, self.done, self.total)
+            if self.sink is not None:
+                self.sink(self.rows[-1], list(self.maps[n_maps:]))
         return record
+
+    def maps_missing(self, branches) -> list:
+        """[(branch, value)] of the ``maps_at`` entries with no map kept on those branches (a load path:
+        a load with no state on a branch)."""
+        return [(b, m) for b in branches for m in self.maps_at if (b, m) not in self._map_keys]
 
     def result(self, final_state=None):
         """The :class:`tengsim.results.ContactResult` of the recorded rows."""

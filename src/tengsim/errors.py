@@ -7,7 +7,9 @@ class TengsimError(ValueError):
 
 class ConfigValueError(TengsimError):
     """A value of the wrong kind for its key (a unit on a dimensionless key, text for a number, a
-    choice not offered): an error in the file, never a property of one point of a study."""
+    choice not offered) or outside its key's own domain (:func:`positive`, :func:`finite`: NaN, a
+    non-positive size): an error in the file, never a property of one point of a study (unlike a
+    combination that cannot be built, e.g. a pyramid wider than its cell)."""
 
 
 def require(condition: bool, message: str) -> None:
@@ -21,9 +23,9 @@ def positive(name: str, value) -> float:
     try:
         v = float(value)
     except (TypeError, ValueError):
-        raise TengsimError(f"{name} must be a number, got {value!r}") from None
+        raise ConfigValueError(f"{name} must be a number, got {value!r}") from None
     if not (v > 0 and v < float("inf")):
-        raise TengsimError(f"{name} must be finite and > 0, got {value!r}")
+        raise ConfigValueError(f"{name} must be finite and > 0, got {value!r}")
     return v
 
 
@@ -32,7 +34,7 @@ def finite(name: str, value) -> float:
     try:
         v = float(value)
     except (TypeError, ValueError):
-        raise TengsimError(f"{name} must be a number, got {value!r}") from None
+        raise ConfigValueError(f"{name} must be a number, got {value!r}") from None
     if v != v or v in (float("inf"), float("-inf")):
-        raise TengsimError(f"{name} must be finite, got {value!r}")
+        raise ConfigValueError(f"{name} must be finite, got {value!r}")
     return v

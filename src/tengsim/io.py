@@ -61,12 +61,23 @@ def interrupts_held():
             signal.raise_signal(signal.SIGINT)
 
 
+def _fsync(path, flags: int = 0) -> None:
+    """Flush ``path`` (a file, or a directory with ``os.O_DIRECTORY``) to the disk."""
+    fd = os.open(path, os.O_RDONLY | flags)
+    try:
+        os.fsync(fd)
+    finally:
+        os.close(fd)
+
+
 @contextlib.contextmanager
 def atomic_path(path: str | os.PathLike):
     """Yield a temporary path beside ``path``; rename it onto ``path`` only on success.
 
     The file gets the mode an ordinary write would give it (the umask for a new file, the old
-    file's mode when one is replaced), not mkstemp's 0600."""
+    file's mode when one is replaced), not mkstemp's 0600.  Its data reach the disk (fsync) before the
+    rename, and the directory entry after it, so that not even an OS crash or power cut leaves an empty
+    or partial file under the final name (a file system that cannot sync a directory is let be)."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part", dir=path.parent)
@@ -79,7 +90,10 @@ def atomic_path(path: str | os.PathLike):
         yield Path(tmp)
         with contextlib.suppress(OSError):  # again: the writer may have made the file at tmp anew
             os.chmod(tmp, _mode_for(path))
+        _fsync(tmp)
         os.replace(tmp, path)
+        with contextlib.suppress(OSError):  # the rename itself, durable (not every platform opens a directory)
+            _fsync(path.parent, os.O_DIRECTORY if hasattr(os, "O_DIRECTORY") else 0)
     except BaseException:
         with contextlib.suppress(FileNotFoundError):
             os.unlink(tmp)
@@ -132,6 +146,24 @@ def dumps(obj, indent: int | None = None) -> str:
 def write_json(path, obj) -> None:
     """Write ``obj`` as strict JSON (NaN and ±inf become null), atomically."""
     write_text(path, dumps(obj, indent=2) + "\n")
+
+
+PAPER = ('"On the contact behavior of micro-/nano-structured interface used in vertical-contact-mode TENGs", '
+         'Nano Energy (2016)')
+
+
+def cf_conventions(ds, title: str):
+    """``ds`` by the CF-1.10 conventions' file rules: the global attributes Conventions, title, source,
+    history (no time stamp: the same result gives the same file) and references first, then its own;
+    no _FillValue on a coordinate variable (a 1-D variable named as its dimension).  Returns ``ds``."""
+    from tengsim._version import __version__
+
+    ds.attrs = {"Conventions": "CF-1.10", "title": title, "source": f"tengsim {__version__}",
+                "history": f"written by tengsim {__version__}", "references": PAPER, **ds.attrs}
+    for name in ds.dims:
+        if name in ds.variables and ds.variables[name].dtype.kind == "f":
+            ds.variables[name].encoding["_FillValue"] = None
+    return ds
 
 
 def write_dataset(ds, path) -> None:
@@ -203,6 +235,22 @@ def csv_text(columns: dict, header: dict | None = None, missing: str | None = No
     if arrays and len(arrays[0]):
         w.writerows(zip(*[_column_text(a, missing) for a in arrays]))
     return buf.getvalue()
+
+
+def csv_row(values) -> str:
+    """One CSV line (ending in a newline) of ``values``, each formatted as :func:`csv_text` formats a column
+    of its kind (floats by ``repr``, booleans 0/1): a row appended to a file as it is computed reads back
+    exactly as the same row written whole."""
+    import numpy as np
+
+    buf = _stdio.StringIO()
+    csv.writer(buf, lineterminator="\n").writerow([_column_text(np.asarray([v]))[0] for v in values])
+    return buf.getvalue()
+
+
+def header_lines(header: dict) -> str:
+    """'# key: json' lines (strict JSON) of ``header``, as :func:`csv_text` writes them."""
+    return "".join(f"# {k}: {dumps(v)}\n" for k, v in header.items())
 
 
 def write_csv(path, columns: dict, header: dict | None = None) -> None:

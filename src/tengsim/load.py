@@ -6,7 +6,7 @@ CSV without its grid in the header gives a result with ``grid=None`` (curves nee
 from __future__ import annotations
 
 import csv
-import itertools
+import io
 import json
 from pathlib import Path
 
@@ -23,30 +23,45 @@ REQUIRED_CONTACT = tuple(k for k in CURVE_COLUMNS if k not in LATER_COLUMNS)
 SWEEP_COLUMNS = ("R", "energy_per_cycle", "average_power")
 
 
-def _read_csv(path: Path):
+def _header(lines):
+    """('# key: json' lines read from the iterator ``lines`` as a dict, the first other line or '')."""
+    header = {}
+    for line in lines:
+        if not line.startswith("#"):
+            return header, line
+        k, _, v = line[1:].rstrip("\r\n").partition(":")
+        try:
+            header[k.strip()] = json.loads(v)
+        except json.JSONDecodeError:
+            header[k.strip()] = v.strip()
+    return header, ""
+
+
+def _read_csv(path: Path, allow_empty: bool = False):
     """('# key: json' header lines as a dict, {column: array}) of a CSV written by
     :func:`tengsim.io.write_csv`: quoted fields are read by :mod:`csv`; a column of numbers is a float
-    array, any other a str array."""
-    header, rows, names = {}, [], None
+    array, any other a str array.  In a partial file (header ``complete: false``, written as the run went,
+    :class:`tengsim.results.RowStream`) a last line without its newline, half written when the run was
+    killed, is left out.  ``allow_empty``: a file with no column line gives ({header}, {})."""
+    rows, names = [], None
     with open(path, newline="") as fh:
-        for line in fh:
-            if not line.startswith("#"):
-                break
-            k, _, v = line[1:].rstrip("\r\n").partition(":")
-            try:
-                header[k.strip()] = json.loads(v)
-            except json.JSONDecodeError:
-                header[k.strip()] = v.strip()
+        lines = iter(io.StringIO(fh.read(), newline=""))  # lines split as the file's own reader splits them
+    header, line = _header(lines)
+    body = [line, *lines]
+    if header.get("complete") is False and body and body[-1] and not body[-1].endswith(("\n", "\r")):
+        body.pop()  # torn by a kill mid-write
+    for row in csv.reader(body):
+        if not row:
+            continue
+        if names is None:
+            names = row
         else:
-            line = ""
-        for row in csv.reader(itertools.chain([line], fh)):
-            if not row:
-                continue
-            if names is None:
-                names = row
-            else:
-                rows.append(row)
+            rows.append(row)
     if names is None:
+        if allow_empty:
+            return header, {}
+        if header.get("complete") is False:
+            raise TengsimError(f"{path}: an incomplete run that had finished no equilibrium yet")
         raise TengsimError(f"{path}: no column header found")
     bad = next((i for i, r in enumerate(rows) if len(r) != len(names)), None)
     if bad is not None:
@@ -100,6 +115,48 @@ def _header_grid(header: dict):
             from None
 
 
+def _partial_maps(path: Path, header: dict) -> list:
+    """The maps an incomplete run writing a NetCDF file kept beside its partial rows (``OUT.partial.maps.npz``,
+    :class:`tengsim.results.RowStream`); none for any other file."""
+    npz = Path(str(path)[: -len(".csv")] + ".maps.npz")
+    if header.get("complete") is not False or not npz.is_file():
+        return []
+    try:
+        with np.load(npz) as z:
+            return [dict(branch=str(b), D=float(d), P=p, H=h)
+                    for b, d, p, h in zip(z["map_branch"], z["map_D"], z["P"], z["H"])]
+    except (OSError, KeyError, ValueError) as exc:
+        raise TengsimError(f"{npz}: cannot read the maps of this incomplete run: {exc}") from None
+
+
+def incomplete_note(kind: str, obj) -> str | None:
+    """One line saying that a loaded result is an incomplete run (written as it went and cut short), or None."""
+    if kind != "contact" or obj.params.get("complete") is not False:
+        return None
+    n = len(obj.table["D"])
+    return (f"an incomplete run: {n} finished equilibri{'um' if n == 1 else 'a'} of {obj.params.get('partial_of', '?')} "
+            "(continue it with --resume)")
+
+
+def read_partial(path) -> tuple[dict, dict]:
+    """``(header, columns)`` of a partial file written by :class:`tengsim.results.RowStream`, for
+    ``--resume``; columns is empty when the run had finished no equilibrium.  Anything else is refused."""
+    path = Path(path)
+    try:
+        header, cols = _read_csv(path, allow_empty=True)
+    except TengsimError as exc:
+        raise TengsimError(f"--resume: {exc}") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise TengsimError(f"--resume: cannot read {path}: {getattr(exc, 'strerror', None) or exc}") from None
+    if header.get("complete") is not False or not header.get("run_digest"):
+        raise TengsimError(f"--resume: {path} is not a partial file written by tengsim (no 'complete: false' "
+                           "and 'run_digest' header)")
+    missing = [k for k in ("branch", "D", "F", "on_grid", "jump") if cols and k not in cols]
+    if missing:
+        raise TengsimError(f"--resume: {path} lacks column(s) {', '.join(missing)}")
+    return header, cols
+
+
 def load_result(path) -> tuple[str, object]:
     """Return ``(kind, obj)``: ('contact', ContactResult), ('device', Dataset or columns dict) for a time
     series, or ('sweep', dict of columns plus 'header') for a load-resistance sweep."""
@@ -117,7 +174,7 @@ def load_result(path) -> tuple[str, object]:
             except TengsimError as exc:
                 raise TengsimError(f"{path}: {exc}") from None
             table = _contact_table(path, cols, grid.dx if grid else None)
-            return "contact", ContactResult(table=table, grid=grid, params=header)
+            return "contact", ContactResult(table=table, grid=grid, params=header, maps=_partial_maps(path, header))
         if "t" in cols:
             return "device", cols
         if "R" in cols:
@@ -132,12 +189,20 @@ def load_result(path) -> tuple[str, object]:
         except Exception as exc:  # noqa: BLE001 - any reader failure is a bad input file
             raise TengsimError(f"cannot read {path} as NetCDF: {exc}") from None
         if "branch" in ds and "D" in ds:
-            params = json.loads(ds.attrs.get("params", "{}"))
+            try:  # the run's parameters, stored once as JSON text (CF layout and older files alike)
+                params = json.loads(ds.attrs.get("params", "{}"))
+            except (TypeError, ValueError) as exc:
+                raise TengsimError(f"{path}: its 'params' attribute is not JSON: {exc}") from None
+            if not isinstance(params, dict):
+                raise TengsimError(f"{path}: its 'params' attribute is not a JSON object")
+            if "x" not in ds.variables or "y" not in ds.variables:
+                raise TengsimError(f"{path}: a contact result without its grid coordinates x, y")
             x, y = ds["x"].values, ds["y"].values
             if len(x) < 3 or len(y) < 3:
                 raise TengsimError(f"{path}: grid coordinates x, y have {len(x)}, {len(y)} points (need >= 3)")
             grid = Grid(len(x), len(y), float(x[1] - x[0]), float(y[1] - y[0]))
-            table = _contact_table(path, {k: ds[k].values for k in ds.data_vars if ds[k].dims == ("step",)},
+            # every column along 'step', coordinates (D, branch: CF layout) and data variables (older files)
+            table = _contact_table(path, {k: v.values for k, v in ds.variables.items() if v.dims == ("step",)},
                                    grid.dx)
             maps = []
             if "P" in ds:

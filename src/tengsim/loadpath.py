@@ -28,6 +28,7 @@ Approach loads below the start's F (the body stays away) are skipped.
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
@@ -48,7 +49,13 @@ class LoadPathSpec:
     walk of step ``d_step`` (jumps bisected ``refine_levels`` times, gap criterion ``jump_h`` as
     in :class:`tengsim.path.PathSpec`).  ``f_tol``: accepted |F − target| (default 1e-4 f_step).
     Rows at the targets have ``on_grid`` True; fold, landing and separation rows have it False.
-    ``maps_at`` lists loads whose maps are kept.
+    ``maps_at`` lists loads whose maps are kept: a load off the f_step lattice becomes an extra target
+    on both branches (its row has ``on_grid`` False), so its map is of the state at that load; a load
+    outside [f_min, the last load of the lattice] is refused.  A load with no state on a branch (on the
+    approach below the load at rest, on the retraction past the pull-off) has no map there.
+    A target whose regula falsi ends (``max_root_steps`` steps, or a D bracket narrower than 1e-12)
+    with |F − target| > ``f_tol`` is recorded with ``converged`` False (status not_converged), and the
+    result's ``params['load_not_met']`` names each such load, its branch and D bracket.
     """
 
     f_min: float
@@ -80,7 +87,14 @@ class LoadPathSpec:
             raise TengsimError(f"refine_levels must be >= 0, got {self.refine_levels!r}")
         if self.f_tol is not None:
             positive("f_tol", self.f_tol)
-        object.__setattr__(self, "maps_at", tuple(float(f) for f in self.maps_at))
+        object.__setattr__(self, "maps_at", tuple(finite("maps_at", f) for f in self.maps_at))
+        last = float(self.targets()[-1])
+        tol = 1e-9 * self.f_step
+        for f in self.maps_at:
+            if not self.f_min - tol <= f <= last + tol:
+                raise TengsimError(f"maps_at load F = {f:g} is outside the path's load range [{self.f_min:g}, "
+                                   f"{last:g}]" + (f" (the last load of the f_step lattice below f_max = "
+                                                   f"{self.f_max:g})" if last < self.f_max - tol else ""))
 
     @property
     def tol_F(self) -> float:
@@ -89,6 +103,14 @@ class LoadPathSpec:
     def targets(self) -> np.ndarray:
         k = int(np.floor((self.f_max - self.f_min) / self.f_step + 1e-9))
         return self.f_min + self.f_step * np.arange(k + 1)
+
+    def path_targets(self) -> list:
+        """The loads the path visits, in increasing order: [(F, on the f_step lattice)], the lattice and the
+        ``maps_at`` loads off it."""
+        lattice = [(float(f), True) for f in self.targets()]
+        tol = 1e-9 * self.f_step
+        extra = [(f, False) for f in sorted(set(self.maps_at)) if all(abs(f - g) > tol for g, _ in lattice)]
+        return sorted(lattice + extra)
 
     def extra_params(self) -> dict:
         return {"control": "load", "f_min": self.f_min, "f_max": self.f_max, "f_step": self.f_step,
@@ -104,10 +126,15 @@ class _Out(Exception):
 
 
 class _LoadBranch:
-    """One branch under load control; ``emit(D, eq, on_grid, jump)`` receives its rows in order."""
+    """One branch under load control; ``emit(D, eq, on_grid, jump[, map_at])`` receives its rows in order.
 
-    def __init__(self, U0, law, kernel, solver, spec: LoadPathSpec, emit):
+    ``misses`` collects a line for each load the branch recorded without meeting it to f_tol."""
+
+    max_root_steps = 60  # regula-falsi steps of one load (a class attribute: tests lower it)
+
+    def __init__(self, U0, law, kernel, solver, spec: LoadPathSpec, emit, name=""):
         self.spec, self.emit, self.grid = spec, emit, kernel.grid
+        self.name, self.misses, self.bracket = name, [], None
         self.trail: list = []
         self.walker = Branch(U0, law, kernel, solver, spec.d_spec(),
                               lambda D, eq, on_grid, jump: self.trail.append((D, eq, jump)))
@@ -137,8 +164,9 @@ class _LoadBranch:
         (Da, ea, Fa), (Db, eb, Fb) = a[:3], b[:3]
         side = 0
         best = min((a, b), key=lambda p: abs(p[2] - Ft))
-        for _ in range(60):
-            if abs(best[2] - Ft) <= self.spec.tol_F or abs(Db - Da) < 1e-12:
+        n = 0
+        for n in range(self.max_root_steps + 1):
+            if abs(best[2] - Ft) <= self.spec.tol_F or abs(Db - Da) < 1e-12 or n == self.max_root_steps:
                 break
             t = (Ft - Fa) / (Fb - Fa)
             D = Da + t * (Db - Da)
@@ -156,6 +184,7 @@ class _LoadBranch:
                 if side == 1:
                     Fa = Ft + 0.5 * (Fa - Ft)
                 side = 1
+        self.bracket = (min(Da, Db), max(Da, Db), f"after {n} regula-falsi step{'' if n == 1 else 's'}")
         return best[0], best[1]
 
     def _fold(self, i, s):
@@ -201,6 +230,7 @@ class _LoadBranch:
                 Fi = self.pts[i][2]
                 if s * (Fi - Ft) >= 0 and below:
                     if self.pts[i][3]:  # crossed through a D-controlled jump: take the far state
+                        self.bracket = (*sorted((self.pts[i - 1][0], self.pts[i][0])), "across a jump in D")
                         return ("root", self.pts[i][0], self.pts[i][1])
                     D, eq = self._root(self.pts[i - 1], self.pts[i], Ft)
                     return ("root", D, eq)
@@ -211,8 +241,10 @@ class _LoadBranch:
                     elif s * Fi < s * self.pts[ibest][2] - noise:
                         return ("fold",) + tuple(self._fold(ibest, s))
 
-    def to(self, Ft, on_grid) -> bool:
-        """Bring the branch to load Ft, emitting fold/landing rows on the way; False if it left."""
+    def to(self, Ft, on_grid, map_at=None) -> bool:
+        """Bring the branch to load Ft, emitting fold/landing rows on the way; False if it left.  The row at
+        Ft keeps the map of the ``maps_at`` entry ``map_at``."""
+        self.bracket = None
         while abs(self.Fc - Ft) > self.spec.tol_F:
             s = 1 if Ft > self.Fc else -1
             try:
@@ -231,9 +263,21 @@ class _LoadBranch:
             except _Out:
                 return self._left(s)
             self.set(land[1], land[2])
-            self.emit(land[1], land[2], False, True)
-        self.emit(self.D, self.eq, on_grid, False)
+            self.emit(land[1], self._checked(land[2], Ff, "the landing load"), False, True)
+        self.emit(self.D, self._checked(self.eq, Ft, "load"), on_grid, False, map_at)
         return True
+
+    def _checked(self, eq, Ft, what):
+        """``eq`` as recorded at load ``Ft``: marked not converged, with a line in ``misses`` naming the load
+        and the D bracket of its search, when its force misses Ft by more than f_tol."""
+        err = abs(self.F(eq) - Ft)
+        if err <= self.spec.tol_F:
+            return eq
+        lo, hi, how = self.bracket if self.bracket is not None else (self.D, self.D, "")
+        msg = (f"{self.name}: {what} F = {Ft:.6g} not met: |F - target| = {err:.3g} > f_tol = {self.spec.tol_F:.3g}"
+               f" (D in [{lo:.6g}, {hi:.6g}]{', ' + how if how else ''})")
+        self.misses.append(msg)
+        return dataclasses.replace(eq, converged=False, message=msg)
 
     def _left(self, s):
         """The body left the D range under this load: record the state at the end of the walk."""
@@ -245,30 +289,48 @@ class _LoadBranch:
 
 
 def run_load_path(U0, law, kernel, solver, spec: LoadPathSpec, start: State | None = None,
-                  progress=None, keep_states: bool = False, observers=()):
+                  progress=None, keep_states: bool = False, observers=(), sink=None):
     """Solve the load-controlled approach–retraction path; returns a ContactResult (same columns as
-    :func:`tengsim.path.run_path`: D is an output, F the control).  ``progress(branch, F, done, total)``."""
+    :func:`tengsim.path.run_path`: D is an output, F the control).  ``progress(branch, F, done, total)``;
+    ``sink(row, maps)`` as for run_path."""
 
     targets = spec.targets()
     rec = Recorder(U0, law, kernel, observers, progress, len(targets) * (2 if spec.retract else 1),
-                   spec.maps_at, "F", map_tol=2 * spec.tol_F)
+                   spec.maps_at, "F", map_tol=2 * spec.tol_F, sink=sink)
     U0 = rec.U0
     state = start if start is not None else State.zero(kernel.grid.shape)
-    up = _LoadBranch(U0, law, kernel, solver, spec, rec.on_row("approach"))
+    visit = spec.path_targets()  # the lattice and the maps_at loads off it
+
+    def map_at(Ft):  # the maps_at entry of the load Ft, if any
+        return next((m for m in spec.maps_at if abs(m - Ft) <= 1e-9 * spec.f_step), None)
+
+    up = _LoadBranch(U0, law, kernel, solver, spec, rec.on_row("approach"), "approach")
     eq0 = up.walker.solve(spec.d_min, state)
     up.set(spec.d_min, eq0)
     up.emit(spec.d_min, eq0, False, False)  # at rest, out of contact
-    for Ft in targets:
+    for Ft, on_lattice in visit:
         if Ft < up.Fc - spec.tol_F and up.D == spec.d_min:
             continue  # a load pulling harder than the far field: the body stays away
-        if not up.to(Ft, True):
+        if not up.to(Ft, on_lattice, map_at(Ft)):
             raise TengsimError(f"load F={Ft:g} is not reached within d_max={spec.d_max:g}; raise d_max")
+    branches = [up]
     if spec.retract:
-        down = _LoadBranch(U0, law, kernel, solver, spec, rec.on_row("retraction"))
+        down = _LoadBranch(U0, law, kernel, solver, spec, rec.on_row("retraction"), "retraction")
+        branches.append(down)
         down.set(up.D, up.eq)
-        down.emit(up.D, up.eq, bool(abs(up.Fc - targets[-1]) <= spec.tol_F), False)
-        for Ft in targets[::-1][1:]:
-            if not down.to(Ft, True):
+        met = bool(abs(up.Fc - targets[-1]) <= spec.tol_F)  # (a miss there is flagged on the approach's row)
+        down.emit(up.D, up.eq, met, False, map_at(targets[-1]) if met else None)
+        for Ft, on_lattice in visit[::-1][1:]:
+            if not down.to(Ft, on_lattice, map_at(Ft)):
                 break  # pulled off: no state under the lower loads
     eq_last = (down if spec.retract else up).eq
-    return rec.result(eq_last.state if keep_states else None)
+    res = rec.result(eq_last.state if keep_states else None)
+    misses = [m for b in branches for m in b.misses]
+    if misses:
+        res.params["load_not_met"] = "; ".join(misses)
+    absent = rec.maps_missing([b.name for b in branches])
+    if absent:  # requested, but that branch has no state at that load: said, not dropped silently
+        res.params["maps_not_made"] = "; ".join(f"{b} F = {m:g}" for b, m in absent) + (
+            " (no state at that load on that branch: below the load at rest on the approach, past the "
+            "pull-off on the retraction)")
+    return res

@@ -21,12 +21,21 @@ from tengsim.errors import TengsimError, finite, positive
 from tengsim.solvers import Problem, State
 
 
+_D_TOL = 1e-9
+"""Relative tolerance (of max(1, |D|)) within which a row's D is a requested ``maps_at`` D."""
+
+
 @dataclass(frozen=True)
 class PathSpec:
     """Approach from ``d_min`` to ``d_max`` then retraction back, in steps of ``d_step``.
 
     Every branch has a row at each D = d_min + k·d_step; step refinement only adds rows between.
-    ``maps_at`` lists D values whose pressure and gap maps are kept (on both branches).
+    ``maps_at`` lists D values whose pressure and gap maps are kept, on both branches, each exactly at
+    its D: a value off the rows the walk visits gets an extra row there (``on_grid`` False: ``on_grid``
+    keeps meaning "on the d_step lattice"), solved from the two rows around it on the branch (their
+    states interpolated; across a jump, from the state before it), without entering the continuation,
+    so every other row is the one the run has without ``maps_at``.  A value outside [d_min, the last D
+    of the lattice] is refused.
 
     ``adaptive=True``: the step h takes the values d_step/2^k (k = 0 … ``refine_levels``) and stays on
     the lattice D = d_min + j·d_step/2^k, so every row lies on the finest lattice and every
@@ -72,7 +81,13 @@ class PathSpec:
             raise TengsimError(f"d_step={self.d_step} gives {n:.0f} steps; choose a larger step")
         if int(self.refine_levels) < 0:
             raise TengsimError(f"refine_levels must be >= 0, got {self.refine_levels!r}")
-        object.__setattr__(self, "maps_at", tuple(float(d) for d in self.maps_at))
+        object.__setattr__(self, "maps_at", tuple(finite("maps_at", d) for d in self.maps_at))
+        last = float(self.targets()[-1])
+        for d in self.maps_at:
+            if not self.d_min - _D_TOL * max(1.0, abs(d)) <= d <= last + _D_TOL * max(1.0, abs(d)):
+                raise TengsimError(f"maps_at D = {d:g} is outside the path's D range [{self.d_min:g}, {last:g}]"
+                                   + (f" (the last D of the d_step lattice below d_max = {self.d_max:g})"
+                                      if last < self.d_max - 1e-9 else ""))
         positive("adapt_tol", self.adapt_tol)
         positive("adapt_h", self.adapt_h)
         if self.adaptive and int(self.refine_levels) > 30:
@@ -226,38 +241,86 @@ class _Adaptive(Branch):
 
 
 def run_path(U0, law, kernel, solver, spec: PathSpec, start: State | None = None,
-             progress=None, keep_states: bool = False, observers=()):
+             progress=None, keep_states: bool = False, observers=(), sink=None):
     """Solve the approach–retraction path; returns a :class:`tengsim.results.ContactResult`.
 
     ``progress(branch, D, done, total)`` is called after each row on the D grid.  ``observers``
-    (registered names or objects, see :mod:`tengsim.observers`) add their columns to every row.  A
-    load-controlled path is :func:`tengsim.loadpath.run_load_path`.
+    (registered names or objects, see :mod:`tengsim.observers`) add their columns to every row.
+    ``sink(row, maps)`` is called with each row as it is recorded (:class:`tengsim.continuation.Recorder`).
+    A load-controlled path is :func:`tengsim.loadpath.run_load_path`.
     """
     if not isinstance(spec, PathSpec):
         raise TengsimError(f"run_path walks a PathSpec (rigid approach D); got {type(spec).__name__} "
                            "(a LoadPathSpec runs with tengsim.loadpath.run_load_path)")
     targets = spec.targets()
     rec = Recorder(U0, law, kernel, observers, progress, len(targets) * (2 if spec.retract else 1),
-                   spec.maps_at, "D")
+                   spec.maps_at, "D", sink=sink)
     U0 = rec.U0
     state = start if start is not None else State.zero(kernel.grid.shape)
+
+    def rows(branch):  # the Recorder's callback, with the extra rows at the maps_at D between the walk's rows
+        if not spec.maps_at:
+            return rec.on_row(branch)
+        return _MapRows(rec.on_row(branch), spec.maps_at, U0, law, kernel, solver, spec.jump_h)
+
     if spec.adaptive:
-        eq = _run_adaptive(U0, law, kernel, solver, spec, state, targets, rec.on_row)
+        eq = _run_adaptive(U0, law, kernel, solver, spec, state, targets, rows)
         return rec.result(eq.state if keep_states else None)
-    walker = Branch(U0, law, kernel, solver, spec, rec.on_row("approach"))
+    walker = Branch(U0, law, kernel, solver, spec, rows("approach"))
     eq = walker.solve(targets[0], state)
     walker.hist = [(targets[0], eq.state)]
     walker.on_row(targets[0], eq, True, False)
     for Da, Db in zip(targets[:-1], targets[1:]):
         eq = walker.advance(Da, eq, Db, 0, True)
     if spec.retract:
-        back = Branch(U0, law, kernel, solver, spec, rec.on_row("retraction"))
+        back = Branch(U0, law, kernel, solver, spec, rows("retraction"))
         back.hist = [(targets[-1], eq.state)]
         back.on_row(targets[-1], eq, True, False)
         rev = targets[::-1]
         for Da, Db in zip(rev[:-1], rev[1:]):
             eq = back.advance(Da, eq, Db, 0, True)
     return rec.result(eq.state if keep_states else None)
+
+
+class _MapRows:
+    """Passes a branch's rows to the Recorder's callback ``record``, in path order, adding a row at each
+    requested D (``maps_at``) the walk steps over: when a row arrives whose step from the row before
+    passes such a D, the state there is solved first (from the two rows' states interpolated; from the
+    state before when the step is a jump) and recorded as an extra row (``on_grid`` False, its map kept:
+    ``map_at``).  The walk's own continuation never sees these states.  A row at a requested D (to
+    :data:`_D_TOL`) is the one that D's map is kept at."""
+
+    def __init__(self, record, maps_at, U0, law, kernel, solver, jump_h):
+        self.record, self.U0, self.law, self.kernel, self.solver = record, U0, law, kernel, solver
+        self.wanted, self.jump_h, self.last = sorted(set(maps_at)), jump_h, None
+
+    def _hit(self, D):
+        return next((m for m in self.wanted if abs(D - m) <= _D_TOL * max(1.0, abs(m))), None)
+
+    def _jumped(self, eqa, eqb, dD):
+        return float(np.max(np.abs(eqb.H - eqa.H))) - abs(dD) > self.jump_h
+
+    def __call__(self, D, eq, on_grid, jump):
+        if self.last is not None:
+            Da, eqa = self.last
+            lo, hi = min(Da, D), max(Da, D)
+            passed = [m for m in self.wanted if lo < m < hi and self._hit(D) != m and self._hit(Da) != m]
+            for m in sorted(passed, reverse=bool(D < Da)):  # in path order
+                t = (m - Da) / (D - Da)
+                start = eqa.state if jump else State(eqa.state.q + t * (eq.state.q - eqa.state.q),
+                                                      eqa.state.w + t * (eq.state.w - eqa.state.w))
+                eqm = self.solver.solve(Problem(self.U0 - m + 1.0, self.law, self.kernel), start)
+                jm = bool(jump) and self._jumped(eqa, eqm, m - Da)
+                self.record(m, eqm, False, jm, m)
+                self.wanted.remove(m)
+                if jump:  # the jump lies on one side of the extra row: flag the row after it
+                    jump = self._jumped(eqm, eq, D - m)
+                Da, eqa = m, eqm
+        m = self._hit(D)
+        self.record(D, eq, on_grid, jump, m)
+        if m is not None:
+            self.wanted.remove(m)
+        self.last = (D, eq)
 
 
 def _run_adaptive(U0, law, kernel, solver, spec, state, targets, make_on_row):

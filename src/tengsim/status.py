@@ -289,7 +289,10 @@ def problems(result) -> list[tuple[str, str]]:
             continue
         where = f"at {k} of {n} equilibria ({_where(t, m)})"
         if kind == NOT_CONVERGED:
-            text = f"residual of Eq. (9) above tol = {p.get('tol', '?')} {where}"
+            text = f"residual of Eq. (9) above tol = {p.get('tol', '?')}"
+            if p.get("load_not_met"):  # load control: the outer solve on D missed a load (tengsim.loadpath)
+                text += f" or load not met to f_tol = {p.get('f_tol', '?')}"
+            text += f" {where}"
         elif kind == OUT_OF_LAW_RANGE:
             text = (f"gaps below the law's safe limit g_safe = {p.get('g_safe', '?')} {where} (compressed "
                     "beyond the physical law; with the periodic kernel this happens once the whole cell is "

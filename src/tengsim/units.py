@@ -60,6 +60,85 @@ def parse_quantity(text, kind: str | None = None, name: str = "value") -> float:
     return v
 
 
+def quantity_dim(text) -> str | None:
+    """The dimension of a quantity's unit ('2um' → 'length'), or None for a bare number (int, float or
+    a numeric string).  An unreadable value or unknown unit is a TengsimError, as in :func:`parse_quantity`."""
+    parse_quantity(text)
+    if isinstance(text, (int, float)):
+        return None
+    s = str(text).strip().replace(" ", "").replace("^2", "2").replace("²", "2")
+    unit = re.fullmatch(f"({_NUM})(.*)", s).group(2)
+    if not unit:
+        return None
+    found = None
+    for base, (dim, _) in _BASE.items():
+        for pre in _PREFIX:
+            if unit == pre + base and (found is None or len(base) > len(found[0])):
+                found = (base, dim)
+    return found[1]
+
+
+DIMENSIONS = {
+    "length": (0, 1, 0, 0),
+    "pressure": (1, -1, -2, 0),
+    "energy/area": (1, 0, -2, 0),
+    "force": (1, 1, -2, 0),
+    "charge/area": (0, -2, 1, 1),
+    "permittivity": (-1, -3, 4, 2),
+    "resistance": (1, 2, -3, -2),
+    "frequency": (0, 0, -1, 0),
+    "time": (0, 0, 1, 0),
+    "mass": (1, 0, 0, 0),
+}
+"""Each dimension of :func:`parse_quantity` as exponents of (kg, m, s, A); expressions multiply them."""
+
+SI_UNIT = {"length": "m", "pressure": "Pa", "energy/area": "J/m2", "force": "N", "charge/area": "C/m2",
+           "permittivity": "F/m", "resistance": "ohm", "frequency": "Hz", "time": "s", "mass": "kg"}
+"""The SI unit text of each dimension (what :func:`parse_quantity` reads back with factor 1)."""
+
+
+def dimension_name(vec) -> str:
+    """'length' for (0, 1, 0, 0); a product of base units (kg m^-1 ...) for a vector with no name."""
+    for name, v in DIMENSIONS.items():
+        if tuple(vec) == v:
+            return name
+    if not any(vec):
+        return "dimensionless"
+    return " ".join(f"{u}^{e}" if e != 1 else u for u, e in zip(("kg", "m", "s", "A"), vec) if e)
+
+
+PLAUSIBLE = {
+    # quantity: (smallest |value|, largest |value|, SI unit, what it is, the unit a user likely meant)
+    "length": (1e-12, 1.0, "m", "a length", "um"),
+    "modulus": (1e2, 1e12, "Pa", "a modulus", "MPa"),
+    "pressure": (0.0, 1e10, "Pa", "a pressure", "kPa"),
+    "energy/area": (1e-6, 10.0, "J/m2", "a work of adhesion", "mJ/m2"),
+}
+"""Ranges a bare number (read as SI) must fall in for its quantity (the [contact] keys of a physical run:
+lengths, E* as a modulus, W as an energy per area; pressures for loads).  No real input lies outside them;
+a value outside is almost surely a number given in another unit (0.59 meant as MPa, 2 as µm).  Zero and
+negative values are left to each key's own check."""
+
+
+def check_plausible(name: str, value, quantity: str) -> float:
+    """Refuse a bare number ``value`` (SI) of ``quantity`` (a key of :data:`PLAUSIBLE`) outside its range:
+    a ConfigValueError naming the value and the likely unit.  Quantities not in the table pass."""
+    from tengsim.errors import ConfigValueError
+
+    x = float(value)
+    if quantity not in PLAUSIBLE or x == 0 or not math.isfinite(x):
+        return x
+    lo, hi, unit, what, likely = PLAUSIBLE[quantity]
+    if lo <= abs(x) <= hi:
+        return x
+    shown = f"{x:g}"
+    hint = "give it with its unit"
+    if lo <= abs(parse_quantity(f"{shown}{likely}")) <= hi:  # the likely unit brings it into range
+        hint += f", e.g. '{shown}{likely}'"
+    raise ConfigValueError(f"{name} = {shown} is read as {shown} {unit} (a bare number is SI), implausible for "
+                           f"{what} ({lo:g} to {hi:g} {unit}): {hint}")
+
+
 class _Units:
     """Conversions shared by :class:`Scaling` and the paper's own (paper Eqs. 7, 9, 10).
 

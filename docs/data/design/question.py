@@ -21,6 +21,14 @@ import xarray as xr  # noqa: E402
 DIMS = ("contact.shape", "contact.pitch", "var.aspect", "contact.E_star")
 
 
+def _at(v, label):
+    """V_OC_at at a named pressure: study.nc labels them with the auxiliary coordinate pressure_label (CF);
+    files from before it have a string coordinate pressure_named."""
+    if "pressure_label" in v.coords:
+        return v.swap_dims(pressure_named="pressure_label").sel(pressure_label=label)
+    return v.sel(pressure_named=label)
+
+
 def flat(ds):
     """One row per point (dict), in grid order."""
     rows = []
@@ -31,7 +39,7 @@ def flat(ds):
                      **{v: r[v].item() for v in ("status", "run_status", "S_V_per_kPa", "linear_range_Pa", "V_sat",
                                                  "P_sat_Pa", "area_fraction_0", "adhesive_full_contact",
                                                  "pull_off_Pa", "seconds", "message")},
-                     "V10": float(r["V_OC_at"].sel(pressure_named="10kPa"))})
+                     "V10": float(_at(r["V_OC_at"], "10kPa"))})
     return rows
 
 
@@ -135,7 +143,7 @@ def main(study_dir, out, name="question"):
     plt.close(fig)
 
     fig, axs = plt.subplots(1, len(shapes), figsize=(3.2 * len(shapes), 3.0), sharey=True, squeeze=False)
-    P = ds["pressure"].values / 1e3
+    P = ds["applied_pressure" if "applied_pressure" in ds.dims else "pressure"].values / 1e3
     cmap = plt.get_cmap("viridis")
     for i, s in enumerate(shapes):
         ax = axs[0, i]

@@ -67,13 +67,16 @@ def register(sub):
     p.add_argument("--out", required=True, help="output file: .csv (curves) or .nc (everything)")
     p.add_argument("--plot", help="also draw F(D), Λc(D), Λc(F) to this .png/.pdf")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--resume", action="store_true",
+                   help="continue the interrupted run of these settings from OUT.partial.csv (rows are written "
+                   "there as they finish; the path is solved again from its start and each row already in the "
+                   "file is checked, so the result equals an uninterrupted run's)")
     p.set_defaults(func=run)
 
 
 def run(args) -> int:
     from tengsim.config import contact_keys, plan_contact
     from tengsim.contact import run_contact
-    from tengsim.progress import Progress
 
     keys = [k for k in contact_keys() if k not in _CLI_ONLY]
     cfg = {k: getattr(args, k) for k in keys if getattr(args, k, None) not in (None, "")}
@@ -86,7 +89,7 @@ def run(args) -> int:
         if cfg.get(key) not in (None, args.positional):
             raise TengsimError(f"{key} given twice: {args.positional!r} and --{key.replace('_', '-')} {cfg[key]!r}")
         cfg[key] = args.positional
-    plan_contact(cfg)  # every option checked before anything is written
+    plan_contact({**cfg, "out": args.out})  # every option checked before anything is written (maps need .nc)
     out = Path(args.out)
     if out.suffix.lower() not in (".csv", ".nc"):
         raise TengsimError(f"--out {args.out}: use a .csv or .nc file")
@@ -97,16 +100,67 @@ def run(args) -> int:
     check_writable(out)
     if args.plot:
         check_writable(args.plot)
-    bar = Progress(args.quiet)
+    stream = open_stream(out, args.resume, args.quiet)
+    res = run_streamed(lambda bar: run_contact(cfg, progress=bar, sink=stream), stream, args.quiet)
+    if res is None:
+        return 130
+    return write_contact(res, out, args.plot, args.quiet, stream)
+
+
+def open_stream(out, resume: bool, quiet: bool = False):
+    """The :class:`tengsim.results.RowStream` writing a run's rows to ``OUT.partial.csv`` as they finish:
+    a new one (refused while a partial file of an interrupted run is there, so nothing finished is
+    overwritten), or with ``resume`` one continuing that file."""
+    from tengsim.load import read_partial
+    from tengsim.results import RowStream, partial_path
+
+    part = partial_path(out)
+    maps = Path(out).suffix.lower() == ".nc"
+    if not resume:
+        if part.exists():
+            raise TengsimError(f"{part} holds an interrupted run of --out {out}: add --resume to continue it, "
+                               "or delete it to start afresh")
+        return RowStream(out, maps=maps)
+    if not part.is_file():
+        raise TengsimError(f"--resume: no partial file {part} to continue (a run writes it as it goes and "
+                           "removes it once the result is saved)")
+    header, cols = read_partial(part)
+    stream = RowStream(out, resume=(header, cols), maps=maps)
+    if not quiet:
+        print(f"tengsim: resuming {part}: its {stream.n_old} finished equilibria are solved again and checked, "
+              "then the run goes on", file=sys.stderr)
+    return stream
+
+
+def run_streamed(call, stream, quiet: bool):
+    """``call(progress_bar)`` with rows streaming to ``stream``; on Ctrl-C, says what was kept and returns None."""
+    from tengsim.progress import Progress
+
+    bar = Progress(quiet)
     try:
-        res = run_contact(cfg, progress=bar)
+        return call(bar)
+    except KeyboardInterrupt:
+        bar.close()
+        stream.close()
+        if stream.path.exists():
+            print(f"tengsim: interrupted; {stream.n_written} finished equilibria kept in {stream.path} "
+                  "(continue with --resume)", file=sys.stderr)
+        else:
+            print("tengsim: interrupted; no partial output was written", file=sys.stderr)
+        return None
+    except TengsimError as exc:  # a run that fails part way keeps what it finished, and says so
+        if stream.n > stream.n_old:
+            raise TengsimError(f"{exc} ({stream.n_written} finished equilibria are kept in {stream.path})") from None
+        raise
     finally:
         bar.close()
-    return write_contact(res, out, args.plot, args.quiet)
+        stream.close()
 
 
-def write_contact(res, out, plot=None, quiet=False) -> int:
+def write_contact(res, out, plot=None, quiet=False, stream=None) -> int:
     res.save(out)
+    if stream is not None:
+        stream.finish()  # the whole result is saved: the partial file goes
     if plot:
         from tengsim.plots import plot_curves
 
@@ -120,4 +174,10 @@ def write_contact(res, out, plot=None, quiet=False) -> int:
 
     for line in warning_lines(res):  # one line per problem kind; a warning, so the exit code stays 0
         print(f"tengsim: warning: {line} (see column 'status')", file=sys.stderr)
+    missed = [m for m in str(res.params.get("load_not_met") or "").split("; ") if m]
+    if missed:  # load control: which loads, and where the search for each ended
+        print(f"tengsim: warning: {len(missed)} load(s) not met, first {missed[0]} (all: parameter "
+              "'load_not_met')", file=sys.stderr)
+    if res.params.get("maps_not_made"):  # load control: a requested map whose load has no state on a branch
+        print(f"tengsim: warning: maps not made: {res.params['maps_not_made']}", file=sys.stderr)
     return 0

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import re
 import sys
 
 from tengsim.errors import TengsimError
@@ -14,10 +15,22 @@ from tengsim.errors import TengsimError
 SUBCOMMANDS = ["contact", "device", "reproduce", "run", "plot", "sweep", "optimize"]
 
 
+class Parser(argparse.ArgumentParser):
+    """argparse with tengsim's manners: a bad option is one line naming it (no usage wall), and a negative
+    number in any notation ('-1e+16', '-.5') is a value, not an option."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self._negative_number_matcher = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$|^-(inf|nan)$", re.I)
+
+    def error(self, message):
+        self.exit(2, f"tengsim: error: {message} (see '{self.prog} --help')\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
     from tengsim._version import __version__
 
-    p = argparse.ArgumentParser(
+    p = Parser(
         prog="tengsim",
         description="Adhesive contact of micro-structured TENG interfaces and the device output.",
     )
@@ -34,7 +47,61 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
+INTERNAL_ERROR = 70  # exit code of a fault inside tengsim (EX_SOFTWARE of sysexits.h); bad input is 2
+
+
+def crash_log_dir():
+    """Where the traceback of an internal error goes: $XDG_CACHE_HOME/tengsim (default ~/.cache/tengsim)."""
+    import os
+    from pathlib import Path
+
+    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    return Path(base) / "tengsim"
+
+
+def _log_internal_error(exc, argv) -> str:
+    """Write the traceback of ``exc`` (with the command line and versions) to a new log file; returns
+    'traceback in PATH', or why none was written (the cache folder, then the temp folder, are tried)."""
+    import os
+    import platform
+    import tempfile
+    import time
+    import traceback
+    from pathlib import Path
+
+    from tengsim._version import __version__
+
+    text = (f"tengsim {__version__}, Python {platform.python_version()} on {platform.platform()}\n"
+            f"command: tengsim {' '.join(sys.argv[1:] if argv is None else map(str, argv))}\n"
+            f"time: {time.strftime('%Y-%m-%d %H:%M:%S %z')}\n\n"
+            + "".join(traceback.format_exception(type(exc), exc, exc.__traceback__)))
+    name = f"crash-{time.strftime('%Y%m%d-%H%M%S')}-{os.getpid()}.log"
+    why = "no folder to write it in"
+    for folder in (crash_log_dir(), Path(tempfile.gettempdir()) / "tengsim"):
+        try:
+            folder.mkdir(parents=True, exist_ok=True)
+            path = folder / name
+            with open(path, "x", encoding="utf-8") as fh:
+                fh.write(text)
+            return f"traceback in {path}"
+        except OSError as err:
+            why = f"{folder}: {err.strerror or err}"
+    return f"traceback not saved: {why}"
+
+
 def main(argv=None) -> int:
+    """Run one command; any fault that is not a user's error is one line plus the path of a log holding
+    its traceback (exit code :data:`INTERNAL_ERROR`)."""
+    try:
+        return _main(argv)
+    except Exception as exc:  # noqa: BLE001 - a bug of tengsim or of a plugin: no traceback on the terminal
+        where = _log_internal_error(exc, argv)
+        msg = " ".join(str(exc).split()) or "(no message)"
+        print(f"tengsim: internal error: {type(exc).__name__}: {msg} ({where})", file=sys.stderr)
+        return INTERNAL_ERROR
+
+
+def _main(argv=None) -> int:
     from tengsim.plugins import load_plugins
 
     try:
@@ -43,7 +110,12 @@ def main(argv=None) -> int:
         print(f"tengsim: error: {exc}", file=sys.stderr)
         return 2
     parser = build_parser()
-    args = parser.parse_args(argv)
+    try:
+        args = parser.parse_args(argv)
+    except SystemExit as exc:  # a bad option: one line already printed (--help and --version exit as usual)
+        if exc.code in (0, None):
+            raise
+        return int(exc.code)
     if not getattr(args, "func", None):
         parser.print_help()
         return 2

@@ -2,6 +2,9 @@
 
 Differential evolution (scipy) whose population is evaluated on Dask, each evaluation stored like a
 sweep point in DIR/points/, so an interrupted optimisation resumes (--resume) without recomputing.
+Only points whose run status is ok are candidates unless --accept names another status; the report
+(DIR/optimum.json) gives the status of the optimum and of its nearest evaluated neighbours.
+Exit code 0 with a candidate optimum, 1 when no evaluated point is one.
 The study file's [objective] names the observable (maximize = "S_V_per_kPa") and optional bounds on
 others (subject_to = { P_sat_Pa = { min = 1e5 } }); see docs/design.md.
 """
@@ -17,6 +20,9 @@ def register(sub):
                        description=__doc__.split("\n\n", 1)[1])
     p.add_argument("study", help="study TOML file with range [axes] and an [objective] table")
     add_study_options(p)
+    p.add_argument("--accept", action="append", default=[], metavar="STATUS",
+                   help="take points of this run status as candidates too (under_resolved, out_of_law_range, "
+                        "not_converged; repeat or comma-separate); by default only 'ok' points are")
     p.add_argument("--quiet", action="store_true", help="no progress output")
     p.set_defaults(func=run)
 
@@ -24,10 +30,13 @@ def register(sub):
 def run(args) -> int:
     from tengsim.study.optimize import optimize_study
 
+    from tengsim.study.optimize import parse_accept
+
+    parse_accept(args.accept)  # a bad status: one line, exit 2, before the study is read
     study, out = load_study_args(args)
     try:
         r = optimize_study(study, out, workers=args.workers, scheduler=args.scheduler, resume=args.resume,
-                           quiet=args.quiet)
+                           quiet=args.quiet, accept=args.accept)
     except KeyboardInterrupt:
         print(f"tengsim: interrupted; evaluated points are kept in {out}/points; continue with --resume",
               file=sys.stderr)

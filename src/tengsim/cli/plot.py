@@ -47,6 +47,13 @@ def run(args) -> int:
         return 0
     out = out or src.with_suffix(".png")
     kind, obj = load_result(src)
+    from tengsim.load import incomplete_note
+
+    note = incomplete_note(kind, obj)
+    if note:  # a partial file of a run cut short: drawn, and said so
+        import sys
+
+        print(f"tengsim: warning: {src}: {note}", file=sys.stderr)
     from tengsim import plots
 
     written = [out]

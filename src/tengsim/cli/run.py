@@ -19,6 +19,8 @@ def register(sub):
                        description=__doc__.split("\n\n", 1)[1])
     p.add_argument("config", help="TOML file with a [contact], [device] or [reproduce] table")
     p.add_argument("--quiet", action="store_true", help="no progress output")
+    p.add_argument("--resume", action="store_true",
+                   help="[contact] only: continue the interrupted run from OUT.partial.csv (as tengsim contact --resume)")
     p.set_defaults(func=run)
 
 
@@ -26,6 +28,8 @@ def run(args) -> int:
     from tengsim.schema import check_tables, read_config
 
     cfg = read_config(args.config)
+    if getattr(args, "resume", False) and "contact" not in cfg:
+        raise TengsimError(f"--resume continues a [contact] run; {args.config} has no [contact] table")
     if "device" in cfg:  # a device file: [device], [waveform], [run], [solver], [sweep] (tengsim device fields)
         from tengsim.cli import device as device_cli
 
@@ -50,10 +54,9 @@ def run(args) -> int:
 
 
 def _contact(section, args) -> int:
-    from tengsim.cli.contact import write_contact
+    from tengsim.cli.contact import open_stream, run_streamed, write_contact
     from tengsim.config import plan_contact
     from tengsim.contact import run_contact
-    from tengsim.progress import Progress
 
     plan_contact(section)  # every key checked before anything is written
     out = section.get("out")
@@ -71,10 +74,9 @@ def _contact(section, args) -> int:
     check_writable(out)
     if plot:
         check_writable(plot)
-    bar = Progress(args.quiet)
-    try:
-        res = run_contact(section, progress=bar)
-    finally:
-        bar.close()
+    stream = open_stream(out, getattr(args, "resume", False), args.quiet)
+    res = run_streamed(lambda bar: run_contact(section, progress=bar, sink=stream), stream, args.quiet)
+    if res is None:
+        return 130
     res.params["config_file"] = str(args.config)
-    return write_contact(res, out, plot, args.quiet)
+    return write_contact(res, out, plot, args.quiet, stream)

@@ -5,8 +5,11 @@ The study file holds a ``[base.contact]`` table (exactly a ``tengsim run`` [cont
 takes per-shape tables [base.shapes.<name>] and '=' expressions over [contact] keys and [base.var]
 variables ("var.aspect" axes); see docs/design.md.
 Every finished point is written at once to DIR/points/<id>.nc; DIR/study.nc and DIR/study.csv are
-rebuilt at the end.  A killed sweep continues with --resume and never recomputes a finished point.
-Exit code 0 when every point finished, 1 when some failed (see study.csv), 2 for a bad study file.
+rebuilt at the end.  A point's status is its run's (ok, under_resolved, out_of_law_range,
+not_converged) or failed.  A killed sweep continues with --resume and never recomputes a sound finished
+point; a point file that is unreadable or does not match its id and digest is reported and computed
+again.  Exit code 0 when every point finished, 1 when some failed (see study.csv), 2 for a bad study
+file.
 """
 from __future__ import annotations
 
@@ -22,7 +25,8 @@ def register(sub):
                    "[study], [observables])")
     add_study_options(p)
     p.add_argument("--retry-failed", dest="retry_failed", action="store_true",
-                   help="with --resume: compute failed points again")
+                   help="with --resume: compute again every point not finished 'ok' (failed points, and "
+                        "finished points of another status)")
     p.add_argument("--quiet", action="store_true", help="no progress output")
     p.set_defaults(func=run)
 

@@ -161,12 +161,17 @@ class DeviceResult:
         write_csv(path, self.columns(names), self.header())
 
     def to_dataset(self):
-        """xarray Dataset over t with every series; parameters as JSON strings in attrs."""
+        """xarray Dataset over t with every series, by the CF-1.10 conventions (UDUNITS units, a long_name
+        each); parameters as JSON strings in attrs (each once)."""
         import xarray as xr
+
+        from tengsim.io import cf_conventions
 
         data = {k: ("t", v, {"units": COLUMNS[k][0], "long_name": COLUMNS[k][1]})
                 for k, v in self.series.items() if k != "t"}
         attrs = {k: json.dumps(v) for k, v in self.header().items() if k != "units"}
         attrs["impacts_s"] = np.asarray(self.impacts_s, float)
         attrs["releases_s"] = np.asarray(self.releases_s, float)
-        return xr.Dataset(data, coords={"t": ("t", self.t, {"units": "s"})}, attrs=attrs)
+        ds = xr.Dataset(data, coords={"t": ("t", self.t, {"units": "s", "long_name": COLUMNS["t"][1]})},
+                        attrs=attrs)
+        return cf_conventions(ds, "tengsim device run: time series of a contact-separation TENG")

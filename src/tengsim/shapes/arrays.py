@@ -92,6 +92,11 @@ class Array:
             cls = SHAPES.get(name)
             if not getattr(cls, "is_pattern", True):
                 raise TengsimError(f"array pattern {pattern!r} cannot be a cell pattern")
+            own = [f.name for f in dimensionless_fields(cls)]
+            bad = [k for k, v in fields.items() if v is not None and k not in own]
+            if bad:
+                raise TengsimError(f"array of {name}: the pattern has no key {', '.join(map(repr, bad))} "
+                                   f"(its keys: {', '.join(own)})")
             try:
                 pattern = cls(**{k: v for k, v in fields.items() if v is not None})
             except TypeError as exc:
@@ -162,6 +167,23 @@ class Array:
         if extra:
             raise TengsimError(f"array of {pname}: the pattern has no physical key {', '.join(map(repr, extra))}")
         return pcls, {k: v for k, v in values.items() if k in mine and v is not None}
+
+    @classmethod
+    def refuse_unused(cls, values: dict, given) -> None:
+        """Refuse, in one line, the keys of a [contact] table (``given``; ``values`` parsed) that this array
+        does not use: seed and distribution without any scatter, waviness_wavelength without a waviness."""
+        physical = "tilt" in values
+        tilt, wav = ("tilt", "waviness") if physical else ("scatter_tilt", "waviness_amplitude")
+        unused = []
+        if not any(values.get(k) for k in ("scatter_height", "scatter_size", tilt)):
+            keys = [k for k in ("seed", "distribution") if k in given]
+            if keys:
+                unused.append(f"{' and '.join(keys)} {'apply' if len(keys) > 1 else 'applies'} only with a scatter "
+                              f"(scatter_height, scatter_size or {tilt} > 0)")
+        if not values.get(wav) and "waviness_wavelength" in given:
+            unused.append(f"waviness_wavelength applies only with a waviness ({wav} > 0)")
+        if unused:
+            raise TengsimError(f"array: {'; '.join(unused)}")
 
     @classmethod
     def lateral_scale(cls, values, eps):
@@ -239,9 +261,18 @@ class Array:
         z = self.heights_map(grid)
         return z.max() - z
 
+    @property
+    def cell_area(self) -> float:
+        """Area of the super-cell, (K L̄)²: the nominal area the force of Eq. (10) is over."""
+        return self.cell ** 2
+
     def params(self) -> dict:
+        """The pattern's parameters as ``pattern_<name>`` (``pattern_cell``: one cell's side L̄), the
+        super-cell's side ``cell`` = K L̄ and area ``cell_area`` (the nominal area of the force), K and the
+        scatter settings with their realised rms."""
         d = {f"pattern_{k}": v for k, v in self.pattern.params().items()}
-        d.update(shape="Array", pattern=self.pattern_name, K=self.K, scatter_height=self.scatter_height,
+        d.update(shape="Array", pattern=self.pattern_name, K=self.K, cell=self.cell, cell_area=self.cell_area,
+                 scatter_height=self.scatter_height,
                  scatter_size=self.scatter_size, scatter_tilt=self.scatter_tilt, distribution=self.distribution,
                  seed=self.seed, waviness_amplitude=self.waviness_amplitude,
                  waviness_wavelength=self.waviness_wavelength,

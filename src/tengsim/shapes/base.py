@@ -35,9 +35,17 @@ class Shape:
     text of ℓ for result metadata).  With physical fields, a shape overrides ``lateral_scale`` and
     ``from_si``; shapes with ℓ = ε can instead set ``si_map`` (physical name → dimensionless name,
     each length divided by ε).
+
+    Nothing accepted is ignored: every key of a shape changes its gap, its grid or the run's scaling
+    (``tests/test_nothing_ignored.py`` walks the registry and checks it), unless the shape names it in
+    ``metadata_fields`` (key → why: recorded with the result, changes nothing solved; none of the
+    built-in shapes has one).  A key that only some variants of a shape use is refused by the others:
+    a shape may define a classmethod ``refuse_unused(values, given)`` (the parsed [contact] values and
+    the keys given) raising a one-line TengsimError (the array: seed without a scatter).
     """
 
     cell: float
+    metadata_fields: dict = {}
     physical_fields: tuple = ()
     field_help: dict = {}
     lateral_unit: str = "ℓ"

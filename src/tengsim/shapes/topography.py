@@ -8,7 +8,8 @@ profilometer formats): tengsim has no parser of its own.  Dimensionless form (pa
 The physical size comes from the file's metadata or from ``physical_size``; a file with neither is
 refused.  A text file carries no unit: its heights (and a size given as a plain number) are in
 ``unit`` (default metres).  Missing data (NaN, masked pixels) is refused unless ``fill_missing``, which
-fills it by SurfaceTopography's harmonic interpolation (``interpolate_undefined_data``).
+fills it by SurfaceTopography's harmonic interpolation (``interpolate_undefined_data``); ``fill_missing``
+for a file without missing data is refused too (it would change nothing).
 """
 from __future__ import annotations
 
@@ -90,7 +91,7 @@ def read(path, physical_size=None, unit: str | None = None, detrend: str = "heig
     if file_unit is None:
         unit = unit or "m"
         kw["unit"] = unit
-    elif unit is not None and _unit_factor(unit) != _unit_factor(file_unit):
+    elif unit is not None:  # the file's own unit is used; another one given is refused, and so is the same one
         raise TengsimError(f"topography file {str(path)!r} declares its unit {file_unit!r}; drop unit = {unit!r}")
     factor = _unit_factor(file_unit or unit)
     if file_size is None or any(s is None for s in np.atleast_1d(file_size)):
@@ -119,6 +120,8 @@ def read(path, physical_size=None, unit: str | None = None, detrend: str = "heig
             raise TengsimError(f"topography file {str(path)!r} has {filled} missing (NaN or masked) pixels: "
                                "give fill_missing (--fill-missing) to fill them by harmonic interpolation")
         topo = topo.interpolate_undefined_data()
+    elif fill_missing:
+        raise TengsimError(f"topography file {str(path)!r} has no missing pixels: drop fill_missing (nothing to fill)")
     if detrend != "none":
         topo = topo.detrend(detrend_mode=detrend)
     h = np.asarray(np.ma.getdata(topo.heights()), dtype=float) * factor
@@ -166,11 +169,13 @@ class Topography:
         Field("file", "str", REQUIRED, help="topography file (any format SurfaceTopography reads)"),
         Field("physical_size", "floats", None, dim="length",
               help="Lx,Ly of a file without a size, e.g. 2um,2um (one value: square)"),
-        Field("unit", "str", None, help="height unit of a file that declares none (default m), e.g. um"),
+        Field("unit", "str", None, help="height unit of a file that declares none (default m), e.g. um; "
+              "refused for a file with its own"),
         Field("detrend", "str", "height", choices=DETREND_MODES,
               help="trend removed first: none, center (mean), height (plane), slope, curvature (quadric)"),
         Field("fill_missing", "bool", False,
-              help="fill missing pixels by harmonic interpolation (refused otherwise)"),
+              help="fill missing pixels by harmonic interpolation (a file with missing pixels is refused "
+              "without it, one without them refused with it)"),
     )
     lateral_unit = "ε"
     positional = "file"  # tengsim contact topography FILE

@@ -2,8 +2,10 @@
 
 study.nc is indexed by the axes for a full grid (a zip group is one dimension, its parameters
 coordinates along it) and by ``point`` for sampled studies.  study.csv has one row per point: the axis
-values in columns named as in [axes], ``id``, ``status``, ``run_status`` (the run's grid status,
-tengsim.status), the scalar observables (units in
+values in columns named as in [axes], ``id``, ``status`` (the one status of the point: the run's own,
+tengsim.status — ok, under_resolved, out_of_law_range, not_converged — or failed, or pending),
+``run_status`` (the same for a computed point, empty otherwise; kept for scripts that read it), the
+scalar observables (units in
 tengsim.study.observe.SCALARS; pull_off_F and jump_in_D as in ``tengsim contact``'s CSV), V_OC at the
 named pressures, and an empty cell wherever there is no value.
 """
@@ -17,22 +19,30 @@ import numpy as np
 
 from tengsim.errors import TengsimError
 from tengsim.io import interrupts_held
+from tengsim.status import SEVERITY
 from tengsim.study.layout import StudyDir
 from tengsim.study.observe import SCALARS, observe, pressure_grid
+from tengsim.study.points import check_point
 
-STATUSES = ("ok", "unconverged", "failed", "pending")
+STATUSES = (*SEVERITY, "failed", "pending")
+"""A point's status: its run's (tengsim.status.SEVERITY, best first), 'failed' (no result; the message
+says why) or 'pending' (not computed yet)."""
 
 
 def _read_point(sd, pid):
-    """(status, message, ContactResult or None, seconds) of one point id."""
+    """(status, message, ContactResult or None, seconds) of one point id.  A point file is trusted only
+    when sound (:func:`tengsim.study.points.check_point`); a bad one is a failed point naming the fault."""
     nc = sd.nc(pid)
     if nc.exists():
+        status, why = check_point(nc, pid)
+        if status is None:
+            return "failed", f"point file {nc.name} {why}", None, math.nan
         try:
             with interrupts_held():
                 res, a = _light_result(nc)
         except (OSError, KeyError, ValueError) as exc:
             return "failed", f"unreadable point file {nc.name}: {exc}", None, math.nan
-        return a.get("status", "ok"), str(a.get("message", "")), res, float(a.get("compute_seconds", math.nan))
+        return status, str(a.get("message", "")), res, float(a.get("compute_seconds", math.nan))
     f = sd.failed(pid)
     if f.exists():
         try:
@@ -45,7 +55,7 @@ def _read_point(sd, pid):
 
 
 _COLUMNS = ("branch", "D", "F", "contact_length", "jump", "converged", "pressure_Pa", "F_N", "contact_length_m",
-            "status")
+            "status", "area_fraction_greenwood")
 
 
 def _light_result(nc):
@@ -71,16 +81,6 @@ def _light_result(nc):
     return ContactResult(table=table, grid=Grid(3, 3, 1.0, 1.0), params=params), attrs
 
 
-def _run_status(res) -> str:
-    """The run's overall status (tengsim.status: ok, under_resolved, out_of_law_range, not_converged);
-    '' for a point without a result, or a file from before the status column."""
-    if res is None or "status" not in res.table:
-        return ""
-    from tengsim.status import overall
-
-    return overall(res.table["status"])
-
-
 def collect(root) -> dict:
     """Per study point (in study.json order): axes, id, status, message, scalars, curves."""
     sd = StudyDir(Path(root))
@@ -101,11 +101,25 @@ def collect(root) -> dict:
         if res is not None:
             try:
                 obs = observe(res, p["tables"]["device"], settings)
-            except (TengsimError, ValueError, FloatingPointError) as exc:
+                if obs.get("notes"):
+                    msg = "; ".join([msg, *obs["notes"]] if msg else obs["notes"])
+            except TengsimError as exc:
                 msg = (msg + "; " if msg else "") + f"observables: {exc}"
+            except Exception as exc:  # noqa: BLE001 - one point's observables never cost the study its table
+                msg = (msg + "; " if msg else "") + f"observables: {type(exc).__name__}: {exc}"
         rows.append({"axes": p["axes"], "index": p["index"], "id": pid, "status": status, "message": msg,
-                     "seconds": secs, "obs": obs, "run_status": _run_status(res)})
+                     "seconds": secs, "obs": obs, "run_status": status if res is not None else ""})
     return {"spec": spec, "rows": rows, "settings": settings}
+
+
+def _cf_units(text: str) -> dict:
+    """CF attributes of a unit text of tengsim.study.observe.SCALARS: a UDUNITS unit as ``units``
+    ('J/m²' as 'J/m2'); a unit in the paper's symbols (ε, 3π W ε m²/n², ...: one number per point, not
+    per study) as ``units = "1"`` with the symbols in ``unit_scale_text``."""
+    u = text.replace("²", "2")
+    if u in ("1", "Pa", "V", "V/kPa", "J/m2", "N", "m", "s"):
+        return {"units": u}
+    return {"units": "1", "unit_scale_text": text}
 
 
 def _coord(values):
@@ -119,7 +133,7 @@ def build_study(root) -> dict:
     """Write DIR/study.nc and DIR/study.csv from what DIR/points/ holds; returns counts by status."""
     import xarray as xr
 
-    from tengsim.io import write_dataset, write_text
+    from tengsim.io import cf_conventions, write_dataset, write_text
 
     root = Path(root)
     c = collect(root)
@@ -181,25 +195,42 @@ def build_study(root) -> dict:
         data["V_OC"] = (["point", "pressure"], voc)
         data["area_fraction"] = (["point", "pressure"], area)
         data["V_OC_at"] = (["point", "pressure_named"], vat)
-    coords["pressure"] = ("pressure", grid, {"units": "Pa"})
-    coords["pressure_named"] = ("pressure_named", np.array(labels))
-    coords["pressure_named_Pa"] = ("pressure_named", np.array(settings["pressures"], float), {"units": "Pa"})
-    ds = xr.Dataset(data, coords=coords)
+    coords["pressure"] = ("pressure", grid, {"units": "Pa", "long_name": "nominal applied pressure (common grid)"})
+    # CF: a coordinate variable is numeric and monotonic, so the named pressures (in the user's order) are
+    # a dimension without one, labelled by two auxiliary coordinates (select with
+    # ds.set_xindex("pressure_label").sel(pressure_label="10kPa"))
+    coords["pressure_label"] = ("pressure_named", np.array(labels),
+                                {"long_name": "named pressure as given in [observables] pressures"})
+    coords["pressure_named_Pa"] = ("pressure_named", np.array(settings["pressures"], float),
+                                   {"units": "Pa", "long_name": "named pressure"})
+    # CF: 'pressure' as a dimension name is taken for air pressure (a vertical axis)
+    ds = xr.Dataset(data, coords=coords).rename({"pressure": "applied_pressure"})
     for k, (u, long) in SCALARS.items():
-        ds[k].attrs.update(units=u, long_name=long)
+        ds[k].attrs.update(_cf_units(u), long_name=long)
+    for a in axes:  # the axes' coordinates: CF asks every variable for a long_name
+        for m in dict.fromkeys([a["name"], *a["members"]]):
+            if m in ds.variables:
+                ds[m].attrs.setdefault("long_name", f"study axis {a['name']}" if m == a["name"] else
+                                       f"parameter {m} along study axis {a['name']}")
+    if "point" in ds.variables:
+        ds["point"].attrs.setdefault("long_name", "sampled point (study.json order)")
     ds["V_OC"].attrs.update(units="V", long_name="Eq. (12) open-circuit voltage under load control")
     ds["area_fraction"].attrs.update(units="1", long_name="charged-area fraction A/S")
     ds["V_OC_at"].attrs.update(units="V", long_name="V_OC at the named pressures")
-    ds["seconds"].attrs["units"] = "s"
-    ds["run_status"].attrs["long_name"] = ("worst status of the run's equilibria (tengsim.status): ok, "
-                                           "under_resolved, out_of_law_range, not_converged")
+    ds["seconds"].attrs.update(units="s", long_name="compute time of the point")
+    ds["id"].attrs.setdefault("long_name", "point id (DIR/points/<id>.nc)")
+    ds["message"].attrs.setdefault("long_name", "why a point failed, or the run's warning")
+    ds["status"].attrs["long_name"] = ("the point's status: its run's (the worst of its equilibria, "
+                                       "tengsim.status: ok, under_resolved, out_of_law_range, not_converged), "
+                                       "failed or pending")
+    ds["run_status"].attrs["long_name"] = "the run's status, as status, for a computed point; empty otherwise"
     from tengsim._version import __version__
 
     ds.attrs.update({"study": json.dumps({k: spec[k] for k in ("source", "sampling", "n", "seed", "base")},
                                          default=str),
                      "axes": json.dumps(axes), "observables": json.dumps(settings),
                      "tengsim_version": __version__})
-    write_dataset(ds, root / "study.nc")
+    write_dataset(cf_conventions(ds, "tengsim design study: observables of every point"), root / "study.nc")
     write_text(root / "study.csv", _csv(spec, rows, per_point, vat, labels))
     counts = {s: int(np.count_nonzero(per_point["status"] == s)) for s in STATUSES}
     return {**counts, "points": n}

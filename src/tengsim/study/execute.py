@@ -4,8 +4,13 @@ The files of a study directory are named by :class:`tengsim.study.layout.StudyDi
 
 Points are computed on a ``dask.distributed`` client: a LocalCluster (one single-threaded worker
 process per core, BLAS/FFT threads pinned to 1) or an existing scheduler.  The client writes each
-result the moment it arrives (``as_completed``), through a temporary file and an atomic rename, so a
-sweep killed at any moment keeps every finished point and never holds a half-written one.
+result the moment it arrives (``as_completed``), through a temporary file, fsync and an atomic rename
+(:func:`tengsim.study.points.write_point`), so a sweep killed at any moment (the OS included) keeps
+every finished point and never holds a half-written one.  A point's status is its run's
+(tengsim.status) or 'failed'.  On --resume every point file is opened and checked (its id, its content
+digest) before it is trusted; a bad one is reported, kept aside and computed again.  A point's id
+covers its code and input files (:mod:`tengsim.study.points`), so a resume never mixes results of two
+versions, plugin sources or input files.
 :class:`PointRunner` is that machinery (client, warm-up, compute a batch, close), shared by
 :func:`run_study` and :func:`tengsim.study.optimize.optimize_study`.
 """
@@ -57,23 +62,32 @@ def _worker_setup(plugins: str = "") -> None:
     load_plugins()
 
 
-def compute_point(contact: dict, pid: str, plugins: str = "") -> dict:
+def compute_point(contact: dict, pid: str, plugins: str = "", expect: dict | None = None) -> dict:
     """Run one point (exactly what ``tengsim run`` runs for the same [contact] table) on a worker.
 
     ``plugins``: the client's ``TENGSIM_PLUGINS`` (modules a worker imports before the point, so a
-    study of user shapes or laws runs on workers that only have the modules installed).
-    Never raises: returns {'status': 'ok' | 'unconverged' | 'failed', 'message', 'data' (the result's
-    xarray Dataset with its attrs; the client writes it), 'seconds', 'host', 'pid', 'started', 'finished'}.
+    study of user shapes or laws runs on workers that only have the modules installed).  ``expect``:
+    the client's :func:`tengsim.study.points.provenance` of the point (what its id covers); a worker
+    that sees another (another tengsim, plugin source or input file) does not compute it: a failed
+    point naming the difference.
+    Never raises: returns {'status': the run's status (tengsim.status: 'ok', 'under_resolved',
+    'out_of_law_range', 'not_converged') or 'failed', 'message', 'data' (the result's xarray Dataset
+    with its attrs; the client writes it), 'seconds', 'host', 'pid', 'started', 'finished'}.
     """
     import traceback
 
     from tengsim._version import __version__
+    from tengsim.study.points import provenance, provenance_difference
 
     t0 = time.time()
     c0 = time.perf_counter()
     info = {"host": socket.gethostname(), "pid": os.getpid(), "started": t0}
     try:
         _worker_setup(plugins)
+        prov = provenance(contact)
+        if expect is not None and prov != expect:
+            raise TengsimError(f"the worker on {info['host']} would compute this point with other code or "
+                               f"input than the client's ({provenance_difference(expect, prov)}); not computed")
         from tengsim.contact import run_contact
 
         c0 = time.perf_counter()
@@ -84,13 +98,14 @@ def compute_point(contact: dict, pid: str, plugins: str = "") -> dict:
         return {**info, "status": "failed", "message": msg.strip(), "seconds": time.perf_counter() - c0,
                 "finished": time.time(), "data": None}
     seconds = time.perf_counter() - c0
-    status = "ok" if res.all_converged else "unconverged"
+    status = res.status  # the run's own status, the one the point reports everywhere
     message = str(res.params.get("warning", ""))
     ds = res.to_dataset()
     ds.attrs.update({"point_id": pid, "status": status, "message": message, "compute_seconds": seconds,
                      "tengsim_version": __version__, "host": info["host"], "worker_pid": info["pid"],
                      "started_unix": t0, "finished_unix": time.time(),
-                     "point_contact": json.dumps(contact, sort_keys=True, default=str)})
+                     "point_contact": json.dumps(contact, sort_keys=True, default=str),
+                     "point_provenance": json.dumps(prov, sort_keys=True)})
     return {**info, "status": status, "message": message, "seconds": seconds, "finished": time.time(),
             "data": ds}
 
@@ -170,7 +185,9 @@ def validate(study) -> tuple[dict, dict]:
 # ---- directory state (the layout: tengsim.study.layout) --------------------------------------------
 
 def check_resume(study, sd: StudyDir, resume: bool) -> None:
-    """Refuse to mix two studies in one directory; on --resume the new study may only add points."""
+    """Refuse to mix two studies in one directory; on --resume the new study may only add points, and
+    its points must be computed by the same code from the same input as the stored ones (the same ids:
+    :mod:`tengsim.study.points`)."""
     if not sd.spec.exists():
         if sd.points.is_dir() and any(sd.points.iterdir()):
             raise TengsimError(f"{sd.root} holds points but no study.json; use another --out")
@@ -186,10 +203,36 @@ def check_resume(study, sd: StudyDir, resume: bool) -> None:
     new_ids = {p.id for p in study.points}
     new_axes = {json.dumps(p.axes, sort_keys=True) for p in study.points}
     lost = old_ids - new_ids
+    if lost and old_axes <= new_axes:
+        # the same axis values give other ids: the table changed (the base), or what else the id covers
+        _check_same_code(old["points"], lost, study, sd)
     if lost or not old_axes <= new_axes:
         n = len(lost) or len(old_axes - new_axes)
         raise TengsimError(f"the study file changed: {n} point(s) of {sd.spec} are not in it any more "
                            "(a resumed study may only add points); use another --out")
+
+
+def _check_same_code(old_points, lost, study, sd) -> None:
+    """Stored points whose table is unchanged but whose id is not: computed by other code or from other
+    input.  One TengsimError saying what changed (a resumed study never mixes their results)."""
+    from tengsim.study.points import provenance, provenance_difference
+    from tengsim.study.spec import canonical
+
+    new = {json.dumps(p.axes, sort_keys=True): p for p in study.points}
+    n, why = 0, ""
+    for o in old_points:
+        if o["id"] not in lost:
+            continue
+        p = new.get(json.dumps(o["axes"], sort_keys=True))
+        if p is None or canonical(o["tables"]["contact"]) != canonical(p.contact):
+            return  # the table itself changed: the study file changed
+        n += 1
+        if not why:
+            why = (provenance_difference(o["provenance"], provenance(p.contact)) if o.get("provenance")
+                   else "written by an older tengsim, before point ids covered the code and input files")
+    raise TengsimError(f"{n} point(s) in {sd.points} were computed by other code or from other input "
+                       f"({why or 'their ids differ'}); a resumed study never mixes their results with new "
+                       "ones: use another --out")
 
 
 # ---- progress -----------------------------------------------------------------------------------
@@ -365,19 +408,26 @@ def run_study(study, out, *, workers=None, scheduler=None, client=None, resume=F
         sd.points.mkdir(parents=True, exist_ok=True)
         if sd.drop_partial():
             say("sweep: removed the temporary files of point writes a kill interrupted")
-        write_json(sd.spec, study.resolved())
-        done, failures = sd.done(), sd.failures()
+        write_json(sd.spec, resolved_with_provenance(study))
+        statuses = verify_points(sd, set(valid) | set(invalid), say, "sweep")
+        done, failures = set(statuses), sd.failures()
         for pid, msg in invalid.items():
             if pid not in done and (pid not in failures or retry_failed):
                 write_json(sd.failed(pid), {"id": pid, "status": "failed", "stage": "validation",
                                             "message": msg, "contact": _contact_of(study, pid)})
         failures = sd.failures()
-        todo = [pid for pid in valid if pid not in done and (pid not in failures or retry_failed)]
+        # --retry-failed: every point not finished 'ok' (failed, or finished with another status)
+        redo = {pid for pid, st in statuses.items() if st != "ok"} if retry_failed else set()
+        todo = [pid for pid in valid if (pid not in done or pid in redo) and (pid not in failures or retry_failed)]
         n_total = len(valid) + len(invalid)
         n_failed = len((failures - done) - set(todo))
-        bar = SweepProgress(n_total, len(done & (set(valid) | set(invalid))), n_failed, quiet, stream)
+        bar = SweepProgress(n_total, len((done - set(todo)) & (set(valid) | set(invalid))), n_failed, quiet,
+                            stream)
         if len(todo) < len(valid):
             say(f"sweep: {len(valid) - len(todo)} point(s) already in {sd.points}, {len(todo)} to compute")
+        if redo & set(todo):
+            say(f"sweep: --retry-failed: computing again {len(redo & set(todo))} finished point(s) whose status "
+                "is not ok")
         _append_log(sd, {"event": "start", "time": time.time(), "todo": todo})
         if todo:
             runner.warm_up()
@@ -394,9 +444,50 @@ def run_study(study, out, *, workers=None, scheduler=None, client=None, resume=F
         summary = build_study(sd.root)
     summary.update(computed=computed, compute_phase_s=t_compute, compute_phase_start_unix=t0_unix,
                    assemble_s=time.perf_counter() - t0)
-    say(f"sweep: wrote {sd.dataset_nc} and {sd.dataset_csv}: {summary['ok']} ok, "
-        f"{summary['failed']} failed, {summary['unconverged']} unconverged, {summary['pending']} pending")
+    say(f"sweep: wrote {sd.dataset_nc} and {sd.dataset_csv}: {status_counts(summary)}")
     return summary
+
+
+def status_counts(summary: dict) -> str:
+    """'3 ok, 2 under_resolved, 0 failed': the count of every status (ok and failed always, the others
+    when some point has them), as a sweep's last line reports them."""
+    from tengsim.study.dataset import STATUSES
+
+    return ", ".join(f"{summary.get(s, 0)} {s}" for s in STATUSES
+                     if s in ("ok", "failed") or summary.get(s, 0))
+
+
+def resolved_with_provenance(study) -> dict:
+    """:meth:`Study.resolved` with each point's provenance (what its id covers besides its table), so
+    that a refused resume can say what changed."""
+    from tengsim.study.points import provenance
+
+    spec = study.resolved()
+    for p in spec["points"]:
+        p["provenance"] = provenance(p["tables"]["contact"])
+    return spec
+
+
+def verify_points(sd: StudyDir, ids, say=None, who: str = "sweep") -> dict:
+    """Open and check every point file of ``ids`` under ``sd`` (:func:`tengsim.study.points.check_point`).
+    Returns {id: run status} of the sound ones.  A bad one (unreadable, empty, another point's, not
+    matching its content digest) is reported through ``say``, logged, and moved aside to
+    ``points/<id>.nc.bad`` (kept for inspection), so that it is computed again."""
+    from tengsim.study.points import check_point
+
+    out = {}
+    for pid in sorted(sd.done() & set(ids)):
+        status, why = check_point(sd.nc(pid), pid)
+        if status is not None:
+            out[pid] = status
+            continue
+        bad = sd.points / f"{pid}.nc.bad"
+        os.replace(sd.nc(pid), bad)
+        if say is not None:
+            say(f"{who}: point file {sd.nc(pid)} {why}: moved to {bad.name}, computing the point again")
+        _append_log(sd, {"event": "bad_point_file", "id": pid, "problem": why, "moved_to": bad.name,
+                         "time": time.time()})
+    return out
 
 
 def _contact_of(study, pid):
@@ -417,10 +508,11 @@ def _compute(client, valid, todo, sd, bar, plugins="") -> list:
     import dask
     from dask.distributed import as_completed
 
-    from tengsim.io import interrupts_held, write_dataset, write_json
+    from tengsim.io import interrupts_held, write_json
+    from tengsim.study.points import provenance, write_point
 
-    futures = {client.submit(compute_point, valid[pid], pid, plugins, key=f"tengsim-point-{pid}", pure=False,
-                             priority=len(todo) - k): pid
+    futures = {client.submit(compute_point, valid[pid], pid, plugins, provenance(valid[pid]),
+                             key=f"tengsim-point-{pid}", pure=False, priority=len(todo) - k): pid
                for k, pid in enumerate(todo)}  # todo is longest first (validate); keep that order
     computed = []
     try:
@@ -438,7 +530,7 @@ def _compute(client, valid, todo, sd, bar, plugins="") -> list:
                                                 **{k: r.get(k) for k in ("seconds", "host", "pid")}})
                 else:
                     with dask.config.set(scheduler="synchronous"):  # local file: no distributed write lock
-                        write_dataset(r["data"], sd.nc(pid))
+                        write_point(r["data"], sd.nc(pid))
                     try:
                         sd.failed(pid).unlink()
                     except FileNotFoundError:

@@ -3,8 +3,11 @@
 ::
 
     DIR/study.json            resolved points of the study (checked on --resume)
-    DIR/points/<id>.nc        one finished contact computation (result + params, timings, status, version)
+    DIR/points/<id>.nc        one finished contact computation (result + params, timings, the run's status,
+                              version, provenance, point_id and content_digest: tengsim.study.points)
     DIR/points/<id>.failed.json   a point that raised (its message); rerun only with --retry-failed
+    DIR/points/<id>.nc.bad    a point file found unsound on --resume (unreadable, another id, a digest
+                              mismatch), kept aside for inspection; the point is computed again
     DIR/points/.<name>.part   a write in progress (an atomic rename gives it its final name)
     DIR/log.jsonl             one line per finished or failed point, in completion order
     DIR/study.nc, study.csv   the assembled dataset (tengsim.study.dataset), rebuilt at the end

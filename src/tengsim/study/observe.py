@@ -132,10 +132,39 @@ def shape_name(params: dict) -> str:
     return str(params.get("shape", "")).lower()
 
 
+def is_array(params: dict) -> bool:
+    """A result of an array of patterns (:mod:`tengsim.shapes.arrays`: ``pattern``, ``K``, ``pattern_*``)."""
+    return shape_name(params) == "array" or (params.get("shape") == "Array" and "pattern_cell" in params)
+
+
+def pattern_params(params: dict) -> dict:
+    """The parameters of the one pattern a result's Λc is measured on: an array's pattern (its
+    ``pattern_*`` parameters, named as the pattern names them; Λc is measured along X through the highest
+    apex, one pattern's), the result's own otherwise."""
+    if not is_array(params):
+        return params
+    name = str(params.get("pattern") or "pyramid")
+    own = {k[len("pattern_"):]: v for k, v in params.items() if k.startswith("pattern_")}
+    return {**own, "shape": name, "config": {"shape": name}}
+
+
+def cell_side(params: dict) -> float:
+    """The side L̄ (in ℓ) of the square cell over which one contact patch is charged: an array's pattern
+    cell (its super-cell holds K × K of them), the shape's ``cell``, else √(cell area)/ℓ of a physical
+    run (``cell_area_m2``, ``lateral_m``); NaN if none of these is known."""
+    p = pattern_params(params)
+    cell = p.get("cell")
+    if cell is not None:
+        return float(cell)
+    if params.get("cell_area_m2") and params.get("lateral_m"):
+        return math.sqrt(float(params["cell_area_m2"])) / float(params["lateral_m"])
+    return math.nan
+
+
 def family(params: dict) -> str:
     """'square', 'disc' or 'line': how Λc (Greenwood's tensile-peak length along X through the apex)
-    maps to the charged area."""
-    name = shape_name(params)
+    maps to the charged area (an array: its pattern's family)."""
+    name = shape_name(pattern_params(params))
     for fam, names in FAMILIES.items():
         if name in names:
             return fam
@@ -150,9 +179,12 @@ def family(params: dict) -> str:
 def area_fraction(res, contact_length) -> np.ndarray:
     """Charged-area fraction A/S of the cell (Eq. 12) from the contact length Λc:
     square patches (pyramid, cube) (Λc/L̄)², discs (cone, hemisphere, sphere, flat punch) π(Λc/2)²/L̄²,
-    line gratings (line, sinusoid) Λc/L̄; clipped to [0, 1].  Λc/L̄ is the same ratio in ℓ or in metres."""
+    line gratings (line, sinusoid) Λc/L̄; clipped to [0, 1].  Λc/L̄ is the same ratio in ℓ or in metres.
+    L̄ is :func:`cell_side` (an array: the pattern's cell, so A/S is that of K × K cells alike, each as
+    the highest one; a run with the ``array_area`` observer has the sum over its cells, used instead by
+    :func:`observe`)."""
     p = res.params
-    cell = float(p.get("cell", math.nan))
+    cell = cell_side(p)
     x = np.asarray(contact_length, float) / cell
     fam = family(p)
     if fam == "line":
@@ -165,7 +197,8 @@ def area_fraction(res, contact_length) -> np.ndarray:
 def full_length(params: dict) -> float:
     """Λc of full contact (2N for the pyramid, the base diameter of a cone or hemisphere; for flat-topped
     pillars and ridges, whose top is in full contact from the first touch, the cell: the plate lies on
-    the land between them); NaN if none."""
+    the land between them); an array: its pattern's; NaN if none."""
+    params = pattern_params(params)
     s = shape_name(params)
     if s == "pyramid":
         return 2 * float(params["N"])
@@ -180,12 +213,12 @@ def full_length(params: dict) -> float:
 
 # ---- the observables ----------------------------------------------------------------------------
 
-def load_control(res):
+def load_control(res, column: str = "contact_length"):
     """Approach states a pressed device passes under increasing load: F above every earlier F, F > 0;
-    the zero-load state is put first, Λc interpolated linearly in F between the last F <= 0 and the first
-    F > 0.  Returns (F, Λc) arrays (possibly empty)."""
+    the zero-load state is put first, Λc (or ``column``) interpolated linearly in F between the last
+    F <= 0 and the first F > 0.  Returns (F, Λc) arrays (possibly empty)."""
     a = res.branch("approach")
-    F, L = np.asarray(a["F"], float), np.asarray(a["contact_length"], float)
+    F, L = np.asarray(a["F"], float), np.asarray(a[column], float)
     keep, best = [], 0.0
     for i, f in enumerate(F):
         if f > best:
@@ -224,7 +257,15 @@ def device_values(device: dict) -> tuple[float, float, float]:
 
 def observe(res, device: dict, settings: dict) -> dict:
     """Scalars (dict name → float) and curves ('V_OC', 'area_fraction' on the common pressure grid,
-    'V_OC_at' at the named pressures) of one contact result."""
+    'V_OC_at' at the named pressures) of one contact result.
+
+    A/S is :func:`area_fraction` of Λc, or, for a run with the ``array_area`` observer, its
+    ``area_fraction_greenwood`` column (Σ over the array's cells).  A value that cannot be had is NaN:
+    every pressure observable of a dimensionless run (no scaling); transition_D and
+    adhesive_full_contact of a shape without a known full-contact length (:func:`full_length`); the
+    V_OC observables of a run with fewer than two loaded states or no known cell (:func:`cell_side`).
+    'notes' lists the reasons that apply to a physical run (V_OC missing; an array's A/S from one cell),
+    for the study's message column."""
     from tengsim.device.formulas import voc_polymer
 
     sigma, eps_r, T = device_values(device)
@@ -242,18 +283,31 @@ def observe(res, device: dict, settings: dict) -> dict:
     grid = pressure_grid(settings)
     curves = {"V_OC": np.full(grid.shape, nan), "area_fraction": np.full(grid.shape, nan),
               "V_OC_at": np.full(len(settings["pressures"]), nan)}
-    if len(Fk):
+    notes = []
+    if "area_fraction_greenwood" in res.table:  # the array_area observer: the sum over the cells
+        A = np.clip(load_control(res, "area_fraction_greenwood")[1], 0.0, 1.0)
+    else:
         A = area_fraction(res, Lk)
+        if is_array(res.params) and len(Fk):
+            notes.append("A/S of the array from its highest cell's contact length (K × K cells alike); "
+                         "observers = ['array_area'] gives the sum over its cells")
+    if len(Fk):
         out["area_fraction_0"] = float(A[0])
         if math.isfinite(full):
             out["adhesive_full_contact"] = float(Lk[0] >= settings["full_contact_fraction"] * full)
     scale = physical_scale(res)
-    if scale is None or len(Fk) < 2:
-        return {"scalars": out, "curves": curves}
+    if scale is None:
+        return {"scalars": out, "curves": curves, "notes": notes}
     k_p, k_D = scale
     out["pull_off_Pa"] = k_p * out["pull_off_F"]
     out["hysteresis_J_m2"] = k_p * k_D * out["hysteresis"]
-    P = k_p * Fk
+    known = np.isfinite(A)
+    if np.count_nonzero(known) < 2:
+        why = ("no cell side known for A/S" if len(Fk) >= 2 and not math.isfinite(cell_side(res.params))
+               else f"{len(Fk)} loaded state(s) (F > 0 rising) on the approach, 2 needed")
+        return {"scalars": out, "curves": curves, "notes": [*notes, f"no V_OC: {why}"]}
+    P = k_p * Fk[known]
+    A = A[known]
     V = voc_polymer(A, sigma, eps_r, T)
 
     def at(x):
@@ -287,4 +341,4 @@ def observe(res, device: dict, settings: dict) -> dict:
         out["P_sat_Pa"] = float(P[0])
     else:
         out["P_sat_Pa"] = float(P[i - 1] + (target - V[i - 1]) * (P[i] - P[i - 1]) / (V[i] - V[i - 1]))
-    return {"scalars": out, "curves": curves}
+    return {"scalars": out, "curves": curves, "notes": notes}

@@ -106,12 +106,13 @@ def plot_study(root, out, vars=MAP_VARS) -> list:
         flat = ds["V_OC"].stack(_p=[d for d in dims]) if len(dims) > 1 else ds["V_OC"].rename({dims[0]: "_p"})
         cval, cnum = _axis_values(ds, by) if by != "point" else (np.arange(ds.sizes["point"]), True)
         cmap = plt.get_cmap("viridis")
-        P = ds["pressure"].values / 1e3
+        pdim = "applied_pressure" if "applied_pressure" in ds.dims else "pressure"  # study.nc before CF: 'pressure'
+        P = ds[pdim].values / 1e3
         for k in range(flat.sizes["_p"]):
             row = flat.isel(_p=k)
             idx = list(ds[by].values).index(row[by].values) if by != "point" else k
             c = cmap(idx / max(1, len(cval) - 1))
-            ax.plot(P, row.transpose(..., "pressure").values, color=c, lw=1)
+            ax.plot(P, row.transpose(..., pdim).values, color=c, lw=1)
         sm = plt.cm.ScalarMappable(cmap=cmap, norm=plt.Normalize(0, max(1, len(cval) - 1)))
         cb = fig.colorbar(sm, ax=ax, label=by)
         cb.set_ticks(np.arange(len(cval)), labels=[str(a) for a in ds[by].values]) if by != "point" else None

@@ -24,7 +24,9 @@ Format (TOML)::
 A point is the base with the axis values put in: [base.contact], then [base.shapes.<its shape>],
 then its axis values; then every expression value is evaluated (in SI; see :func:`evaluate`).
 Its id is a short SHA-256 of the canonical JSON of
-its resolved ``[contact]`` table (the computation), so points that run the same contact share it.
+its resolved ``[contact]`` table (the computation) and of what else determines its result (the format,
+the tengsim version, plugin and input-file digests: :mod:`tengsim.study.points`), so points that run
+the same contact share it and a changed code or input file never does.
 """
 from __future__ import annotations
 
@@ -157,9 +159,16 @@ def _jsonable(x):
     return json.loads(canonical(x))
 
 
-def point_id(contact: dict) -> str:
-    """Deterministic id of a contact computation: first 16 hex digits of SHA-256(canonical JSON)."""
-    return hashlib.sha256(canonical(contact).encode()).hexdigest()[:16]
+def point_id(contact: dict, provenance: dict | None = None) -> str:
+    """Deterministic id of a contact computation: the first 16 hex digits of the SHA-256 of the canonical
+    JSON of its table and its ``provenance`` (default :func:`tengsim.study.points.provenance`: the
+    point-file format, the tengsim version, the plugin modules' and the input files' digests), so that
+    other code or data never gives a point the id of this one."""
+    if provenance is None:
+        from tengsim.study.points import provenance as current
+
+        provenance = current(contact)
+    return hashlib.sha256(canonical({"contact": contact, "provenance": provenance}).encode()).hexdigest()[:16]
 
 
 # ---- parsing ------------------------------------------------------------------------------------
@@ -398,32 +407,60 @@ def evaluate(contact: dict, var: dict) -> dict:
     """Evaluate the expression values of a [contact] table: strings starting with '='.
 
     An expression is + - * / and parentheses over numbers, the point's [var] variables, and other
-    [contact] keys (quantities such as '5um' in SI, expressions first evaluated themselves).  Its value
-    is in SI (a bare number, which physical keys read as SI); ``dx``, whose bare number is in X units,
-    gets 'm' appended.  E.g. ``height = "=aspect*0.5*pitch"``, ``d_max = "=1.3*height/eps + 2"``.
+    [contact] keys (quantities such as '5um' in SI, expressions first evaluated themselves).  It is
+    computed in SI with its dimension: a unit string's, a physical run's key's (a bare number on E_star,
+    W, eps or a shape's length is SI), none for [var]s and plain numbers (a plain number added to a
+    quantity is read in its SI unit).  The value gets the key's own unit: in a physical run dx,
+    thickness, f_min, f_max and f_step (whose bare numbers are in X units or F) get their SI unit
+    appended ('0.0004m', '-2000Pa'), SI keys keep the number in SI, dimensionless keys (d_*, tabor, law
+    parameters, every key of a dimensionless run) a plain number.  A value of the wrong dimension is
+    refused (``d_max = "=2*eps"`` is a length, ``dx = "=E_star/2"`` a pressure), as is a bare dx,
+    thickness or load used as an operand in a physical run (it is not SI).
+    E.g. ``height = "=aspect*0.5*pitch"``, ``d_max = "=1.3*height/eps + 2"``, ``thickness = "=200*pitch"``.
     """
     import ast
 
+    if not any(isinstance(v, str) and v.startswith("=") for v in contact.values()):
+        return dict(contact)
+    from tengsim.config import key_dims
+    from tengsim.units import DIMENSIONS, SI_UNIT, parse_quantity, quantity_dim
+
+    zero = (0, 0, 0, 0)
+    qdims = key_dims(contact)  # {} in a dimensionless run
     out = dict(contact)
+    done = {}  # key -> (SI value, dimension vector, plain) of its evaluated expression
     busy = set()
 
     def value(name):
+        """(SI value, dimension, plain): plain for a number with no dimension of its own."""
         if name in var:
-            return float(var[name])
+            return float(var[name]), zero, True
         if name not in out:
             raise TengsimError(f"expression: unknown name {name!r} (a [contact] key or a [var] variable)")
         v = out[name]
+        if name in done:
+            return done[name]
         if isinstance(v, str) and v.startswith("="):
             if name in busy:
                 raise TengsimError(f"expression: {name!r} depends on itself")
             busy.add(name)
-            v = out[name] = calc(name, v)
+            done[name] = calc(name, v)
             busy.discard(name)
+            return done[name]
         if isinstance(v, bool) or isinstance(v, (dict, list)):
             raise TengsimError(f"expression: {name} = {v!r} is not a number")
-        from tengsim.units import parse_quantity
-
-        return parse_quantity(v, name=name)
+        x = parse_quantity(v, name=name)
+        d = quantity_dim(v)
+        if d is not None:
+            return x, DIMENSIONS[d], False
+        if name not in qdims:
+            return x, zero, True
+        dim, si = qdims[name]
+        if not si:
+            own = "X units" if dim == "length" else "units of F (Eq. 10)"
+            raise TengsimError(f"expression: {name} = {v!r} is in {own}, not SI: give it with a unit "
+                               f"(e.g. '{v}{'um' if dim == 'length' else 'kPa'}') to use it in an expression")
+        return x, DIMENSIONS[dim], False
 
     def calc(key, text):
         src = text[1:].strip()
@@ -436,35 +473,49 @@ def evaluate(contact: dict, var: dict) -> dict:
             if isinstance(n, ast.Expression):
                 return ev(n.body)
             if isinstance(n, ast.Constant) and isinstance(n.value, (int, float)) and not isinstance(n.value, bool):
-                return float(n.value)
+                return float(n.value), zero, True
             if isinstance(n, ast.Name):
                 return value(n.id)
             if isinstance(n, ast.UnaryOp) and isinstance(n.op, (ast.USub, ast.UAdd)):
-                x = ev(n.operand)
-                return -x if isinstance(n.op, ast.USub) else x
+                x, d, p = ev(n.operand)
+                return (-x if isinstance(n.op, ast.USub) else x), d, p
             if isinstance(n, ast.BinOp) and isinstance(n.op, (ast.Add, ast.Sub, ast.Mult, ast.Div)):
-                a, b = ev(n.left), ev(n.right)
-                if isinstance(n.op, ast.Add):
-                    return a + b
-                if isinstance(n.op, ast.Sub):
-                    return a - b
+                (a, da, pa), (b, db, pb) = ev(n.left), ev(n.right)
+                if isinstance(n.op, (ast.Add, ast.Sub)):
+                    if not pa and not pb and da != db:
+                        raise TengsimError(f"{key} = {text!r}: adds {_what(da)} and {_what(db)}")
+                    d, p = (db, pb) if pa else (da, pa)
+                    return (a + b if isinstance(n.op, ast.Add) else a - b), d, p
                 if isinstance(n.op, ast.Mult):
-                    return a * b
+                    return a * b, tuple(x + y for x, y in zip(da, db)), pa and pb
                 if b == 0:
                     raise TengsimError(f"{key} = {text!r}: division by zero")
-                return a / b
+                return a / b, tuple(x - y for x, y in zip(da, db)), pa and pb
             raise TengsimError(f"{key} = {text!r}: only numbers, names, + - * / and parentheses are allowed")
 
-        return float(f"{ev(tree):.12g}")
+        x, d, p = ev(tree)
+        want = DIMENSIONS[qdims[key][0]] if key in qdims else zero
+        if not p and d != want:
+            takes = f"{key} takes {_what(want)}" + ("" if key in qdims else " (it is dimensionless here)")
+            raise TengsimError(f"{key} = {text!r} is {_what(d)}, but {takes}")
+        return float(f"{x:.12g}"), want, False
 
     for k in list(out):
         v = out[k]
         if isinstance(v, str) and v.startswith("="):
-            out[k] = value(k) if not isinstance(out[k], float) else out[k]
-            out[k] = float(out[k])
-    if isinstance(contact.get("dx"), str) and contact["dx"].startswith("="):
-        out["dx"] = f"{out['dx']:.12g}m"
+            x = value(k)[0]
+            if k in qdims and not qdims[k][1]:  # a bare number here is not SI: give the SI value its unit
+                out[k] = f"{x:.12g}{SI_UNIT[qdims[k][0]]}"
+            else:
+                out[k] = x
     return out
+
+
+def _what(vec) -> str:
+    from tengsim.units import dimension_name
+
+    name = dimension_name(vec)
+    return "a plain number" if name == "dimensionless" else f"a {name}"
 
 
 def expand(study: Study) -> list:
