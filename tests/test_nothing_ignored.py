@@ -49,7 +49,16 @@ SHAPE_CASES = {
     ("sinusoid", "dimensionless"): ({"wavelength": 10.0, "amplitude": 1.0}, {"wavelength": 8.0, "amplitude": 2.0}),
     ("sinusoid", "physical"): ({"wavelength": "1.4nm", "amplitude": "0.14nm", **GPA},
                                {"wavelength": "1.2nm", "amplitude": "0.3nm"}),
+    # the rough surface refuses boundary = 'free' (PERIODIC_ONLY); its default short cut-off (cell/32) is below
+    # 2 pixels at dx = 0.5, so the base tables give one
+    ("rough", "dimensionless"): ({"cell": 8.0, "short_cutoff": 1.5, "boundary": "periodic"},
+                                 {"cell": 10.0, "hurst": 0.5, "rms_height": 2.0, "rms_slope": 0.3, "short_cutoff": 2.0,
+                                  "long_cutoff": 4.0, "seed": 1}),
+    ("rough", "physical"): ({"cell": "3nm", "short_cutoff": "0.3nm", "boundary": "periodic", **GPA},
+                            {"cell": "3.5nm", "hurst": 0.6, "rms_height": "0.2nm", "rms_slope": 0.3,
+                             "short_cutoff": "0.4nm", "long_cutoff": "2nm", "seed": 2}),
 }
+PERIODIC_ONLY = {"rough"}  # shapes that refuse boundary = 'free' with one line (their base tables are periodic)
 SPECIAL = {"array", "topography"}  # their cases are built below (a pattern per array; files for a topography)
 
 # the array's own keys: (context that makes the key apply, changed value); the pattern's keys are walked
@@ -234,6 +243,11 @@ def test_each_common_key_changes_the_plan(name, mode, files):
     if mode == "physical":
         cases.update(_scaled(plan_contact(_table(name, base))))
         cases["tabor"] = ({}, 0.6)
+    if name in PERIODIC_ONLY:  # boundary: 'periodic' is the base's, 'free' is refused
+        del cases["boundary"]
+        with pytest.raises(TengsimError, match="boundary = 'free' is refused") as e:
+            plan_contact(_table(name, base, boundary="free"))
+        assert "\n" not in str(e.value)
     for key, (ctx, value) in cases.items():
         _assert_changes(name, base, key, ctx, value)
 
@@ -259,8 +273,9 @@ def test_array_keys_change_the_plan_or_are_refused(mode):
     for more, words in ARRAY_UNUSED[mode]:
         with pytest.raises(TengsimError, match=words.replace("(", r"\(").replace(")", r"\)")):
             plan_contact(_table("array", base, **more))
-    union = {k: v for (p, m), (b, alt) in SHAPE_CASES.items() if m == mode for k, v in {**b, **alt}.items()}
     patterns = [p for p in SHAPES.names() if getattr(SHAPES.get(p), "is_pattern", True)]
+    union = {k: v for (p, m), (b, alt) in SHAPE_CASES.items() if m == mode and p in patterns
+             for k, v in {**b, **alt}.items()}
     assert set(patterns) <= {p for p, _ in SHAPE_CASES}, "a new pattern shape: add its case to SHAPE_CASES"
     ref = plan_contact(_table("array", base))
     for p in patterns:

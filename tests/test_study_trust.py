@@ -362,6 +362,7 @@ PHYSICAL = {
     "cube": {"half_width": "0.5um", "height": "0.5um", "pitch": "2um"},
     "line": {"half_width": "0.5um", "height": "0.5um", "pitch": "2um"},
     "sinusoid": {"wavelength": "2um", "amplitude": "0.2um"},
+    "rough": {"cell": "2um", "rms_height": "0.1um", "short_cutoff": "0.6um"},
     "topography": {"file": "TOPO", "physical_size": "2um", "unit": "um"},
     # the crash: group A pyramids, K = 2, physical units
     "array": {"pattern": "pyramid", "K": 2, "pitch": "2um", "base": "1um", "height": "0.7um"},

@@ -80,6 +80,8 @@ BASES = {  # shape: a physical [contact] table whose lengths are all literals wi
     "cube": {"half_width": "0.3um", "height": "0.2um", "pitch": "1um"},
     "line": {"half_width": "0.3um", "height": "0.2um", "pitch": "1um"},
     "sinusoid": {"wavelength": "2um", "amplitude": "0.2um"},
+    "rough": {"cell": "2um", "rms_height": "0.1um", "short_cutoff": "0.25um", "long_cutoff": "1um",
+              "boundary": "periodic"},
     "array": {"pattern": "pyramid", "K": 2, "pitch": "2um", "base": "1um", "height": "0.7um", "waviness": "10nm"},
 }
 NOT_EXPRESSIONS = {("topography", "physical_size")}  # a list (two lengths): no expression reads it

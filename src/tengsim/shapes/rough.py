@@ -1,0 +1,161 @@
+"""Self-affine random roughness: a periodic surface from SurfaceTopography's Fourier-synthesis generator.
+
+The surface is defined independently of the run's grid: SurfaceTopography's ``fourier_synthesis`` draws
+it (seeded numpy ``Generator``, PCG64: the same numbers on every machine) on a reference grid just fine
+enough to hold every Fourier mode below the short-wavelength cut-off, it is rescaled to the exact rms
+height (or rms slope) asked for, and it is then evaluated on the run's grid by Fourier interpolation
+(exact for a band-limited surface).  So the same ``seed`` gives the same surface, and a finer ``dx``
+samples the same surface more finely.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+
+from tengsim.errors import TengsimError, positive
+from tengsim.grid import Grid
+from tengsim.registry import KERNELS, SHAPES
+from tengsim.schema import Field
+from tengsim.shapes.base import Shape, _length
+
+
+@lru_cache(maxsize=8)
+def _coefficients(cell, hurst, rms_height, rms_slope, short_cutoff, long_cutoff, seed):
+    """Fourier coefficients c[kx, ky] (h(x) = Σ c e^{iq·(x − x0)}, x0 the reference grid's first pixel
+    centre) of the surface with the exact rms height or slope, and the reference grid's pixel count."""
+    from SurfaceTopography.Generation import fourier_synthesis
+
+    n = 2 * int(np.floor(cell / short_cutoff + 1e-9)) + 3  # odd: every mode |k| <= cell/short_cutoff fits
+    topo = fourier_synthesis((n, n), (cell, cell), hurst=hurst, rms_height=1.0, short_cutoff=short_cutoff,
+                             long_cutoff=long_cutoff, rng=np.random.default_rng(seed))
+    c = np.fft.fft2(np.asarray(topo.heights(), dtype=float)) / n**2
+    c[0, 0] = 0.0
+    q = 2 * np.pi * np.fft.fftfreq(n, d=1.0 / n) / cell
+    q2 = q[:, None] ** 2 + q[None, :] ** 2
+    power = np.sum(np.abs(c) ** 2 * (q2 if rms_slope is not None else 1.0))  # Parseval: <h²> or <|∇h|²>
+    if not power > 0:
+        raise TengsimError(f"rough: the cut-offs short_cutoff = {short_cutoff:g}, long_cutoff = {long_cutoff:g} "
+                           f"leave no Fourier mode in the cell {cell:g}")
+    c *= (rms_slope if rms_slope is not None else rms_height) / np.sqrt(power)
+    c.setflags(write=False)
+    return c, n
+
+
+def _interpolate(c: np.ndarray, n_ref: int, cell: float, grid: Grid) -> np.ndarray:
+    """The band-limited surface of coefficients ``c`` (reference grid of ``n_ref`` pixels) on ``grid``."""
+    n = grid.nx
+    k = np.fft.fftfreq(n_ref, d=1.0 / n_ref).round().astype(int)
+    keep = np.abs(k) <= (n_ref - 3) // 2  # the modes that can be nonzero (below the short cut-off)
+    if (n_ref - 3) // 2 > (n - 1) // 2:  # pragma: no cover - the grid check refuses this first
+        raise TengsimError(f"rough: a {n}×{n} grid cannot hold the surface's modes")
+    k = k[keep]
+    c = c[np.ix_(keep, keep)]
+    idx = np.mod(k, n)  # the same integer wave numbers on the run's grid (all |k| < n/2: no aliasing)
+    # the run's first pixel centre lies (dx − dx_ref)/2 past the reference one's
+    shift = np.exp(2j * np.pi * k * (grid.dx - cell / n_ref) / 2 / cell)
+    spec = np.zeros((n, n), dtype=complex)
+    spec[np.ix_(idx, idx)] = c * shift[:, None] * shift[None, :]
+    return np.fft.ifft2(spec).real * n * n
+
+
+@dataclass(frozen=True)
+class Rough(Shape):
+    """Periodic self-affine random surface (PSD C(q) ∝ q^{−2(1+H)} between the cut-offs), from
+    SurfaceTopography's generator; U0 = max(h) − h (the apex at the highest point).  Use the periodic
+    kernel (boundary = 'periodic'; 'free' is refused).
+
+    Give the rms height or the rms slope (not both; neither: rms height 1 ε).  Cut-offs: short (default
+    cell/32, at least 2 pixels of the run's grid), long (default the cell; the PSD is flat below it).
+    Physical input: ℓ = ε, every length divided by ε.
+    """
+
+    cell: float = 32.0
+    hurst: float = 0.8
+    rms_height: float | None = None
+    rms_slope: float | None = None
+    short_cutoff: float | None = None
+    long_cutoff: float | None = None
+    seed: int = 0
+
+    physical_fields = (
+        _length("cell", "periodic cell side"),
+        Field("hurst", "float", 0.8, help="Hurst exponent H, 0 < H < 1"),
+        _length("rms_height", "rms height (default 1 ε unless rms_slope is given)", None),
+        Field("rms_slope", "float", None, help="rms slope (instead of rms_height)"),
+        _length("short_cutoff", "short-wavelength cut-off (default cell/32; >= 2 dx)", None),
+        _length("long_cutoff", "long-wavelength cut-off, PSD flat beyond it (default the cell)", None),
+        Field("seed", "int", 0, help="random seed: the same seed, the same surface"),
+    )
+    field_help = {"cell": "periodic cell side in ε", "hurst": "Hurst exponent H, 0 < H < 1",
+                  "rms_height": "rms height in ε (default 1 unless rms_slope is given)",
+                  "rms_slope": "rms slope (instead of rms_height)",
+                  "short_cutoff": "short-wavelength cut-off in ε (default cell/32; >= 2 dx)",
+                  "long_cutoff": "long-wavelength cut-off in ε, PSD flat beyond it (default the cell)",
+                  "seed": "random seed: the same seed, the same surface"}
+    si_map = {"cell": "cell"}
+    lateral_unit = "ε"
+    is_pattern = False  # already a periodic surface: not a cell pattern of tengsim.shapes.arrays
+
+    def __post_init__(self):
+        positive("cell", self.cell)
+        h = self.hurst
+        if isinstance(h, bool) or not isinstance(h, (int, float)) or not 0 < h < 1:
+            raise TengsimError(f"rough: hurst must be in (0, 1), got {h!r}")
+        if self.rms_height is not None and self.rms_slope is not None:
+            raise TengsimError(f"rough: give rms_height or rms_slope, not both (got rms_height = {self.rms_height!r}, "
+                               f"rms_slope = {self.rms_slope!r})")
+        if self.rms_slope is not None:
+            positive("rms_slope", self.rms_slope)
+        else:
+            object.__setattr__(self, "rms_height", positive("rms_height", 1.0 if self.rms_height is None
+                                                            else self.rms_height))
+        if self.long_cutoff is None:
+            object.__setattr__(self, "long_cutoff", float(self.cell))
+        if self.short_cutoff is None:
+            object.__setattr__(self, "short_cutoff", self.cell / 32)
+        positive("long_cutoff", self.long_cutoff)
+        positive("short_cutoff", self.short_cutoff)
+        if self.long_cutoff > self.cell * (1 + 1e-12):
+            raise TengsimError(f"rough: long_cutoff = {self.long_cutoff:g} exceeds the cell {self.cell:g}")
+        if self.short_cutoff >= self.long_cutoff:
+            raise TengsimError(f"rough: short_cutoff = {self.short_cutoff:g} must be below long_cutoff = "
+                               f"{self.long_cutoff:g}")
+        s = self.seed
+        if isinstance(s, bool) or not isinstance(s, (int, np.integer)) or s < 0:
+            raise TengsimError(f"rough: seed must be an integer >= 0, got {s!r}")
+
+    @classmethod
+    def refuse_unused(cls, values: dict, given) -> None:
+        b = values.get("boundary") or "free"
+        if KERNELS.canonical(b) != "periodic":
+            raise TengsimError(f"rough: boundary = {b!r} is refused: the random surface is periodic, "
+                               "give boundary = 'periodic'")
+
+    def grid(self, dx: float) -> Grid:
+        g = Grid.square(self.cell, dx)
+        self._check_grid(g)
+        return g
+
+    def _check_grid(self, grid: Grid) -> None:
+        if grid.nx != grid.ny or abs(grid.lx - self.cell) > 1e-9 * self.cell or abs(grid.ly - self.cell) > 1e-9 * self.cell:
+            raise TengsimError(f"rough: the grid ({grid.nx}×{grid.ny}, {grid.lx:g}×{grid.ly:g}) must tile the "
+                               f"cell {self.cell:g} exactly")
+        if self.short_cutoff < 2 * grid.dx * (1 - 1e-9):
+            raise TengsimError(f"rough: short_cutoff = {self.short_cutoff:g} is below 2 pixels of the grid "
+                               f"(dx = {grid.dx:g}): use dx <= {self.short_cutoff / 2:g} or a longer short_cutoff")
+
+    def heights(self, grid: Grid) -> np.ndarray:
+        """The surface h on ``grid`` (mean 0)."""
+        self._check_grid(grid)
+        c, n_ref = _coefficients(float(self.cell), float(self.hurst), self.rms_height, self.rms_slope,
+                                 float(self.short_cutoff), float(self.long_cutoff), int(self.seed))
+        return _interpolate(c, n_ref, float(self.cell), grid)
+
+    def gap(self, grid: Grid) -> np.ndarray:
+        h = self.heights(grid)
+        return h.max() - h
+
+
+SHAPES.register("rough", Rough, summary="self-affine random rough surface (periodic kernel)")
