@@ -9,6 +9,7 @@ samples the same surface more finely.
 """
 from __future__ import annotations
 
+import inspect
 from dataclasses import dataclass
 from functools import lru_cache
 
@@ -21,6 +22,23 @@ from tengsim.schema import Field
 from tengsim.shapes.base import Shape, _length
 
 
+def _synthesis(fourier_synthesis, nb_grid_pts, physical_sizes, seed, **kw):
+    """SurfaceTopography's generator driven by ``seed``: its ``rng`` argument where it has one (1.19 on);
+    older releases draw amplitudes from ``amplitude_distribution`` and phases from NumPy's global RNG,
+    which is then seeded for the call and restored after it.  A seed names one surface per
+    SurfaceTopography release (the draws are the library's)."""
+    if "rng" in inspect.signature(fourier_synthesis).parameters:
+        return fourier_synthesis(nb_grid_pts, physical_sizes, rng=np.random.default_rng(seed), **kw)
+    rng = np.random.default_rng(seed)
+    state = np.random.get_state()
+    np.random.seed(seed)
+    try:
+        return fourier_synthesis(nb_grid_pts, physical_sizes, amplitude_distribution=lambda n: rng.normal(size=n),
+                                 **kw)
+    finally:
+        np.random.set_state(state)
+
+
 @lru_cache(maxsize=8)
 def _coefficients(cell, hurst, rms_height, rms_slope, short_cutoff, long_cutoff, seed):
     """Fourier coefficients c[kx, ky] (h(x) = Σ c e^{iq·(x − x0)}, x0 the reference grid's first pixel
@@ -28,8 +46,8 @@ def _coefficients(cell, hurst, rms_height, rms_slope, short_cutoff, long_cutoff,
     from SurfaceTopography.Generation import fourier_synthesis
 
     n = 2 * int(np.floor(cell / short_cutoff + 1e-9)) + 3  # odd: every mode |k| <= cell/short_cutoff fits
-    topo = fourier_synthesis((n, n), (cell, cell), hurst=hurst, rms_height=1.0, short_cutoff=short_cutoff,
-                             long_cutoff=long_cutoff, rng=np.random.default_rng(seed))
+    topo = _synthesis(fourier_synthesis, (n, n), (cell, cell), seed, hurst=hurst, rms_height=1.0,
+                      short_cutoff=short_cutoff, long_cutoff=long_cutoff)
     c = np.fft.fft2(np.asarray(topo.heights(), dtype=float)) / n**2
     c[0, 0] = 0.0
     q = 2 * np.pi * np.fft.fftfreq(n, d=1.0 / n) / cell
