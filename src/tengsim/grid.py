@@ -72,3 +72,79 @@ class Grid:
     def mesh(self) -> tuple[np.ndarray, np.ndarray]:
         """Coordinate arrays X, Y of shape ``(nx, ny)`` (indexing 'ij')."""
         return np.meshgrid(self.x, self.y, indexing="ij")
+
+
+@dataclass(frozen=True)
+class Mirror:
+    """Mirror symmetry of fields on an odd ``grid`` about its centre pixel, along ``axes`` (0: X, 1: Y).
+
+    The irreducible block holds the centre pixel and the pixels after it along each mirrored axis:
+    reduced index i is full index c + i (c = (n − 1)/2), and full index c − i holds the same value.
+    A pixel of the block stands for ``weights()`` pixels of the full grid (1 on a mirror line, 2 off
+    it, per mirrored axis), so a full-grid sum is the weighted sum over the block.
+    """
+
+    grid: Grid
+    axes: tuple
+
+    def __post_init__(self):
+        axes = tuple(sorted(set(int(a) for a in self.axes)))
+        if not axes or any(a not in (0, 1) for a in axes):
+            raise TengsimError(f"mirror axes must be a non-empty subset of (0, 1), got {self.axes!r}")
+        for a in axes:
+            n = self.grid.shape[a]
+            if n % 2 == 0 or n < 5:
+                raise TengsimError(f"a mirror along axis {a} needs an odd pixel count >= 5, got {n}")
+        object.__setattr__(self, "axes", axes)
+
+    def _centre(self, a: int) -> int:
+        return (self.grid.shape[a] - 1) // 2
+
+    @property
+    def reduced_shape(self) -> tuple[int, int]:
+        return tuple(n - self._centre(a) if a in self.axes else n for a, n in enumerate(self.grid.shape))
+
+    @property
+    def reduced_grid(self) -> Grid:
+        """The block's grid: same pixel size (pixel area ``grid.area``), reduced counts."""
+        nx, ny = self.reduced_shape
+        return Grid(nx, ny, self.grid.dx, self.grid.dy)
+
+    @property
+    def fraction(self) -> float:
+        """Pixels of the block over pixels of the full grid."""
+        return float(np.prod(self.reduced_shape)) / float(np.prod(self.grid.shape))
+
+    def reduce(self, a: np.ndarray) -> np.ndarray:
+        """The irreducible block of a full-grid field (a contiguous copy)."""
+        a = np.asarray(a)
+        if a.shape != self.grid.shape:
+            raise TengsimError(f"field of shape {a.shape} is not on the {self.grid.shape} grid")
+        sl = tuple(slice(self._centre(k), None) if k in self.axes else slice(None) for k in range(2))
+        return np.ascontiguousarray(a[sl])
+
+    def unfold(self, r: np.ndarray) -> np.ndarray:
+        """The full-grid field whose irreducible block is ``r`` (mirrored copies)."""
+        r = np.asarray(r)
+        if r.shape != self.reduced_shape:
+            raise TengsimError(f"block of shape {r.shape} is not the {self.reduced_shape} block")
+        out = r
+        for k in self.axes:
+            tail = np.flip(np.take(out, np.arange(1, out.shape[k]), axis=k), axis=k)
+            out = np.concatenate([tail, out], axis=k)
+        return np.ascontiguousarray(out)
+
+    def weights(self) -> np.ndarray:
+        """Multiplicity of each block pixel in the full grid (1, 2 or 4), shape ``reduced_shape``."""
+        w = np.ones(self.reduced_shape)
+        for k in self.axes:
+            m = np.full(self.reduced_shape[k], 2.0)
+            m[0] = 1.0
+            w *= m[:, None] if k == 0 else m[None, :]
+        return w
+
+    def is_symmetric(self, a: np.ndarray, rtol: float = 1e-12) -> bool:
+        """Is the full-grid field ``a`` mirror symmetric along every axis of the mirror (to ``rtol``)?"""
+        a = np.asarray(a, dtype=float)
+        scale = max(float(np.max(np.abs(a))) if a.size else 0.0, 1e-300)
+        return all(float(np.max(np.abs(a - np.flip(a, axis=k)))) <= rtol * scale for k in self.axes)
