@@ -17,6 +17,7 @@ import pytest
 from tengsim.config import common_fields, contact_table, law_fields, law_keys, plan_contact
 from tengsim.errors import TengsimError
 from tengsim.plugins import LAWS, SHAPES
+from tengsim.shapes.roughened import roughness_fields
 
 DX = 0.5
 GPA = {"E_star": "1GPa", "W": "50mJ/m2", "tabor": 0.5}
@@ -94,11 +95,16 @@ COMMON = {
     "adaptive": ({}, True), "adapt_tol": ({"adaptive": True}, 0.1), "boundary": ({}, "periodic"),
     "thickness": ({}, 5.0), "substrate": ({"thickness": 5.0}, "frictionless"),
     "poisson": ({"thickness": 5.0}, 0.3), "solver": ({}, "vsr"), "tol": ({}, 1e-5), "law": ({}, "md"),
+    "symmetry": ({}, "off"),
     "observers": ({}, ["array_area"]),
+    "resolve": ({}, "auto"), "resolve_tol": ({"resolve": "auto"}, 0.05), "max_pixels": ({"resolve": "auto"}, 10000),
 }
 # [contact] keys that are not the run's: the CLI's output files (`tengsim run` reads them; out must be .nc
 # when maps are asked for, test_maps_need_a_nc_output)
 OUTPUTS = {"out", "plot", "shape"}
+# the roughness superimposed on a shape (tengsim.shapes.roughened): walked per shape by
+# test_roughness_keys_change_the_gap_or_are_refused (its cut-offs depend on the shape's cell and grid)
+ROUGHNESS = {f.name for f in roughness_fields()}
 # common keys refused where they do not apply: (table additions, words)
 COMMON_UNUSED = [
     ({"f_max": 1.0}, "f_max does not apply to control = 'approach'"),
@@ -107,6 +113,8 @@ COMMON_UNUSED = [
     ({"substrate": "frictionless"}, "give its thickness too"),
     ({"poisson": 0.3}, "give its thickness too"),
     ({"maps_at": [9.0]}, "maps_at D = 9 is outside the path's D range [-1, 4]"),
+    ({"resolve_tol": 0.05}, "resolve_tol applies only with resolve = 'auto'"),
+    ({"max_pixels": 10000}, "max_pixels applies only with resolve = 'auto'"),
     ({"control": "load", "f_max": 1.0, "f_step": 0.5, "maps_at": [2.0]}, "maps_at load F = 2 is outside"),
 ]
 
@@ -128,7 +136,8 @@ def _sig(plan) -> dict:
     g = plan.shape.grid(plan.dx)
     return {"grid": (g.nx, g.ny, g.dx, g.dy), "U0": plan.shape.gap(g), "tabor": plan.tabor, "path": plan.path,
             "boundary": plan.boundary, "solver": plan.solver, "tol": plan.tol, "law": repr(plan.law),
-            "observers": plan.observers, "kernel": plan.kernel_params,
+            "symmetry": plan.symmetry,
+            "observers": plan.observers, "kernel": plan.kernel_params, "resolve": plan.resolve,
             "scaling": None if plan.scaling is None else plan.scaling.params()}
 
 
@@ -219,8 +228,8 @@ def test_every_key_has_a_case(name, mode, files):
     assert not missing, (f"shape {name} ({mode}) accepts {missing} but this test has no case for them: give "
                          "each a changed value (it must change the plan) or declare it in metadata_fields")
     common = {f.name for f in common_fields()}
-    assert common <= set(COMMON) | OUTPUTS | {"E_star", "W", "eps"}, \
-        f"common keys without a case: {sorted(common - set(COMMON) - OUTPUTS)}"
+    assert common <= set(COMMON) | OUTPUTS | ROUGHNESS | {"E_star", "W", "eps"}, \
+        f"common keys without a case: {sorted(common - set(COMMON) - OUTPUTS - ROUGHNESS)}"
 
 
 @pytest.mark.parametrize("name, mode", [c for c in CASES if c[0] not in SPECIAL],
@@ -338,3 +347,30 @@ def test_maps_need_a_nc_output():
         plan_contact({**base, "out": "r.csv"})
     plan_contact({**base, "out": "r.nc"})
     plan_contact({**{k: v for k, v in base.items() if k != "maps_at"}, "out": "r.csv"})
+
+
+@pytest.mark.parametrize("name, mode", CASES, ids=[f"{n}-{m}" for n, m in CASES])
+def test_roughness_keys_change_the_gap_or_are_refused(name, mode, files):
+    """roughness = true and each roughness_* key (with it) change the gap of every shape but rough, which
+    refuses them (already rough); a roughness_* key without roughness = true is refused (one line each)."""
+    base = _topo_base(files) if name == "topography" else (
+        {"K": 2, **_base("pyramid", mode)} if name == "array" else _base(name, mode))
+    if name in PERIODIC_ONLY:
+        for more in ({"roughness": True}, {"roughness": True, "roughness_seed": 2}):
+            with pytest.raises(TengsimError, match="already rough") as e:
+                plan_contact(_table(name, base, **more))
+            assert "\n" not in str(e.value)
+        return
+    plan = plan_contact(_table(name, base))
+    g = plan.shape.grid(plan.dx)
+    on = {"roughness": True, "roughness_short_cutoff": 2.5 * g.dx}  # >= 2 pixels, below the cell
+    cases = {"roughness": ({}, on), "roughness_hurst": (on, 0.5), "roughness_rms_height": (on, 2.0),
+             "roughness_rms_slope": (on, 0.3), "roughness_short_cutoff": (on, 3.0 * g.dx),
+             "roughness_long_cutoff": (on, 0.8 * plan.shape.cell), "roughness_seed": (on, 1)}
+    assert set(cases) == ROUGHNESS, "a new roughness key: add its case here"
+    for key, (ctx, value) in cases.items():
+        _assert_changes(name, base, key, ctx, value)
+        if key != "roughness":
+            with pytest.raises(TengsimError, match=f"{key} applies only with roughness = true") as e:
+                plan_contact(_table(name, base, **{key: value}))
+            assert "\n" not in str(e.value)

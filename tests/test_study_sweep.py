@@ -35,7 +35,9 @@ boundary = "free"
 "contact.N" = [0.946, 1.5]
 "contact.tabor" = { start = 0.3, stop = 0.5, num = 2 }
 """
-TINY = {"shape": "pyramid", "N": 0.946, "cell": 3.78, "tabor": 0.5, "dx": 0.4, "d_min": -1.0,
+# dx 0.25 (grid 0.252): resolved (process zone 0.35 >= 1.2 dx); dx 0.4 (grid 0.42, ℓ = 0.83 dx) is under_resolved
+# since issue 22 item 2 — group A's pull-off there is 1.06 % off the finest grid (benchmarks/status_calibration.py)
+TINY = {"shape": "pyramid", "N": 0.946, "cell": 3.78, "tabor": 0.5, "dx": 0.25, "d_min": -1.0,
         "d_max": 2.5, "d_step": 0.25}
 
 
@@ -579,7 +581,8 @@ def test_worker_dying_mid_point_is_a_failed_point_others_finish(tmp_path, monkey
     monkeypatch.setenv("TENGSIM_PLUGINS", name)
     monkeypatch.setattr(plugins, "_LOADED", set())
     try:
-        study = parse_study({"base": {"contact": {"shape": "bomb", "radius": 1.0, "cell": 4.0, "dx": 0.4,
+        # dx 0.2: μ = 1 resolved (process zone 0.29 >= 1.2 dx; at dx 0.4 it is under_resolved since issue 22 item 2)
+        study = parse_study({"base": {"contact": {"shape": "bomb", "radius": 1.0, "cell": 4.0, "dx": 0.2,
                                                   "d_min": -0.5, "d_max": 0.5, "d_step": 0.5}},
                              "axes": {"contact.fuse": [0.0, 1.0], "contact.tabor": [0.5, 1.0]}}, source="bomb")
         with dask.config.set({"distributed.scheduler.allowed-failures": 0}):  # no retries on other workers

@@ -21,10 +21,11 @@ from tengsim.study.layout import StudyDir
 from tengsim.study.points import check_point, provenance, write_point
 from tengsim.study.spec import point_id
 
-# a Maugis–Dugdale sphere whose status turns from ok to under_resolved between dx = 0.4 and 0.45
-# (measured: dx 0.3 / 0.35-0.4 ok, pull-off -0.178 / -0.168; dx 0.45-0.5 under_resolved, -0.153; 0.55-0.6
-# under_resolved, -0.165): a coarse grid gives a *less* tensile pull-off, a grid artefact
-MD = {"shape": "sphere", "radius": 1.0, "cell": 4.0, "law": "md", "tabor": 3.0, "dx": 0.5, "d_min": -0.5,
+# a sphere whose status turns from ok to under_resolved between dx = 0.4 and 0.45.  Issue 22 item 2: it was
+# a Maugis–Dugdale sphere at μ = 3, whose dx 0.3 / 0.4 were 'ok' with pull-offs 6 % apart (pixel snap
+# number ≈ 12: every grid is under-resolved now); LJ 9-3 at μ = 0.5: dx 0.3 / 0.35-0.4 ok (process zone
+# 0.44 >= 1.2 dx), pull-off -0.5275 / -0.5274; dx 0.45-0.5 under_resolved (grid 0.444, zone 0.47), -0.5308
+MD = {"shape": "sphere", "radius": 1.0, "cell": 4.0, "law": "lj93", "tabor": 0.5, "dx": 0.5, "d_min": -0.5,
       "d_max": 0.5, "d_step": 0.25}
 
 

@@ -17,6 +17,7 @@ from tengsim.loadpath import LoadPathSpec, run_load_path
 from tengsim.observers import Summary
 from tengsim.path import PathSpec, run_path
 from tengsim.plugins import KERNELS, LAWS, OBSERVERS, SHAPES, SOLVERS
+from tengsim.resolve import resolve_contact, run_contact
 from tengsim.results import ContactResult, Jump
 from tengsim.shapes import (Array, Cone, Cube, FlatPunch, HeightMap, Hemisphere, Line, Paraboloid, Pyramid,
                             Sinusoid1D, Topography, random_rough)
@@ -31,5 +32,5 @@ __all__ = [
     "HeightMap", "Hemisphere", "Jump", "LJ93", "Line", "Paraboloid", "PathSpec",
     "PeriodicKernel", "Problem", "Pyramid", "Repulsive", "Sinusoid1D", "State", "TengsimError",
     "VSRSolver", "contact_length", "force", "parse_quantity", "random_rough",
-    "repulsive_area", "run_path", "simulate", "simulate_pyramid", "__version__",
+    "repulsive_area", "resolve_contact", "run_contact", "run_path", "simulate", "simulate_pyramid", "__version__",
 ]

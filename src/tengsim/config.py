@@ -19,6 +19,7 @@ from tengsim.path import PathSpec
 from tengsim.plugins import KERNELS, LAWS, OBSERVERS, SHAPES, SOLVERS
 from tengsim.schema import Field, Table, dataclass_fields, signature_fields
 from tengsim.shapes.base import dimensionless_fields, physical_fields
+from tengsim.shapes.roughened import LENGTH_KEYS as _ROUGHNESS_LENGTHS, roughen, roughness_fields
 from tengsim.units import Scaling, parse_quantity
 
 PHYSICAL_KEYS = ("E_star", "W", "eps")
@@ -55,6 +56,7 @@ def key_dims(cfg: dict) -> dict:
         return {}
     out = {f.name: (f.dim, True) for f in common_fields() if f.dim}
     out.update({k: (d, False) for k, d in X_UNIT_KEYS.items()})
+    out.update({k: ("length", False) for k in _ROUGHNESS_LENGTHS})  # bare: ε or X units, as dx
     out.update({f.name: (f.dim, True) for f in phys if f.dim})
     return out
 
@@ -94,6 +96,9 @@ def _observer_names(v):
         raise TengsimError(f"observers must be a list of names, got {v!r}")
     return tuple(OBSERVERS.canonical(x) for x in v)
 
+
+RESOLVE_CHOICES = ("off", "auto")
+"""resolve: one grid (off) or automatic refinement (auto, tengsim.resolve)."""
 
 CONTROLS = ("approach", "load")
 """Path controls of a [contact] table: the rigid approach D (PathSpec) or the load F (LoadPathSpec)."""
@@ -204,11 +209,22 @@ def common_fields() -> list:
               "E = E*(1 - ν²) (needs thickness)"),
         Field("solver", "str", "fast", choices=SOLVERS.names, help="solver: " + SOLVERS.help()),
         Field("tol", default=1e-6, help="max residual of Eq. (9) in ε"),
+        Field("symmetry", "str", "auto", choices=("auto", "off"),
+              help="auto: solve on the irreducible quarter (half) of the cell when the shape and its grid are "
+              "mirror symmetric (same answer, less time and memory); off: always the full grid"),
         Field("law", "str", "lj93", check=LAWS.canonical, help="interaction law: " + LAWS.help()),
         Field("observers", "any", (), check=_observer_names,
               help="extra observers adding columns: "
               + ("; ".join(f"{n}: {OBSERVERS.summary(n)}" for n in OBSERVERS.names() if n != "summary")
                  or "none registered (F, Λc, areas, gaps, pressures are always there)")),
+        *roughness_fields(),  # a roughness superimposed on the shape (tengsim.shapes.roughened)
+        Field("resolve", "str", "off", choices=RESOLVE_CHOICES,
+              help="auto: refine the grid (dx/√2 per level, from dx or a coarse default) until every equilibrium "
+              "is ok and the observables changed by at most resolve_tol (tengsim.resolve); off: the one grid dx"),
+        Field("resolve_tol", "float", None, help="resolve = auto: relative tolerance of the observables, "
+              "> 0 and < 1 (default 0.01)"),
+        Field("max_pixels", "int", None, help="resolve = auto: largest grid nx·ny, >= 9 (default: what the "
+              "free memory holds)"),
         Field("out", "str", None, help="output file, .csv or .nc"),
         Field("plot", "str", None, help="figure of F(D), Λc(D), Λc(F), .png/.pdf/.svg"),
     ]
@@ -339,6 +355,8 @@ class ContactPlan:
     scaling: Scaling | None = None
     observers: tuple = ()
     kernel_params: dict = field(default_factory=dict)
+    resolve: dict = field(default_factory=dict)  # resolve = auto: {resolve, resolve_tol, max_pixels, dx (start)}
+    symmetry: str = "auto"
 
 
 def _dx(raw, lateral, name="dx"):
@@ -472,6 +490,8 @@ def plan_contact(cfg: dict) -> ContactPlan:
         vals = contact_table(name, "dimensionless", law_name).parse(cfg)
         tabor = positive("tabor", 0.5 if vals["tabor"] is None else vals["tabor"])
         shape = _build(cls, name, {f.name: vals[f.name] for f in dims if vals[f.name] is not None})
+    shape, rough_extra = roughen(shape, vals, given, scaling)  # roughness = true: Roughened(shape, ...)
+    extra.update(rough_extra)
     raw_dx = cfg.get("dx")  # not given: the shape's own pixel (a height map's) or 0.1
     dx = _dx(raw_dx, lateral) if raw_dx not in (None, "") else getattr(shape, "native_dx", 0.1)
     kernel_params = _film(cfg, vals, lateral, extra)
@@ -486,8 +506,28 @@ def plan_contact(cfg: dict) -> ContactPlan:
     from tengsim.resources import check_memory
 
     check_memory(grid.nx, grid.ny, vals["boundary"], vals["solver"], maps=2 * len(path.maps_at))
+    resolve = _resolve(vals, given, dx if raw_dx not in (None, "") else None)
     return ContactPlan(shape, tabor, dx, path, vals["boundary"], vals["solver"], tol, law, extra, scaling,
-                       tuple(vals["observers"]), kernel_params)
+                       tuple(vals["observers"]), kernel_params, symmetry=vals["symmetry"], resolve=resolve)
+
+
+def _resolve(vals, given, dx) -> dict:
+    """The refinement settings of a table: {} for resolve = off (resolve_tol, max_pixels refused there),
+    else resolve, resolve_tol (default 0.01), max_pixels (None: the free memory's) and the start dx (None: a
+    coarse default, tengsim.resolve.default_dx)."""
+    if vals["resolve"] != "auto":
+        bad = [k for k in ("resolve_tol", "max_pixels") if k in given]
+        if bad:
+            raise ConfigValueError(f"{' and '.join(bad)} {'apply' if len(bad) > 1 else 'applies'} only with "
+                                   "resolve = 'auto'")
+        return {}
+    tol = vals["resolve_tol"]
+    if tol is not None and not 0 < tol < 1:
+        raise ConfigValueError(f"resolve_tol must be > 0 and < 1, got {tol!r}")
+    mp = vals["max_pixels"]
+    if mp is not None and mp < 9:
+        raise ConfigValueError(f"max_pixels must be >= 9 (pixels nx·ny), got {mp!r}")
+    return {"resolve": "auto", "resolve_tol": 0.01 if tol is None else float(tol), "max_pixels": mp, "dx": dx}
 
 
 def _common_names():

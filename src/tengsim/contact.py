@@ -7,23 +7,62 @@ from tengsim import status
 from tengsim._version import __version__
 from tengsim.config import plan_contact
 from tengsim.errors import TengsimError, positive
+from tengsim.grid import Mirror
 from tengsim.shapes import Pyramid, Shape
 from tengsim.laws import LJ93, Law, make_law
 from tengsim.kernels import make_kernel
 from tengsim.loadpath import LoadPathSpec, run_load_path
 from tengsim.path import PathSpec, run_path
 from tengsim.plugins import KERNELS
-from tengsim.resources import check_memory
+from tengsim.resources import MAP_WORK, check_memory
 from tengsim.solvers import make_solver
+from tengsim.solvers.mirror import MirrorSolver
 
 MONITOR_MIN_POINTS = 1024**2  # grids from this size on report progress inside each solve
+SYMMETRY_CHOICES = ("auto", "off")
+#: full-grid arrays a block run still holds beside the block's workspace (U0, g0, the unfolded H and P the
+#: path keeps, its zero start; measured ~10, docs/benchmarks.md "Symmetry-reduced kernels"), for the memory check
+MIRROR_FULL_ARRAYS = 12
+_AXIS_NAMES = ("x", "y")
+
+
+def choose_symmetry(shape, U0, grid, boundary: str, solver_name: str, symmetry: str = "auto"):
+    """(mirror axes, label) of a run: the mirrors the shape declares (``mirror_axes``) that its gap U0 has on
+    ``grid`` (odd pixel counts along them), when the kernel is the free or periodic one (half-space or
+    film) and the solver is 'fast' or 'vsr'; else () and the reason.  ``symmetry='off'``: always ()."""
+    sym = str(symmetry).strip().lower()
+    if sym not in SYMMETRY_CHOICES:
+        raise TengsimError(f"symmetry = {symmetry!r} is not one of {', '.join(SYMMETRY_CHOICES)}")
+    if sym == "off":
+        return (), "off"
+    declared = tuple(getattr(shape, "mirror_axes", ()) or ())
+    if not declared:
+        return (), "none (shape has no mirror)"
+    if boundary not in ("free", "periodic"):
+        return (), f"none (boundary {boundary})"
+    if solver_name not in ("fast", "vsr"):
+        return (), f"none (solver {solver_name or '?'})"
+    axes = tuple(a for a in sorted(set(declared)) if grid.shape[a] % 2 == 1 and grid.shape[a] >= 5
+                 and Mirror(grid, (a,)).is_symmetric(U0))
+    if not axes:
+        return (), "none (gap not mirror symmetric on the grid)"
+    return axes, "+".join(_AXIS_NAMES[a] for a in axes)
+
+
+def _mirror_kernel_class():
+    """The kernel acting on the irreducible block (tengsim.kernels.mirror.MirrorKernel), or None without it."""
+    try:
+        from tengsim.kernels.mirror import MirrorKernel
+    except ModuleNotFoundError:  # pragma: no cover - a tree without the mirror kernel: the full grid
+        return None
+    return MirrorKernel
 
 
 def simulate(shape: Shape, tabor: float, dx: float, path: PathSpec, boundary: str = "free",
              solver="fast", tol: float = 1e-6, law: Law | str | None = None, progress=None,
              grid=None, extra_params: dict | None = None, observers=(), scaling=None,
              kernel_params: dict | None = None, throw: bool = False, check_memory_first: bool = True,
-             sink=None):
+             sink=None, symmetry: str = "auto"):
     """Approach–retraction run of ``shape`` against a rigid flat plate (paper Eq. 9).
 
     ``tabor`` is μ (the elastic coupling is μ^{3/2}); ``dx`` the grid spacing in X units;
@@ -44,6 +83,11 @@ def simulate(shape: Shape, tabor: float, dx: float, path: PathSpec, boundary: st
     before any solve, with the run's parameters known then (all but the recorded pixel snap number and
     the status): :class:`tengsim.results.RowStream` writes them as its header, or refuses a file to
     resume that another run wrote.
+
+    ``symmetry``: 'auto' solves on the irreducible quarter (or half) of the cell when the shape declares
+    mirrors its gap has on the grid, the kernel is 'free' or 'periodic' and the solver 'fast' or 'vsr'
+    (:func:`choose_symmetry`; the same answer, to round-off); 'off' the full grid.  ``params['symmetry']``
+    says what was used ('x+y', 'x', 'y', 'off' or 'none (why)'), ``block_nx``, ``block_ny`` the block.
     """
     tabor = positive("tabor", tabor)
     if scaling is not None and abs(scaling.mu - tabor) > 1e-9 * tabor:
@@ -52,13 +96,27 @@ def simulate(shape: Shape, tabor: float, dx: float, path: PathSpec, boundary: st
     boundary = KERNELS.canonical(boundary)
     grid = grid or shape.grid(dx)
     solver_obj = make_solver(solver, tol=tol) if isinstance(solver, str) else solver
-    if check_memory_first:  # before any large array: one clear error, needed vs available
-        check_memory(grid.nx, grid.ny, boundary, getattr(solver_obj, "name", ""), getattr(solver_obj, "memory", 10),
-                     maps=2 * len(path.maps_at))
+    if isinstance(solver_obj, MirrorSolver):
+        solver_obj = solver_obj.inner
+    U0 = shape.gap(grid)
+    axes, sym_label = choose_symmetry(shape, U0, grid, boundary, getattr(solver_obj, "name", ""), symmetry)
+    mirror_kernel = _mirror_kernel_class() if axes else None
+    if axes and mirror_kernel is None:
+        axes, sym_label = (), "none (no mirror kernel)"
+    mirror = Mirror(grid, axes) if axes else None
+    bnx, bny = mirror.reduced_shape if mirror else (grid.nx, grid.ny)
+    if check_memory_first:  # before any large array: one clear error, needed vs available (the block's)
+        full_arrays = MAP_WORK * 2 * len(path.maps_at) + (MIRROR_FULL_ARRAYS if mirror else 0)
+        check_memory(bnx, bny, boundary, getattr(solver_obj, "name", ""), getattr(solver_obj, "memory", 10),
+                     maps=-(-full_arrays * grid.nx * grid.ny // (MAP_WORK * bnx * bny)))
     if (hasattr(progress, "monitor") and grid.nx * grid.ny >= MONITOR_MIN_POINTS and is_dataclass(solver_obj)
             and getattr(solver_obj, "monitor", 0) is None):  # long solves report as they go
         solver_obj = replace(solver_obj, monitor=progress.monitor(), monitor_every=10)
-    kernel = make_kernel(boundary, grid, tabor**1.5, **(kernel_params or {}))
+    if mirror is None:
+        kernel = make_kernel(boundary, grid, tabor**1.5, **(kernel_params or {}))
+    else:
+        kernel = mirror_kernel(boundary, grid, tabor**1.5, mirror, **(kernel_params or {}))
+        solver_obj = MirrorSolver(solver_obj)
     walk = run_load_path if isinstance(path, LoadPathSpec) else run_path  # load or rigid-approach control
     params = {
         "tengsim_version": __version__,
@@ -69,6 +127,8 @@ def simulate(shape: Shape, tabor: float, dx: float, path: PathSpec, boundary: st
         **{k: v for k, v in (getattr(kernel, "params", dict)() or {}).items() if k not in ("boundary", "coupling")},
         "solver": solver_obj.name,
         "tol": solver_obj.tol,
+        "symmetry": sym_label,
+        **({"block_nx": bnx, "block_ny": bny} if mirror is not None else {}),
         "dx": grid.dx,
         "nx": grid.nx,
         "ny": grid.ny,
@@ -86,7 +146,7 @@ def simulate(shape: Shape, tabor: float, dx: float, path: PathSpec, boundary: st
             params.setdefault(k, v)
     if sink is not None and hasattr(sink, "begin"):
         sink.begin(dict(params))
-    res = walk(shape.gap(grid), law, kernel, solver_obj, path, progress=progress, observers=observers, sink=sink)
+    res = walk(U0, law, kernel, solver_obj, path, progress=progress, observers=observers, sink=sink)
     recorded = res.params  # what the path recorded (the pixel snap number)
     res.params = {**params, **recorded}
     if scaling is not None:
@@ -117,10 +177,13 @@ def run_contact(cfg: dict, progress=None, sink=None):
     for :func:`simulate` (the config is not among the parameters it is given: a CLI run and a TOML run
     of the same settings spell it differently, and resume only cares about what is solved)."""
     plan = plan_contact(cfg)
+    if getattr(plan, "resolve", None):  # refinement is the layer above's: never run one grid silently instead
+        raise TengsimError("resolve = 'auto' runs through tengsim.resolve.run_contact (tengsim.run_contact), "
+                           "not tengsim.contact.run_contact")
     res = simulate(plan.shape, plan.tabor, plan.dx, plan.path, boundary=plan.boundary,
                    solver=plan.solver, tol=plan.tol, law=plan.law, progress=progress,
                    extra_params=plan.extra, observers=plan.observers, scaling=plan.scaling,
                    kernel_params=plan.kernel_params, check_memory_first=False,  # plan_contact checked it
-                   sink=sink)
+                   sink=sink, symmetry=getattr(plan, "symmetry", "auto"))
     res.params["config"] = {k: v for k, v in cfg.items() if k not in ("out", "plot")}
     return res

@@ -5,7 +5,7 @@ recorder that turns each equilibrium into a row of the result table.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, is_dataclass, replace
 
 import numpy as np
 
@@ -14,12 +14,40 @@ from tengsim.analysis import apex_index
 from tengsim.errors import TengsimError
 from tengsim.results import CURVE_COLUMNS, PHYSICAL_COLUMNS, ContactResult
 from tengsim.solvers import Problem, State
-from tengsim.status import pixel_snap_number, process_zone_width, row_status
+from tengsim.status import EdgeScan, pixel_snap_number, row_status
 
 
 def secant(s0: State, s1: State, c: float) -> State:
     """The state c steps of (s0 → s1) beyond s1: the secant predictor of a continuation step."""
     return State(s1.q + c * (s1.q - s0.q), s1.w + c * (s1.w - s0.w))
+
+
+PERSIST_FACTOR = 10  # a fast solve stopped at its cap goes on for up to this many times max_iter more
+
+
+def persist(solver, problem: Problem, eq):
+    """The automatic fallback of a fast solve that stopped at its iteration cap (issue 23): go on from
+    where it stopped, with ``PERSIST_FACTOR`` × max_iter more iterations.
+
+    Where the law is stiffer than a pixel (pixel snap number ≫ 1) the fast solver's work is a long
+    sequence of single pixels snapping in, then a slow settling of the stiff contact; both make progress
+    every iteration, only more slowly than the cap allows (measured, docs/benchmarks.md "Stiff laws").
+    Runs only on a solve that did not converge, so every equilibrium that converges within the cap is
+    unchanged bit for bit.  Any other solver, or a solve that failed otherwise (line search, non-finite),
+    is returned as it is; a continued solve that still fails says so in its message, with both counts."""
+    inner = getattr(solver, "inner", solver)
+    if (PERSIST_FACTOR < 1 or getattr(inner, "name", None) != "fast" or not is_dataclass(inner)
+            or not np.isfinite(eq.residual)
+            or not str(eq.message).startswith("not converged")):
+        return eq
+    more = replace(inner, max_iter=PERSIST_FACTOR * int(inner.max_iter))
+    more = solver.with_inner(more) if hasattr(solver, "with_inner") else more
+    eq2 = more.solve(problem, eq.state)
+    what = "converged" if eq2.converged else f"not converged ({eq2.message})"
+    return replace(eq2, iterations=eq.iterations + eq2.iterations, n_conv=eq.n_conv + eq2.n_conv,
+                   seconds=eq.seconds + eq2.seconds,
+                   message=f"{what} after the cap: {eq.iterations} + {eq2.iterations} iterations "
+                           f"(max|r| {eq.residual:.2e} at the cap)")
 
 
 class Branch:
@@ -31,7 +59,11 @@ class Branch:
         self.hist: list = []  # accepted (D, state) on this branch, newest last
 
     def solve(self, D, start):
-        return self.solver.solve(Problem(self.U0 - D + 1.0, self.law, self.kernel), start)
+        problem = Problem(self.U0 - D + 1.0, self.law, self.kernel)
+        eq = self.solver.solve(problem, start)
+        if eq.converged:
+            return eq
+        return persist(self.solver, problem, eq)
 
     def _start(self, D):
         (D1, s1) = self.hist[-1]
@@ -98,6 +130,7 @@ class Recorder:
         self.U0, self.law, self.grid = U0, law, grid
         # the run's pixel snap number (one convolution), so that each row is classified once, as recorded
         self.snap = pixel_snap_number(law, kernel)
+        self.edges = EdgeScan(U0, law, grid.dx, grid.dy, getattr(kernel, "coupling", None))  # every contact edge
         self.apex = apex_index(U0)
         self.summary = obs.Summary()
         self.extra = obs.resolve(observers)
@@ -120,10 +153,11 @@ class Recorder:
             more = {}
             for o in self.extra:
                 more.update(self._observe(o, eq, self.ctx))
-            pz = process_zone_width(eq.H, self.grid.dx, self.apex, self.law)
+            pz = self.edges(eq.H)
             self.rows.append(dict(branch=branch, D=D, on_grid=on_grid, jump=jump, converged=eq.converged,
                                   in_law_range=in_range, process_zone=pz,
-                                  status=row_status(bool(eq.converged), in_range, pz, self.grid.dx, self.snap),
+                                  status=row_status(bool(eq.converged), in_range, pz, self.grid.dx, self.snap,
+                                                    self.edges.face),
                                   residual=eq.residual, iterations=eq.iterations, n_conv=eq.n_conv,
                                   seconds=eq.seconds, energy=eq.energy, **s, **more))
             value = D if self.control == "D" else s["F"]
@@ -153,4 +187,5 @@ class Recorder:
         for o in self.extra:
             res.units.update(getattr(o, "units", None) or {})
         res.params["pixel_snap_number"] = self.snap
+        res.params["face_uncertainty"] = self.edges.face
         return res

@@ -195,6 +195,11 @@ def load_result(path) -> tuple[str, object]:
                 raise TengsimError(f"{path}: its 'params' attribute is not JSON: {exc}") from None
             if not isinstance(params, dict):
                 raise TengsimError(f"{path}: its 'params' attribute is not a JSON object")
+            if "level" in ds.dims:  # resolve = auto: the table of the grids (ContactResult._resolution_vars)
+                params["resolution"] = {k[len("resolution_"):]: [None if isinstance(x, float) and x != x else x
+                                                                 for x in v.values.tolist()]
+                                        for k, v in ds.variables.items() if v.dims == ("level",)
+                                        and k.startswith("resolution_")}
             if "x" not in ds.variables or "y" not in ds.variables:
                 raise TengsimError(f"{path}: a contact result without its grid coordinates x, y")
             x, y = ds["x"].values, ds["y"].values

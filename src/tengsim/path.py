@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from tengsim.analysis import force
-from tengsim.continuation import Branch, Recorder, StateOnly, secant
+from tengsim.continuation import Branch, Recorder, StateOnly, persist, secant
 from tengsim.errors import TengsimError, finite, positive
 from tengsim.solvers import Problem, State
 
@@ -309,7 +309,8 @@ class _MapRows:
                 t = (m - Da) / (D - Da)
                 start = eqa.state if jump else State(eqa.state.q + t * (eq.state.q - eqa.state.q),
                                                       eqa.state.w + t * (eq.state.w - eqa.state.w))
-                eqm = self.solver.solve(Problem(self.U0 - m + 1.0, self.law, self.kernel), start)
+                pm = Problem(self.U0 - m + 1.0, self.law, self.kernel)
+                eqm = persist(self.solver, pm, self.solver.solve(pm, start))  # past the cap (issue 23)
                 jm = bool(jump) and self._jumped(eqa, eqm, m - Da)
                 self.record(m, eqm, False, jm, m)
                 self.wanted.remove(m)
@@ -415,7 +416,8 @@ def walk_states(U0, law, kernel, solver, Ds, start: State | None = None):
             (D0, s0), (D1, s1) = prev
             c = (D - D1) / (D1 - D0)
             state = secant(s0, s1, c)
-        eq = solver.solve(Problem(U0 - D + 1.0, law, kernel), state)
+        problem = Problem(U0 - D + 1.0, law, kernel)
+        eq = persist(solver, problem, solver.solve(problem, state))  # past the cap (issue 23)
         prev = (prev + [(D, eq.state)])[-2:]
         state = eq.state
         yield D, eq

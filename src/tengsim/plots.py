@@ -222,3 +222,49 @@ def plot_sweep(data, path, title: str = "") -> None:
     if title:
         fig.suptitle(title)
     save(fig, path)
+
+
+def plot_resolution(res, path, title: str = "") -> None:
+    """Convergence of an automatically refined run (``resolve = "auto"``, tengsim.resolve): one panel per
+    observable against the grid spacing dx (log axis, finest right), each grid's status marked, the
+    Richardson-extrapolated value as a line and its error estimate (± |error|) as a band."""
+    from tengsim.errors import TengsimError
+
+    tab = res.params.get("resolution")
+    if not isinstance(tab, dict) or not tab.get("dx"):
+        raise TengsimError("the result holds no resolution table (run with --resolve auto)")
+    rich = res.params.get("richardson") or {}
+    fixed = ("dx", "nx", "ny", "seconds", "convolutions", "status")
+
+    def num(v):
+        return np.array([np.nan if x is None else x for x in v], dtype=float)
+
+    names = [k for k in tab if k not in fixed and np.isfinite(num(tab[k])).any()]
+    if not names:
+        raise TengsimError("the resolution table has no finite observable")
+    plt = _plt()
+    dx = num(tab["dx"])
+    st = [str(s) for s in tab.get("status", ["?"] * len(dx))]
+    fig, axs = plt.subplots(1, len(names), figsize=(3.6 * len(names), 3.2), squeeze=False, constrained_layout=True)
+    for ax, n in zip(axs[0], names):
+        f = num(tab[n])
+        ax.plot(dx, f, "-", color="tab:blue", lw=1)
+        for ok in (True, False):
+            m = np.array([(s == "ok") == ok for s in st])
+            if m.any():
+                ax.plot(dx[m], f[m], "o" if ok else "x", color="tab:blue" if ok else "tab:red",
+                        label="status ok" if ok else "status not ok")
+        r = rich.get(n) or {}
+        ext, err = r.get("extrapolated"), r.get("error")
+        if ext is not None and err is not None and np.isfinite(ext) and np.isfinite(err):
+            ax.axhline(ext, color="k", lw=0.8, ls="--", label=f"Richardson {ext:.5g} (p = {r.get('order', np.nan):.2g})")
+            ax.axhspan(ext - abs(err), ext + abs(err), color="0.8", alpha=0.6, lw=0)
+        ax.set_xscale("log")
+        ax.set_xticks(dx, [f"{d:.3g}" for d in dx], fontsize=7, rotation=45)
+        ax.minorticks_off()
+        ax.invert_xaxis()
+        ax.set_xlabel("dx")
+        ax.set_title(n, fontsize=9)
+        ax.legend(fontsize=7)
+    fig.suptitle(title + (f"  [{res.params.get('resolve_status', '?')}, tol {res.params.get('resolve_tol', '?')}]"))
+    save(fig, path)

@@ -35,7 +35,7 @@ _CF_COLUMNS = {
     "min_pressure": ("smallest surface pressure P (Eq. 8; negative: tensile)", "pressure"),
     "energy": ("total energy E(q) of the cell as the solver minimises it (dimensionless)", "1"),
     "seconds": ("wall time of the solve", "s"),
-    "process_zone": ("measured cohesive window along the apex row (tengsim.status)", "lateral"),
+    "process_zone": ("measured cohesive window at the narrowest contact edge (tengsim.status)", "lateral"),
     "F_N": ("force per cell (positive: compressive)", "N"),
     "pressure_Pa": ("nominal pressure: force per cell / cell area (positive: compressive)", "Pa"),
     "contact_length_m": ("Greenwood contact length Λc", "m"),
@@ -53,6 +53,10 @@ _CF_COLUMNS = {
     "x": ("in-plane position X", "lateral"),
     "y": ("in-plane position Y", "lateral"),
 }
+# the refinement's table (tengsim.resolve) along dimension 'level': column -> (long_name, unit as above)
+_RESOLUTION_CF = {"dx": ("grid spacing of the level", "lateral"), "nx": ("pixels along x", "1"),
+                  "ny": ("pixels along y", "1"), "seconds": ("wall time of the level's run", "s"),
+                  "convolutions": ("convolutions (FFT pairs) of the level's run", "1")}
 # a unit text an observer may declare (its `units`) -> the scale it names; other texts that are not
 # UDUNITS units below are written as a `comment`, never as `units`
 _OBSERVER_SCALES = {"ε": "eps", "W/ε": "pressure", "ℓ": "lateral", "ℓ²": "area", "1": "1"}
@@ -150,7 +154,8 @@ class ContactResult:
         s = self.table.get("status")
         if s is None or np.asarray(s).dtype.kind not in "US":  # older files: classify from the columns
             s = _status.classify(self.table, self.grid.dx)
-        return _status.overall(s)
+        refined = self.params.get("resolve_status")  # resolve = auto stopped by max_pixels (tengsim.resolve)
+        return _status.overall([*np.asarray(s).astype(str).tolist(), *([str(refined)] if refined else [])])
 
     def raise_for_status(self) -> "ContactResult":
         """Raise :class:`tengsim.status.ResultStatusError` unless :attr:`status` is 'ok'; else return self."""
@@ -297,8 +302,9 @@ class ContactResult:
         scales = self.unit_scales()
         for k, var in ds.variables.items():
             var.attrs.update(self._cf_attrs(k, scales))
+        params, ds = self._resolution_vars(ds, scales)
         conv = t["converged"].astype(bool)
-        attrs = {"params": json.dumps(self.params, default=str), "status": self.status,
+        attrs = {"params": json.dumps(params, default=str), "status": self.status,
                  "pull_off_F": self.pull_off_force, "n_unconverged": int(np.count_nonzero(~conv))}
         if "in_law_range" in t:
             attrs["n_outside_law_range"] = int(np.count_nonzero(~t["in_law_range"].astype(bool)))
@@ -306,6 +312,38 @@ class ContactResult:
         ds.attrs = attrs
         return cf_conventions(ds, "tengsim contact result: approach-retraction curves of a rigid plate on an "
                                   "adhesive micro-structured half-space")
+
+    def _resolution_vars(self, ds, scales):
+        """(params without 'resolution', ds with it): the refinement's table (tengsim.resolve, one row per grid)
+        as variables ``resolution_<column>`` along dimension ``level`` (coarsest first), CF attributes as the
+        curves' (dx in ℓ, F in its unit, D in ε)."""
+        tab = self.params.get("resolution")
+        if not isinstance(tab, dict) or not tab.get("dx"):
+            return self.params, ds
+        for k, v in tab.items():
+            if k == "status":
+                a = np.array([str(x) for x in v])
+                long, unit = "status of the grid's run (tengsim.status)", None
+            else:
+                a = np.array([np.nan if x is None else x for x in v], dtype=float)
+                if k in ("nx", "ny", "convolutions"):
+                    a = a.astype(np.int64)
+                long, unit = _RESOLUTION_CF.get(k) or (
+                    (f"{k} on the grid (observable of the refinement)", "eps") if k.endswith("_D") else
+                    (f"{k} on the grid (observable of the refinement)", "force") if k.endswith("_F") else
+                    (f"{k} on the grid (observable of the refinement)", "1"))
+            name = f"resolution_{k}"
+            ds[name] = ("level", a)
+            attrs = {"long_name": long}
+            if unit in _SCALES:
+                text, si = _SCALES[unit]
+                attrs.update(units="1", unit_scale_text=text)
+                if unit in scales:
+                    attrs.update(unit_scale=scales[unit], unit_scale_units=si)
+            elif unit is not None:
+                attrs["units"] = unit
+            ds[name].attrs.update(attrs)
+        return {k: v for k, v in self.params.items() if k != "resolution"}, ds
 
     def csv_columns(self) -> dict:
         t = self.table

@@ -6,37 +6,43 @@ problems, in the order of :data:`SEVERITY`); the run's status is the worst row. 
 * ``not_converged`` — the solver stopped before the residual of Eq. (9) reached ``tol``;
 * ``out_of_law_range`` — some gap fell below the law's ``g_safe`` (the state is compressed into the
   safe extension of the law, not the physical law);
-* ``under_resolved`` — the grid spacing is coarser than the adhesive process zone (below).
+* ``under_resolved`` — the grid spacing is coarser than the adhesive process zone, the law snaps
+  pixel by pixel, or a walled face is rasterised too coarsely (below).
 
-Resolution criterion (measured per equilibrium).  Along the X row through the apex, walking out from
-the apex on each side, the *cohesive window* ℓ is the distance over which the gap opens from the law's
+Resolution criterion (measured per equilibrium, :class:`EdgeScan`).  At every contact edge on the
+grid — every row and column of the gap scanned both ways, not only the row through the apex — the
+*cohesive window* ℓ is the distance, normal to the edge, over which the gap opens from the law's
 tensile-peak gap g* (P(g*) = −σ0, the most tensile stress; LJ 9-3: g* = 3^{1/6}) to g0 + h0, where g0
 is the contact gap (P(g0) = 0; LJ 9-3: 1) and h0 = W/σ0 the Dugdale range of the law (W = −Φ(g0);
 LJ 9-3: h0 = 9√3/16 = 0.974), all as the law declares them (:class:`tengsim.laws.Law`: ``g_peak``,
 ``max_tension``, ``g_zero``, ``work``, ``cohesive_range``).  Positions are interpolated linearly in
-the gap between pixels; ℓ is the smaller of the two sides.  An equilibrium is **under-resolved when
-ℓ < 0.75 dx**.  Rows without such an opening edge on the row (no contact, or contact up to the cell
-border) are not judged.
+the gap between pixels.  Each contact spot (connected pixels with g < g*: an array's K apices,
+scattered, tilted and measured surfaces have many) gets the lower quartile of its edge's widths; the
+narrowest spot counts.  An equilibrium is **under-resolved when ℓ < 1.2 dx**.  Rows without an
+opening edge (no contact, or contact over the whole cell) are not judged.
 
-Calibration (LJ 9-3 sphere, free kernel, docs/validation.md): ℓ is 0.65–0.73 of the Maugis–Dugdale
-cohesive zone c − a at pull-off (Maugis 1992, λ = 1.157 μ), and nearly independent of dx, so the
-criterion reads "the Maugis–Dugdale zone is narrower than about one pixel".  Measured at pull-off
-(D step 0.25): μ = 3 has ℓ = 0.086–0.095; dx = 0.36 / 0.27 / 0.19 / 0.15 give ℓ/dx = 0.26 / 0.32 / 0.47
-/ 0.60 (flagged) and pull-offs +47 / +21 / +8 / +4 % above MD; dx = 0.095 gives 0.90 (ok) and +2.4 %.
-μ = 1 (ℓ ≈ 0.33): dx = 0.57 gives 0.57 (flagged), +14 %; dx = 0.36 gives 0.90 (ok), +5.8 % (the
-grid-converged LJ value is +4.9 %).  Resolved runs lie within 1.8 % of the finest grid; the full table
-is in docs/validation.md.
+Walls (cube, line, flat punch, a cliff in a height map): where U0 itself jumps by more than twice the
+window within one pixel (and four times its neighbouring step), no dx makes the gap open gradually,
+and the edge of the face is a crack tip: its process zone lies inside the face and is the Dugdale zone
+of that crack, set by the law and E* alone.  A wall edge whose face pixel is past the tensile peak
+counts as ℓ = 0.7 ℓ_D (the window's share of the Dugdale zone at a crack-like edge, measured on the
+sphere; ℓ_D below).  The face itself is sampled at pixel centres, so each wall lies anywhere within
+half a pixel: a face n pixels wide is known to 2/n of its area (``face_uncertainty``, a-priori); above
+FACE_LIMIT = 1 % every judged row is under-resolved.
+
+Calibration against grid convergence (benchmarks/status_calibration.py, docs/validation.md): coarse →
+fine runs of every registered shape and law; runs whose pull-off or jump D move by more than 1 % from the
+finest grid must not be ``ok``, runs within 1 % must not be flagged.
 
 Pixel snap (a second, a-priori cause of under-resolution).  A law that softens beyond its tensile
-peak faster than one pixel is stiff — s = max_g dP/dg × c_pix > 1 (the law's declared
-``max_softening``), with c_pix the gap change of a pixel under unit pressure on that pixel alone
-(one convolution of the run's kernel) — has no stable state in that band of gaps: pixels snap in and
-out one at a time and the contact edge is pinned to the lattice, whatever the process zone.  Every
-judged row of such a run is under-resolved.  Measured (docs/validation.md, MD sphere): MD law at
-μ = 3, smoothing 0.2, dx 0.05, s = 2.0, pull-off +8.2 % over Maugis with the edge stuck for 0.6 ε of
-D; smoothing 0.6 (s = 0.67 / 0.52 at dx 0.05 / 0.035) +0.72 / +0.21 %; μ = 1, smoothing 0.2,
-s = 0.79 / 0.38 at dx 0.1 / 0.05: +1.1 / +0.27 %.  LJ 9-3 has s = 0.66 at μ = 3, dx 0.1.  s grows
-about as μ^{3/2} dx.
+peak faster than one pixel is stiff — s = max_g dP/dg × c_pix (the law's declared ``max_softening``),
+with c_pix the gap change of a pixel under unit pressure on that pixel alone (one convolution of the
+run's kernel) — has no stable state in that band of gaps when s > 1: pixels snap in and out one at a
+time and the contact edge is pinned to the lattice, whatever the process zone; below 1 the lattice
+still traps the edge, by less.  Every judged row of a run with s > SNAP_LIMIT is under-resolved.
+Measured (MD sphere, μ = 1, smoothing 0.2, cell 5): s = 0.79 / 0.58 / 0.41 at dx 0.091 / 0.067 / 0.048,
+pull-off +1.7 / +0.9 % against the finest; (μ = 3, smoothing 0.6: s = 0.67 / 0.52, +0.72 / +0.21 % over
+Maugis).  s grows about as μ^{3/2} dx.
 
 A-priori estimate (stated with every run, ``params['process_zone_estimate']``): at a crack-like
 contact edge (JKR limit) the Dugdale zone is ℓ_D = (π/4) E* W/σ0², i.e. π/(4 κ σ0²) in units of the
@@ -49,6 +55,7 @@ from dataclasses import dataclass
 from functools import lru_cache
 
 import numpy as np
+from scipy import ndimage
 
 from tengsim.errors import TengsimError
 
@@ -58,8 +65,14 @@ OUT_OF_LAW_RANGE = "out_of_law_range"
 NOT_CONVERGED = "not_converged"
 #: worst last: a row's status is the worst of its problems, a run's the worst of its rows
 SEVERITY = (OK, UNDER_RESOLVED, OUT_OF_LAW_RANGE, NOT_CONVERGED)
-#: an equilibrium is under-resolved where its cohesive window ℓ < RESOLUTION · dx
-RESOLUTION = 0.75
+#: an equilibrium is under-resolved where its cohesive window ℓ < RESOLUTION · dx (calibrated on grid convergence:
+#: pull-off and jump D within 1 % of the finest grid for every shape and law from ℓ/dx = 1.24 up; 0.83–1.12 missed)
+RESOLUTION = 1.2
+#: ... or where the run's pixel snap number s > SNAP_LIMIT (lattice trapping: pull-off +1.7 % at s = 0.79)
+SNAP_LIMIT = 0.6
+#: ... or where a face bounded by walls is known to worse than FACE_LIMIT of its area (pixel-centre sampling;
+#: a flat top's pull-off moves as its area to the power 0.8–1, measured on the cube)
+FACE_LIMIT = 0.01
 
 _LABEL = {NOT_CONVERGED: "not converged", OUT_OF_LAW_RANGE: "out of the law's range",
           UNDER_RESOLVED: "under-resolved"}
@@ -192,9 +205,10 @@ def _window_1d(g: np.ndarray, w: CohesiveWindow) -> float:
 
 
 def process_zone_width(H: np.ndarray, dx: float, apex: tuple[int, int], law) -> float:
-    """Measured cohesive window ℓ of one equilibrium (module docstring): the distance along the X row
-    through ``apex`` over which the gap g = H + 1 opens from g* to g0 + h0, the smaller of the two
-    sides; NaN if the row has no such edge or the law has no tension."""
+    """The cohesive window ℓ along the X row through ``apex`` only: the distance over which the gap
+    g = H + 1 opens from g* to g0 + h0, the smaller of the two sides; NaN if the row has no such edge or
+    the law has no tension.  The measure before :class:`EdgeScan` (which the status uses), kept as the
+    1-D reference and for the calibration's comparison (benchmarks/status_calibration.py)."""
     w = cohesive_window(law)
     if w is None:
         return float("nan")
@@ -205,31 +219,197 @@ def process_zone_width(H: np.ndarray, dx: float, apex: tuple[int, int], law) -> 
     return float(min(sides) * dx) if sides else float("nan")
 
 
+# ---- the measured process zone at every contact edge of the grid ---------------------------------
+
+#: an opening from g* to g0 + h0 within one pixel step of the undeformed gap U0 that rises there by more
+#: than WALL_STEP × (g0 + h0 − g*) and WALL_RATIO × its step on the face side is a wall (a geometric
+#: edge: cube, line, flat punch, a cliff in a height map), where the gap cannot open gradually
+WALL_STEP = 2.0
+WALL_RATIO = 4.0
+#: at a wall edge the process zone is the crack-tip (Dugdale) zone inside the face: WALL_FACTOR × ℓ_D,
+#: the measured window's share of ℓ_D at a crack-like edge (sphere, JKR limit: ℓ ≈ 0.7 (c − a) ≈ 0.7 ℓ_D)
+WALL_FACTOR = 0.7
+#: a contact spot's edge width is the EDGE_QUANTILE of its crossings (robust to single pixels: the
+#: lattice meets the edge differently along each row); the worst spot counts
+EDGE_QUANTILE = 0.25
+
+
+def _wall_steps(U0: np.ndarray, w: CohesiveWindow, axis: int) -> np.ndarray:
+    """Steps i → i+1 along ``axis`` (shape n−1 along it) where U0 jumps like a wall (WALL_STEP, WALL_RATIO)."""
+    d = np.abs(np.diff(U0, axis=axis))
+    before = d.copy()  # the step on the face side (i−1 → i), and after (i+1 → i+2) for the other way;
+    after = d.copy()   # at the grid's border a step is compared with itself (no wall there)
+    sl = [slice(None)] * 2
+    lo, hi = list(sl), list(sl)
+    lo[axis], hi[axis] = slice(1, None), slice(None, -1)
+    before[tuple(lo)] = d[tuple(hi)]
+    after[tuple(hi)] = d[tuple(lo)]
+    big = d > WALL_STEP * (w.g_end - w.g_peak)
+    return big & ((d > WALL_RATIO * before) | (d > WALL_RATIO * after))
+
+
+def _scan(G, walls, labels, cos, w, wall_pix):
+    """Openings along axis 1 of G (m × n) in the + direction: (labels of the contact spot each opening
+    leaves, normal widths in pixels).  See :class:`EdgeScan`."""
+    n = G.shape[1]
+    if n < 2:
+        return np.empty(0, int), np.empty(0)
+    a, b = G[:, :-1], G[:, 1:]
+    P = np.flatnonzero((a < w.g_peak) & (b >= w.g_peak))
+    E = np.flatnonzero((a < w.g_end) & (b >= w.g_end))
+    if not len(P) or not len(E):
+        return np.empty(0, int), np.empty(0)
+    nxt = np.append(P[1:], np.iinfo(np.int64).max)  # the next opening: its g* crossing ends this one's window
+    k = np.searchsorted(E, P)
+    keep = k < len(E)
+    P, nxt, e = P[keep], nxt[keep], E[np.minimum(k[keep], len(E) - 1)]
+    keep = (P // (n - 1) == e // (n - 1)) & (e < nxt)
+    P, e = P[keep], e[keep]
+    af, bf = a.ravel(), b.ravel()
+    pos_p = P % (n - 1) + (w.g_peak - af[P]) / (bf[P] - af[P])
+    pos_e = e % (n - 1) + (w.g_end - af[e]) / (bf[e] - af[e])
+    inner = P + P // (n - 1)  # the pixel i (flat in G) the opening leaves, and i+1 beyond it
+    at_wall = walls.ravel()[e]
+    c = cos.ravel()[inner + 1]
+    width = np.where(at_wall, wall_pix, (pos_e - pos_p) * c)
+    # a wall opening is judged once the face pixel at the wall is past the peak (its zone has formed);
+    # a gradual opening where the scan runs within 45° of the edge normal (the other scan sees the rest)
+    judged = np.where(at_wall, e > P, c >= np.sqrt(0.5))
+    return labels.ravel()[inner][judged], width[judged]
+
+
+def face_uncertainty(U0: np.ndarray, walls) -> float:
+    """Relative uncertainty of the area of the flat faces bounded by walls (0: no walls).  The grid samples
+    U0 at pixel centres, so a wall lies anywhere within half a pixel of the step: each wall step leaves
+    half a pixel of a face's area unknown.  A face is a connected region below the walls' mid-heights;
+    the worst face counts: (its wall steps) / (2 × its pixels), 2/n for a square face n pixels wide."""
+    wx, wy = walls
+    if not (wx.any() or wy.any()):
+        return 0.0
+    U0 = np.asarray(U0, dtype=float)
+    mids = np.concatenate([(0.5 * (U0[:-1] + U0[1:]))[wx], (0.5 * (U0[:, :-1] + U0[:, 1:]))[wy]])
+    labels, n = ndimage.label(U0 < np.median(mids))
+    if n == 0:
+        return 0.0
+    lo_x = np.where(U0[:-1] < U0[1:], labels[:-1], labels[1:])[wx]  # the face side of each wall step
+    lo_y = np.where(U0[:, :-1] < U0[:, 1:], labels[:, :-1], labels[:, 1:])[wy]
+    steps = np.bincount(np.concatenate([lo_x, lo_y]), minlength=n + 1)[1:]
+    pixels = np.bincount(labels.ravel(), minlength=n + 1)[1:]
+    return float(np.max(steps / (2.0 * np.maximum(pixels, 1))))
+
+
+class EdgeScan:
+    """The process zone of one equilibrium measured at every contact edge of the grid (one per run:
+    the walls of U0 and the law's numbers are found once; each call is element-wise on the gap).
+
+    Every row and every column of the gap g = H + 1 is scanned both ways; an *opening* leaves a pixel
+    with g < g* and reaches g0 + h0 before g falls below g* again.  Its width (linear interpolation of
+    g between pixels, times the cosine between the scan and the gap's gradient, so that it is the width
+    normal to the edge; an opening is read only by the scan within 45° of that normal) is the cohesive
+    window ℓ there.  An opening whose g0 + h0 crossing is a wall step of U0 (:data:`WALL_STEP`) is a
+    geometric edge: its zone is the crack tip's inside the face, WALL_FACTOR × ℓ_D (the a-priori Dugdale
+    zone, :func:`process_zone_estimate`), judged once the face pixel at the wall is past the peak.
+    Openings are grouped by the contact spot they leave (connected pixels with g < g*); a spot's width is
+    the EDGE_QUANTILE of its openings; the result is the narrowest spot's, in lateral units (NaN: no
+    opening anywhere, or a law without tension).
+    """
+
+    def __init__(self, U0, law, dx: float, dy: float | None = None, coupling: float | None = None):
+        self.w = cohesive_window(law)
+        self.dx, self.dy = float(dx), float(dy if dy is not None else dx)
+        self.face = 0.0  # a law without tension: nothing is judged
+        if self.w is None:
+            return
+        U0 = np.asarray(U0, dtype=float)
+        self.walls = (_wall_steps(U0, self.w, 0), _wall_steps(U0, self.w, 1))
+        lD = process_zone_estimate(law, coupling) if coupling else float("nan")
+        self.wall_zone = WALL_FACTOR * lD if lD == lD else 0.0
+        self.face = face_uncertainty(U0, self.walls)
+
+    def __call__(self, H) -> float:
+        w = self.w
+        if w is None:
+            return float("nan")
+        g = np.asarray(H, dtype=float) + 1.0
+        near = g < w.g_end
+        rows, cols = np.flatnonzero(near.any(axis=1)), np.flatnonzero(near.any(axis=0))
+        if not len(rows):
+            return float("nan")
+        # the work is element-wise on the box around the edges (2 pixels' margin: central differences)
+        i0, i1 = max(rows[0] - 2, 0), min(rows[-1] + 3, g.shape[0])
+        j0, j1 = max(cols[0] - 2, 0), min(cols[-1] + 3, g.shape[1])
+        g = g[i0:i1, j0:j1]
+        wx, wy = self.walls[0][i0:i1 - 1, j0:j1], self.walls[1][i0:i1, j0:j1 - 1]
+        inside = g < w.g_peak
+        if not inside.any() or inside.all():
+            return float("nan")
+        labels, _ = ndimage.label(inside)
+        gx, gy = np.gradient(g, self.dx, self.dy) if min(g.shape) > 1 else (np.ones_like(g), np.zeros_like(g))
+        norm = np.hypot(gx, gy)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            cx, cy = np.abs(gx) / norm, np.abs(gy) / norm
+        cx, cy = np.nan_to_num(cx), np.nan_to_num(cy)
+        labs, widths = [], []
+        for G, W, L, C, d in ((g.T, wx.T, labels.T, cx.T, self.dx), (g, wy, labels, cy, self.dy)):
+            for s in (slice(None), slice(None, None, -1)):
+                lab, wid = _scan(G[:, s], W[:, s], L[:, s], C[:, s], w, self.wall_zone / d)
+                labs.append(lab)
+                widths.append(wid * d)
+        lab, wid = np.concatenate(labs), np.concatenate(widths)
+        if not len(wid):
+            return float("nan")
+        order = np.lexsort((wid, lab))
+        lab, wid = lab[order], wid[order]
+        starts = np.flatnonzero(np.r_[True, lab[1:] != lab[:-1]])
+        counts = np.diff(np.r_[starts, len(lab)])
+        return float(wid[starts + np.floor(EDGE_QUANTILE * (counts - 1)).astype(int)].min())
+
+
+def edge_process_zone(H, dx: float, law, U0=None, coupling: float | None = None, dy: float | None = None) -> float:
+    """The process zone of one equilibrium at every contact edge (:class:`EdgeScan`; U0 None: no walls)."""
+    return EdgeScan(np.zeros_like(np.asarray(H, float)) if U0 is None else U0, law, dx, dy, coupling)(H)
+
+
 # ---- classification -----------------------------------------------------------------------------
 
 def _zone(table: dict) -> tuple[np.ndarray, np.ndarray]:
-    """(process zone per row, rows where it was measured: an opening edge on the apex row; 0 or NaN:
-    none, or an older file)."""
+    """(process zone per row, rows where it was measured: an opening contact edge somewhere on the grid;
+    0 or NaN: none, or an older file)."""
     pz = np.asarray(table.get("process_zone", np.full(len(table["D"]), np.nan)), dtype=float)
     with np.errstate(invalid="ignore"):
         return pz, np.isfinite(pz) & (pz > 0)
 
 
+def _snaps(snap) -> bool:
+    return snap is not None and snap == snap and snap > SNAP_LIMIT
+
+
+def _coarse_face(face) -> bool:
+    return face is not None and face == face and face > FACE_LIMIT
+
+
 def snapping(table: dict, snap: float | None) -> np.ndarray:
-    """Rows judged (an opening contact edge on the apex row) in a run whose pixel snap number > 1."""
-    if not (snap is not None and snap > 1.0):
+    """Rows judged (an opening contact edge) in a run whose pixel snap number > SNAP_LIMIT."""
+    if not _snaps(snap):
         return np.zeros(len(table["D"]), bool)
     return _zone(table)[1]
 
 
-def flags(table: dict, dx: float, snap: float | None = None) -> dict:
+def coarse_faces(table: dict, face: float | None) -> np.ndarray:
+    """Rows judged (an opening contact edge) in a run whose walled faces are known to worse than FACE_LIMIT."""
+    if not _coarse_face(face):
+        return np.zeros(len(table["D"]), bool)
+    return _zone(table)[1]
+
+
+def flags(table: dict, dx: float, snap: float | None = None, face: float | None = None) -> dict:
     """Boolean arrays, one per problem kind, over the rows of a result table (``snap``: the run's
-    pixel snap number, :func:`pixel_snap_number`)."""
+    pixel snap number, :func:`pixel_snap_number`; ``face``: its face uncertainty, :func:`face_uncertainty`)."""
     n = len(table["D"])
     conv = np.asarray(table["converged"]).astype(bool)
     in_range = np.asarray(table.get("in_law_range", np.ones(n))).astype(bool)
     return {NOT_CONVERGED: ~conv, OUT_OF_LAW_RANGE: ~in_range,
-            UNDER_RESOLVED: narrow_zone(table, dx) | snapping(table, snap)}
+            UNDER_RESOLVED: narrow_zone(table, dx) | snapping(table, snap) | coarse_faces(table, face)}
 
 
 def narrow_zone(table: dict, dx: float) -> np.ndarray:
@@ -238,21 +418,22 @@ def narrow_zone(table: dict, dx: float) -> np.ndarray:
     return measured & (pz < RESOLUTION * dx)
 
 
-def row_status(converged: bool, in_range: bool, process_zone: float, dx: float, snap: float | None = None) -> str:
+def row_status(converged: bool, in_range: bool, process_zone: float, dx: float, snap: float | None = None,
+               face: float | None = None) -> str:
     """The status of one equilibrium as it is recorded (the same rules as :func:`classify` on a table)."""
     if not converged:
         return NOT_CONVERGED
     if not in_range:
         return OUT_OF_LAW_RANGE
     measured = process_zone == process_zone and process_zone > 0
-    if measured and (process_zone < RESOLUTION * dx or (snap is not None and snap > 1.0)):
+    if measured and (process_zone < RESOLUTION * dx or _snaps(snap) or _coarse_face(face)):
         return UNDER_RESOLVED
     return OK
 
 
-def classify(table: dict, dx: float, snap: float | None = None) -> np.ndarray:
+def classify(table: dict, dx: float, snap: float | None = None, face: float | None = None) -> np.ndarray:
     """Per-row status strings: the worst problem of each row (SEVERITY order), 'ok' if none."""
-    f = flags(table, dx, snap)
+    f = flags(table, dx, snap, face)
     out = np.full(len(table["D"]), OK, dtype=object)
     for kind in SEVERITY[1:]:
         out[f[kind]] = kind
@@ -278,8 +459,8 @@ def _where(table: dict, mask: np.ndarray) -> str:
 def problems(result) -> list[tuple[str, str]]:
     """(kind, one-line description naming where) for each problem kind present, worst first."""
     t, dx, p = result.table, result.grid.dx, result.params
-    snap = p.get("pixel_snap_number")
-    f = flags(t, dx, snap)
+    snap, face = p.get("pixel_snap_number"), p.get("face_uncertainty")
+    f = flags(t, dx, snap, face)
     n = len(t["D"])
     out = []
     for kind in reversed(SEVERITY[1:]):
@@ -304,13 +485,18 @@ def problems(result) -> list[tuple[str, str]]:
                 pz = float(np.nanmin(np.asarray(t["process_zone"], dtype=float)[narrow]))
                 est = p.get("process_zone_estimate", float("nan"))
                 parts.append(f"process zone {pz:.3g} < {RESOLUTION:g} dx = {RESOLUTION * dx:.3g} (dx = {dx:.3g}; "
-                             f"cohesive window g* → g0 + h0 on the apex row; a-priori Dugdale estimate {est:.3g}; "
+                             f"cohesive window g* → g0 + h0 at the narrowest contact edge; a-priori Dugdale "
+                             f"estimate {est:.3g}; "
                              f"resolved for dx <= {pz / RESOLUTION:.3g})")
             if snapping(t, snap).any():
                 parts.append(f"the law softens faster than one pixel is stiff (max dP/dg × pixel compliance = "
-                             f"{snap:.3g} > 1): pixels snap one at a time and the contact edge is pinned to the "
-                             f"grid; refine dx to about {dx / snap:.3g} or below, or soften the law (md: a larger "
-                             "smoothing)")
+                             f"{snap:.3g} > {SNAP_LIMIT:g}): pixels snap one at a time and the contact edge is "
+                             f"pinned to the grid; refine dx to about {dx * SNAP_LIMIT / snap:.3g} or below, or soften "
+                             "the law (md: a larger smoothing)")
+            if coarse_faces(t, face).any():
+                parts.append(f"a flat face bounded by walls is known to {100 * face:.2g} % of its area > "
+                             f"{100 * FACE_LIMIT:g} % (each wall lies somewhere within half a pixel); refine dx to "
+                             f"about {dx * FACE_LIMIT / face:.3g} or below")
             text = "; ".join(parts) + f" {where}"
         out.append((kind, f"{_LABEL[kind]}: {text}"))
     return out
@@ -326,9 +512,11 @@ def attach(result, law, coupling: float) -> None:
     (:class:`tengsim.continuation.Recorder`, :func:`row_status`): the a-priori process-zone estimate,
     the criterion, the overall status and the warning lines (``params['warning']``, joined)."""
     result.params["process_zone_estimate"] = process_zone_estimate(law, coupling)
-    result.params["resolution_criterion"] = f"process_zone >= {RESOLUTION:g} dx and pixel_snap_number <= 1"
+    result.params["resolution_criterion"] = (f"process_zone >= {RESOLUTION:g} dx and pixel_snap_number <= "
+                                             f"{SNAP_LIMIT:g} and face_uncertainty <= {FACE_LIMIT:g}")
     if "status" not in result.table:  # a table from elsewhere (an older file): classify it here, once
-        result.table["status"] = classify(result.table, result.grid.dx, result.params.get("pixel_snap_number"))
+        result.table["status"] = classify(result.table, result.grid.dx, result.params.get("pixel_snap_number"),
+                                          result.params.get("face_uncertainty"))
     result.params["status"] = overall(result.table["status"])
     lines = warning_lines(result)
     if lines:

@@ -76,7 +76,6 @@ def register(sub):
 
 def run(args) -> int:
     from tengsim.config import contact_keys, plan_contact
-    from tengsim.contact import run_contact
 
     keys = [k for k in contact_keys() if k not in _CLI_ONLY]
     cfg = {k: getattr(args, k) for k in keys if getattr(args, k, None) not in (None, "")}
@@ -105,6 +104,15 @@ def run(args) -> int:
     if res is None:
         return 130
     return write_contact(res, out, args.plot, args.quiet, stream)
+
+
+def run_contact(cfg: dict, progress=None, sink=None):
+    """:func:`tengsim.resolve.run_contact` (one grid, or refined with resolve = 'auto'), transition D judged
+    with the shape's full-contact length (:func:`tengsim.study.observe.full_length`)."""
+    from tengsim.resolve import run_contact as run
+    from tengsim.study.observe import full_length
+
+    return run(cfg, progress=progress, sink=sink, full_length=lambda p: full_length({**p, "config": cfg}))
 
 
 def open_stream(out, resume: bool, quiet: bool = False):
@@ -174,6 +182,11 @@ def write_contact(res, out, plot=None, quiet=False, stream=None) -> int:
 
     for line in warning_lines(res):  # one line per problem kind; a warning, so the exit code stays 0
         print(f"tengsim: warning: {line} (see column 'status')", file=sys.stderr)
+    if res.params.get("resolve_message"):  # resolve = auto stopped by max_pixels: the dx reached and needed
+        print(f"tengsim: warning: {res.params['resolve_message']}", file=sys.stderr)
+    elif res.params.get("resolve") == "auto" and not quiet:
+        grids = ", ".join(f"{d:.4g}" for d in res.params.get("resolve_grids", ()))
+        print(f"tengsim: resolved: dx {grids}; status {res.params.get('resolve_status')}", file=sys.stderr)
     missed = [m for m in str(res.params.get("load_not_met") or "").split("; ") if m]
     if missed:  # load control: which loads, and where the search for each ended
         print(f"tengsim: warning: {len(missed)} load(s) not met, first {missed[0]} (all: parameter "

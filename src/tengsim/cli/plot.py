@@ -1,7 +1,8 @@
 """``tengsim plot RESULT``: redraw the figures of a saved result.
 
 A contact result (.nc or .csv) gives F(D), Λc(D), Λc(F), and, when it holds maps (``--maps``), a
-second figure ``<out stem>_maps<suffix>`` of the pressure and gap maps; a device time series gives
+second figure ``<out stem>_maps<suffix>`` of the pressure and gap maps, and for a refined run
+(``--resolve auto``) ``<out stem>_resolution<suffix>``, its observables against dx; a device time series gives
 its traces; a load sweep (``tengsim device sweep``) its power and energy against R; a study folder
 is drawn by ``tengsim.study.plot``.
 """
@@ -63,6 +64,10 @@ def run(args) -> int:
         if obj.maps and not args.no_maps:
             plots.plot_maps(obj, maps_out, title=src.name)
             written.append(maps_out)
+        if isinstance(obj.params.get("resolution"), dict):  # resolve = auto: the convergence over the grids
+            res_out = out.with_name(f"{out.stem}_resolution{out.suffix}")
+            plots.plot_resolution(obj, res_out, title=src.name)
+            written.append(res_out)
     elif kind == "sweep":
         plots.plot_sweep(obj, out, title=src.name)
     else:

@@ -54,9 +54,8 @@ def run(args) -> int:
 
 
 def _contact(section, args) -> int:
-    from tengsim.cli.contact import open_stream, run_streamed, write_contact
+    from tengsim.cli.contact import open_stream, run_contact, run_streamed, write_contact
     from tengsim.config import plan_contact
-    from tengsim.contact import run_contact
 
     plan_contact(section)  # every key checked before anything is written
     out = section.get("out")

@@ -72,6 +72,21 @@ class FreeKernel(_Film):
         return {"boundary": "free", "coupling": self.coupling, **self.film_params()}
 
 
+def periodic_multiplier(body, grid: Grid, cols: slice = slice(None)) -> np.ndarray:
+    """The periodic kernel's Fourier multiplier on the rfft2 layout of ``grid`` (its ``cols`` of the
+    last axis only): 2κ/|q|, times the film's C(|q| T, ν), mean mode 0 or the film's mean compliance.
+    ``body``: an object with ``coupling`` and the film fields (``film``, ``thickness``, ``poisson``, ``substrate``)."""
+    qx = 2 * np.pi * np.fft.fftfreq(grid.nx, d=grid.dx)
+    qy = (2 * np.pi * np.fft.rfftfreq(grid.ny, d=grid.dy))[cols]
+    q = np.hypot(*np.meshgrid(qx, qy, indexing="ij"))
+    with np.errstate(divide="ignore"):
+        mult = np.where(q > 0, 2 * body.coupling / np.where(q > 0, q, 1.0), 0.0)
+    if body.film:
+        mult *= film.compliance_factor(q * body.thickness, body.poisson, body.substrate)
+        mult[q == 0] = film.mean_compliance(body.thickness, body.poisson, body.coupling)
+    return mult
+
+
 @dataclass
 class PeriodicKernel(_Film):
     """Periodic array of cells: ŵ(q) = (2κ/|q|) P̂(q), ŵ(0) = 0; with a film of ``thickness`` T,
@@ -87,14 +102,7 @@ class PeriodicKernel(_Film):
         positive("coupling", self.coupling)
         self._init_film()
         g = self.grid
-        qx = 2 * np.pi * np.fft.fftfreq(g.nx, d=g.dx)
-        qy = 2 * np.pi * np.fft.rfftfreq(g.ny, d=g.dy)
-        q = np.hypot(*np.meshgrid(qx, qy, indexing="ij"))
-        with np.errstate(divide="ignore"):
-            mult = np.where(q > 0, 2 * self.coupling / np.where(q > 0, q, 1.0), 0.0)
-        if self.film:
-            mult *= film.compliance_factor(q * self.thickness, self.poisson, self.substrate)
-            mult[0, 0] = film.mean_compliance(self.thickness, self.poisson, self.coupling)
+        mult = periodic_multiplier(self, g)
         self.mean_compliance = float(mult[0, 0])
         self.pinned_mean = not self.mean_compliance > 0
         self._spectrum = mult

@@ -10,8 +10,9 @@ from tengsim.shapes.axisymmetric import Cone, FlatPunch, Hemisphere, Paraboloid
 from tengsim.shapes.flat_topped import Cube, Line
 from tengsim.shapes.periodic import Sinusoid1D, random_rough
 from tengsim.shapes.rough import Rough
+from tengsim.shapes.roughened import Roughened
 from tengsim.shapes.topography import Topography
 from tengsim.shapes.arrays import Array
 
 __all__ = ["Array", "Cone", "Cube", "FlatPunch", "HeightMap", "Hemisphere", "Line", "Paraboloid", "Pyramid",
-           "Rough", "Shape", "Sinusoid1D", "Topography", "dimensionless_fields", "physical_fields", "random_rough"]
+           "Rough", "Roughened", "Shape", "Sinusoid1D", "Topography", "dimensionless_fields", "physical_fields", "random_rough"]

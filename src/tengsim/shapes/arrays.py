@@ -85,6 +85,14 @@ class Array:
     is_pattern = False
     lateral_unit = "the pattern's ℓ"
 
+    @property
+    def mirror_axes(self) -> tuple:
+        """The pattern's mirrors when no cell differs from another (no scatter, no tilt, no waviness),
+        else none: a scattered array has no symmetry to use."""
+        if self.scatter_height or self.scatter_size or self.scatter_tilt or self.waviness_amplitude:
+            return ()
+        return tuple(getattr(self.pattern, "mirror_axes", ()))
+
     def __init__(self, pattern="pyramid", K=2, scatter_height=0.0, scatter_size=0.0, scatter_tilt=0.0,
                  distribution="normal", seed=0, waviness_amplitude=0.0, waviness_wavelength=1.0, **fields):
         if isinstance(pattern, str):

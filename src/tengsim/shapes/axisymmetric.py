@@ -27,6 +27,7 @@ class Paraboloid(Shape):
     physical_fields = (_length("radius", "sphere radius R"), _length("pitch", "cell side (default 10 ℓ)", None))
     field_help = {"radius": "radius in X units (1 with ℓ = sqrt(Rε))", "cell": "cell side"}
     lateral_unit = "sqrt(R ε)"
+    mirror_axes = (0, 1)  # axisymmetric: X and Y mirrors
 
     @classmethod
     def lateral_scale(cls, values, eps):
@@ -72,6 +73,7 @@ class Hemisphere(Shape):
     field_help = {"radius": "radius ρ in X units", "cell": "cell side",
                   "k": "lateral/vertical unit ratio ℓ/ε (1: X and U0 both in ε)"}
     lateral_unit = "sqrt(R ε)"
+    mirror_axes = (0, 1)  # axisymmetric: X and Y mirrors
 
     def __post_init__(self):
         positive("radius", self.radius)
@@ -118,6 +120,7 @@ class Cone(Shape):
     field_help = {"slope": "tan of the surface inclination", "cell": "cell side",
                   "height": "cap height in ε (default: none)"}
     lateral_unit = "ε/slope"
+    mirror_axes = (0, 1)  # axisymmetric: X and Y mirrors
 
     @classmethod
     def lateral_scale(cls, values, eps):
@@ -164,6 +167,7 @@ class FlatPunch(Shape):
     field_help = {"radius": "punch radius a", "cell": "cell side", "step": "height of the step in ε"}
     si_map = {"pitch": "cell"}
     lateral_unit = "ε"
+    mirror_axes = (0, 1)  # axisymmetric: X and Y mirrors
 
     def __post_init__(self):
         positive("radius", self.radius)

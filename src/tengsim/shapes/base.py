@@ -50,6 +50,9 @@ class Shape:
     field_help: dict = {}
     lateral_unit: str = "ℓ"
     si_map: dict = {}
+    #: mirror symmetries of the gap about the cell centre (0: X ↦ −X, 1: Y ↦ −Y) that a solve may use
+    #: (issue 22: the irreducible block); none declared, none used.  A run checks them on its grid.
+    mirror_axes = ()
 
     def gap(self, grid: Grid) -> np.ndarray:  # pragma: no cover - abstract
         raise NotImplementedError

@@ -22,6 +22,7 @@ class _FlatTop(Shape):
 
     si_map = {"pitch": "cell"}
     lateral_unit = "ε"
+    mirror_axes = (0, 1)  # the cube: X and Y; the line (uniform along Y): X, and Y trivially
 
     def __post_init__(self):
         positive("half_width", self.half_width)

@@ -26,6 +26,7 @@ class Sinusoid1D(Shape):
     field_help = {"wavelength": "wavelength λ (the cell side)", "amplitude": "amplitude Δ in ε"}
     si_map = {"wavelength": "wavelength"}
     lateral_unit = "ε"
+    mirror_axes = (0, 1)  # cos(2πX/λ) about the crest, uniform along Y
 
     def __post_init__(self):
         positive("wavelength", self.wavelength)

@@ -26,6 +26,7 @@ class Pyramid(Shape):
                        _length("height", "height n"))
     field_help = {"N": "n/(2ε): half the base in X, the height in ε over 2", "cell": "cell side L̄ = L n/(ε m)"}
     lateral_unit = "ε m/n"
+    mirror_axes = (0, 1)
 
     def __post_init__(self):
         positive("pyramid N", self.N)

@@ -23,6 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from tengsim.solvers._linesearch import Ray, Trial, WolfeLineSearch
+from tengsim.solvers._weights import Weights
 from tengsim.solvers._workspace import Spare
 from tengsim.errors import TengsimError
 from tengsim.registry import SOLVERS
@@ -30,11 +31,18 @@ from tengsim.registry import SOLVERS
 
 @dataclass
 class Problem:
-    """One equilibrium problem: initial gap g0 = U0 − D + 1, a law and a kernel."""
+    """One equilibrium problem: initial gap g0 = U0 − D + 1, a law and a kernel.
+
+    ``weights`` (shape of g0, or None: uniform): the multiplicity of each pixel, for a problem posed on
+    the irreducible block of a mirror-symmetric one (tengsim.solvers.mirror).  Then the energy is
+    E = ΔA Σ m_i [½ q_i w_i + Φ(g_i)], and every inner product and sum of the solvers is m-weighted
+    (the block's kernel K is not symmetric in the plain product, but M K is); max|r| stays a plain max.
+    """
 
     g0: np.ndarray
     law: object
     kernel: object
+    weights: np.ndarray | None = None
 
     @property
     def dA(self) -> float:
@@ -121,9 +129,12 @@ class FastSolver:
 
     def solve(self, problem: Problem, start: State) -> Equilibrium:
         t0 = time.perf_counter()
-        ws = self._spare.take(np.size(problem.g0), self.memory, problem.dA)
+        lines = None if problem.weights is None else Weights(problem.weights, np.shape(problem.g0))
+        dA = problem.dA if lines is None else problem.dA * lines.scale
+        ws = self._spare.take(np.size(problem.g0), self.memory, dA)
+        ws.memory.lines = lines
         try:
-            return self._descend(_Descent(problem, start, ws), t0)
+            return self._descend(_Descent(problem, start, ws, lines), t0)
         finally:
             self._spare.give(ws)
 
@@ -164,14 +175,21 @@ class _Descent:
     minimum it had reached.  So the mean of q is held fixed and G = q − P is used without its mean
     (the K-metric gradient is the same); ΣP comes with the law's sweeps and Σd with the direction's,
     so this costs no extra pass.
+
+    A weighted problem (``lines``, tengsim.solvers._weights): the sweeps' plain sums are corrected on
+    the few pixels whose weight differs from the interior one, and ΔA carries the interior weight.
     """
 
-    def __init__(self, problem: Problem, start: State, ws):
+    def __init__(self, problem: Problem, start: State, ws, lines=None):
         K = problem.kernel
         self.problem, self.law, self.dA = problem, problem.law, problem.dA
+        self.lines = lines
+        if lines is not None:
+            self.dA = problem.dA * lines.scale
         self.shape = problem.g0.shape
         self.g0 = np.ascontiguousarray(problem.g0, dtype=float).ravel()
         self.n = self.g0.size
+        self.nw = self.n if lines is None else lines.total  # the (weighted) pixel count
         self.q = np.array(start.q, dtype=float).ravel()
         self.w = np.array(start.w, dtype=float).ravel()
         self.sw, self.mem, self.cP = ws.sweeper, ws.memory, ws.cP
@@ -179,18 +197,22 @@ class _Descent:
         self.r, self.rn, self.G, self.Gn, self.y, self.ky = ws.r, ws.rn, ws.G, ws.Gn, ws.y, ws.ky
         # a film's periodic kernel has a finite mean compliance, K(0) > 0: it says pinned_mean = False
         self.proj = bool(getattr(K, "pinned_mean", getattr(K, "periodic", False)))
-        self.search = WolfeLineSearch(problem.law, ws.sweeper, self.dA, ws.gt, ws.Pt, sum_p=self.proj)
+        self.search = WolfeLineSearch(problem.law, ws.sweeper, self.dA, ws.gt, ws.Pt, sum_p=self.proj,
+                                      lines=lines)
         self._apply, self._takes_out = K.apply, _takes_out(K.apply)
         # the start: g, P, ΣΦ, r (one convolution), G, E
         np.add(self.g0, self.w, out=self.g)
         self.phis, self.sum_p = self.law_sweep()
         np.subtract(self.w, self.convolve(self.P), out=self.r)
         self.n_conv = 1
-        self.mean_q = float(self.q.mean())
+        if lines is None:
+            self.mean_q = float(self.q.mean())
+        else:
+            self.mean_q = (float(self.q.sum()) - lines.sum(self.q)) / self.nw
         np.subtract(self.q, self.P, out=self.G)
         if self.proj:
-            self.G -= self.mean_q - self.sum_p / self.n
-        self.qw = float(np.vdot(self.q, self.w))
+            self.G -= self.mean_q - self.sum_p / self.nw
+        self.qw = self._dot(self.q, self.w)
         self.E = self.dA * (0.5 * self.qw + self.phis)
         self.rmax = max(float(self.r.max()), -float(self.r.min()))
         self.E_best = self.E
@@ -198,6 +220,11 @@ class _Descent:
         self.corr = None
 
     # ---- the pieces ---------------------------------------------------------------------------
+    def _dot(self, a, b) -> float:
+        """a·b, m-weighted (in units of the interior weight) for a weighted problem."""
+        v = float(np.vdot(a, b))
+        return v if self.lines is None else v - self.lines.dot(a, b)
+
     def convolve(self, x):
         """K x into the workspace's output array (one convolution; not counted here)."""
         out, shape = self.cP, self.shape
@@ -215,7 +242,10 @@ class _Descent:
 
     def law_sweep(self):
         """ΣΦ(g) and ΣP (periodic kernels only, else 0), with P(g) written into P."""
-        return self.sw.sum(self._law_block, [0.0, 0.0])
+        acc = self.sw.sum(self._law_block, [0.0, 0.0])
+        if self.lines is not None:
+            acc = _weigh_law(self.lines, self.law, self.g, self.P, acc, self.proj)
+        return acc
 
     def lowest_energy(self) -> float:
         """The lowest E so far: E may rise by round-off in an accepted step (approximate Wolfe);
@@ -243,7 +273,12 @@ class _Descent:
     def _direction(self):
         gamma, c = self.mem.coefficients()
         k2 = 0 if c is None else c.size
-        return self.sw.sum(self._direction_block, [0.0, 0.0, 0.0, 0.0], gamma, c, k2)
+        acc = self.sw.sum(self._direction_block, [0.0, 0.0, 0.0, 0.0], gamma, c, k2)
+        L = self.lines
+        if L is not None:  # the sweep wrote d and K d whole: correct its sums on the deficit pixels
+            cw, cKd, cr = L.dots(self.d, self.w, self.Kd, self.r)
+            acc = [acc[0] - cw, acc[1] - cKd, acc[2] - cr, acc[3] - (L.sum(self.d) if self.proj else 0.0)]
+        return acc
 
     def direction(self) -> Ray:
         """d = −H G and K d = −K H G (one sweep), and E along d.
@@ -272,7 +307,7 @@ class _Descent:
             self.qw += alpha * (2.0 * ray.dw + alpha * ray.dKd)
             self.corr = None
         self.E = self.dA * (0.5 * self.qw + self.phis)
-        self.mean_q += alpha * self.sum_d / self.n
+        self.mean_q += alpha * self.sum_d / self.nw
 
     def _reanchor(self, alpha):
         """q ← q + α d and w = K q exactly (one convolution), then g, P, ΣΦ, q·w anew.
@@ -290,7 +325,7 @@ class _Descent:
         w[:] = w_exact
         np.add(self.g0, w, out=self.g)
         self.phis, self.sum_p = self.law_sweep()
-        self.qw = float(np.vdot(q, w))
+        self.qw = self._dot(q, w)
         return corr
 
     def _residual_block(self, sl, m, sc, acc, alpha, step, corr, mu, k2):
@@ -325,7 +360,7 @@ class _Descent:
         re-anchored), the new residual and gradient, the pair y = ΔG, K y = Δr and their products.
 
         Returns (d·K y, y·K y, d·r_new, y·r_new, B K y): what the memory update needs; sets max|r|."""
-        mu = self.mean_q - self.sum_p / self.n if self.proj else 0.0
+        mu = self.mean_q - self.sum_p / self.nw if self.proj else 0.0
         self.convolve(self.P)
         self.n_conv += 1
         k2 = 2 * len(self.mem.order)
@@ -336,6 +371,14 @@ class _Descent:
         else:
             dky, yky, drn, yrn, _, x = (sum(a[j] for a in accs) for j in range(6))
             self.rmax = max(a[4] for a in accs)
+        L = self.lines
+        if L is not None:  # max|r| stays a plain max; the products are weighted
+            ky, rn = self.ky, self.rn
+            c_dky, c_drn = L.dots(self.d, ky, rn)
+            c_yky, c_yrn = L.dots(self.y, ky, rn)
+            dky, yky, drn, yrn = dky - c_dky, yky - c_yky, drn - c_drn, yrn - c_yrn
+            if k2:
+                x = x - L.rows(self.mem.B[:k2], ky)
         return dky, yky, drn, yrn, (x if k2 else None)
 
     def _store_block(self, sl, m, sc, acc, alpha, slot):
@@ -366,6 +409,13 @@ class _Descent:
         st = State(self.q.reshape(self.shape), self.w.reshape(self.shape))
         return _finish(self.problem, st, self.P.reshape(self.shape).copy(), self.r, self.E, ok, it,
                        self.n_conv, t0, msg)
+
+
+def _weigh_law(lines, law, g, P, acc, sum_p):
+    """[ΣΦ, ΣP] of a sweep, m-weighted: less the deficit pixels' share (Φ there evaluated anew)."""
+    i = lines.idx
+    phis = acc[0] - float(np.dot(lines.c, law.energy(g[i])))
+    return [phis, acc[1] - lines.sum(P) if sum_p else acc[1]]
 
 
 def _takes_out(fn) -> bool:
@@ -423,13 +473,30 @@ class VSRSolver:
     def solve(self, problem: Problem, start: State) -> Equilibrium:
         t0 = time.perf_counter()
         K, law, g0, dA = problem.kernel, problem.law, problem.g0, problem.dA
+        m = problem.weights
+        if m is None:  # uniform: plain sums
+            def energy(q, w, phi):
+                return dA * (0.5 * np.vdot(q, w) + phi.sum())
+
+            def rnorm(r):
+                return float(np.linalg.norm(r))
+        else:  # a weighted problem (a mirror block): m-weighted sums, a plain max|r|
+            m = np.asarray(m, dtype=float)
+            if m.shape != np.shape(g0):
+                raise TengsimError(f"weights of shape {m.shape} do not match the problem's {np.shape(g0)}")
+
+            def energy(q, w, phi):
+                return dA * (0.5 * np.vdot(m * q, w) + np.vdot(m, phi))
+
+            def rnorm(r):
+                return float(np.sqrt(np.vdot(m * r, r)))
         q, w = start.q.copy(), start.w.copy()
         phi, P = law.evaluate(g0 + w)
         r = w - K.apply(P)
-        E = dA * (0.5 * np.vdot(q, w) + phi.sum())
+        E = energy(q, w, phi)
         n_conv, it, dt, cap = 1, 0, self.dt0, 1.0
         msg = ""
-        norm = float(np.linalg.norm(r))
+        norm = rnorm(r)
         while True:
             rmax = float(np.max(np.abs(r)))
             if rmax <= self.tol:
@@ -445,10 +512,10 @@ class VSRSolver:
                 w_try = K.apply(q_try)
                 n_conv += 1
             phi_t, P_t = law.evaluate(g0 + w_try)
-            E_t = dA * (0.5 * np.vdot(q_try, w_try) + phi_t.sum())
+            E_t = energy(q_try, w_try, phi_t)
             r_t = w_try - K.apply(P_t)
             n_conv += 1
-            n_t = float(np.linalg.norm(r_t))
+            n_t = rnorm(r_t)
             # keep a step that lowers the energy (to round-off) without blowing up the residual;
             # a rejected Δτ caps later steps, which keeps the stiffest mode stable near convergence,
             # where energy changes fall below round-off

@@ -42,6 +42,7 @@ class KMetricLBFGS:
         self.order: list[int] = []  # slots, oldest first; the active slots are always 0 .. k-1
         self._last = (1.0, np.zeros(0), np.zeros(0))
         self._perm = np.zeros(0, int)   # active slots in age order (oldest first), as an index array
+        self.lines = None  # a weighted problem's deficit pixels (tengsim.solvers._weights): m-weighted products
 
     @property
     def empty(self) -> bool:
@@ -56,7 +57,10 @@ class KMetricLBFGS:
         """Recompute <s_i, G>, <y_i, G> exactly from r = K G (one pass over the rows)."""
         k = len(self.order)
         if k:
-            p = self.dA * (self.B[: 2 * k] @ r)
+            p = self.B[: 2 * k] @ r
+            if self.lines is not None:
+                p = p - self.lines.rows(self.B[: 2 * k], r)
+            p = self.dA * p
             self.pS[:k], self.pY[:k] = p[0::2], p[1::2]
 
     def coefficients(self):

@@ -50,8 +50,9 @@ class WolfeLineSearch:
     """
 
     def __init__(self, law, sweeper, dA, g_trial, P_trial, sum_p=False, c1=1e-4, c2=0.9, max_eval=40,
-                 first_move=0.25):
+                 first_move=0.25, lines=None):
         self.law, self.sweeper, self.dA = law, sweeper, float(dA)
+        self.lines = lines  # a weighted problem's deficit pixels (tengsim.solvers._weights), or None
         self.g_trial, self.P_trial = g_trial, P_trial
         self.sum_p = bool(sum_p)
         self.c1, self.c2, self.max_eval, self.first_move = c1, c2, int(max_eval), first_move
@@ -83,6 +84,13 @@ class WolfeLineSearch:
     def evaluate(self, a, ray: Ray):
         """(E(α), E'(α), ΣΦ, ΣP) at α = ``a``, with g(α), P(α) written into the trial buffers."""
         phis, dpk, sp = self.sweeper.sum(self._block, [0.0, 0.0, 0.0], a, ray.g, ray.P, ray.Kd)
+        L = self.lines
+        if L is not None:  # m-weighted sums: the deficit pixels' share off (ΔA carries the interior weight)
+            i, c, Pt = L.idx, L.c, self.P_trial
+            phis -= float(np.dot(c, self.law.energy(self.g_trial[i])))
+            dpk -= float(np.dot(c * (Pt[i] - ray.P[i]), ray.Kd[i]))
+            if self.sum_p:
+                sp -= float(np.dot(c, Pt[i]))
         e = self.dA * (0.5 * ray.qw + a * ray.dw + 0.5 * a * a * ray.dKd + phis)
         de = ray.slope + self.dA * (a * ray.dKd - dpk)
         return e, de, phis, sp

@@ -98,6 +98,10 @@ def collect(root) -> dict:
             cache[pid] = _read_point(sd, pid)
         status, msg, res, secs = cache[pid]
         obs = None
+        if res is not None and res.params.get("resolve") == "auto" and not res.params.get("resolve_message"):
+            grids = res.params.get("resolve_grids") or [res.grid.dx if res.grid is not None else math.nan]
+            note = f"resolve auto: converged at dx = {grids[-1]:.4g} ({len(grids)} grids)"  # dx reached
+            msg = "; ".join([msg, note]) if msg else note
         if res is not None:
             try:
                 obs = observe(res, p["tables"]["device"], settings)

@@ -88,10 +88,11 @@ def compute_point(contact: dict, pid: str, plugins: str = "", expect: dict | Non
         if expect is not None and prov != expect:
             raise TengsimError(f"the worker on {info['host']} would compute this point with other code or "
                                f"input than the client's ({provenance_difference(expect, prov)}); not computed")
-        from tengsim.contact import run_contact
+        from tengsim.resolve import run_contact  # resolve = 'auto': refined until converged
+        from tengsim.study.observe import full_length
 
         c0 = time.perf_counter()
-        res = run_contact(dict(contact))
+        res = run_contact(dict(contact), full_length=lambda p: full_length({**p, "config": dict(contact)}))
     except Exception as exc:  # noqa: BLE001 - recorded as a failed point, the others go on
         msg = str(exc) if isinstance(exc, TengsimError) else \
             f"{type(exc).__name__}: {exc}\n{traceback.format_exc(limit=-3)}"

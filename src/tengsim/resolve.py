@@ -1,0 +1,329 @@
+"""Automatic grid refinement (``resolve = "auto"``): a contact run repeated on finer grids until it is converged.
+
+:func:`resolve_contact` runs the same path on grids dx0, dx0/√2, dx0/2, ... (:data:`FACTOR` = √2 in dx, twice
+the pixels per level) and stops when
+
+(a) no equilibrium of the finest grid is ``under_resolved`` (:mod:`tengsim.status`; a run whose rows are
+    ``out_of_law_range`` or ``not_converged`` is not refined further for that: a finer grid does not cure
+    them, and the result keeps that status),
+(b) each observable changed by at most ``resolve_tol`` between the last two grids, and
+(c) the finest grid's Richardson error estimate of each observable is within ``resolve_tol``,
+
+all relative to the observable, with an absolute floor for values near 0 (:data:`FLOORS`: 1 ε for the D
+observables, 0.01 for F and for an area fraction).  If the next grid would have more than ``max_pixels``
+pixels (default: what the machine's free memory holds, :func:`default_max_pixels`) it stops with status
+``under_resolved`` and one line naming the dx reached and the dx still needed (extrapolated from the
+observed order).
+
+Observables (:func:`contact_observables`): the pull-off force (``ContactResult.pull_off_force``), the D of
+the first jump-in and jump-out (``ContactResult.jumps``) and, given the shape's full-contact length, the
+transition D (``ContactResult.transition_D``); a caller adds its own (a study: A/S and V_OC at its named
+pressures) with ``observe``.  An observable NaN on both of the last grids is not judged; NaN on one only is
+a change (a jump that appears on the finer grid).
+
+Richardson (:func:`richardson`), with h the grid spacings, coarse to fine, and f the values: from the last
+three grids the observed order p solves (f1 − f2)/(f2 − f3) = (h1^p − h2^p)/(h2^p − h3^p) (the spacings are
+not exactly in ratio √2: the pixel counts are FFT-friendly), clipped to [:data:`P_MIN`, :data:`P_MAX`]; with
+two grids, or differences of opposite sign (no monotone convergence), p = 1 (conservative).  The error of
+the finest value is e = (f3 − f2)/((h2/h3)^p − 1) and the extrapolated value f3 + e.
+
+Why √2: the change between the last two grids is e·(r^p − 1) for a ratio r; with r = √2 and second order
+it equals the finest grid's error, so criteria (b) and (c) ask the same; with r = 2 (b) would demand an
+error of tol/3 and a grid up to 4× larger than needed.  A level costs about twice the one before, so the
+whole sequence about twice the finest grid.
+
+Nested start: each grid walks the whole path from its own first equilibrium; the coarse solution is not
+used as a start.  A path starts out of contact (d_min below the first touch), where the first equilibrium
+is the zero state and costs a handful of convolutions, and every later one is warm-started from the
+previous row (secant predictor), so a resampled coarse state could only replace that first, cheap solve
+(measured in docs/validation.md, "Automatic refinement").
+"""
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+
+from tengsim.errors import TengsimError
+
+FACTOR = math.sqrt(2.0)
+"""Refinement factor in dx between two grids (twice the pixels)."""
+DEFAULT_TOL = 0.01
+P_MIN, P_MAX = 0.5, 4.0
+"""Range the observed order is clipped to."""
+FLOORS = {"D": 1.0, "F": 0.01, "fraction": 0.01, "V": 0.01}
+"""Absolute floor of the relative change of an observable by kind (D in ε, F of Eq. 10, A/S, V_OC in V):
+|Δf| <= tol · max(|f|, floor)."""
+MIN_SIDE = 9
+"""Fewest pixels across the cell of a default starting grid."""
+
+
+def _kind(name: str) -> str:
+    if name.endswith("_D") or name.startswith("D_"):
+        return "D"
+    if name.startswith("area_fraction") or name.startswith("A_"):
+        return "fraction"
+    if name.startswith("V_OC"):
+        return "V"
+    return "F"
+
+
+def floor_of(name: str) -> float:
+    return FLOORS[_kind(name)]
+
+
+def contact_observables(res, full_length: float | None = None, fraction: float = 0.95) -> dict:
+    """{name: value} judged by the refinement: pull_off_F, jump_in_D, jump_out_D, and transition_D when the
+    shape's full-contact length ``full_length`` is given (NaN where a run has none)."""
+    out = {"pull_off_F": res.pull_off_force}
+    jumps = res.jumps
+    out["jump_in_D"] = next((j.D_after for j in jumps if j.kind == "jump-in"), math.nan)
+    out["jump_out_D"] = next((j.D_after for j in jumps if j.kind == "jump-out"), math.nan)
+    if full_length is not None and math.isfinite(full_length):
+        out["transition_D"] = res.transition_D(full_length, fraction)
+    return out
+
+
+def _order(h, f) -> tuple[float, bool]:
+    """(observed order clipped to [P_MIN, P_MAX], True) from three grids, or (1, False) where it cannot be had."""
+    from scipy.optimize import brentq
+
+    (h1, h2, h3), (f1, f2, f3) = h, f
+    d12, d23 = f1 - f2, f2 - f3
+    if d23 == 0 or d12 == 0 or (d12 > 0) != (d23 > 0):
+        return 1.0, False
+
+    def g(p):
+        return (h1**p - h2**p) / (h2**p - h3**p) - d12 / d23
+
+    lo, hi = g(P_MIN), g(P_MAX)
+    if lo >= 0:
+        return P_MIN, True
+    if hi <= 0:
+        return P_MAX, True
+    return float(brentq(g, P_MIN, P_MAX, xtol=1e-10)), True
+
+
+def richardson(h, f) -> dict:
+    """Richardson extrapolation of the values ``f`` on grids of spacing ``h`` (coarse to fine): the last
+    three (or two) grids give {'order', 'observed' (bool: the order was measured, else 1 was assumed),
+    'extrapolated', 'error' (of the finest value, signed: extrapolated − finest)}; NaN with fewer than two
+    finite values."""
+    h = [float(x) for x in h]
+    f = [float(x) for x in f]
+    nan = {"order": math.nan, "observed": False, "extrapolated": math.nan, "error": math.nan}
+    if len(h) < 2 or not all(math.isfinite(x) for x in f[-2:]):
+        return nan
+    if len(h) >= 3 and all(math.isfinite(x) for x in f[-3:]):
+        p, observed = _order(h[-3:], f[-3:])
+    else:
+        p, observed = 1.0, False
+    r = h[-2] / h[-1]
+    err = (f[-1] - f[-2]) / (r**p - 1.0)
+    return {"order": p, "observed": observed, "extrapolated": f[-1] + err, "error": err}
+
+
+def relative(name: str, delta: float, value: float) -> float:
+    """|delta| relative to max(|value|, floor of ``name``)."""
+    return abs(delta) / max(abs(value), floor_of(name))
+
+
+def default_max_pixels(boundary: str = "free", solver: str = "fast") -> int:
+    """The largest n² whose run fits in the machine's free memory (:mod:`tengsim.resources`); 4096² if that
+    cannot be read."""
+    from tengsim.resources import available_bytes, estimate_bytes
+
+    avail = available_bytes()
+    if avail is None:
+        return 4096**2
+    lo, hi = 3, 3
+    while estimate_bytes(hi, hi, boundary, solver) <= avail and hi < 2**17:
+        lo, hi = hi, hi * 2
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        if estimate_bytes(mid, mid, boundary, solver) <= avail:
+            lo = mid
+        else:
+            hi = mid
+    return max(9, lo * lo)
+
+
+def default_dx(shape, law, coupling: float, boundary: str = "free") -> float:
+    """Starting dx when none is given: the a-priori Dugdale zone ℓ_D (:func:`tengsim.status.process_zone_estimate`,
+    the cohesive zone spans one pixel) and the dx below which pixels no longer snap one at a time (the pixel
+    snap number s ∝ dx, :func:`tengsim.status.pixel_snap_number`, measured on a grid of the cell), whichever is
+    smaller, and at most cell/MIN_SIDE.  Coarser grids are under-resolved by those criteria whatever their
+    observables do, so they would only be spent."""
+    from tengsim import status
+    from tengsim.kernels import make_kernel
+
+    cell = float(getattr(shape, "cell"))
+    dx = cell / MIN_SIDE
+    lD = status.process_zone_estimate(law, coupling)
+    if math.isfinite(lD) and lD > 0:
+        dx = min(dx, lD)
+    g = shape.grid(dx)
+    s = status.pixel_snap_number(law, make_kernel(boundary, g, coupling))
+    if s > 1:
+        dx = g.dx / s
+    return dx
+
+
+def _levels_table(levels: list, names: list) -> dict:
+    cols = {k: [lv[k] for lv in levels] for k in ("dx", "nx", "ny", "seconds", "convolutions", "status")}
+    for n in names:
+        cols[n] = [lv["obs"].get(n, math.nan) for lv in levels]
+    return cols
+
+
+def _judge(levels: list, names: list, tol: float) -> tuple[bool, dict, dict]:
+    """(converged, {name: relative change of the last two grids}, {name: richardson dict with 'rel_error'})."""
+    h = [lv["dx"] for lv in levels]
+    changes, rich = {}, {}
+    ok = len(levels) >= 2 and levels[-1]["status"] != "under_resolved"  # other problems: refining cannot fix
+    for n in names:
+        f = [lv["obs"].get(n, math.nan) for lv in levels]
+        if len(f) >= 2:
+            a, b = f[-2], f[-1]
+            if math.isnan(a) and math.isnan(b):
+                continue
+            if math.isnan(a) != math.isnan(b):
+                changes[n] = math.inf
+                ok = False
+                continue
+            changes[n] = relative(n, b - a, b)
+            ok = ok and changes[n] <= tol
+        r = richardson(h, f)
+        if math.isfinite(r["error"]):
+            r["rel_error"] = relative(n, r["error"], r["extrapolated"])
+            ok = ok and r["rel_error"] <= tol
+        rich[n] = r
+    return ok, changes, rich
+
+
+def _dx_needed(levels: list, rich: dict, changes: dict, tol: float) -> float:
+    """dx at which every observable's error estimate and change between grids would be tol, both scaling as
+    h^p (p the observed order, else 1): h·(tol/e)^(1/p) with e the larger of the two, the smallest dx of all."""
+    h = levels[-1]["dx"]
+    need = h
+    for n, r in rich.items():
+        e = max((x for x in (r.get("rel_error", math.nan), changes.get(n, math.nan)) if math.isfinite(x)),
+                default=math.nan)
+        p = r["order"] if math.isfinite(r["order"]) else 1.0
+        if math.isfinite(e) and e > tol:
+            need = min(need, h * (tol / e) ** (1.0 / p))
+    return need
+
+
+def resolve_contact(shape, tabor: float, path, dx: float | None = None, law=None, boundary: str = "free",
+                    resolve_tol: float = DEFAULT_TOL, max_pixels: int | None = None, observe=None,
+                    full_length: float | None = None, progress=None, **simulate_kw):
+    """Run :func:`tengsim.contact.simulate` on finer and finer grids until converged (module doc).
+
+    ``dx`` the first grid's spacing (None: :func:`default_dx`), ``resolve_tol`` the relative tolerance,
+    ``max_pixels`` the largest grid nx·ny (None: :func:`default_max_pixels`), ``observe(result) -> dict``
+    extra observables, ``full_length`` the shape's full-contact Λc (for transition_D); the other keywords go
+    to ``simulate``.  Returns the finest grid's ContactResult with ``params['resolution']`` (the table: one
+    row per grid), ``params['richardson']``, ``resolve``, ``resolve_tol``, ``max_pixels``, ``resolve_grids``,
+    ``resolve_status`` and, if stopped by ``max_pixels``, ``resolve_message``."""
+    from tengsim.contact import simulate
+    from tengsim.errors import positive
+    from tengsim.laws import LJ93, make_law
+
+    tol = check_tol(resolve_tol)
+    law = make_law(law) if isinstance(law, str) else (law or LJ93())
+    tabor = positive("tabor", tabor)
+    solver = simulate_kw.get("solver", "fast")
+    if max_pixels is None:
+        max_pixels = default_max_pixels(boundary, solver if isinstance(solver, str) else "fast")
+    max_pixels = check_max_pixels(max_pixels)
+    dx = default_dx(shape, law, tabor**1.5, boundary) if dx is None else positive("dx", dx)
+    levels, names, res, seen = [], [], None, set()
+    stop = None
+    while True:
+        grid = shape.grid(dx)
+        if (grid.nx, grid.ny) in seen:  # the FFT-friendly pixel count did not change: one more step
+            dx /= FACTOR
+            continue
+        if grid.nx * grid.ny > max_pixels:
+            if not levels:
+                raise TengsimError(f"max_pixels = {max_pixels} is below the first grid's {grid.nx}×{grid.ny} "
+                                   f"pixels (dx = {grid.dx:.4g}): give a larger max_pixels or a coarser dx")
+            stop = grid
+            break
+        seen.add((grid.nx, grid.ny))
+        t0 = time.perf_counter()
+        res = simulate(shape, tabor, dx, path, boundary=boundary, law=law, grid=grid, progress=progress,
+                       **simulate_kw)
+        obs = contact_observables(res, full_length)
+        if observe is not None:
+            obs.update(observe(res))
+        names.extend(k for k in obs if k not in names)
+        levels.append({"dx": grid.dx, "nx": grid.nx, "ny": grid.ny, "seconds": time.perf_counter() - t0,
+                       "convolutions": int(np.nansum(np.asarray(res.table["n_conv"], dtype=float))),
+                       "status": res.status, "obs": obs})
+        done, changes, rich = _judge(levels, names, tol)
+        if done:
+            break
+        dx = grid.dx / FACTOR
+    _, changes, rich = _judge(levels, names, tol)
+    p = res.params
+    p.update(resolve="auto", resolve_tol=tol, max_pixels=int(max_pixels),
+             resolve_grids=[lv["dx"] for lv in levels], resolution=_levels_table(levels, names),
+             richardson={n: {k: r[k] for k in ("order", "observed", "extrapolated", "error")}
+                         | {"rel_error": r.get("rel_error", math.nan), "change": changes.get(n, math.nan)}
+                         for n, r in rich.items()},
+             resolve_seconds=sum(lv["seconds"] for lv in levels))
+    if stop is not None:
+        need = _dx_needed(levels, rich, changes, tol)
+        worst = max(changes, key=lambda n: changes[n], default=None)
+        why = (f"{worst} changed {changes[worst]:.2%} between the last two grids" if worst is not None
+               else "one grid only")
+        msg = (f"under-resolved: refinement stopped by max_pixels = {max_pixels} at dx = {levels[-1]['dx']:.4g} "
+               f"({levels[-1]['nx']}×{levels[-1]['ny']}; next {stop.nx}×{stop.ny}); {why}, "
+               f"dx ≈ {need:.3g} needed for resolve_tol = {tol:g}")
+        p["resolve_status"] = "under_resolved"
+        p["resolve_message"] = msg
+        p["warning"] = "; ".join(x for x in (p.get("warning", ""), msg) if x)
+    else:
+        p["resolve_status"] = "ok"
+    p["status"] = res.status
+    return res
+
+
+def check_tol(v) -> float:
+    if isinstance(v, bool) or not isinstance(v, (int, float)) or not 0 < float(v) < 1:
+        raise TengsimError(f"resolve_tol must be a number > 0 and < 1, got {v!r}")
+    return float(v)
+
+
+def check_max_pixels(v) -> int:
+    if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or int(v) < 9:
+        raise TengsimError(f"max_pixels must be a whole number >= 9 (pixels nx·ny), got {v!r}")
+    return int(v)
+
+
+def run_contact(cfg: dict, progress=None, sink=None, observe=None, full_length=None):
+    """:func:`tengsim.contact.run_contact`, refined automatically when the table says ``resolve = "auto"``.
+
+    The refinement's grids each stream their rows to ``sink`` would mix grids in one file, so a sink is not
+    given rows of a refined run (its result is written whole at the end).  ``observe(result) -> dict``: more
+    observables to converge; ``full_length(params) -> float``: the shape's full-contact Λc from its parameters
+    (for transition_D; e.g. :func:`tengsim.study.observe.full_length`)."""
+    from tengsim import contact
+    from tengsim.config import plan_contact
+
+    plan = plan_contact(cfg)
+    if plan.resolve.get("resolve", "off") != "auto":  # one grid: exactly tengsim.contact.run_contact's call
+        kw = {k: v for k, v in (("progress", progress), ("sink", sink)) if v is not None}
+        return contact.run_contact(cfg, **kw)
+    res = resolve_contact(plan.shape, plan.tabor, plan.path, dx=plan.resolve.get("dx"), law=plan.law,
+                          boundary=plan.boundary, resolve_tol=plan.resolve["resolve_tol"],
+                          max_pixels=plan.resolve.get("max_pixels"), progress=progress,
+                          full_length=None if full_length is None else full_length(plan.shape.params()),
+                          observe=observe, symmetry=getattr(plan, "symmetry", "auto"),
+                          solver=plan.solver, tol=plan.tol, extra_params=plan.extra, observers=plan.observers,
+                          scaling=plan.scaling, kernel_params=plan.kernel_params)
+    res.params["config"] = {k: v for k, v in cfg.items() if k not in ("out", "plot")}
+    return res

@@ -1,0 +1,218 @@
+"""Automatic grid refinement (``resolve = "auto"``, tengsim.resolve; issue 22 item 1).
+
+Fast: Richardson on synthetic sequences of known order; a cheap pyramid refinement (5 grids, about 2 s)
+reaching ``ok``; ``max_pixels`` stopping it with ``under_resolved`` and its one line; the resolution table
+through CSV and NetCDF (CF check) and ``tengsim plot``; the refusals.  Slow: the Maugis–Dugdale sphere of
+the issue's done-when.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from tengsim import resolve
+from tengsim.cli.main import main
+from tengsim.errors import TengsimError
+from tengsim.load import load_result
+
+PYR = ["contact", "pyramid", "--N", "0.946", "--cell", "3.78", "--tabor", "0.5", "--d-min", "-1", "--d-max", "2",
+       "--d-step", "0.1", "--dx", "0.4", "--resolve", "auto", "--quiet"]
+PYR_CFG = {"shape": "pyramid", "N": 0.946, "cell": 3.78, "tabor": 0.5, "d_min": -1.0, "d_max": 2.0, "d_step": 0.1,
+           "dx": 0.4, "resolve": "auto"}
+
+
+# ---- Richardson -------------------------------------------------------------------------------------
+@pytest.mark.parametrize("p", [0.8, 1.0, 2.0, 3.0])
+def test_richardson_recovers_a_known_order_on_uneven_grids(p):
+    h = [0.42, 0.29, 0.18]  # ratios 1.45, 1.61: as the FFT-friendly pixel counts give them
+    f = [2.0 + 0.7 * x**p for x in h]
+    r = resolve.richardson(h, f)
+    assert r["observed"] and r["order"] == pytest.approx(p, rel=1e-8)
+    assert r["extrapolated"] == pytest.approx(2.0, abs=1e-10)
+    assert r["error"] == pytest.approx(2.0 - f[-1], rel=1e-8)
+
+
+def test_richardson_two_grids_assume_first_order_and_odd_cases():
+    r = resolve.richardson([0.2, 0.1], [1.2, 1.1])  # order 1 assumed: error = Δ/(r − 1)
+    assert not r["observed"] and r["order"] == 1.0 and r["error"] == pytest.approx(-0.1)
+    r = resolve.richardson([0.4, 0.2, 0.1], [1.0, 1.2, 1.1])  # not monotone: order 1, not measured
+    assert not r["observed"] and r["order"] == 1.0
+    r = resolve.richardson([0.4, 0.2, 0.1], [1 + 0.4**6, 1 + 0.2**6, 1 + 0.1**6])  # clipped to P_MAX
+    assert r["observed"] and r["order"] == resolve.P_MAX
+    assert math.isnan(resolve.richardson([0.2], [1.0])["error"])
+    assert math.isnan(resolve.richardson([0.2, 0.1], [1.0, math.nan])["error"])
+
+
+def test_relative_change_has_an_absolute_floor():
+    assert resolve.relative("jump_in_D", 0.005, 0.0) == pytest.approx(0.005)  # floor 1 ε
+    assert resolve.relative("pull_off_F", 1e-4, 0.0) == pytest.approx(0.01)  # floor 0.01
+    assert resolve.relative("pull_off_F", -0.05, -5.0) == pytest.approx(0.01)
+
+
+# ---- a cheap refinement -----------------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def refined(tmp_path_factory):
+    d = tmp_path_factory.mktemp("resolve")
+    assert main([*PYR, "--out", str(d / "r.nc")]) == 0
+    load_result(d / "r.nc")[1].save(d / "r.csv")  # the same result as CSV (a CLI run writes it the same way)
+    return d
+
+
+def test_cheap_refinement_reaches_ok(refined):
+    _, res = load_result(refined / "r.nc")
+    p = res.params
+    assert res.status == "ok" and p["resolve_status"] == "ok" and p["resolve"] == "auto"
+    assert p["resolve_tol"] == 0.01 and p["max_pixels"] >= 9
+    grids = p["resolve_grids"]
+    assert len(grids) >= 3 and grids[0] == pytest.approx(0.42, rel=0.01)
+    ratios = np.array(grids[:-1]) / np.array(grids[1:])
+    assert np.all((ratios > 1.3) & (ratios < 1.7))  # √2 in dx, to the FFT-friendly pixel counts
+    assert res.grid.dx == pytest.approx(grids[-1], rel=1e-12)  # the finest grid's curves
+    tab = p["resolution"]
+    assert tab["nx"][-1] == res.grid.nx and tab["status"][-1] == "ok" and len(tab["dx"]) == len(grids)
+    assert all(s > 0 for s in tab["seconds"]) and all(c > 0 for c in tab["convolutions"])
+    assert tab["pull_off_F"][-1] == pytest.approx(res.pull_off_force, rel=1e-12)
+    for name in ("pull_off_F", "transition_D"):
+        r = p["richardson"][name]
+        assert r["rel_error"] <= 0.01 and r["change"] <= 0.01, name
+    # the curves are exactly those of a plain run on the finest grid
+    from tengsim.contact import run_contact
+
+    plain = run_contact({k: v for k, v in PYR_CFG.items() if k != "resolve"} | {"dx": grids[-1]})
+    np.testing.assert_allclose(res.table["F"], plain.table["F"], rtol=0, atol=1e-9)
+
+
+def test_csv_and_netcdf_carry_the_same_table(refined):
+    _, a = load_result(refined / "r.nc")
+    _, b = load_result(refined / "r.csv")
+    ta, tb = a.params["resolution"], b.params["resolution"]
+    assert set(ta) == set(tb) == {"dx", "nx", "ny", "seconds", "convolutions", "status", "pull_off_F",
+                                  "jump_in_D", "jump_out_D", "transition_D"}
+    assert ta == tb
+    assert a.params["richardson"] == b.params["richardson"]
+    import xarray as xr
+
+    ds = xr.load_dataset(refined / "r.nc")
+    assert ds["resolution_dx"].dims == ("level",) and ds.sizes["level"] == len(ta["dx"])
+    assert ds["resolution_pull_off_F"].attrs["units"] == "1" and ds["resolution_seconds"].attrs["units"] == "s"
+    assert "resolution" not in __import__("json").loads(ds.attrs["params"])  # stored once: as the variables
+    for k, v in ds.variables.items():
+        assert v.attrs.get("long_name"), k
+
+
+def test_netcdf_with_the_table_passes_the_cf_check(refined, monkeypatch):
+    runner = pytest.importorskip("compliance_checker.runner")
+    cs = runner.CheckSuite()
+    cs.load_all_available_checkers()
+    results, errors = cs.run_all(cs.load_dataset(str(refined / "r.nc")), ["cf:1.10"], skip_checks=[])["cf:1.10"]
+    failed = [(r.name, r.msgs) for r in results
+              if (r.value[0] < r.value[1] if isinstance(r.value, tuple) else not r.value)]
+    assert errors == {} and failed == []
+
+
+def test_plot_shows_the_convergence(refined, capsys):
+    assert main(["plot", str(refined / "r.csv"), "--out", str(refined / "f.png")]) == 0
+    assert (refined / "f_resolution.png").stat().st_size > 1000
+
+
+# ---- max_pixels -------------------------------------------------------------------------------------
+def test_max_pixels_stops_with_under_resolved_and_one_line(tmp_path, capsys):
+    out = tmp_path / "m.csv"
+    assert main([*PYR, "--max-pixels", str(21 * 21), "--out", str(out)]) == 0
+    err = capsys.readouterr().err
+    lines = [ln for ln in err.splitlines() if "max_pixels" in ln]
+    assert len(lines) == 1 and "dx = 0.18" in lines[0] and "needed" in lines[0]
+    _, res = load_result(out)
+    assert res.status == "under_resolved" and res.params["resolve_status"] == "under_resolved"
+    assert res.params["resolution"]["nx"] == [9, 13, 21] and res.grid.nx == 21
+    msg = res.params["resolve_message"]
+    assert "\n" not in msg and "dx ≈" in msg
+    need = float(msg.split("dx ≈ ")[1].split()[0])
+    assert 0.01 < need < 0.18  # extrapolated from the observed convergence: finer than reached
+
+
+def test_api_resolve_contact_and_the_first_grid_above_max_pixels():
+    from tengsim import PathSpec, Pyramid, resolve_contact
+
+    res = resolve_contact(Pyramid(0.946, 3.78), 0.5, PathSpec(-1.0, 2.0, 0.1), dx=0.4, max_pixels=13 * 13)
+    assert res.status == "under_resolved" and len(res.params["resolve_grids"]) == 2
+    assert res.params["richardson"]["pull_off_F"]["observed"] is False  # two grids: order 1 assumed
+    with pytest.raises(TengsimError, match="below the first grid's 9×9"):
+        resolve_contact(Pyramid(0.946, 3.78), 0.5, PathSpec(-1.0, 2.0, 0.1), dx=0.4, max_pixels=50)
+
+
+def test_default_start_and_max_pixels():
+    from tengsim.laws import MaugisDugdale
+    from tengsim.shapes import Paraboloid
+
+    dx = resolve.default_dx(Paraboloid(1.0, 16.0), MaugisDugdale(), 1.0)
+    assert 0.1 < dx < 0.13  # the pixel-snap bound of the MD law at μ = 1 (status: "refine dx to about 0.116")
+    assert resolve.default_max_pixels() >= 9
+
+
+# ---- refusals ---------------------------------------------------------------------------------------
+BASE = ["contact", "pyramid", "--N", "0.946", "--cell", "3.78", "--d-min", "-1", "--d-max", "0", "--d-step", "0.5",
+        "--dx", "0.5", "--quiet"]
+
+
+@pytest.mark.parametrize("extra, words", [
+    (["--resolve-tol", "0.02"], "resolve_tol applies only with resolve = 'auto'"),
+    (["--max-pixels", "100"], "max_pixels applies only with resolve = 'auto'"),
+    (["--resolve", "auto", "--resolve-tol", "0"], "resolve_tol must be > 0 and < 1, got 0"),
+    (["--resolve", "auto", "--resolve-tol", "1"], "resolve_tol must be > 0 and < 1, got 1"),
+    (["--resolve", "auto", "--resolve-tol", "x"], "resolve_tol"),
+    (["--resolve", "auto", "--max-pixels", "4"], "max_pixels must be >= 9"),
+    (["--resolve", "auto", "--max-pixels", "10.5"], "max_pixels must be an integer"),
+    (["--resolve", "maybe"], "resolve = 'maybe' is not one of off, auto"),
+    (["--resolve", "auto", "--max-pixels", "50"], "max_pixels = 50 is below the first grid's"),
+])
+def test_bad_values_are_refused_with_one_line(tmp_path, capsys, extra, words):
+    out = tmp_path / "bad.csv"
+    assert main([*BASE, *extra, "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and words in err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_one_grid_run_contact_refuses_resolve_auto():
+    from tengsim.contact import run_contact
+
+    with pytest.raises(TengsimError, match="tengsim.resolve.run_contact"):
+        run_contact({**PYR_CFG, "d_max": 0.0})
+
+
+# ---- the issue's done-when (slow) -------------------------------------------------------------------
+@pytest.mark.slow
+def test_md_sphere_converges_to_maugis(tmp_path):
+    """`tengsim contact sphere --law md --tabor 1 --cell 16 --d-min -2 --d-max 0.5 --d-step 0.05 --resolve auto`:
+    pull-off within 1 % of Maugis–Dugdale (λ = 1.157 μ), status ok, the grid sequence in the file."""
+    from tengsim.references import maugis_dugdale_pulloff_from_tabor
+
+    out = tmp_path / "md.csv"
+    assert main(["contact", "sphere", "--law", "md", "--tabor", "1", "--cell", "16", "--d-min", "-2", "--d-max",
+                 "0.5", "--d-step", "0.05", "--resolve", "auto", "--quiet", "--out", str(out)]) == 0
+    _, res = load_result(out)
+    md = -maugis_dugdale_pulloff_from_tabor(1.0) / 3  # F = ∬P/(3π), ∬P = −π P̄
+    assert res.status == "ok" and len(res.params["resolve_grids"]) >= 2
+    assert abs(res.pull_off_force / md - 1) < 0.01
+
+
+# ---- sweeps -----------------------------------------------------------------------------------------
+def test_sweep_passes_resolve_and_reports_status_and_dx(tmp_path, study_client):
+    """"contact.resolve" = "auto" in [base.contact]: each point refined; a point stopped by max_pixels is
+    under_resolved with its one line (dx reached, dx needed) in study.csv's message, an ok one names its dx."""
+    import csv
+
+    from tengsim.study import parse_study, run_study
+
+    base = {k: v for k, v in PYR_CFG.items()}
+    study = parse_study({"base": {"contact": base}, "axes": {"contact.max_pixels": [21 * 21, 10**6]}}, source="t")
+    s = run_study(study, tmp_path / "out", client=study_client, quiet=True)
+    assert (s["ok"], s["under_resolved"], s["failed"]) == (1, 1, 0)
+    rows = {r["contact.max_pixels"]: r for r in csv.DictReader(open(tmp_path / "out" / "study.csv"))}
+    low, high = rows[str(21 * 21)], rows[str(10**6)]
+    assert low["status"] == "under_resolved" and "stopped by max_pixels = 441 at dx = 0.18" in low["message"]
+    assert "needed" in low["message"]
+    assert high["status"] == "ok" and "resolve auto: converged at dx = 0.0771" in high["message"]
