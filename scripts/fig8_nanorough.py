@@ -95,7 +95,9 @@ def run_case(eps, dx, rms, d_step=2.0, d_min=-30.0, log=print):
                         V_OC_rep=float(voc_polymer(a_rep, SIGMA, EPS_R, T_POLY)),
                         min_gap=float(H.min()), status=str(t["status"][i]), converged=bool(t["converged"][i]),
                         residual=float(t["residual"][i])))
-    return dict(eps=eps, dx=dx, rms=rms, grid=f"{g.nx}x{g.ny}", tabor=plan.tabor, rows=out, seconds=secs,
+    jumps = [float(P_kpa[i]) for i in range(len(P_kpa)) if bool(t["jump"][i])]
+    return dict(eps=eps, dx=dx, rms=rms, grid=f"{g.nx}x{g.ny}", tabor=plan.tabor, rows=out, seconds=secs, jumps=jumps,
+                max_iterations=int(np.max(t["iterations"])), n_unconverged=int(np.sum(~t["converged"].astype(bool))),
                 status=str(res.params.get("status", "")),
                 snap=res.params.get("pixel_snap_number"), pz=res.params.get("process_zone_estimate"),
                 lateral=sc.lateral, n_states=len(t["D"]))
@@ -203,6 +205,14 @@ def main(argv=None):
                                     **{k: (f"{v:.6g}" if isinstance(v, float) else v) for k, v in row.items()
                                        if k in fields}})
                     fh.flush()
+                    new = not (out / "jumps.csv").exists()
+                    with open(out / "jumps.csv", "a", newline="") as fj:
+                        wj = csv.writer(fj)
+                        if new:
+                            wj.writerow(["eps_nm", "dx_nm", "grid", "rms_nm", "jump_landings_kPa", "states",
+                                         "unconverged", "max_iterations", "seconds"])
+                        wj.writerow([eps, f"{dx:.4f}", r["grid"], rms, ";".join(f"{v:.3f}" for v in r["jumps"]),
+                                     r["n_states"], r["n_unconverged"], r["max_iterations"], f"{r['seconds']:.1f}"])
                     a = [row.get("A_c", float("nan")) for row in r["rows"]]
                     print(f"  -> {r['grid']} {r['seconds']:.0f} s status {r['status']}: A_c/S "
                           + " / ".join(f"{v:.4f}" for v in a), file=sys.stderr, flush=True)

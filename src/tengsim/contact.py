@@ -11,12 +11,15 @@ from tengsim.grid import Mirror
 from tengsim.shapes import Pyramid, Shape
 from tengsim.laws import LJ93, Law, make_law
 from tengsim.kernels import make_kernel
+from tengsim.kernels.distributed import SlabPeriodicKernel
 from tengsim.loadpath import LoadPathSpec, run_load_path
 from tengsim.path import PathSpec, run_path
 from tengsim.plugins import KERNELS
 from tengsim.resources import MAP_WORK, check_memory
 from tengsim.solvers import make_solver
 from tengsim.solvers.mirror import MirrorSolver
+from tengsim.solvers.distributed import SlabSolver
+from tengsim import parallel
 
 MONITOR_MIN_POINTS = 1024**2  # grids from this size on report progress inside each solve
 SYMMETRY_CHOICES = ("auto", "off")
@@ -47,6 +50,18 @@ def choose_symmetry(shape, U0, grid, boundary: str, solver_name: str, symmetry: 
     if not axes:
         return (), "none (gap not mirror symmetric on the grid)"
     return axes, "+".join(_AXIS_NAMES[a] for a in axes)
+
+
+def _check_distributed(comm, boundary, solver, grid):
+    """An MPI run splits the periodic kernel's FFT across the processes: refuse what it cannot split."""
+    n = comm.Get_size()
+    if boundary != "periodic":
+        raise TengsimError(f"an MPI run ({n} processes) splits the periodic kernel across them: give boundary = "
+                           f"'periodic' (got {boundary!r}), or run without mpiexec")
+    if getattr(solver, "name", "") != "fast":
+        raise TengsimError(f"an MPI run ({n} processes) uses the fast solver, not {getattr(solver, 'name', solver)!r}")
+    if grid.nx < n or grid.ny // 2 + 1 < n:
+        raise TengsimError(f"the {grid.nx}×{grid.ny} grid is too small to split over {n} processes")
 
 
 def _mirror_kernel_class():
@@ -99,7 +114,13 @@ def simulate(shape: Shape, tabor: float, dx: float, path: PathSpec, boundary: st
     if isinstance(solver_obj, MirrorSolver):
         solver_obj = solver_obj.inner
     U0 = shape.gap(grid)
+    comm = parallel.world()  # mpiexec -n N: the periodic kernel split in slabs over the N processes
+    if comm is not None:
+        _check_distributed(comm, boundary, solver_obj, grid)
+        symmetry = "off"
     axes, sym_label = choose_symmetry(shape, U0, grid, boundary, getattr(solver_obj, "name", ""), symmetry)
+    if comm is not None:
+        sym_label = "off (MPI run: the slabs hold the full grid)"
     mirror_kernel = _mirror_kernel_class() if axes else None
     if axes and mirror_kernel is None:
         axes, sym_label = (), "none (no mirror kernel)"
@@ -112,7 +133,10 @@ def simulate(shape: Shape, tabor: float, dx: float, path: PathSpec, boundary: st
     if (hasattr(progress, "monitor") and grid.nx * grid.ny >= MONITOR_MIN_POINTS and is_dataclass(solver_obj)
             and getattr(solver_obj, "monitor", 0) is None):  # long solves report as they go
         solver_obj = replace(solver_obj, monitor=progress.monitor(), monitor_every=10)
-    if mirror is None:
+    if comm is not None:
+        kernel = SlabPeriodicKernel(grid, tabor**1.5, comm, **(kernel_params or {}))
+        solver_obj = SlabSolver(solver_obj)
+    elif mirror is None:
         kernel = make_kernel(boundary, grid, tabor**1.5, **(kernel_params or {}))
     else:
         kernel = mirror_kernel(boundary, grid, tabor**1.5, mirror, **(kernel_params or {}))
@@ -128,6 +152,7 @@ def simulate(shape: Shape, tabor: float, dx: float, path: PathSpec, boundary: st
         "solver": solver_obj.name,
         "tol": solver_obj.tol,
         "symmetry": sym_label,
+        **({"mpi_processes": comm.Get_size()} if comm is not None else {}),
         **({"block_nx": bnx, "block_ny": bny} if mirror is not None else {}),
         "dx": grid.dx,
         "nx": grid.nx,

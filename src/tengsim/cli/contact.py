@@ -99,6 +99,11 @@ def run(args) -> int:
     check_writable(out)
     if args.plot:
         check_writable(args.plot)
+    from tengsim import parallel
+
+    if not parallel.is_root():  # mpiexec -n N: every process solves its slab, rank 0 alone writes and reports
+        run_contact(cfg)
+        return 0
     stream = open_stream(out, args.resume, args.quiet)
     res = run_streamed(lambda bar: run_contact(cfg, progress=bar, sink=stream), stream, args.quiet)
     if res is None:

@@ -23,6 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from tengsim.solvers._linesearch import Ray, Trial, WolfeLineSearch
+from tengsim.solvers._reduce import for_kernel
 from tengsim.solvers._weights import Weights
 from tengsim.solvers._workspace import Spare
 from tengsim.errors import TengsimError
@@ -133,6 +134,9 @@ class FastSolver:
         dA = problem.dA if lines is None else problem.dA * lines.scale
         ws = self._spare.take(np.size(problem.g0), self.memory, dA)
         ws.memory.lines = lines
+        ws.memory.red = red = for_kernel(problem.kernel)  # a slab-distributed kernel: sums over all ranks
+        if red is not None and lines is not None:
+            raise TengsimError("a distributed solve cannot also be a weighted (mirror) one")
         try:
             return self._descend(_Descent(problem, start, ws, lines), t0)
         finally:
@@ -190,6 +194,9 @@ class _Descent:
         self.g0 = np.ascontiguousarray(problem.g0, dtype=float).ravel()
         self.n = self.g0.size
         self.nw = self.n if lines is None else lines.total  # the (weighted) pixel count
+        self.red = red = for_kernel(K)  # None, or the sums and maxima over the ranks of a distributed solve
+        if red is not None:
+            self.nw = red.sum([float(self.n)])[0]
         self.q = np.array(start.q, dtype=float).ravel()
         self.w = np.array(start.w, dtype=float).ravel()
         self.sw, self.mem, self.cP = ws.sweeper, ws.memory, ws.cP
@@ -198,14 +205,16 @@ class _Descent:
         # a film's periodic kernel has a finite mean compliance, K(0) > 0: it says pinned_mean = False
         self.proj = bool(getattr(K, "pinned_mean", getattr(K, "periodic", False)))
         self.search = WolfeLineSearch(problem.law, ws.sweeper, self.dA, ws.gt, ws.Pt, sum_p=self.proj,
-                                      lines=lines)
+                                      lines=lines, red=red)
         self._apply, self._takes_out = K.apply, _takes_out(K.apply)
         # the start: g, P, ΣΦ, r (one convolution), G, E
         np.add(self.g0, self.w, out=self.g)
         self.phis, self.sum_p = self.law_sweep()
         np.subtract(self.w, self.convolve(self.P), out=self.r)
         self.n_conv = 1
-        if lines is None:
+        if red is not None:
+            self.mean_q = red.sum([float(self.q.sum())])[0] / self.nw
+        elif lines is None:
             self.mean_q = float(self.q.mean())
         else:
             self.mean_q = (float(self.q.sum()) - lines.sum(self.q)) / self.nw
@@ -215,6 +224,8 @@ class _Descent:
         self.qw = self._dot(self.q, self.w)
         self.E = self.dA * (0.5 * self.qw + self.phis)
         self.rmax = max(float(self.r.max()), -float(self.r.min()))
+        if red is not None:
+            self.rmax = red.max(self.rmax)
         self.E_best = self.E
         self.sum_d = 0.0
         self.corr = None
@@ -223,6 +234,8 @@ class _Descent:
     def _dot(self, a, b) -> float:
         """a·b, m-weighted (in units of the interior weight) for a weighted problem."""
         v = float(np.vdot(a, b))
+        if self.red is not None:
+            return self.red.sum([v])[0]
         return v if self.lines is None else v - self.lines.dot(a, b)
 
     def convolve(self, x):
@@ -245,6 +258,8 @@ class _Descent:
         acc = self.sw.sum(self._law_block, [0.0, 0.0])
         if self.lines is not None:
             acc = _weigh_law(self.lines, self.law, self.g, self.P, acc, self.proj)
+        if self.red is not None:
+            acc = self.red.sum(acc)
         return acc
 
     def lowest_energy(self) -> float:
@@ -278,6 +293,8 @@ class _Descent:
         if L is not None:  # the sweep wrote d and K d whole: correct its sums on the deficit pixels
             cw, cKd, cr = L.dots(self.d, self.w, self.Kd, self.r)
             acc = [acc[0] - cw, acc[1] - cKd, acc[2] - cr, acc[3] - (L.sum(self.d) if self.proj else 0.0)]
+        if self.red is not None:
+            acc = self.red.sum(acc)
         return acc
 
     def direction(self) -> Ray:
@@ -379,6 +396,11 @@ class _Descent:
             dky, yky, drn, yrn = dky - c_dky, yky - c_yky, drn - c_drn, yrn - c_yrn
             if k2:
                 x = x - L.rows(self.mem.B[:k2], ky)
+        if self.red is not None:  # every rank's partial products and max|r|
+            dky, yky, drn, yrn = self.red.sum([dky, yky, drn, yrn])
+            self.rmax = self.red.max(self.rmax)
+            if k2:
+                x = self.red.sum(np.asarray(x, dtype=float))
         return dky, yky, drn, yrn, (x if k2 else None)
 
     def _store_block(self, sl, m, sc, acc, alpha, slot):

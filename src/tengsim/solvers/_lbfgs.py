@@ -43,6 +43,7 @@ class KMetricLBFGS:
         self._last = (1.0, np.zeros(0), np.zeros(0))
         self._perm = np.zeros(0, int)   # active slots in age order (oldest first), as an index array
         self.lines = None  # a weighted problem's deficit pixels (tengsim.solvers._weights): m-weighted products
+        self.red = None    # a distributed solve's sums over all ranks (tengsim.solvers._reduce)
 
     @property
     def empty(self) -> bool:
@@ -60,6 +61,8 @@ class KMetricLBFGS:
             p = self.B[: 2 * k] @ r
             if self.lines is not None:
                 p = p - self.lines.rows(self.B[: 2 * k], r)
+            if self.red is not None:  # a distributed solve: the rows' products over all ranks
+                p = self.red.sum(np.asarray(p, dtype=float))
             p = self.dA * p
             self.pS[:k], self.pY[:k] = p[0::2], p[1::2]
 

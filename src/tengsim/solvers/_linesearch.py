@@ -50,9 +50,10 @@ class WolfeLineSearch:
     """
 
     def __init__(self, law, sweeper, dA, g_trial, P_trial, sum_p=False, c1=1e-4, c2=0.9, max_eval=40,
-                 first_move=0.25, lines=None):
+                 first_move=0.25, lines=None, red=None):
         self.law, self.sweeper, self.dA = law, sweeper, float(dA)
         self.lines = lines  # a weighted problem's deficit pixels (tengsim.solvers._weights), or None
+        self.red = red      # a distributed solve's sums over all ranks (tengsim.solvers._reduce), or None
         self.g_trial, self.P_trial = g_trial, P_trial
         self.sum_p = bool(sum_p)
         self.c1, self.c2, self.max_eval, self.first_move = c1, c2, int(max_eval), first_move
@@ -60,6 +61,8 @@ class WolfeLineSearch:
     def first_step(self, Kd) -> float:
         """α for a first direction (empty memory): the gap moves by at most ``first_move`` (0.25 ε)."""
         m = max(float(Kd.max()), -float(Kd.min()))
+        if self.red is not None:
+            m = self.red.max(m)
         return self.first_move / m if m > self.first_move else 1.0
 
     def swap(self, g, P):
@@ -91,6 +94,8 @@ class WolfeLineSearch:
             dpk -= float(np.dot(c * (Pt[i] - ray.P[i]), ray.Kd[i]))
             if self.sum_p:
                 sp -= float(np.dot(c, Pt[i]))
+        if self.red is not None:  # every rank's share of the grid
+            phis, dpk, sp = self.red.sum([phis, dpk, sp])
         e = self.dA * (0.5 * ray.qw + a * ray.dw + 0.5 * a * a * ray.dKd + phis)
         de = ray.slope + self.dA * (a * ray.dKd - dpk)
         return e, de, phis, sp
