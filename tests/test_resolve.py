@@ -147,8 +147,15 @@ def test_default_start_and_max_pixels():
     from tengsim.laws import MaugisDugdale
     from tengsim.shapes import Paraboloid
 
-    dx = resolve.default_dx(Paraboloid(1.0, 16.0), MaugisDugdale(), 1.0)
-    assert 0.1 < dx < 0.13  # the pixel-snap bound of the MD law at μ = 1 (status: "refine dx to about 0.116")
+    from tengsim import status
+    from tengsim.kernels import make_kernel
+
+    shape, law = Paraboloid(1.0, 16.0), MaugisDugdale()
+    dx = resolve.default_dx(shape, law, 1.0)
+    # the pixel-snap bound of the MD law at μ = 1: s(dx) ∝ dx falls to the status' limit (0.6) at dx ≈ 0.07
+    assert 0.06 < dx < 0.08
+    s = status.pixel_snap_number(law, make_kernel("free", shape.grid(dx), 1.0))
+    assert 0.8 * status.SNAP_LIMIT < s <= status.SNAP_LIMIT * 1.02
     assert resolve.default_max_pixels() >= 9
 
 

@@ -12,6 +12,7 @@ from tengsim.shapes import Pyramid, Shape
 from tengsim.laws import LJ93, Law, make_law
 from tengsim.kernels import make_kernel
 from tengsim.kernels.distributed import SlabPeriodicKernel
+from tengsim.kernels.mirror import MirrorKernel
 from tengsim.loadpath import LoadPathSpec, run_load_path
 from tengsim.path import PathSpec, run_path
 from tengsim.plugins import KERNELS
@@ -64,15 +65,6 @@ def _check_distributed(comm, boundary, solver, grid):
         raise TengsimError(f"the {grid.nx}×{grid.ny} grid is too small to split over {n} processes")
 
 
-def _mirror_kernel_class():
-    """The kernel acting on the irreducible block (tengsim.kernels.mirror.MirrorKernel), or None without it."""
-    try:
-        from tengsim.kernels.mirror import MirrorKernel
-    except ModuleNotFoundError:  # pragma: no cover - a tree without the mirror kernel: the full grid
-        return None
-    return MirrorKernel
-
-
 def simulate(shape: Shape, tabor: float, dx: float, path: PathSpec, boundary: str = "free",
              solver="fast", tol: float = 1e-6, law: Law | str | None = None, progress=None,
              grid=None, extra_params: dict | None = None, observers=(), scaling=None,
@@ -121,9 +113,6 @@ def simulate(shape: Shape, tabor: float, dx: float, path: PathSpec, boundary: st
     axes, sym_label = choose_symmetry(shape, U0, grid, boundary, getattr(solver_obj, "name", ""), symmetry)
     if comm is not None:
         sym_label = "off (MPI run: the slabs hold the full grid)"
-    mirror_kernel = _mirror_kernel_class() if axes else None
-    if axes and mirror_kernel is None:
-        axes, sym_label = (), "none (no mirror kernel)"
     mirror = Mirror(grid, axes) if axes else None
     bnx, bny = mirror.reduced_shape if mirror else (grid.nx, grid.ny)
     if check_memory_first:  # before any large array: one clear error, needed vs available (the block's)
@@ -139,7 +128,7 @@ def simulate(shape: Shape, tabor: float, dx: float, path: PathSpec, boundary: st
     elif mirror is None:
         kernel = make_kernel(boundary, grid, tabor**1.5, **(kernel_params or {}))
     else:
-        kernel = mirror_kernel(boundary, grid, tabor**1.5, mirror, **(kernel_params or {}))
+        kernel = MirrorKernel(boundary, grid, tabor**1.5, mirror, **(kernel_params or {}))
         solver_obj = MirrorSolver(solver_obj)
     walk = run_load_path if isinstance(path, LoadPathSpec) else run_path  # load or rigid-approach control
     params = {

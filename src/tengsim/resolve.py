@@ -150,9 +150,10 @@ def default_max_pixels(boundary: str = "free", solver: str = "fast") -> int:
 
 
 def default_dx(shape, law, coupling: float, boundary: str = "free") -> float:
-    """Starting dx when none is given: the a-priori Dugdale zone ℓ_D (:func:`tengsim.status.process_zone_estimate`,
-    the cohesive zone spans one pixel) and the dx below which pixels no longer snap one at a time (the pixel
-    snap number s ∝ dx, :func:`tengsim.status.pixel_snap_number`, measured on a grid of the cell), whichever is
+    """Starting dx when none is given: the a-priori Dugdale zone ℓ_D (:func:`tengsim.status.process_zone_estimate`)
+    over ``status.RESOLUTION`` (the zone spans the pixels the grid status asks for) and the dx at which the pixel
+    snap number s ∝ dx (:func:`tengsim.status.pixel_snap_number`, measured on a grid of the cell) falls to
+    ``status.SNAP_LIMIT``, whichever is
     smaller, and at most cell/MIN_SIDE.  Coarser grids are under-resolved by those criteria whatever their
     observables do, so they would only be spent."""
     from tengsim import status
@@ -162,11 +163,11 @@ def default_dx(shape, law, coupling: float, boundary: str = "free") -> float:
     dx = cell / MIN_SIDE
     lD = status.process_zone_estimate(law, coupling)
     if math.isfinite(lD) and lD > 0:
-        dx = min(dx, lD)
+        dx = min(dx, lD / status.RESOLUTION)  # the zone spans the pixels the status asks for
     g = shape.grid(dx)
     s = status.pixel_snap_number(law, make_kernel(boundary, g, coupling))
-    if s > 1:
-        dx = g.dx / s
+    if s > status.SNAP_LIMIT:
+        dx = g.dx * status.SNAP_LIMIT / s
     return dx
 
 
