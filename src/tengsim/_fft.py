@@ -124,6 +124,18 @@ def _setstate(self, st):
     self._tls = threading.local()
 
 
+class _Convolver:
+    """What every convolver shares: per-thread buffers that are not pickled, and its backend's name."""
+
+    __getstate__ = _getstate
+    __setstate__ = _setstate
+
+    @property
+    def backend(self) -> str:
+        """"pocketfft" (scipy's binding, direct) or "scipy.fft" (the public functions)."""
+        return "pocketfft" if self._direct else "scipy.fft"
+
+
 def _checked(conv, shape) -> bool:
     """Does the direct pocketfft path of ``conv`` agree with the public scipy.fft one?"""
     try:
@@ -144,7 +156,7 @@ def _use_direct(conv, shape) -> bool:
     return True
 
 
-class PaddedConvolver:
+class PaddedConvolver(_Convolver):
     """w = crop(irfft2(rfft2(pad(p)) · spectrum)): the free kernel's convolution, one object per grid.
 
     Pads the (nx, ny) field to ``padded`` = (px, py), transforms only the nx rows that are not zero
@@ -166,13 +178,6 @@ class PaddedConvolver:
         spec = rfft2_padded(p, self.padded)
         spec *= self.spectrum
         return np.ascontiguousarray(irfft2_cropped(spec, self.padded, self.shape))
-
-    __getstate__ = _getstate
-    __setstate__ = _setstate
-
-    @property
-    def backend(self) -> str:
-        return "pocketfft" if self._direct else "scipy.fft"
 
     def _buffers(self):
         b = getattr(self._tls, "b", None)
@@ -205,7 +210,7 @@ class PaddedConvolver:
         return out
 
 
-class PeriodicConvolver:
+class PeriodicConvolver(_Convolver):
     """w = irfft2(rfft2(p) · spectrum) on a periodic cell, one object per grid.
 
     On scipy's pocketfft binding where available (checked against :func:`convolve_periodic` once):
@@ -219,13 +224,6 @@ class PeriodicConvolver:
         self.threads = _threads(self.shape)
         self._tls = threading.local()
         self._direct = _use_direct(self, self.shape)
-
-    __getstate__ = _getstate
-    __setstate__ = _setstate
-
-    @property
-    def backend(self) -> str:
-        return "pocketfft" if self._direct else "scipy.fft"
 
     def _apply_public(self, p):
         return convolve_periodic(p, self.spectrum)
@@ -344,7 +342,7 @@ def _crop(a, axis, n):
     return a[:n] if axis == 0 else a[:, :n]
 
 
-class MirrorConvolver:
+class MirrorConvolver(_Convolver):
     """w = K p on the irreducible block of a mirror-symmetric field (see the modes above).
 
     ``shape``: the block (m0, m1); ``modes``: per axis, one of :data:`MIRROR_MODES` (at least one axis
@@ -383,13 +381,6 @@ class MirrorConvolver:
         self.threads = _threads(full if "even" not in self.modes else (self._lines, max(self.lengths)))
         self._tls = threading.local()
         self._direct = _use_direct(self, self.shape)
-
-    __getstate__ = _getstate
-    __setstate__ = _setstate
-
-    @property
-    def backend(self) -> str:
-        return "pocketfft" if self._direct else "scipy.fft"
 
     # the public path: plain scipy.fft calls, one axis at a time
     def _real_public(self, a, k, forward):

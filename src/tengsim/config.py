@@ -20,7 +20,7 @@ from tengsim.plugins import KERNELS, LAWS, OBSERVERS, SHAPES, SOLVERS
 from tengsim.schema import Field, Table, dataclass_fields, signature_fields
 from tengsim.shapes.base import dimensionless_fields, physical_fields
 from tengsim.shapes.roughened import LENGTH_KEYS as _ROUGHNESS_LENGTHS, roughen, roughness_fields
-from tengsim.units import Scaling, parse_quantity
+from tengsim.units import Scaling, number_or_text, parse_quantity
 
 PHYSICAL_KEYS = ("E_star", "W", "eps")
 """Keys that make a [contact] table a physical run (with any physical-only key of the shape)."""
@@ -109,14 +109,7 @@ _ADAPTIVE_KEYS = ("adaptive", "adapt_tol")
 
 def _load_value(v, label="load"):
     """A load key: a number (F of Eq. 10) or a string, a number or a pressure with a unit (checked later)."""
-    if isinstance(v, bool) or not isinstance(v, (int, float, str)):
-        raise TengsimError(f"{label} must be a number or a pressure with a unit, got {v!r}")
-    if isinstance(v, str):
-        try:
-            return float(v)
-        except ValueError:
-            return v.strip()
-    return float(v)
+    return number_or_text(v, label, "a pressure")
 
 
 def _load_F(name, v, scaling):

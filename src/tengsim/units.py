@@ -28,6 +28,19 @@ _BASE = {
 _NUM = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
 
 
+def number_or_text(v, label: str, quantity: str):
+    """A key that takes a plain number or, in a physical run, ``quantity`` with a unit ("5nm", "-2kPa"): the
+    number as float, a numeric string as float, other text stripped (its unit is checked later)."""
+    if isinstance(v, bool) or not isinstance(v, (int, float, str)):
+        raise TengsimError(f"{label} must be a number or {quantity} with a unit, got {v!r}")
+    if isinstance(v, str):
+        try:
+            return float(v)
+        except ValueError:
+            return v.strip()
+    return float(v)
+
+
 def parse_quantity(text, kind: str | None = None, name: str = "value") -> float:
     """'0.59MPa' → 590000.0 (SI).  A bare number is taken as SI.  ``kind`` checks the dimension.
 

@@ -118,31 +118,7 @@ class Rough(Shape):
 
     def __post_init__(self):
         positive("cell", self.cell)
-        h = self.hurst
-        if isinstance(h, bool) or not isinstance(h, (int, float)) or not 0 < h < 1:
-            raise TengsimError(f"rough: hurst must be in (0, 1), got {h!r}")
-        if self.rms_height is not None and self.rms_slope is not None:
-            raise TengsimError(f"rough: give rms_height or rms_slope, not both (got rms_height = {self.rms_height!r}, "
-                               f"rms_slope = {self.rms_slope!r})")
-        if self.rms_slope is not None:
-            positive("rms_slope", self.rms_slope)
-        else:
-            object.__setattr__(self, "rms_height", positive("rms_height", 1.0 if self.rms_height is None
-                                                            else self.rms_height))
-        if self.long_cutoff is None:
-            object.__setattr__(self, "long_cutoff", float(self.cell))
-        if self.short_cutoff is None:
-            object.__setattr__(self, "short_cutoff", self.cell / 32)
-        positive("long_cutoff", self.long_cutoff)
-        positive("short_cutoff", self.short_cutoff)
-        if self.long_cutoff > self.cell * (1 + 1e-12):
-            raise TengsimError(f"rough: long_cutoff = {self.long_cutoff:g} exceeds the cell {self.cell:g}")
-        if self.short_cutoff >= self.long_cutoff:
-            raise TengsimError(f"rough: short_cutoff = {self.short_cutoff:g} must be below long_cutoff = "
-                               f"{self.long_cutoff:g}")
-        s = self.seed
-        if isinstance(s, bool) or not isinstance(s, (int, np.integer)) or s < 0:
-            raise TengsimError(f"rough: seed must be an integer >= 0, got {s!r}")
+        settle_spectrum(self, float(self.cell), key=lambda k: k, lead="rough: ", cell_name="the cell")
 
     @classmethod
     def refuse_unused(cls, values: dict, given) -> None:
@@ -177,3 +153,39 @@ class Rough(Shape):
 
 
 SHAPES.register("rough", Rough, summary="self-affine random rough surface (periodic kernel)")
+
+
+def settle_spectrum(obj, cell: float, key, lead: str = "", cell_name: str = "the cell") -> None:
+    """Check a self-affine spectrum's fields on ``obj`` (a frozen dataclass with ``hurst``, ``rms_height``,
+    ``rms_slope``, ``short_cutoff``, ``long_cutoff``, ``seed``) for a surface over ``cell``, and fill the
+    defaults (rms height 1 without a slope, long cut-off the cell, short cut-off cell/32).  ``key(name)``
+    spells a field in the messages, ``lead`` starts them: one-line TengsimErrors naming the value."""
+    def pos(name, v):
+        if isinstance(v, bool) or not isinstance(v, (int, float, np.floating)) or not (np.isfinite(v) and v > 0):
+            raise TengsimError(f"{key(name)} must be finite and > 0, got {v!r}")
+        return float(v)
+
+    h = obj.hurst
+    if isinstance(h, bool) or not isinstance(h, (int, float)) or not 0 < h < 1:
+        raise TengsimError(f"{lead}{key('hurst')} must be in (0, 1), got {h!r}")
+    if obj.rms_height is not None and obj.rms_slope is not None:
+        raise TengsimError(f"{lead}give {key('rms_height')} or {key('rms_slope')}, not both (got "
+                           f"{key('rms_height')} = {obj.rms_height!r}, {key('rms_slope')} = {obj.rms_slope!r})")
+    if obj.rms_slope is not None:
+        pos("rms_slope", obj.rms_slope)
+    else:
+        object.__setattr__(obj, "rms_height", 1.0 if obj.rms_height is None else pos("rms_height", obj.rms_height))
+    if obj.long_cutoff is None:
+        object.__setattr__(obj, "long_cutoff", float(cell))
+    if obj.short_cutoff is None:
+        object.__setattr__(obj, "short_cutoff", cell / 32)
+    pos("long_cutoff", obj.long_cutoff)
+    pos("short_cutoff", obj.short_cutoff)
+    if obj.long_cutoff > cell * (1 + 1e-12):
+        raise TengsimError(f"{lead}{key('long_cutoff')} = {obj.long_cutoff:g} exceeds {cell_name} {cell:g}")
+    if obj.short_cutoff >= obj.long_cutoff:
+        raise TengsimError(f"{lead}{key('short_cutoff')} = {obj.short_cutoff:g} must be below {key('long_cutoff')} = "
+                           f"{obj.long_cutoff:g}")
+    sd = obj.seed
+    if isinstance(sd, bool) or not isinstance(sd, (int, np.integer)) or sd < 0:
+        raise TengsimError(f"{lead}{key('seed')} must be an integer >= 0, got {sd!r}")

@@ -33,7 +33,8 @@ import numpy as np
 from tengsim.errors import TengsimError
 from tengsim.grid import Grid
 from tengsim.schema import Field
-from tengsim.shapes.rough import Rough
+from tengsim.units import number_or_text
+from tengsim.shapes.rough import Rough, settle_spectrum
 
 LENGTH_KEYS = {"roughness_rms_height": "height", "roughness_short_cutoff": "lateral",
                "roughness_long_cutoff": "lateral"}
@@ -42,14 +43,7 @@ LENGTH_KEYS = {"roughness_rms_height": "height", "roughness_short_cutoff": "late
 
 def _length_value(v, label="roughness length"):
     """A roughness length: a number (ε or X units) or, in a physical run, a length with a unit (checked later)."""
-    if isinstance(v, bool) or not isinstance(v, (int, float, str)):
-        raise TengsimError(f"{label} must be a number or a length with a unit, got {v!r}")
-    if isinstance(v, str):
-        try:
-            return float(v)
-        except ValueError:
-            return v.strip()
-    return float(v)
+    return number_or_text(v, label, "a length")
 
 
 def roughness_fields() -> tuple:
@@ -74,12 +68,6 @@ def roughness_fields() -> tuple:
     )
 
 
-def _positive(name, v):
-    if isinstance(v, bool) or not isinstance(v, (int, float, np.floating)) or not (math.isfinite(v) and v > 0):
-        raise TengsimError(f"{name} must be finite and > 0, got {v!r}")
-    return float(v)
-
-
 @dataclass(frozen=True)
 class Roughened:
     """``base`` (any shape but ``rough``) with a self-affine random roughness superimposed; see the module
@@ -98,32 +86,9 @@ class Roughened:
         if isinstance(self.base, (Rough, Roughened)):
             raise TengsimError("roughness: the shape is already rough (give the rough shape's own hurst, rms_height, "
                                "rms_slope, short_cutoff, long_cutoff and seed instead of the roughness keys)")
-        h = self.hurst
-        if isinstance(h, bool) or not isinstance(h, (int, float)) or not 0 < h < 1:
-            raise TengsimError(f"roughness_hurst must be in (0, 1), got {h!r}")
-        if self.rms_height is not None and self.rms_slope is not None:
-            raise TengsimError(f"give roughness_rms_height or roughness_rms_slope, not both (got {self.rms_height!r} "
-                               f"and {self.rms_slope!r})")
-        if self.rms_slope is not None:
-            _positive("roughness_rms_slope", self.rms_slope)
-        else:
-            object.__setattr__(self, "rms_height", 1.0 if self.rms_height is None
-                               else _positive("roughness_rms_height", self.rms_height))
         cell = float(self.base.cell)
-        if self.long_cutoff is None:
-            object.__setattr__(self, "long_cutoff", cell)
-        if self.short_cutoff is None:
-            object.__setattr__(self, "short_cutoff", cell / 32)
-        _positive("roughness_long_cutoff", self.long_cutoff)
-        _positive("roughness_short_cutoff", self.short_cutoff)
-        if self.long_cutoff > cell * (1 + 1e-12):
-            raise TengsimError(f"roughness_long_cutoff = {self.long_cutoff:g} exceeds the shape's cell {cell:g}")
-        if self.short_cutoff >= self.long_cutoff:
-            raise TengsimError(f"roughness_short_cutoff = {self.short_cutoff:g} must be below roughness_long_cutoff "
-                               f"= {self.long_cutoff:g}")
+        settle_spectrum(self, cell, key=lambda k: "roughness_" + k, cell_name="the shape's cell")
         s = self.seed
-        if isinstance(s, bool) or not isinstance(s, (int, np.integer)) or s < 0:
-            raise TengsimError(f"roughness_seed must be an integer >= 0, got {s!r}")
         object.__setattr__(self, "_rough", Rough(cell=cell, hurst=self.hurst, rms_height=self.rms_height,
                                                  rms_slope=self.rms_slope, short_cutoff=self.short_cutoff,
                                                  long_cutoff=self.long_cutoff, seed=int(s)))
