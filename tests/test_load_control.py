@@ -244,3 +244,39 @@ def test_a_map_whose_load_has_no_state_is_named_not_dropped():
     assert [m["branch"] for m in res.maps] == ["retraction"]
     assert abs(ts.force(res.maps[0]["P"], grid) + 0.25) <= spec.tol_F
     assert res.params["maps_not_made"].startswith("approach F = -0.25 (no state at that load")
+
+
+# ---- maps at nominal pressures in a physical load-controlled run ---------------------------------------------
+_PHYS = ["contact", "pyramid", "--pitch", "2um", "--base", "1um", "--height", "0.7um", "--E-star", "0.59MPa",
+         "--W", "54mJ/m2", "--tabor", "0.5", "--dx", "0.2", "--quiet"]
+
+
+def test_physical_load_maps_at_a_pressure(tmp_path):
+    """--maps-at 10kPa in a load-controlled physical run keeps the maps at that nominal pressure (converted like
+    f_min); the mapped state's pressure is 10 kPa to the load tolerance."""
+    import xarray as xr
+
+    from tengsim.cli.main import main
+
+    out = tmp_path / "lm.nc"
+    assert main(_PHYS + ["--control", "load", "--f-min", "0kPa", "--f-max", "20kPa", "--f-step", "10kPa",
+                         "--maps-at", "10kPa", "--out", str(out)]) == 0
+    with xr.open_dataset(out) as ds:
+        assert ds["P"].shape[0] == 2  # approach and retraction
+        rows = [i for i, d in enumerate(ds["D"].values) if d in set(ds["map_D"].values)]
+        assert rows and all(abs(ds["pressure_Pa"].values[i] - 1e4) < 1.0 for i in rows)
+
+
+@pytest.mark.parametrize("extra, words", [
+    (["--maps-at", "10kPa"], "maps_at = '10kPa' has a unit: with control = 'approach'"),
+    (["--control", "load", "--f-max", "20kPa", "--f-step", "10kPa", "--maps-at", "10kg"],
+     "maps_at = '10kg' is a mass, expected a pressure"),
+])
+def test_maps_at_with_a_wrong_unit_is_refused(tmp_path, capsys, extra, words):
+    from tengsim.cli.main import main
+
+    out = tmp_path / "x.nc"
+    assert main(_PHYS + extra + ["--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert words in err and len(err.strip().splitlines()) == 1
+    assert not out.exists()

@@ -112,6 +112,32 @@ def _load_value(v, label="load"):
     return number_or_text(v, label, "a pressure")
 
 
+def _maps_values(v, label="maps_at"):
+    """maps_at: a list (or comma-separated text) of numbers, or pressures with a unit (control = load)."""
+    items = v
+    if isinstance(v, str):
+        items = [t for t in v.split(",") if t.strip()]
+    elif isinstance(v, (int, float)) and not isinstance(v, bool):
+        items = [v]
+    if not isinstance(items, (list, tuple)):
+        raise TengsimError(f"{label} must be a list of numbers (or of pressures with a unit), got {v!r}")
+    return tuple(number_or_text(x, label, "a pressure") for x in items)
+
+
+def _maps_at(vals, scaling, control):
+    """maps_at as numbers: D values (approach) or loads F of Eq. (10), a pressure converted (load)."""
+    out = []
+    for m in vals["maps_at"]:
+        if control == "load":
+            out.append(_load_F("maps_at", m, scaling))
+        elif isinstance(m, str):
+            raise TengsimError(f"maps_at = {m!r} has a unit: with control = 'approach' maps_at are D values in ε "
+                               "(pressures with a unit are loads: control = 'load')")
+        else:
+            out.append(finite("maps_at", m))
+    return tuple(out)
+
+
 def _load_F(name, v, scaling):
     """A load key's value as F of Eq. (10): numbers as they are, a pressure p as p·cell area / force unit."""
     from tengsim.units import parse_quantity
@@ -142,7 +168,7 @@ def _path_spec(vals, given, scaling):
         if "d_max" in given:  # else LoadPathSpec's wider search range
             kw["d_max"] = vals["d_max"]
         return LoadPathSpec(f.get("f_min", 0.0), f["f_max"], f["f_step"], refine_levels=vals["refine_levels"],
-                            maps_at=tuple(vals["maps_at"]), **kw)
+                            maps_at=_maps_at(vals, scaling, control), **kw)
     bad = [k for k in _LOAD_KEYS if k in given]
     if bad:
         raise TengsimError(f"{', '.join(bad)} {'does' if len(bad) == 1 else 'do'} not apply to control = "
@@ -152,7 +178,7 @@ def _path_spec(vals, given, scaling):
     kw = {"adaptive": True} if vals["adaptive"] else {}
     if vals["adapt_tol"] is not None:
         kw["adapt_tol"] = vals["adapt_tol"]
-    return PathSpec(vals["d_min"], vals["d_max"], vals["d_step"], maps_at=tuple(vals["maps_at"]),
+    return PathSpec(vals["d_min"], vals["d_max"], vals["d_step"], maps_at=_maps_at(vals, scaling, control),
                     refine_levels=vals["refine_levels"], **kw)
 
 
@@ -179,7 +205,9 @@ def common_fields() -> list:
         Field("d_max", default=4.0, help="last rigid approach D, in ε"),
         Field("d_step", default=0.05, help="step in D, in ε"),
         Field("refine_levels", "int", 4, help="step bisections before a change is called a jump"),
-        Field("maps_at", "floats", (), help="D values (control = load: loads F) whose pressure and gap maps "
+        Field("maps_at", "any", (), check=_maps_values,
+              help="D values (control = load: loads F, or in a physical run nominal pressures with a unit, e.g. "
+              "'50kPa') whose pressure and gap maps "
               "are kept, on both branches, exactly there (a value between the path's rows gets a row of its "
               "own; one outside the path is refused); needs a .nc out"),
         Field("control", "str", "approach", choices=CONTROLS,
