@@ -203,6 +203,11 @@ def _judge(levels: list, names: list, tol: float) -> tuple[bool, dict, dict]:
     return ok, changes, rich
 
 
+#: an extrapolated dx finer than the last grid's / NEED_FLOOR (64× its pixels) is not given as a number: it comes
+#: from an order clipped at 0.5 or a jump on one grid only, and says only "much finer"
+NEED_FLOOR = 8.0
+
+
 def _dx_needed(levels: list, rich: dict, changes: dict, tol: float) -> float:
     """dx at which every observable's error estimate and change between grids would be tol, both scaling as
     h^p (p the observed order, else 1): h·(tol/e)^(1/p) with e the larger of the two, the smallest dx of all."""
@@ -281,9 +286,12 @@ def resolve_contact(shape, tabor: float, path, dx: float | None = None, law=None
         worst = max(changes, key=lambda n: changes[n], default=None)
         why = (f"{worst} changed {changes[worst]:.2%} between the last two grids" if worst is not None
                else "one grid only")
+        floor = levels[-1]["dx"] / NEED_FLOOR
+        need_text = (f"dx ≈ {need:.3g} needed" if need >= floor else
+                     f"dx below {floor:.3g} needed (the grids so far converge too irregularly to extrapolate further)")
         msg = (f"under-resolved: refinement stopped by max_pixels = {max_pixels} at dx = {levels[-1]['dx']:.4g} "
                f"({levels[-1]['nx']}×{levels[-1]['ny']}; next {stop.nx}×{stop.ny}); {why}, "
-               f"dx ≈ {need:.3g} needed for resolve_tol = {tol:g}")
+               f"{need_text} for resolve_tol = {tol:g}")
         p["resolve_status"] = "under_resolved"
         p["resolve_message"] = msg
         p["warning"] = "; ".join(x for x in (p.get("warning", ""), msg) if x)
