@@ -51,23 +51,64 @@ GROUPS = {
 }
 
 
+def _symmetric_fast(args, name, g, d_max, grid, reps, wall_fast, cpu_fast, fast_ref, log):
+    """tengsim fast with symmetry = 'auto' (the X+Y block): its row, ratios to the full-grid fast run, and its
+    largest |ΔF| from it relative to max|F|."""
+    from tengsim.contact import simulate_pyramid
+    from tengsim.grid import Mirror
+    from tengsim.kernels import FreeKernel
+    from tengsim.kernels.mirror import MirrorKernel, ReducedKernel
+
+    mk = MirrorKernel("free", grid, args.mu ** 1.5, Mirror(grid, (0, 1)))
+    pb = np.random.default_rng(0).standard_normal(mk.mirror.reduced_shape)
+    t_conv = time_call(lambda: mk.reduced.apply(pb))
+    wall = cpu = np.inf
+    for _ in range(reps):
+        cnt = ConvCounter(FreeKernel, ReducedKernel)
+        try:
+            t0, c0 = time.perf_counter(), time.process_time()
+            res = simulate_pyramid(g["N"], g["cell"], tabor=args.mu, dx=args.dx, d_min=args.d_min, d_max=d_max,
+                                   d_step=args.d_step, boundary="free", solver="fast", tol=args.tol,
+                                   refine_levels=args.refine_levels, symmetry="auto")
+            wall, cpu = min(wall, time.perf_counter() - t0), min(cpu, time.process_time() - c0)
+        finally:
+            cnt.restore()
+    T = res.table
+    nconv = np.asarray(T["n_conv"])
+    keys = [_key(b, D) for b, D in zip(np.asarray(T["branch"]).astype(str), T["D"])]
+    common = [(F, fast_ref[k][0]) for k, F in zip(keys, T["F"]) if k in fast_ref]
+    scale = max(abs(f) for _, f in common) if common else np.nan
+    dF = max(abs(a - b) for a, b in common) / scale if common else np.nan
+    row = dict(group=name, solver="tengsim fast, symmetry", path=f"full, block {res.params.get('block_nx')}²",
+               n_eq=len(nconv), wall_s=wall, ratio_vs_fast=wall / wall_fast, cpu_s=cpu,
+               cpu_ratio_vs_fast=cpu / cpu_fast, conv_median=float(np.median(nconv[1:])), conv_max=int(nconv.max()),
+               conv_total=cnt.n, t_conv_ms=t_conv * 1e3, fft_share_ratio=wall / (cnt.n * t_conv),
+               max_residual=float(np.max(T["residual"])), all_converged=bool(np.all(T["converged"])),
+               note=f"symmetry {res.params.get('symmetry')}; max|ΔF|/max|F| vs full grid {dF:.1e}")
+    log(f"   fast, symmetry: {wall:.2f} s ({wall_fast / wall:.2f}x faster than the full grid), {cnt.n} conv, "
+        f"t_conv {t_conv * 1e3:.3f} ms, max|dF|/max|F| {dF:.1e}")
+    return row
+
+
 # ----------------------------------------------------------------------------------------------
 class ConvCounter:
-    """Counts calls of a kernel class's ``apply`` (one convolution each)."""
+    """Counts calls of the ``apply`` of one or more kernel classes (one convolution each): the full grid's
+    kernel and, for a symmetry-reduced run, the block's (tengsim.kernels.mirror.ReducedKernel)."""
 
-    def __init__(self, cls):
-        self.cls, self.n = cls, 0
-        self._orig = cls.apply
+    def __init__(self, *classes):
+        self.n = 0
+        self._orig = [(cls, cls.apply) for cls in classes]
         counter = self
+        for cls, orig in self._orig:
+            def apply(self_, p, *a, _orig=orig, **k):
+                counter.n += 1
+                return _orig(self_, p, *a, **k)
 
-        def apply(self_, p, *a, **k):
-            counter.n += 1
-            return counter._orig(self_, p, *a, **k)
-
-        cls.apply = apply
+            cls.apply = apply
 
     def restore(self):
-        self.cls.apply = self._orig
+        for cls, orig in self._orig:
+            cls.apply = orig
 
 
 def time_call(fn, repeat=30, min_time=0.2):
@@ -169,7 +210,7 @@ def run_group(name, args, log):
             c0 = time.process_time()
             res = simulate_pyramid(g["N"], g["cell"], tabor=args.mu, dx=args.dx, d_min=args.d_min,
                                    d_max=d_max, d_step=args.d_step, boundary="free", solver="fast",
-                                   tol=args.tol, refine_levels=args.refine_levels)
+                                   tol=args.tol, refine_levels=args.refine_levels, symmetry="off")
             wall_fast = min(wall_fast, time.perf_counter() - t0)
             cpu_fast = min(cpu_fast, time.process_time() - c0)
         finally:
@@ -197,6 +238,8 @@ def run_group(name, args, log):
     rows_out.append(row)
     log(f"   fast: {wall_fast:.2f} s, {conv_total} conv, median {row['conv_median']:.0f}/eq (warm), "
         f"max {row['conv_max']}, wall/(conv*t_conv) = {row['fft_share_ratio']:.2f}")
+    if args.symmetry:
+        rows_out.append(_symmetric_fast(args, name, g, d_max, grid, reps, wall_fast, cpu_fast, fast_ref, log))
 
     # ---- tengsim VSR -------------------------------------------------------------------------
     vsr_mode = args.vsr_mode[min(args.groups.index(name), len(args.vsr_mode) - 1)]
@@ -345,6 +388,10 @@ def run_group(name, args, log):
                          f"{pr.gtol.min():.1e}..{pr.gtol.max():.1e}; FFT grid {pr.info['fft_grid']}{fail_note}{rep_note}"),
                    **_cmp_cols(cmpp))
         curves["peer"] = peer_rows
+        sym = next((r for r in rows_out if r.get("solver") == "tengsim fast, symmetry"), None)
+        if sym is not None and k_peer == n_eq:  # the peer on the whole path: its ratio to the symmetric run too
+            row["note"] += f"; {pr.wall_time / sym['wall_s']:.1f}x tengsim fast with symmetry"
+            log(f"   peer / tengsim fast with symmetry: {pr.wall_time / sym['wall_s']:.1f}x")
         rows_out.append(row)
         log(f"   peer: {pr.wall_time:.2f} s ({row['ratio_vs_fast']:.1f}x fast), median {row['conv_median']:.0f} conv/eq,"
             f" max {row['conv_max']}; max dF {row['dF_approach']:.2e}/{row['dF_retraction']:.2e}"
@@ -447,6 +494,8 @@ def main(argv=None):
                     help="runs of every solver's path per group (one value per group); the fastest counts")
     ap.add_argument("--vsr-max-iter", type=int, default=20000)
     ap.add_argument("--no-peer", action="store_true")
+    ap.add_argument("--symmetry", action="store_true",
+                    help="also tengsim fast on the symmetry-reduced block (symmetry = auto; the first row is the full grid)")
     ap.add_argument("--peer-max-eq", type=int, nargs="+", default=None,
                     help="per group like --vsr-mode (0 = full path): solve only the first K equilibria of the "
                          "path with the peer (a cut path; its ratio is then against tengsim fast's own seconds "

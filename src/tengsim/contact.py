@@ -179,11 +179,12 @@ def simulate(shape: Shape, tabor: float, dx: float, path: PathSpec, boundary: st
 def simulate_pyramid(N: float, cell: float, tabor: float = 0.5, dx: float = 0.05,
                      d_min: float = -1.0, d_max: float = 4.0, d_step: float = 0.05,
                      boundary: str = "free", solver="fast", tol: float = 1e-6,
-                     maps_at=(), progress=None, **path_kw):
-    """The paper's pyramid unit cell (Eq. 11) with N = n/(2ε) and L̄ = ``cell``."""
+                     maps_at=(), progress=None, symmetry: str = "auto", **path_kw):
+    """The paper's pyramid unit cell (Eq. 11) with N = n/(2ε) and L̄ = ``cell`` (``symmetry`` as in :func:`simulate`)."""
     shape = Pyramid(N, cell)
     spec = PathSpec(d_min, d_max, d_step, maps_at=tuple(maps_at), **path_kw)
-    return simulate(shape, tabor, dx, spec, boundary=boundary, solver=solver, tol=tol, progress=progress)
+    return simulate(shape, tabor, dx, spec, boundary=boundary, solver=solver, tol=tol, progress=progress,
+                    symmetry=symmetry)
 
 
 def run_contact(cfg: dict, progress=None, sink=None):
