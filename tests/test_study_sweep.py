@@ -333,7 +333,7 @@ def test_kill_and_resume_equals_uninterrupted(tmp_path, client):
 
 
 OPT = {"base": {"contact": {"shape": "pyramid", "pitch": "2um", "base": "1um", "height": "0.7um",
-                            "E_star": "0.59MPa", "W": "54mJ/m2", "eps": "0.37um", "dx": 0.45, "d_min": -1.0,
+                            "E_star": "0.59MPa", "W": "54mJ/m2", "eps": "0.37um", "dx": 0.25, "d_min": -1.0,
                             "d_max": 4.0, "d_step": 0.25}},
        "axes": {"contact.E_star": {"start": "0.5MPa", "stop": "3MPa", "scale": "log"}},
        "objective": {"maximize": "V_sat", "maxiter": 1, "popsize": 2, "seed": 2}}
