@@ -8,13 +8,14 @@ from tengsim.cli.main import main
 
 DESIGN = Path(__file__).parents[1] / "examples" / "design"
 PAIRS = [("question_resolved", "question"), ("question_periodic_resolved", "question_periodic")]
-KEYS = ("resolve", "resolve_tol", "max_pixels")
+KEYS = ("resolve", "resolve_tol", "max_pixels", "resolve_pressures")
 
 
 @pytest.mark.parametrize("name, coarse", PAIRS)
 def test_resolved_study_is_the_coarse_one_with_refinement(name, coarse):
-    """Every point valid; the same 90 points as the coarse file once the three refinement keys are removed;
-    each point refines from the coarse grid (45², within max_pixels) with tolerance 1 %."""
+    """Every point valid; the same 90 points as the coarse file once the refinement keys are removed;
+    each point refines from the coarse grid (45², within max_pixels) with tolerance 1 %, converging A/S at
+    the study's [observables] pressures too."""
     from tengsim.config import plan_contact
     from tengsim.study.execute import validate
     from tengsim.study.spec import load_study
@@ -27,6 +28,7 @@ def test_resolved_study_is_the_coarse_one_with_refinement(name, coarse):
     assert strip == [dict(p.contact) for p in c.points]
     for p in s.points:
         assert (p.contact["resolve"], p.contact["resolve_tol"], p.contact["max_pixels"]) == ("auto", 0.01, 10000)
+        assert p.contact["resolve_pressures"] == [f"{x:.6g}Pa" for x in s.observables["pressures"]]
         plan = plan_contact(dict(p.contact))
         g = plan.shape.grid(plan.dx)
         assert (g.nx, g.ny) == (45, 45) and g.nx * g.ny <= p.contact["max_pixels"]

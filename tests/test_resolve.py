@@ -232,3 +232,76 @@ def test_needed_dx_is_not_extrapolated_absurdly_far():
     rich = {"pull_off": {"order": 0.5, "rel_error": 6.0}}
     need = resolve._dx_needed(levels, rich, {"pull_off": 6.0}, 0.01)
     assert need < 0.14 / resolve.NEED_FLOOR  # the raw estimate is far below the floor
+
+
+# ---- A/S at named pressures (physical runs) ---------------------------------------------------------
+PHYS = ["contact", "pyramid", "--E-star", "0.59MPa", "--W", "54mJ/m2", "--eps", "0.37um", "--pitch", "5um",
+        "--base", "2.5um", "--height", "1.75um", "--d-min", "-1", "--d-max", "9", "--d-step", "0.333", "--quiet"]
+
+
+def test_resolve_pressures_are_judged_and_written(tmp_path, capsys):
+    """resolve_pressures: A/S at each pressure is an observable of every grid (the resolution table), equal to
+    the study layer's A/S of that grid's result at that pressure, and it can stop the refinement."""
+    from tengsim.study.observe import area_at, area_name
+
+    out = tmp_path / "rp.nc"
+    assert main([*PHYS, "--resolve", "auto", "--dx", "0.45um", "--max-pixels", "2500", "--resolve-pressures",
+                 "1kPa,100kPa", "--out", str(out)]) == 0
+    _, res = load_result(out)
+    table = res.params["resolution"]
+    for p in (1e3, 1e5):
+        col = np.asarray(table[area_name(p)], float)
+        assert len(col) == len(res.params["resolve_grids"]) >= 2 and np.all((col > 0) & (col <= 1))
+        cfg = res.params["config"]
+        assert area_at([p], cfg)(res)[area_name(p)] == pytest.approx(col[-1], rel=1e-9)
+    assert res.params["config"]["resolve_pressures"] in ("1kPa,100kPa", ["1kPa", "100kPa"], ("1kPa", "100kPa"))
+
+
+def test_area_observer_is_nan_outside_the_run_and_for_dimensionless():
+    from tengsim.study.observe import area_at, area_name
+
+    res = resolve.run_contact({**PYR_CFG, "resolve": "off", "dx": 0.2})
+    assert math.isnan(area_at([1e4])(res)[area_name(1e4)])  # no physical scale
+    assert area_name(1e4) == "A_S_at_10000Pa" and area_name(2.5e3) == "A_S_at_2500Pa"
+
+
+@pytest.mark.parametrize("extra, words", [
+    (["--resolve-pressures", "10kPa"], "resolve_pressures applies only with resolve = 'auto'"),
+    (["--resolve", "auto", "--resolve-pressures", "5um"], "is a length, expected a pressure"),
+    (["--resolve", "auto", "--resolve-pressures=-3kPa"], "resolve_pressures must be pressures > 0"),
+])
+def test_resolve_pressures_refused_with_one_line(tmp_path, capsys, extra, words):
+    out = tmp_path / "bad.csv"
+    assert main([*PHYS, *extra, "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and words in err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_resolve_pressures_refused_in_a_dimensionless_run(tmp_path, capsys):
+    assert main([*BASE, "--resolve", "auto", "--resolve-pressures", "10kPa", "--out", str(tmp_path / "b.csv")]) == 2
+    assert "applies only to a physical run" in capsys.readouterr().err
+    with pytest.raises(TengsimError, match="needs the A/S observer"):
+        resolve.run_contact({"shape": "pyramid", "E_star": "0.59MPa", "W": "54mJ/m2", "eps": "0.37um",
+                             "pitch": "5um", "base": "2.5um", "height": "1.75um", "d_min": -1, "d_max": 2,
+                             "d_step": 0.5, "resolve": "auto", "resolve_pressures": "10kPa"})
+
+
+def test_study_points_converge_their_observable_pressures():
+    """A physical study point with resolve = 'auto' gets the study's [observables] pressures as
+    resolve_pressures (so its id covers them); a dimensionless one and resolve = 'off' do not."""
+    from tengsim.study import parse_study
+
+    phys = {"shape": "pyramid", "E_star": "0.59MPa", "W": "54mJ/m2", "eps": "0.37um", "pitch": "5um",
+            "base": "2.5um", "height": "1.75um", "d_min": -1, "d_max": 2, "d_step": 0.5, "resolve": "auto"}
+    st = parse_study({"base": {"contact": phys}, "axes": {"contact.W": ["54mJ/m2", "60mJ/m2"]},
+                      "observables": {"pressures": ["2kPa", "20kPa"]}}, source="t")
+    assert all(p.contact["resolve_pressures"] == ["2000Pa", "20000Pa"] for p in st.points)
+    st2 = parse_study({"base": {"contact": {**phys, "resolve": "off"}}, "axes": {"contact.W": ["54mJ/m2"]}},
+                      source="t")
+    assert "resolve_pressures" not in st2.points[0].contact
+    st3 = parse_study({"base": {"contact": dict(PYR_CFG)}, "axes": {"contact.dx": [0.4]}}, source="t")
+    assert "resolve_pressures" not in st3.points[0].contact
+    own = parse_study({"base": {"contact": {**phys, "resolve_pressures": ["5kPa"]}},
+                       "axes": {"contact.W": ["54mJ/m2"]}}, source="t")
+    assert own.points[0].contact["resolve_pressures"] == ["5kPa"]

@@ -17,13 +17,23 @@ from tengsim.loadpath import LoadPathSpec, run_load_path
 from tengsim.observers import Summary
 from tengsim.path import PathSpec, run_path
 from tengsim.plugins import KERNELS, LAWS, OBSERVERS, SHAPES, SOLVERS
-from tengsim.resolve import resolve_contact, run_contact
+from tengsim.resolve import resolve_contact
 from tengsim.results import ContactResult, Jump
 from tengsim.shapes import (Array, Cone, Cube, FlatPunch, HeightMap, Hemisphere, Line, Paraboloid, Pyramid,
                             Sinusoid1D, Topography, random_rough)
 from tengsim.solvers import Equilibrium, FastSolver, Problem, State, VSRSolver
 from tengsim.status import ResultStatusError
 from tengsim.units import Scaling, parse_quantity
+
+
+def run_contact(cfg: dict, progress=None, sink=None, observe=None):
+    """One run of a [contact] table (the keys of ``tengsim contact``; ``resolve = "auto"``: refined until
+    converged, :func:`tengsim.resolve.run_contact`), with the study layer's full-contact length and A/S
+    observer (``resolve_pressures``) wired in, as ``tengsim contact`` runs it.  Returns a ContactResult."""
+    from tengsim.resolve import run_contact as run
+    from tengsim.study.observe import contact_hooks
+
+    return run(cfg, progress=progress, sink=sink, observe=observe, **contact_hooks(cfg))
 
 __all__ = [
     "KERNELS", "LAWS", "OBSERVERS", "SHAPES", "SOLVERS", "Scaling", "Summary",

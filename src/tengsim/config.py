@@ -246,6 +246,10 @@ def common_fields() -> list:
               "> 0 and < 1 (default 0.01)"),
         Field("max_pixels", "int", None, help="resolve = auto: largest grid nx·ny, >= 9 (default: what the "
               "free memory holds)"),
+        Field("resolve_pressures", "floats", None, dim="pressure",
+              help="resolve = auto, physical run: nominal pressures (with a unit, e.g. '10kPa'; a bare number is "
+              "Pa) at which the charged-area fraction A/S (and so V_OC, Eq. 12) must converge too; a study "
+              "sets its [observables] pressures here"),
         Field("out", "str", None, help="output file, .csv or .nc"),
         Field("plot", "str", None, help="figure of F(D), Λc(D), Λc(F), .png/.pdf/.svg"),
     ]
@@ -527,17 +531,17 @@ def plan_contact(cfg: dict) -> ContactPlan:
     from tengsim.resources import check_memory
 
     check_memory(grid.nx, grid.ny, vals["boundary"], vals["solver"], maps=2 * len(path.maps_at))
-    resolve = _resolve(vals, given, dx if raw_dx not in (None, "") else None)
+    resolve = _resolve(vals, given, dx if raw_dx not in (None, "") else None, scaling)
     return ContactPlan(shape, tabor, dx, path, vals["boundary"], vals["solver"], tol, law, extra, scaling,
                        tuple(vals["observers"]), kernel_params, symmetry=vals["symmetry"], resolve=resolve)
 
 
-def _resolve(vals, given, dx) -> dict:
-    """The refinement settings of a table: {} for resolve = off (resolve_tol, max_pixels refused there),
-    else resolve, resolve_tol (default 0.01), max_pixels (None: the free memory's) and the start dx (None: a
-    coarse default, tengsim.resolve.default_dx)."""
+def _resolve(vals, given, dx, scaling=None) -> dict:
+    """The refinement settings of a table: {} for resolve = off (resolve_tol, max_pixels, resolve_pressures
+    refused there), else resolve, resolve_tol (default 0.01), max_pixels (None: the free memory's), the start dx
+    (None: a coarse default, tengsim.resolve.default_dx) and pressures (Pa; () if none: physical runs only)."""
     if vals["resolve"] != "auto":
-        bad = [k for k in ("resolve_tol", "max_pixels") if k in given]
+        bad = [k for k in ("resolve_tol", "max_pixels", "resolve_pressures") if k in given]
         if bad:
             raise ConfigValueError(f"{' and '.join(bad)} {'apply' if len(bad) > 1 else 'applies'} only with "
                                    "resolve = 'auto'")
@@ -548,7 +552,16 @@ def _resolve(vals, given, dx) -> dict:
     mp = vals["max_pixels"]
     if mp is not None and mp < 9:
         raise ConfigValueError(f"max_pixels must be >= 9 (pixels nx·ny), got {mp!r}")
-    return {"resolve": "auto", "resolve_tol": 0.01 if tol is None else float(tol), "max_pixels": mp, "dx": dx}
+    pressures = tuple(vals["resolve_pressures"] or ())
+    if "resolve_pressures" in given:
+        if scaling is None:
+            raise ConfigValueError("resolve_pressures applies only to a physical run (E_star, W and the shape's "
+                                   "sizes with units): a dimensionless run has no pressure")
+        bad = [p for p in pressures if not p > 0]
+        if bad or not pressures:
+            raise ConfigValueError(f"resolve_pressures must be pressures > 0, got {vals['resolve_pressures']!r}")
+    return {"resolve": "auto", "resolve_tol": 0.01 if tol is None else float(tol), "max_pixels": mp, "dx": dx,
+            "pressures": pressures}
 
 
 def _common_names():

@@ -313,17 +313,26 @@ def check_max_pixels(v) -> int:
     return int(v)
 
 
-def run_contact(cfg: dict, progress=None, sink=None, observe=None, full_length=None):
+def run_contact(cfg: dict, progress=None, sink=None, observe=None, full_length=None, area_at=None):
     """:func:`tengsim.contact.run_contact`, refined automatically when the table says ``resolve = "auto"``.
 
     The refinement's grids each stream their rows to ``sink`` would mix grids in one file, so a sink is not
     given rows of a refined run (its result is written whole at the end).  ``observe(result) -> dict``: more
     observables to converge; ``full_length(params) -> float``: the shape's full-contact Λc from its parameters
-    (for transition_D; e.g. :func:`tengsim.study.observe.full_length`)."""
+    (for transition_D; e.g. :func:`tengsim.study.observe.full_length`); ``area_at(pressures) -> observe``: the
+    observer of A/S at the table's ``resolve_pressures`` (Pa; :func:`tengsim.study.observe.area_at`), needed
+    when the table names them.  ``tengsim.run_contact``, ``tengsim contact`` and a study's points pass both."""
     from tengsim import contact
     from tengsim.config import plan_contact
 
     plan = plan_contact(cfg)
+    pressures = plan.resolve.get("pressures", ())
+    if pressures:
+        if area_at is None:
+            raise TengsimError("resolve_pressures needs the A/S observer: call tengsim.run_contact (or pass "
+                               "area_at=tengsim.study.observe.area_at)")
+        extra = area_at(pressures)
+        observe = extra if observe is None else (lambda res, a=observe, b=extra: {**a(res), **b(res)})
     if plan.resolve.get("resolve", "off") != "auto":  # one grid: exactly tengsim.contact.run_contact's call
         kw = {k: v for k, v in (("progress", progress), ("sink", sink)) if v is not None}
         return contact.run_contact(cfg, **kw)

@@ -113,11 +113,11 @@ def run(args) -> int:
 
 def run_contact(cfg: dict, progress=None, sink=None):
     """:func:`tengsim.resolve.run_contact` (one grid, or refined with resolve = 'auto'), transition D judged
-    with the shape's full-contact length (:func:`tengsim.study.observe.full_length`)."""
+    with the shape's full-contact length, A/S at ``resolve_pressures`` (:func:`tengsim.study.observe.contact_hooks`)."""
     from tengsim.resolve import run_contact as run
-    from tengsim.study.observe import full_length
+    from tengsim.study.observe import contact_hooks
 
-    return run(cfg, progress=progress, sink=sink, full_length=lambda p: full_length({**p, "config": cfg}))
+    return run(cfg, progress=progress, sink=sink, **contact_hooks(cfg))
 
 
 def open_stream(out, resume: bool, quiet: bool = False):

@@ -176,14 +176,14 @@ def family(params: dict) -> str:
         return "square"
 
 
-def area_fraction(res, contact_length) -> np.ndarray:
+def area_fraction(res, contact_length, params: dict | None = None) -> np.ndarray:
     """Charged-area fraction A/S of the cell (Eq. 12) from the contact length Λc:
     square patches (pyramid, cube) (Λc/L̄)², discs (cone, hemisphere, sphere, flat punch) π(Λc/2)²/L̄²,
     line gratings (line, sinusoid) Λc/L̄; clipped to [0, 1].  Λc/L̄ is the same ratio in ℓ or in metres.
     L̄ is :func:`cell_side` (an array: the pattern's cell, so A/S is that of K × K cells alike, each as
     the highest one; a run with the ``array_area`` observer has the sum over its cells, used instead by
-    :func:`observe`)."""
-    p = res.params
+    :func:`observe`).  ``params``: the result's parameters to read (default ``res.params``)."""
+    p = res.params if params is None else params
     cell = cell_side(p)
     x = np.asarray(contact_length, float) / cell
     fam = family(p)
@@ -255,6 +255,62 @@ def device_values(device: dict) -> tuple[float, float, float]:
     return sigma, eps_r, T
 
 
+def loaded_area(res, params: dict | None = None) -> tuple[np.ndarray, np.ndarray, list]:
+    """(F, A/S, notes) of the approach states a pressed device passes (:func:`load_control`): A/S is
+    :func:`area_fraction` of Λc, or, for a run with the ``array_area`` observer, its
+    ``area_fraction_greenwood`` column (Σ over the array's cells).  ``params`` as in :func:`area_fraction`."""
+    p = res.params if params is None else params
+    Fk, Lk = load_control(res)
+    notes = []
+    if "area_fraction_greenwood" in res.table:  # the array_area observer: the sum over the cells
+        A = np.clip(load_control(res, "area_fraction_greenwood")[1], 0.0, 1.0)
+    else:
+        A = area_fraction(res, Lk, p)
+        if is_array(p) and len(Fk):
+            notes.append("A/S of the array from its highest cell's contact length (K × K cells alike); "
+                         "observers = ['array_area'] gives the sum over its cells")
+    return Fk, A, notes
+
+
+def area_name(pressure_Pa: float) -> str:
+    """The refinement observable of A/S at a pressure: ``A_S_at_10000Pa``."""
+    return f"A_S_at_{pressure_Pa:.6g}Pa".replace("+", "").replace(".", "p")
+
+
+def area_at(pressures, cfg: dict | None = None):
+    """The observer ``res -> {area_name(P): A/S at P}`` that automatic refinement (``resolve_pressures``,
+    :func:`tengsim.resolve.run_contact`) also converges: the charged-area fraction of Eq. (12) at each
+    nominal pressure P (Pa) on the approach (linear in F between loaded states; NaN outside the states the
+    run reaches or for a run without a physical scale).  V_OC (Eq. 12) is σT/(ε_r ε0) × A/S, so its relative
+    change is A/S's.  ``cfg``: the run's [contact] table (the shape's name for the patch family)."""
+    pressures = [float(p) for p in pressures]
+
+    def observe_area(res) -> dict:
+        out = {area_name(p): math.nan for p in pressures}
+        scale = physical_scale(res)
+        if scale is None:
+            return out
+        params = res.params if cfg is None else {**res.params, "config": cfg}
+        Fk, A, _ = loaded_area(res, params)
+        known = np.isfinite(A)
+        if np.count_nonzero(known) < 2:
+            return out
+        P, A = scale[0] * Fk[known], A[known]
+        for p in pressures:
+            if P[0] <= p <= P[-1]:
+                out[area_name(p)] = float(np.interp(p, P, A))
+        return out
+
+    return observe_area
+
+
+def contact_hooks(cfg: dict) -> dict:
+    """What :func:`tengsim.resolve.run_contact` needs from this layer for the [contact] table ``cfg``: the
+    shape's full-contact length (transition_D) and the A/S observer (``resolve_pressures``)."""
+    return {"full_length": lambda p: full_length({**p, "config": cfg}),
+            "area_at": lambda pressures: area_at(pressures, cfg)}
+
+
 def observe(res, device: dict, settings: dict) -> dict:
     """Scalars (dict name → float) and curves ('V_OC', 'area_fraction' on the common pressure grid,
     'V_OC_at' at the named pressures) of one contact result.
@@ -283,14 +339,7 @@ def observe(res, device: dict, settings: dict) -> dict:
     grid = pressure_grid(settings)
     curves = {"V_OC": np.full(grid.shape, nan), "area_fraction": np.full(grid.shape, nan),
               "V_OC_at": np.full(len(settings["pressures"]), nan)}
-    notes = []
-    if "area_fraction_greenwood" in res.table:  # the array_area observer: the sum over the cells
-        A = np.clip(load_control(res, "area_fraction_greenwood")[1], 0.0, 1.0)
-    else:
-        A = area_fraction(res, Lk)
-        if is_array(res.params) and len(Fk):
-            notes.append("A/S of the array from its highest cell's contact length (K × K cells alike); "
-                         "observers = ['array_area'] gives the sum over its cells")
+    _, A, notes = loaded_area(res)
     if len(Fk):
         out["area_fraction_0"] = float(A[0])
         if math.isfinite(full):

@@ -380,8 +380,10 @@ def _parse_axis(name, spec, where) -> Axis:
 
 # ---- expansion ----------------------------------------------------------------------------------
 
-def _resolve(base: dict, assign: dict) -> dict:
-    """A point's tables: [base.contact] < [base.shapes.<shape>] < axis values; then expressions evaluated."""
+def _resolve(base: dict, assign: dict, pressures=()) -> dict:
+    """A point's tables: [base.contact] < [base.shapes.<shape>] < axis values; then expressions evaluated;
+    a physical point refined automatically (resolve = 'auto') also converges A/S at the study's
+    [observables] pressures (``resolve_pressures``, unless the table names its own)."""
     tables = {t: dict(v) for t, v in base.items() if t != "shapes"}
     tables.setdefault("var", {})
     for name, v in assign.items():
@@ -398,7 +400,25 @@ def _resolve(base: dict, assign: dict) -> dict:
         own = {k: v for k, v in shapes.get(shape, {}).items() if f"contact.{k}" not in assign}
         tables["contact"].update(own)
     tables["contact"] = evaluate(tables["contact"], tables["var"])
+    c = tables["contact"]
+    if (pressures and str(c.get("resolve", "")).strip().lower() == "auto" and "resolve_pressures" not in c
+            and _physical(c)):
+        c["resolve_pressures"] = [f"{float(p):.6g}Pa" for p in pressures]
     return tables
+
+
+def _pressures(study) -> tuple:
+    return tuple(study.observables.get("pressures", ()))
+
+
+def _physical(contact: dict) -> bool:
+    """A [contact] table of a physical run (one that :func:`tengsim.config.key_dims` gives units to)."""
+    from tengsim.config import key_dims
+
+    try:
+        return bool(key_dims(contact))
+    except TengsimError:
+        return False  # plan_contact names the problem
 
 
 
@@ -535,7 +555,7 @@ def expand(study: Study) -> list:
                 assign.update(zip(a.members, a.values[k]))
                 if len(a.members) > 1:
                     labels[a.name] = a.coord()[k]
-            pts.append(Point({**labels, **assign}, _resolve(study.base, assign), tuple(idx)))
+            pts.append(Point({**labels, **assign}, _resolve(study.base, assign, _pressures(study)), tuple(idx)))
         return pts
     from scipy.stats import qmc
 
@@ -557,7 +577,7 @@ def expand(study: Study) -> list:
                 assign.update(zip(a.members, a.values[k]))
                 if len(a.members) > 1:
                     labels[a.name] = a.coord()[k]
-        pts.append(Point({**labels, **assign}, _resolve(study.base, assign), (i,)))
+        pts.append(Point({**labels, **assign}, _resolve(study.base, assign, _pressures(study)), (i,)))
     return pts
 
 
@@ -568,7 +588,7 @@ def point_at(study: Study, x) -> Point:
     for a, v in zip(study.axes, x):
         lo, hi, scale, unit = a.continuous
         assign[a.members[0]] = _with_unit(10**v if scale == "log" else v, unit)
-    return Point(assign, _resolve(study.base, assign), ())
+    return Point(assign, _resolve(study.base, assign, _pressures(study)), ())
 
 
 def numeric(v) -> float:
