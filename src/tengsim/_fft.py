@@ -136,6 +136,20 @@ class _Convolver:
         return "pocketfft" if self._direct else "scipy.fft"
 
 
+class _IntoConvolver(_Convolver):
+    """A convolver whose direct path writes into ``out`` itself (periodic, mirror)."""
+
+    def __call__(self, p, out=None):
+        """K p into ``out`` (a new array when None)."""
+        if self._direct:
+            return self._apply_direct(p, out)
+        w = self._apply_public(p)
+        if out is None:
+            return w
+        np.copyto(out, w)
+        return out
+
+
 def _checked(conv, shape) -> bool:
     """Does the direct pocketfft path of ``conv`` agree with the public scipy.fft one?"""
     try:
@@ -210,7 +224,7 @@ class PaddedConvolver(_Convolver):
         return out
 
 
-class PeriodicConvolver(_Convolver):
+class PeriodicConvolver(_IntoConvolver):
     """w = irfft2(rfft2(p) · spectrum) on a periodic cell, one object per grid.
 
     On scipy's pocketfft binding where available (checked against :func:`convolve_periodic` once):
@@ -240,16 +254,6 @@ class PeriodicConvolver(_Convolver):
         if out is None:
             out = np.empty(self.shape)
         _pp.c2r(cb, (1,), self.shape[1], False, 2, out, t)
-        return out
-
-    def __call__(self, p, out=None):
-        """K p into ``out`` (a new array when None)."""
-        if self._direct:
-            return self._apply_direct(p, out)
-        w = self._apply_public(p)
-        if out is None:
-            return w
-        np.copyto(out, w)
         return out
 
 
@@ -342,7 +346,7 @@ def _crop(a, axis, n):
     return a[:n] if axis == 0 else a[:, :n]
 
 
-class MirrorConvolver(_Convolver):
+class MirrorConvolver(_IntoConvolver):
     """w = K p on the irreducible block of a mirror-symmetric field (see the modes above).
 
     ``shape``: the block (m0, m1); ``modes``: per axis, one of :data:`MIRROR_MODES` (at least one axis
@@ -580,15 +584,6 @@ class MirrorConvolver(_Convolver):
         self._even(out, 0, out, t)
         return self._even(out, 1, out, t)
 
-    def __call__(self, p, out=None):
-        """K p on the block into ``out`` (a new array when None)."""
-        if self._direct:
-            return self._apply_direct(p, out)
-        w = self._apply_public(p)
-        if out is None:
-            return w
-        np.copyto(out, w)
-        return out
 
 
 def mirror_spectrum(coeff, modes):
