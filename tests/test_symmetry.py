@@ -260,6 +260,41 @@ def test_config_symmetry_key(tmp_path, capsys):
 
 
 @pytest.mark.slow
+def test_whole_run_memory_under_30_percent():
+    """Group B at dx 0.1 (99², block 50²), the path D −1 → 4 → −1 in 0.25: the tracemalloc peak of the whole
+    symmetric run is <= 30 % of the full grid's (measured 0.292).  What keeps it there: the equilibria the
+    path holds keep H and P on the block (FoldedEquilibrium, unfolded when read, the last one kept), g0 and
+    the zero start are made on the block, the jump test compares blocks."""
+    shape, mu = _group("B")
+    run = lambda sym: simulate(shape, mu, 0.1, PathSpec(-1.0, 4.0, 0.25), symmetry=sym)  # noqa: E731
+    run("auto")  # imports, FFT plans
+    on, off = _peak(lambda: run("auto")), _peak(lambda: run("off"))
+    assert on / off <= 0.30, f"whole run, block / full peak = {on / off:.3f}"
+
+
+def test_folded_equilibrium_reads_like_the_full_one():
+    """H and P read unfolded (read-only, the same array on a second read), max_change on the blocks equals
+    the full grids', dataclasses.replace gives a plain equilibrium holding the unfolded fields."""
+    import dataclasses
+
+    from tengsim.kernels.mirror import MirrorKernel
+    from tengsim.solvers.mirror import FoldedEquilibrium
+
+    shape, mu = _group("A")
+    grid = shape.grid(0.1)
+    K = MirrorKernel("free", grid, mu**1.5, Mirror(grid, (0, 1)))
+    s = MirrorSolver(make_solver("fast"))
+    U0 = shape.gap(grid)
+    e1 = s.solve(Problem(U0 + 1.0, LJ93(), K), State.zero(grid.shape))
+    e2 = s.solve(Problem(U0 + 0.5, LJ93(), K), e1.state)
+    assert isinstance(e1, FoldedEquilibrium) and e1.H.shape == grid.shape and not e1.H.flags.writeable
+    assert e2.H is e2.H and np.array_equal(e1.H, np.asarray(e1.H))
+    full = float(np.max(np.abs(np.asarray(e2.H) - np.asarray(e1.H))))
+    assert e2.max_change(e1) == full
+    r = dataclasses.replace(e2, message="x")
+    assert type(r) is FoldedEquilibrium and r._mirror is None and r.H is e2.H  # the unfolded fields, passed on
+
+
 def test_memory_check_of_a_symmetric_run_matches_its_peak_rss():
     """simulate's memory check counts the block's workspace and MIRROR_FULL_ARRAYS full-grid arrays: within
     30 % of the measured peak RSS growth of a symmetric run at 525² (measured 69.1 MiB vs 68.9 estimated;

@@ -55,11 +55,13 @@ class Branch:
 
     def __init__(self, U0, law, kernel, solver, spec, on_row):
         self.U0, self.law, self.kernel, self.solver, self.spec = U0, law, kernel, solver, spec
+        fold = getattr(solver, "fold_gap", None)  # a mirror solver takes g0 on its block
+        self._U0s = U0 if fold is None else fold(U0, kernel)
         self.on_row = on_row
         self.hist: list = []  # accepted (D, state) on this branch, newest last
 
     def solve(self, D, start):
-        problem = Problem(self.U0 - D + 1.0, self.law, self.kernel)
+        problem = Problem(self._U0s - D + 1.0, self.law, self.kernel)
         eq = self.solver.solve(problem, start)
         if eq.converged:
             return eq
@@ -76,7 +78,7 @@ class Branch:
         return s1, False
 
     def _jumped(self, eqa, eqb, dD):
-        return float(np.max(np.abs(eqb.H - eqa.H))) - abs(dD) > self.spec.jump_h
+        return eqb.max_change(eqa) - abs(dD) > self.spec.jump_h
 
     def advance(self, Da, eqa, Db, level, on_grid):
         start, predicted = self._start(Db)

@@ -123,16 +123,19 @@ class Mirror:
         sl = tuple(slice(self._centre(k), None) if k in self.axes else slice(None) for k in range(2))
         return np.ascontiguousarray(a[sl])
 
-    def unfold(self, r: np.ndarray) -> np.ndarray:
-        """The full-grid field whose irreducible block is ``r`` (mirrored copies)."""
+    def unfold(self, r: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+        """The full-grid field whose irreducible block is ``r`` (mirrored copies), into ``out`` if given."""
         r = np.asarray(r)
         if r.shape != self.reduced_shape:
             raise TengsimError(f"block of shape {r.shape} is not the {self.reduced_shape} block")
-        out = r
-        for k in self.axes:
-            tail = np.flip(np.take(out, np.arange(1, out.shape[k]), axis=k), axis=k)
-            out = np.concatenate([tail, out], axis=k)
-        return np.ascontiguousarray(out)
+        out = np.empty(self.grid.shape, dtype=r.dtype) if out is None else out
+        c = [self._centre(k) if k in self.axes else 0 for k in range(2)]
+        out[c[0]:, c[1]:] = r
+        if 0 in self.axes:  # row c0 - i is row c0 + i
+            out[:c[0], c[1]:] = r[:0:-1, :]
+        if 1 in self.axes:  # column c1 - j is column c1 + j
+            out[:, :c[1]] = out[:, :c[1]:-1]
+        return out
 
     def weights(self) -> np.ndarray:
         """Multiplicity of each block pixel in the full grid (1, 2 or 4), shape ``reduced_shape``."""

@@ -256,7 +256,8 @@ def run_path(U0, law, kernel, solver, spec: PathSpec, start: State | None = None
     rec = Recorder(U0, law, kernel, observers, progress, len(targets) * (2 if spec.retract else 1),
                    spec.maps_at, "D", sink=sink)
     U0 = rec.U0
-    state = start if start is not None else State.zero(kernel.grid.shape)
+    # the zero start is made in the first solve's call: not held for the whole walk (a full-grid pair beside
+    # a mirror block's states)
 
     def rows(branch):  # the Recorder's callback, with the extra rows at the maps_at D between the walk's rows
         if not spec.maps_at:
@@ -264,10 +265,10 @@ def run_path(U0, law, kernel, solver, spec: PathSpec, start: State | None = None
         return _MapRows(rec.on_row(branch), spec.maps_at, U0, law, kernel, solver, spec.jump_h)
 
     if spec.adaptive:
-        eq = _run_adaptive(U0, law, kernel, solver, spec, state, targets, rows)
+        eq = _run_adaptive(U0, law, kernel, solver, spec, start, targets, rows)
         return rec.result(eq.state if keep_states else None)
     walker = Branch(U0, law, kernel, solver, spec, rows("approach"))
-    eq = walker.solve(targets[0], state)
+    eq = walker.solve(targets[0], start if start is not None else State.zero(kernel.grid.shape))
     walker.hist = [(targets[0], eq.state)]
     walker.on_row(targets[0], eq, True, False)
     for Da, Db in zip(targets[:-1], targets[1:]):
@@ -298,7 +299,7 @@ class _MapRows:
         return next((m for m in self.wanted if abs(D - m) <= _D_TOL * max(1.0, abs(m))), None)
 
     def _jumped(self, eqa, eqb, dD):
-        return float(np.max(np.abs(eqb.H - eqa.H))) - abs(dD) > self.jump_h
+        return eqb.max_change(eqa) - abs(dD) > self.jump_h
 
     def __call__(self, D, eq, on_grid, jump):
         if self.last is not None:
@@ -324,10 +325,10 @@ class _MapRows:
         self.last = (D, eq)
 
 
-def _run_adaptive(U0, law, kernel, solver, spec, state, targets, make_on_row):
+def _run_adaptive(U0, law, kernel, solver, spec, start, targets, make_on_row):
     f_scale = [0.0]
     walker = _Adaptive(U0, law, kernel, solver, spec, make_on_row("approach"), f_scale)
-    eq = walker.solve(targets[0], state)
+    eq = walker.solve(targets[0], start if start is not None else State.zero(kernel.grid.shape))
     walker.hist, walker.hist_F = [(targets[0], eq.state)], [force(eq.P, kernel.grid)]
     walker.curve = [(targets[0], walker.hist_F[0])]
     walker.on_row(targets[0], eq, True, False)

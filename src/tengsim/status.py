@@ -346,9 +346,11 @@ class EdgeScan:
         labels, _ = ndimage.label(inside)
         gx, gy = np.gradient(g, self.dx, self.dy) if min(g.shape) > 1 else (np.ones_like(g), np.zeros_like(g))
         norm = np.hypot(gx, gy)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            cx, cy = np.abs(gx) / norm, np.abs(gy) / norm
-        cx, cy = np.nan_to_num(cx), np.nan_to_num(cy)
+        with np.errstate(invalid="ignore", divide="ignore"):  # the cosines in place: fewer full-size temporaries
+            cx = np.divide(np.abs(gx, out=gx), norm, out=gx)
+            cy = np.divide(np.abs(gy, out=gy), norm, out=gy)
+        del norm
+        cx, cy = np.nan_to_num(cx, copy=False), np.nan_to_num(cy, copy=False)
         labs, widths = [], []
         for G, W, L, C, d in ((g.T, wx.T, labels.T, cx.T, self.dx), (g, wy, labels, cy, self.dy)):
             for s in (slice(None), slice(None, None, -1)):

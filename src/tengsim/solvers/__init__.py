@@ -80,6 +80,10 @@ class Equilibrium:
     seconds: float
     message: str = ""
 
+    def max_change(self, other: "Equilibrium") -> float:
+        """max |H − other.H| over the grid (the path's jump test)."""
+        return float(np.max(np.abs(self.H - other.H)))
+
 
 def _finish(problem, state, P, r, energy, converged, it, n_conv, t0, msg):
     H = problem.g0 + state.w - 1.0

@@ -56,6 +56,15 @@ class MirrorSolver:
         """The same wrapper around ``dataclasses.replace(inner, **changes)``."""
         return MirrorSolver(replace(self.inner, **changes))
 
+    def fold_gap(self, U0, kernel):
+        """The block of the full-grid gap ``U0`` for problems on ``kernel`` (its mirror's; ``U0`` itself
+        when the kernel has none): a path's g0 = U0 − D + 1 then costs a block's memory."""
+        mirror = getattr(kernel, "mirror", None)
+        U0 = np.asarray(U0, dtype=float)
+        if mirror is None or U0.shape != tuple(mirror.grid.shape):
+            return U0
+        return mirror.reduce(U0)
+
     def solve(self, problem: Problem, start: State) -> Equilibrium:
         K = problem.kernel
         mirror, reduced = getattr(K, "mirror", None), getattr(K, "reduced", None)
@@ -74,8 +83,57 @@ class MirrorSolver:
         if problem.weights is not None:
             raise TengsimError("MirrorSolver: the problem is weighted already")
         eq = self.inner.solve(Problem(g0b, problem.law, reduced, weights=m), start_b)
-        return Equilibrium(eq.state, mirror.unfold(eq.H), mirror.unfold(eq.P), eq.residual, eq.converged,
-                           eq.iterations, eq.n_conv, eq.energy, eq.seconds, eq.message)
+        out = FoldedEquilibrium(eq.state, eq.H, eq.P, eq.residual, eq.converged, eq.iterations, eq.n_conv,
+                                eq.energy, eq.seconds, eq.message)
+        out._mirror = mirror
+        return out
+
+
+class FoldedEquilibrium(Equilibrium):
+    """An :class:`~tengsim.solvers.Equilibrium` that keeps H and P on the block and gives them unfolded to
+    the full grid when read.  The equilibria a path holds (secant, jump tests) then cost a block's memory;
+    the one most recently read is kept unfolded (one slot per mirror, per field), so the reads of one row
+    (force, contact length, status, observers, maps) unfold it once.  Built without a mirror (e.g. by
+    ``dataclasses.replace``, which passes the unfolded fields) it is a plain equilibrium."""
+
+    _mirror = None
+
+    def _full(self, name):
+        block = self.__dict__["_" + name]
+        m = self._mirror
+        if m is None:
+            return block
+        slot = m.__dict__.setdefault("_unfolded", {})
+        hit = slot.get(name)
+        if hit is not None and hit[0] is block:
+            return hit[1]
+        full = m.unfold(block)
+        full.flags.writeable = False  # shared by every read: a reader that wants to write copies
+        slot[name] = (block, full)
+        return full
+
+    def max_change(self, other) -> float:
+        """max |H − other.H|: on the blocks when both are folded by the same mirror (the unfolded fields
+        only repeat the block's values)."""
+        if self._mirror is not None and getattr(other, "_mirror", None) is self._mirror:
+            return float(np.max(np.abs(self.__dict__["_H"] - other.__dict__["_H"])))
+        return super().max_change(other)
+
+    @property
+    def H(self):
+        return self._full("H")
+
+    @H.setter
+    def H(self, v):
+        self.__dict__["_H"] = v
+
+    @property
+    def P(self):
+        return self._full("P")
+
+    @P.setter
+    def P(self, v):
+        self.__dict__["_P"] = v
 
 
 def _reduce_state(start: State, mirror, full, block) -> State:
