@@ -6,7 +6,6 @@ from dataclasses import is_dataclass, replace
 from tengsim import status
 from tengsim._version import __version__
 from tengsim.config import plan_contact
-from tengsim.continuation import NestedStart
 from tengsim.errors import TengsimError, positive
 from tengsim.grid import Mirror
 from tengsim.shapes import Pyramid, Shape
@@ -70,8 +69,7 @@ def simulate(shape: Shape, tabor: float, dx: float, path: PathSpec, boundary: st
              solver="fast", tol: float = 1e-6, law: Law | str | None = None, progress=None,
              grid=None, extra_params: dict | None = None, observers=(), scaling=None,
              kernel_params: dict | None = None, throw: bool = False, check_memory_first: bool = True,
-             sink=None, symmetry: str = "auto", coarse=None, keep_path: bool = False,
-             nested_mode: str = "energy"):
+             sink=None, symmetry: str = "auto"):
     """Approach–retraction run of ``shape`` against a rigid flat plate (paper Eq. 9).
 
     ``tabor`` is μ (the elastic coupling is μ^{3/2}); ``dx`` the grid spacing in X units;
@@ -97,11 +95,6 @@ def simulate(shape: Shape, tabor: float, dx: float, path: PathSpec, boundary: st
     mirrors its gap has on the grid, the kernel is 'free' or 'periodic' and the solver 'fast' or 'vsr'
     (:func:`choose_symmetry`; the same answer, to round-off); 'off' the full grid.  ``params['symmetry']``
     says what was used ('x+y', 'x', 'y', 'off' or 'none (why)'), ``block_nx``, ``block_ny`` the block.
-
-    Nested start (:mod:`tengsim.resolve`): ``coarse`` the ``path_states`` of a coarser grid's run of the same
-    shape and path, offered at every step as a second start (:class:`tengsim.continuation.NestedStart`,
-    ``nested_mode``); ``keep_path=True`` keeps this run's in ``result.path_states``.  A D path only (a load
-    path and an MPI run ignore both).
     """
     tabor = positive("tabor", tabor)
     if scaling is not None and abs(scaling.mu - tabor) > 1e-9 * tabor:
@@ -167,15 +160,7 @@ def simulate(shape: Shape, tabor: float, dx: float, path: PathSpec, boundary: st
             params.setdefault(k, v)
     if sink is not None and hasattr(sink, "begin"):
         sink.begin(dict(params))
-    nested = {}
-    if walk is run_path and comm is None:
-        hint = None if coarse is None else NestedStart(coarse, kernel, law, boundary == "periodic", nested_mode)
-        nested = {"hint": hint, "keep_path": bool(keep_path)}
-    res = walk(U0, law, kernel, solver_obj, path, progress=progress, observers=observers, sink=sink, **nested)
-    if nested.get("hint") is not None:
-        h = nested["hint"]
-        params.update(nested_start=nested_mode, nested_hints=h.offered, nested_taken=h.taken,
-                      nested_conv=h.n_conv)
+    res = walk(U0, law, kernel, solver_obj, path, progress=progress, observers=observers, sink=sink)
     recorded = res.params  # what the path recorded (the pixel snap number)
     res.params = {**params, **recorded}
     if scaling is not None:

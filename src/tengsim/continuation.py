@@ -51,16 +51,12 @@ def persist(solver, problem: Problem, eq):
 
 
 class Branch:
-    """Walks one branch, refining steps and predicting starts.
+    """Walks one branch, refining steps and predicting starts."""
 
-    ``hint`` (a :class:`NestedStart` or None) offers a second start at each step, from a coarser grid's
-    path (nested start); :meth:`solve_step` takes the better of it and the path's own start."""
-
-    def __init__(self, U0, law, kernel, solver, spec, on_row, hint=None, branch: str = ""):
+    def __init__(self, U0, law, kernel, solver, spec, on_row):
         self.U0, self.law, self.kernel, self.solver, self.spec = U0, law, kernel, solver, spec
         self.on_row = on_row
         self.hist: list = []  # accepted (D, state) on this branch, newest last
-        self.hint, self.branch = hint, branch
 
     def solve(self, D, start):
         problem = Problem(self.U0 - D + 1.0, self.law, self.kernel)
@@ -68,20 +64,6 @@ class Branch:
         if eq.converged:
             return eq
         return persist(self.solver, problem, eq)
-
-    def solve_step(self, D, start, predicted):
-        """(equilibrium, predicted) of a continuation step from ``start`` (``predicted``: extrapolated by
-        the secant), or from the nested-start hint where that is the better start (then ``predicted`` is
-        True: a jump from it is confirmed from the state before, as one from the secant is); the hint's
-        convolution is counted in the equilibrium's ``n_conv``."""
-        extra = 0
-        if self.hint is not None:
-            start, used, extra = self.hint.choose(self.branch, D, start, self.U0 - D + 1.0, predicted, self.hist)
-            predicted = predicted or used
-        eq = self.solve(D, start)
-        if extra:
-            eq = replace(eq, n_conv=eq.n_conv + extra)
-        return eq, predicted
 
     def _start(self, D):
         (D1, s1) = self.hist[-1]
@@ -97,7 +79,8 @@ class Branch:
         return float(np.max(np.abs(eqb.H - eqa.H))) - abs(dD) > self.spec.jump_h
 
     def advance(self, Da, eqa, Db, level, on_grid):
-        eqb, predicted = self.solve_step(Db, *self._start(Db))
+        start, predicted = self._start(Db)
+        eqb = self.solve(Db, start)
         if predicted and self._jumped(eqa, eqb, Db - Da):
             eqb = self.solve(Db, eqa.state)  # confirm without the predictor
         if self._jumped(eqa, eqb, Db - Da):
@@ -113,136 +96,6 @@ class Branch:
             self.hist = self.hist[-1:]
         self.on_row(Db, eqb, on_grid, jump)
         return eqb
-
-
-class PathStates:
-    """The elastic pressure q of every equilibrium a path recorded, on the full grid (float32), by branch
-    in path order, with its jump flag: what the next finer grid's run starts from (nested start,
-    :class:`NestedStart`; kept when :func:`tengsim.path.run_path` is asked to, as ``result.path_states``)."""
-
-    def __init__(self, grid, mirror=None):
-        self.grid, self.mirror = grid, mirror
-        self.rows: dict = {}  # branch -> [(D, q, jump)]
-
-    def add(self, branch, D, q, jump):
-        q = np.asarray(q)
-        if self.mirror is not None and q.shape != self.grid.shape:
-            q = self.mirror.unfold(q)
-        self.rows.setdefault(branch, []).append((float(D), q.astype(np.float32), bool(jump)))
-
-    def near(self, branch, D):
-        """q at ``D`` on ``branch`` (own grid): the row at D, else the linear interpolation of the two
-        consecutive rows around D; None outside the branch's rows or across a jump (the later row jumped)."""
-        rows = self.rows.get(branch, ())
-        tol = 1e-9 * max(1.0, abs(D))
-        for i, (d, q, _) in enumerate(rows):
-            if abs(d - D) <= tol:
-                return q
-            if i and (rows[i - 1][0] - D) * (d - D) < 0:
-                if rows[i][2]:
-                    return None
-                d0, q0 = rows[i - 1][0], rows[i - 1][1]
-                t = (D - d0) / (d - d0)
-                return (1.0 - t) * q0 + t * q
-        return None
-
-
-def _linear_index(n_from: int, d_from: float, x_to: np.ndarray, periodic: bool):
-    """(i0, i1, t) of linear interpolation at the points ``x_to`` from ``n_from`` cell-centred samples of
-    spacing ``d_from`` centred on 0 (clamped at the ends, or wrapped on a periodic cell)."""
-    s = x_to / d_from + (n_from - 1) / 2.0
-    if not periodic:
-        s = np.clip(s, 0.0, n_from - 1.0)
-    i0 = np.floor(s).astype(int)
-    t = s - i0
-    i1 = i0 + 1
-    if periodic:
-        i0, i1 = i0 % n_from, i1 % n_from
-    else:
-        i1 = np.minimum(i1, n_from - 1)
-    return i0, i1, t
-
-
-class NestedStart:
-    """Nested start of a path from a coarser grid's path (``coarse``, a :class:`PathStates` of the same
-    shape and path): at each continuation step the coarse q at the same D and branch, prolonged to this
-    grid (bilinear in x, y; wrapped on a periodic cell) with w = K q (one convolution), is a second
-    candidate start beside the path's own (secant) start.  ``mode`` 'energy': the one of lower energy
-    E(q) = Σ m [½ q·w + Φ(g0 + w)] is taken (the path's own start costs no convolution to judge: its
-    w is carried); 'unpredicted': the hint only where the path has no secant prediction (a branch's
-    first steps, the step after a jump), taken without comparison.  ``n_conv``: convolutions spent on hints."""
-
-    MODES = ("energy", "unpredicted", "always", "correction")
-
-    def __init__(self, coarse: PathStates, kernel, law, periodic: bool, mode: str = "energy"):
-        if mode not in self.MODES:
-            raise TengsimError(f"nested start mode {mode!r} is not one of {', '.join(self.MODES)}")
-        self.coarse, self.kernel, self.law, self.mode = coarse, kernel, law, mode
-        self.mirror, self.reduced = getattr(kernel, "mirror", None), getattr(kernel, "reduced", None)
-        fine, cg = kernel.grid, coarse.grid
-        self._ix = _linear_index(cg.nx, cg.dx, fine.x, periodic)
-        self._iy = _linear_index(cg.ny, cg.dy, fine.y, periodic)
-        self._weights = None
-        self.n_conv = self.offered = self.taken = 0
-
-    def prolong(self, q: np.ndarray) -> np.ndarray:
-        """A coarse-grid field on this grid (full grid)."""
-        (i0, i1, t), (j0, j1, u) = self._ix, self._iy
-        q = np.asarray(q, dtype=float)
-        a = q[i0, :] * (1.0 - t)[:, None] + q[i1, :] * t[:, None]
-        return a[:, j0] * (1.0 - u)[None, :] + a[:, j1] * u[None, :]
-
-    def state(self, q_fine: np.ndarray) -> State:
-        """The solver's state (the mirror block where the kernel has one) of a full-grid q: w = K q."""
-        if self.mirror is not None and self.reduced is not None:
-            qb = self.mirror.reduce(q_fine)
-            return State(qb, self.reduced.apply(qb))
-        return State(q_fine, self.kernel.apply(q_fine))
-
-    def energy(self, state: State, g0: np.ndarray) -> float:
-        q, w = np.asarray(state.q), np.asarray(state.w)
-        m = 1.0
-        if q.shape != g0.shape:
-            g0 = self.mirror.reduce(g0)
-            if self._weights is None:
-                self._weights = self.mirror.weights()
-            m = self._weights
-        return float(np.sum(m * (0.5 * q * w + self.law.energy(g0 + w))))
-
-    def choose(self, branch, D, start, g0, predicted, hist=None):
-        """(start, hint taken, convolutions spent) for the step to ``D`` whose own start is ``start``."""
-        if self.mode == "unpredicted" and predicted:
-            return start, False, 0
-        q = self.coarse.near(branch, D)
-        if q is None:
-            return start, False, 0
-        if self.mode == "correction":  # the path's own start plus the coarse grid's error of that start
-            qs = [self.coarse.near(branch, d) for d, _ in (hist or [])[-2:]]
-            if not qs or any(x is None for x in qs):
-                return start, False, 0
-            if predicted and len(qs) == 2:
-                (D0, _), (D1, _) = hist[-2:]
-                c = (D - D1) / (D1 - D0)
-                q = q - (qs[1] + c * (qs[1] - qs[0]))
-            else:
-                q = q - qs[-1]
-            dq = self.state(self.prolong(q))
-            own = start
-            if self.mirror is not None and np.shape(own.q) != np.shape(dq.q):
-                own = State(self.mirror.reduce(own.q), self.mirror.reduce(own.w))
-            hint = State(own.q + dq.q, own.w + dq.w)
-        else:
-            hint = self.state(self.prolong(q))
-        self.n_conv += 1
-        self.offered += 1
-        if self.mode in ("energy", "correction"):
-            own = start
-            if self.mirror is not None and np.shape(own.q) != np.shape(hint.q):
-                own = State(self.mirror.reduce(own.q), self.mirror.reduce(own.w))
-            if not self.energy(hint, g0) < self.energy(own, g0):
-                return start, False, 1
-        self.taken += 1
-        return hint, True, 1
 
 
 @dataclass
@@ -267,7 +120,7 @@ class Recorder:
     """
 
     def __init__(self, U0, law, kernel, observers=(), progress=None, total=0, maps_at=(), control="D",
-                 map_tol=1e-9, sink=None, keep_path: bool = False):
+                 map_tol=1e-9, sink=None):
         grid = kernel.grid
         U0 = np.asarray(U0, dtype=float)
         if U0.shape != grid.shape:
@@ -289,8 +142,6 @@ class Recorder:
         self.rows, self.maps, self.done, self._map_keys = [], [], 0, set()
         self.t_start = time.perf_counter()
         self.sink = sink
-        # every row's q, for a finer grid's nested start (tengsim.resolve)
-        self.path_states = PathStates(grid, getattr(kernel, "mirror", None)) if keep_path else None
 
     def on_row(self, branch):
         """The callback ``(D, eq, on_grid, jump, map_at=None)`` that records a row of ``branch``."""
@@ -309,8 +160,6 @@ class Recorder:
                                                     self.edges.face),
                                   residual=eq.residual, iterations=eq.iterations, n_conv=eq.n_conv,
                                   seconds=eq.seconds, energy=eq.energy, **s, **more))
-            if self.path_states is not None:
-                self.path_states.add(branch, D, eq.state.q, jump)
             value = D if self.control == "D" else s["F"]
             for m in self.maps_at:
                 tol = self.map_tol * (max(1.0, abs(m)) if self.control == "D" else 1.0) + 1e-9
@@ -337,7 +186,6 @@ class Recorder:
                                       final_state=final_state, extra_columns=self.extra_cols)
         for o in self.extra:
             res.units.update(getattr(o, "units", None) or {})
-        res.path_states = self.path_states
         res.params["pixel_snap_number"] = self.snap
         res.params["face_uncertainty"] = self.edges.face
         return res

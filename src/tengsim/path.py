@@ -107,8 +107,8 @@ class PathSpec:
 class _Adaptive(Branch):
     """Walks one branch with adaptive steps on the dyadic lattice of ``d_step`` (see PathSpec)."""
 
-    def __init__(self, U0, law, kernel, solver, spec, on_row, f_scale, hint=None, branch=""):
-        super().__init__(U0, law, kernel, solver, spec, on_row, hint, branch)
+    def __init__(self, U0, law, kernel, solver, spec, on_row, f_scale):
+        super().__init__(U0, law, kernel, solver, spec, on_row)
         self.f_scale = f_scale      # one-element list: the most tensile |F| met so far on the path
         self.hist_F: list = []      # F of the states in hist
         self.curve: list = []       # (D, F) of the last rows accepted on this piece, in path order
@@ -186,7 +186,8 @@ class _Adaptive(Branch):
                 k += 1
             nj = j + sgn * 2 ** (L - k)
             Db = self.spec.d_min + nj * h_min
-            eqb, predicted = self.solve_step(Db, *self._start(Db))
+            start, predicted = self._start(Db)
+            eqb = self.solve(Db, start)
             if predicted and self._jumped(eq, eqb, Db - Da):
                 eqb = self.solve(Db, eq.state)  # confirm without the predictor
             jump = self._jumped(eq, eqb, Db - Da)
@@ -240,13 +241,8 @@ class _Adaptive(Branch):
 
 
 def run_path(U0, law, kernel, solver, spec: PathSpec, start: State | None = None,
-             progress=None, keep_states: bool = False, observers=(), sink=None, hint=None,
-             keep_path: bool = False):
+             progress=None, keep_states: bool = False, observers=(), sink=None):
     """Solve the approach–retraction path; returns a :class:`tengsim.results.ContactResult`.
-
-    ``hint``: a :class:`tengsim.continuation.NestedStart` (a coarser grid's path) offering a second start
-    at every continuation step (nested start; None: the path's own starts only, as always).
-    ``keep_path``: keep every row's q in ``result.path_states`` (for a finer grid's nested start).
 
     ``progress(branch, D, done, total)`` is called after each row on the D grid.  ``observers``
     (registered names or objects, see :mod:`tengsim.observers`) add their columns to every row.
@@ -258,7 +254,7 @@ def run_path(U0, law, kernel, solver, spec: PathSpec, start: State | None = None
                            "(a LoadPathSpec runs with tengsim.loadpath.run_load_path)")
     targets = spec.targets()
     rec = Recorder(U0, law, kernel, observers, progress, len(targets) * (2 if spec.retract else 1),
-                   spec.maps_at, "D", sink=sink, keep_path=keep_path)
+                   spec.maps_at, "D", sink=sink)
     U0 = rec.U0
     state = start if start is not None else State.zero(kernel.grid.shape)
 
@@ -268,16 +264,16 @@ def run_path(U0, law, kernel, solver, spec: PathSpec, start: State | None = None
         return _MapRows(rec.on_row(branch), spec.maps_at, U0, law, kernel, solver, spec.jump_h)
 
     if spec.adaptive:
-        eq = _run_adaptive(U0, law, kernel, solver, spec, state, targets, rows, hint)
+        eq = _run_adaptive(U0, law, kernel, solver, spec, state, targets, rows)
         return rec.result(eq.state if keep_states else None)
-    walker = Branch(U0, law, kernel, solver, spec, rows("approach"), hint, "approach")
+    walker = Branch(U0, law, kernel, solver, spec, rows("approach"))
     eq = walker.solve(targets[0], state)
     walker.hist = [(targets[0], eq.state)]
     walker.on_row(targets[0], eq, True, False)
     for Da, Db in zip(targets[:-1], targets[1:]):
         eq = walker.advance(Da, eq, Db, 0, True)
     if spec.retract:
-        back = Branch(U0, law, kernel, solver, spec, rows("retraction"), hint, "retraction")
+        back = Branch(U0, law, kernel, solver, spec, rows("retraction"))
         back.hist = [(targets[-1], eq.state)]
         back.on_row(targets[-1], eq, True, False)
         rev = targets[::-1]
@@ -328,16 +324,16 @@ class _MapRows:
         self.last = (D, eq)
 
 
-def _run_adaptive(U0, law, kernel, solver, spec, state, targets, make_on_row, hint=None):
+def _run_adaptive(U0, law, kernel, solver, spec, state, targets, make_on_row):
     f_scale = [0.0]
-    walker = _Adaptive(U0, law, kernel, solver, spec, make_on_row("approach"), f_scale, hint, "approach")
+    walker = _Adaptive(U0, law, kernel, solver, spec, make_on_row("approach"), f_scale)
     eq = walker.solve(targets[0], state)
     walker.hist, walker.hist_F = [(targets[0], eq.state)], [force(eq.P, kernel.grid)]
     walker.curve = [(targets[0], walker.hist_F[0])]
     walker.on_row(targets[0], eq, True, False)
     eq = walker.walk(targets[0], eq, targets[-1])
     if spec.retract:
-        back = _Adaptive(U0, law, kernel, solver, spec, make_on_row("retraction"), f_scale, hint, "retraction")
+        back = _Adaptive(U0, law, kernel, solver, spec, make_on_row("retraction"), f_scale)
         back.hist, back.hist_F = [(targets[-1], eq.state)], [force(eq.P, kernel.grid)]
         back.curve = [(targets[-1], back.hist_F[0])]
         back.on_row(targets[-1], eq, True, False)

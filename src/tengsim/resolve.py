@@ -32,11 +32,12 @@ it equals the finest grid's error, so criteria (b) and (c) ask the same; with r 
 error of tol/3 and a grid up to 4× larger than needed.  A level costs about twice the one before, so the
 whole sequence about twice the finest grid.
 
-Nested start: each grid walks the whole path from its own first equilibrium; the coarse solution is not
-used as a start.  A path starts out of contact (d_min below the first touch), where the first equilibrium
-is the zero state and costs a handful of convolutions, and every later one is warm-started from the
-previous row (secant predictor), so a resampled coarse state could only replace that first, cheap solve
-(measured in docs/validation.md, "Automatic refinement").
+Nested start: not used (measured, docs/validation.md "Automatic refinement").  Each grid walks the whole
+path from the zero state.  Offering the coarse grid's equilibrium at the same D and branch, prolonged to the
+finer grid (one convolution), as a second start at every step beside the secant predictor saved 2.5–6.6 %
+on the finest grids of two sphere cases at best, and cost up to 15 % where the path is cheap: the secant predictor's
+error is below the coarse grid's discretization error, and on the sphere the grids differ where the work
+is, at the pixel-snapping contact edge (the experiment is commit 422dd44 on branch ``nested``).
 """
 from __future__ import annotations
 
@@ -224,14 +225,13 @@ def _dx_needed(levels: list, rich: dict, changes: dict, tol: float) -> float:
 
 def resolve_contact(shape, tabor: float, path, dx: float | None = None, law=None, boundary: str = "free",
                     resolve_tol: float = DEFAULT_TOL, max_pixels: int | None = None, observe=None,
-                    full_length: float | None = None, progress=None, nested: bool | str = True, **simulate_kw):
+                    full_length: float | None = None, progress=None, **simulate_kw):
     """Run :func:`tengsim.contact.simulate` on finer and finer grids until converged (module doc).
 
     ``dx`` the first grid's spacing (None: :func:`default_dx`), ``resolve_tol`` the relative tolerance,
     ``max_pixels`` the largest grid nx·ny (None: :func:`default_max_pixels`), ``observe(result) -> dict``
-    extra observables, ``full_length`` the shape's full-contact Λc (for transition_D), ``nested`` the nested
-    start (True: 'energy', a mode of :class:`tengsim.continuation.NestedStart`, or False: each grid from its
-    own starts only); the other keywords go to ``simulate``.  Returns the finest grid's ContactResult with ``params['resolution']`` (the table: one
+    extra observables, ``full_length`` the shape's full-contact Λc (for transition_D); the other keywords go
+    to ``simulate``.  Returns the finest grid's ContactResult with ``params['resolution']`` (the table: one
     row per grid), ``params['richardson']``, ``resolve``, ``resolve_tol``, ``max_pixels``, ``resolve_grids``,
     ``resolve_status`` and, if stopped by ``max_pixels``, ``resolve_message``."""
     from tengsim.contact import simulate
@@ -246,7 +246,6 @@ def resolve_contact(shape, tabor: float, path, dx: float | None = None, law=None
         max_pixels = default_max_pixels(boundary, solver if isinstance(solver, str) else "fast")
     max_pixels = check_max_pixels(max_pixels)
     dx = default_dx(shape, law, tabor**1.5, boundary) if dx is None else positive("dx", dx)
-    mode = _nested_mode(nested)
     levels, names, res, seen = [], [], None, set()
     stop = None
     while True:
@@ -262,12 +261,8 @@ def resolve_contact(shape, tabor: float, path, dx: float | None = None, law=None
             break
         seen.add((grid.nx, grid.ny))
         t0 = time.perf_counter()
-        coarse = None if res is None or mode is None else res.path_states
-        if res is not None:
-            res.path_states = None
         res = simulate(shape, tabor, dx, path, boundary=boundary, law=law, grid=grid, progress=progress,
-                       coarse=coarse, keep_path=mode is not None, nested_mode=mode or "energy", **simulate_kw)
-        del coarse
+                       **simulate_kw)
         obs = contact_observables(res, full_length)
         if observe is not None:
             obs.update(observe(res))
@@ -280,9 +275,8 @@ def resolve_contact(shape, tabor: float, path, dx: float | None = None, law=None
             break
         dx = grid.dx / FACTOR
     _, changes, rich = _judge(levels, names, tol)
-    res.path_states = None
     p = res.params
-    p.update(resolve="auto", resolve_tol=tol, resolve_nested=mode or "off", max_pixels=int(max_pixels),
+    p.update(resolve="auto", resolve_tol=tol, max_pixels=int(max_pixels),
              resolve_grids=[lv["dx"] for lv in levels], resolution=_levels_table(levels, names),
              richardson={n: {k: r[k] for k in ("order", "observed", "extrapolated", "error")}
                          | {"rel_error": r.get("rel_error", math.nan), "change": changes.get(n, math.nan)}
@@ -308,18 +302,6 @@ def resolve_contact(shape, tabor: float, path, dx: float | None = None, law=None
     return res
 
 
-def _nested_mode(v) -> str | None:
-    from tengsim.continuation import NestedStart
-
-    if v is True:
-        return "energy"
-    if v is False or v is None or v == "off":
-        return None
-    if v in NestedStart.MODES:
-        return v
-    raise TengsimError(f"nested must be True, False, 'off' or one of {', '.join(NestedStart.MODES)}, got {v!r}")
-
-
 def check_tol(v) -> float:
     if isinstance(v, bool) or not isinstance(v, (int, float)) or not 0 < float(v) < 1:
         raise TengsimError(f"resolve_tol must be a number > 0 and < 1, got {v!r}")
@@ -332,7 +314,7 @@ def check_max_pixels(v) -> int:
     return int(v)
 
 
-def run_contact(cfg: dict, progress=None, sink=None, observe=None, full_length=None, nested: bool | str = True):
+def run_contact(cfg: dict, progress=None, sink=None, observe=None, full_length=None):
     """:func:`tengsim.contact.run_contact`, refined automatically when the table says ``resolve = "auto"``.
 
     The refinement's grids each stream their rows to ``sink`` would mix grids in one file, so a sink is not
@@ -350,7 +332,7 @@ def run_contact(cfg: dict, progress=None, sink=None, observe=None, full_length=N
                           boundary=plan.boundary, resolve_tol=plan.resolve["resolve_tol"],
                           max_pixels=plan.resolve.get("max_pixels"), progress=progress,
                           full_length=None if full_length is None else full_length(plan.shape.params()),
-                          observe=observe, nested=nested, symmetry=getattr(plan, "symmetry", "auto"),
+                          observe=observe, symmetry=getattr(plan, "symmetry", "auto"),
                           solver=plan.solver, tol=plan.tol, extra_params=plan.extra, observers=plan.observers,
                           scaling=plan.scaling, kernel_params=plan.kernel_params)
     res.params["config"] = {k: v for k, v in cfg.items() if k not in ("out", "plot")}

@@ -100,9 +100,6 @@ class ContactResult:
     final_state: object = None
     units: dict = field(default_factory=dict)
     scaling: object = None
-    #: the q of every row (a tengsim.continuation.PathStates) when the run was asked to keep them, for a finer
-    #: grid's nested start (tengsim.resolve); not written to files
-    path_states: object = field(default=None, repr=False, compare=False)
 
     @classmethod
     def from_rows(cls, rows, maps, grid, seconds=0.0, final_state=None, extra_columns=()):
