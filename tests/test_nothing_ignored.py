@@ -115,6 +115,7 @@ COMMON_UNUSED = [
     ({"maps_at": [9.0]}, "maps_at D = 9 is outside the path's D range [-1, 4]"),
     ({"resolve_tol": 0.05}, "resolve_tol applies only with resolve = 'auto'"),
     ({"max_pixels": 10000}, "max_pixels applies only with resolve = 'auto'"),
+    ({"resolve_pressures": "5kPa"}, "resolve_pressures applies only with resolve = 'auto'"),
     ({"control": "load", "f_max": 1.0, "f_step": 0.5, "maps_at": [2.0]}, "maps_at load F = 2 is outside"),
 ]
 
@@ -228,7 +229,7 @@ def test_every_key_has_a_case(name, mode, files):
     assert not missing, (f"shape {name} ({mode}) accepts {missing} but this test has no case for them: give "
                          "each a changed value (it must change the plan) or declare it in metadata_fields")
     common = {f.name for f in common_fields()}
-    assert common <= set(COMMON) | OUTPUTS | ROUGHNESS | {"E_star", "W", "eps"}, \
+    assert common <= set(COMMON) | OUTPUTS | ROUGHNESS | {"E_star", "W", "eps", "resolve_pressures"}, \
         f"common keys without a case: {sorted(common - set(COMMON) - OUTPUTS - ROUGHNESS)}"
 
 
@@ -252,6 +253,11 @@ def test_each_common_key_changes_the_plan(name, mode, files):
     if mode == "physical":
         cases.update(_scaled(plan_contact(_table(name, base))))
         cases["tabor"] = ({}, 0.6)
+        cases["resolve_pressures"] = ({"resolve": "auto"}, "5kPa")  # physical runs only (refused below)
+    else:
+        with pytest.raises(TengsimError, match="resolve_pressures applies only to a physical run") as e:
+            plan_contact(_table(name, base, resolve="auto", resolve_pressures="5kPa"))
+        assert "\n" not in str(e.value)
     if name in PERIODIC_ONLY:  # boundary: 'periodic' is the base's, 'free' is refused
         del cases["boundary"]
         with pytest.raises(TengsimError, match="boundary = 'free' is refused") as e:
