@@ -319,3 +319,42 @@ def test_memory_check_of_a_symmetric_run_matches_its_peak_rss():
     est = resources.estimate_bytes(bx, by, "free", "fast", 10,
                                    maps=-(-MIRROR_FULL_ARRAYS * nx * ny // (MAP_WORK * bx * by)))
     assert abs(est - peak) <= 0.3 * peak, (est, peak)
+
+
+class _Counting:
+    """A solver that adds up the convolutions of every solve it is asked for."""
+
+    def __init__(self, inner):
+        self._inner, self.total, self.calls = inner, 0, 0
+
+    def solve(self, problem, start):
+        eq = self._inner.solve(problem, start)
+        self.total += eq.n_conv
+        self.calls += 1
+        return eq
+
+    def __getattr__(self, name):
+        return getattr(self._inner, name)
+
+
+@pytest.mark.parametrize("kw", [dict(), dict(maps_at=(0.3, 1.7)), dict(adaptive=True)])
+def test_n_conv_spent_counts_every_solve(kw):
+    """params['n_conv_spent'] is the sum over every solve of the run (counted here by a wrapping solver),
+    the discarded ones included (a predicted start that jumped, a refined step): on group A's path with a
+    jump it exceeds the rows' own n_conv."""
+    shape, mu = _group("A")
+    solver = _Counting(make_solver("fast"))
+    res = simulate(shape, mu, 0.2, PathSpec(-1.0, 3.0, 0.5, **kw), solver=solver, symmetry="off")
+    assert res.params["n_conv_spent"] == solver.total
+    rows = int(np.sum(res.table["n_conv"]))
+    assert solver.calls >= len(res.table["D"]) - 1
+    if res.jumps:
+        assert solver.total > rows - res.table["n_conv"][0]
+
+
+def test_load_path_counts_its_root_finding():
+    shape, mu = _group("A")
+    solver = _Counting(make_solver("fast"))
+    res = simulate(shape, mu, 0.2, LoadPathSpec(f_min=-0.2, f_max=0.5, f_step=0.1, d_max=5.0), solver=solver,
+                   symmetry="off")
+    assert res.params["n_conv_spent"] == solver.total > int(np.sum(res.table["n_conv"]))

@@ -50,6 +50,14 @@ def persist(solver, problem: Problem, eq):
                            f"(max|r| {eq.residual:.2e} at the cap)")
 
 
+def spent(res, walkers):
+    """``res`` with ``params['n_conv_spent']``: the convolutions of every solve of the run, those of the
+    rows (the table's ``n_conv``) and those discarded (a predicted start that jumped, solved again; a step
+    refined after a jump; the adaptive walk's rejected steps)."""
+    res.params["n_conv_spent"] = int(sum(w.spent for w in walkers))
+    return res
+
+
 class Branch:
     """Walks one branch, refining steps and predicting starts."""
 
@@ -59,13 +67,15 @@ class Branch:
         self._U0s = U0 if fold is None else fold(U0, kernel)
         self.on_row = on_row
         self.hist: list = []  # accepted (D, state) on this branch, newest last
+        self.spent = 0  # convolutions of every solve of this branch, recorded or discarded (jump checks, refining)
 
     def solve(self, D, start):
         problem = Problem(self._U0s - D + 1.0, self.law, self.kernel)
         eq = self.solver.solve(problem, start)
-        if eq.converged:
-            return eq
-        return persist(self.solver, problem, eq)
+        if not eq.converged:
+            eq = persist(self.solver, problem, eq)
+        self.spent += int(eq.n_conv)
+        return eq
 
     def _start(self, D):
         (D1, s1) = self.hist[-1]

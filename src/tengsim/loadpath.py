@@ -36,7 +36,7 @@ import numpy as np
 
 from tengsim.analysis import force
 from tengsim.errors import TengsimError, finite, positive
-from tengsim.continuation import Branch, Recorder
+from tengsim.continuation import Branch, Recorder, spent
 from tengsim.path import PathSpec
 from tengsim.solvers import State
 
@@ -324,7 +324,7 @@ def run_load_path(U0, law, kernel, solver, spec: LoadPathSpec, start: State | No
             if not down.to(Ft, on_lattice, map_at(Ft)):
                 break  # pulled off: no state under the lower loads
     eq_last = (down if spec.retract else up).eq
-    res = rec.result(eq_last.state if keep_states else None)
+    res = spent(rec.result(eq_last.state if keep_states else None), [b.walker for b in branches])
     misses = [m for b in branches for m in b.misses]
     if misses:
         res.params["load_not_met"] = "; ".join(misses)

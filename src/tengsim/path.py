@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from tengsim.analysis import force
-from tengsim.continuation import Branch, Recorder, StateOnly, persist, secant
+from tengsim.continuation import Branch, Recorder, StateOnly, persist, secant, spent
 from tengsim.errors import TengsimError, finite, positive
 from tengsim.solvers import Problem, State
 
@@ -259,15 +259,19 @@ def run_path(U0, law, kernel, solver, spec: PathSpec, start: State | None = None
     # the zero start is made in the first solve's call: not held for the whole walk (a full-grid pair beside
     # a mirror block's states)
 
+    walkers = []  # whatever solved: the branches and the map rows (their convolutions, for n_conv_spent)
+
     def rows(branch):  # the Recorder's callback, with the extra rows at the maps_at D between the walk's rows
         if not spec.maps_at:
             return rec.on_row(branch)
-        return _MapRows(rec.on_row(branch), spec.maps_at, U0, law, kernel, solver, spec.jump_h)
+        walkers.append(_MapRows(rec.on_row(branch), spec.maps_at, U0, law, kernel, solver, spec.jump_h))
+        return walkers[-1]
 
     if spec.adaptive:
-        eq = _run_adaptive(U0, law, kernel, solver, spec, start, targets, rows)
-        return rec.result(eq.state if keep_states else None)
+        eq = _run_adaptive(U0, law, kernel, solver, spec, start, targets, rows, walkers)
+        return spent(rec.result(eq.state if keep_states else None), walkers)
     walker = Branch(U0, law, kernel, solver, spec, rows("approach"))
+    walkers.append(walker)
     eq = walker.solve(targets[0], start if start is not None else State.zero(kernel.grid.shape))
     walker.hist = [(targets[0], eq.state)]
     walker.on_row(targets[0], eq, True, False)
@@ -275,12 +279,14 @@ def run_path(U0, law, kernel, solver, spec: PathSpec, start: State | None = None
         eq = walker.advance(Da, eq, Db, 0, True)
     if spec.retract:
         back = Branch(U0, law, kernel, solver, spec, rows("retraction"))
+        walkers.append(back)
         back.hist = [(targets[-1], eq.state)]
         back.on_row(targets[-1], eq, True, False)
         rev = targets[::-1]
         for Da, Db in zip(rev[:-1], rev[1:]):
             eq = back.advance(Da, eq, Db, 0, True)
-    return rec.result(eq.state if keep_states else None)
+    return spent(rec.result(eq.state if keep_states else None), walkers)
+
 
 
 class _MapRows:
@@ -294,6 +300,7 @@ class _MapRows:
     def __init__(self, record, maps_at, U0, law, kernel, solver, jump_h):
         self.record, self.U0, self.law, self.kernel, self.solver = record, U0, law, kernel, solver
         self.wanted, self.jump_h, self.last = sorted(set(maps_at)), jump_h, None
+        self.spent = 0  # convolutions of the extra rows' solves
 
     def _hit(self, D):
         return next((m for m in self.wanted if abs(D - m) <= _D_TOL * max(1.0, abs(m))), None)
@@ -312,6 +319,7 @@ class _MapRows:
                                                       eqa.state.w + t * (eq.state.w - eqa.state.w))
                 pm = Problem(self.U0 - m + 1.0, self.law, self.kernel)
                 eqm = persist(self.solver, pm, self.solver.solve(pm, start))  # past the cap (issue 23)
+                self.spent += int(eqm.n_conv)
                 jm = bool(jump) and self._jumped(eqa, eqm, m - Da)
                 self.record(m, eqm, False, jm, m)
                 self.wanted.remove(m)
@@ -325,9 +333,10 @@ class _MapRows:
         self.last = (D, eq)
 
 
-def _run_adaptive(U0, law, kernel, solver, spec, start, targets, make_on_row):
+def _run_adaptive(U0, law, kernel, solver, spec, start, targets, make_on_row, walkers):
     f_scale = [0.0]
     walker = _Adaptive(U0, law, kernel, solver, spec, make_on_row("approach"), f_scale)
+    walkers.append(walker)
     eq = walker.solve(targets[0], start if start is not None else State.zero(kernel.grid.shape))
     walker.hist, walker.hist_F = [(targets[0], eq.state)], [force(eq.P, kernel.grid)]
     walker.curve = [(targets[0], walker.hist_F[0])]
@@ -335,6 +344,7 @@ def _run_adaptive(U0, law, kernel, solver, spec, start, targets, make_on_row):
     eq = walker.walk(targets[0], eq, targets[-1])
     if spec.retract:
         back = _Adaptive(U0, law, kernel, solver, spec, make_on_row("retraction"), f_scale)
+        walkers.append(back)
         back.hist, back.hist_F = [(targets[-1], eq.state)], [force(eq.P, kernel.grid)]
         back.curve = [(targets[-1], back.hist_F[0])]
         back.on_row(targets[-1], eq, True, False)

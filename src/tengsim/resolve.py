@@ -268,7 +268,8 @@ def resolve_contact(shape, tabor: float, path, dx: float | None = None, law=None
             obs.update(observe(res))
         names.extend(k for k in obs if k not in names)
         levels.append({"dx": grid.dx, "nx": grid.nx, "ny": grid.ny, "seconds": time.perf_counter() - t0,
-                       "convolutions": int(np.nansum(np.asarray(res.table["n_conv"], dtype=float))),
+                       "convolutions": int(res.params.get("n_conv_spent",
+                                                          np.nansum(np.asarray(res.table["n_conv"], dtype=float)))),
                        "status": res.status, "obs": obs})
         done, changes, rich = _judge(levels, names, tol)
         if done:
