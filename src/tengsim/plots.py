@@ -224,6 +224,10 @@ def plot_sweep(data, path, title: str = "") -> None:
     save(fig, path)
 
 
+_OBS_TITLES = {"pull_off_F": "pull-off F", "jump_in_D": "jump-in D", "jump_out_D": "jump-out D",
+               "transition_D": "transition D"}
+
+
 def plot_resolution(res, path, title: str = "") -> None:
     """Convergence of an automatically refined run (``resolve = "auto"``, tengsim.resolve): one panel per
     observable against the grid spacing dx (log axis, finest right), each grid's status marked, the
@@ -245,8 +249,12 @@ def plot_resolution(res, path, title: str = "") -> None:
     plt = _plt()
     dx = num(tab["dx"])
     st = [str(s) for s in tab.get("status", ["?"] * len(dx))]
-    fig, axs = plt.subplots(1, len(names), figsize=(3.6 * len(names), 3.2), squeeze=False, constrained_layout=True)
-    for ax, n in zip(axs[0], names):
+    ncol = min(len(names), 4)  # at most four panels a row: a page's width
+    nrow = -(-len(names) // ncol)
+    fig, axs = plt.subplots(nrow, ncol, figsize=(3.6 * ncol, 3.2 * nrow), squeeze=False, constrained_layout=True)
+    for ax in axs.flat[len(names):]:
+        ax.set_visible(False)
+    for ax, n in zip(axs.flat, names):
         f = num(tab[n])
         ax.plot(dx, f, "-", color="tab:blue", lw=1)
         for ok in (True, False):
@@ -264,7 +272,8 @@ def plot_resolution(res, path, title: str = "") -> None:
         ax.minorticks_off()
         ax.invert_xaxis()
         ax.set_xlabel("dx")
-        ax.set_title(n, fontsize=9)
+        ax.set_title(_OBS_TITLES.get(n, n) if not n.startswith("A_S_at_") else
+                     f"A/S at {n[len('A_S_at_'):-2].replace('p', '.')} Pa", fontsize=9)
         ax.legend(fontsize=7)
     fig.suptitle(title + (f"  [{res.params.get('resolve_status', '?')}, tol {res.params.get('resolve_tol', '?')}]"))
     save(fig, path)
