@@ -259,7 +259,6 @@ def test_config_symmetry_key(tmp_path, capsys):
     assert not (tmp_path / "x.csv").exists()
 
 
-@pytest.mark.slow
 def test_whole_run_memory_under_30_percent():
     """Group B at dx 0.1 (99², block 50²), the path D −1 → 4 → −1 in 0.25: the tracemalloc peak of the whole
     symmetric run is <= 30 % of the full grid's (measured 0.292).  What keeps it there: the equilibria the
@@ -295,6 +294,7 @@ def test_folded_equilibrium_reads_like_the_full_one():
     assert type(r) is FoldedEquilibrium and r._mirror is None and r.H is e2.H  # the unfolded fields, passed on
 
 
+@pytest.mark.slow
 def test_memory_check_of_a_symmetric_run_matches_its_peak_rss():
     """simulate's memory check counts the block's workspace and MIRROR_FULL_ARRAYS full-grid arrays: within
     30 % of the measured peak RSS growth of a symmetric run at 525² (measured 69.1 MiB vs 68.9 estimated;

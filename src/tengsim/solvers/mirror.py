@@ -119,21 +119,8 @@ class FoldedEquilibrium(Equilibrium):
             return float(np.max(np.abs(self.__dict__["_H"] - other.__dict__["_H"])))
         return super().max_change(other)
 
-    @property
-    def H(self):
-        return self._full("H")
-
-    @H.setter
-    def H(self, v):
-        self.__dict__["_H"] = v
-
-    @property
-    def P(self):
-        return self._full("P")
-
-    @P.setter
-    def P(self, v):
-        self.__dict__["_P"] = v
+    H = property(lambda self: self._full("H"), lambda self, v: self.__dict__.__setitem__("_H", v))
+    P = property(lambda self: self._full("P"), lambda self, v: self.__dict__.__setitem__("_P", v))
 
 
 def _reduce_state(start: State, mirror, full, block) -> State:
