@@ -305,3 +305,11 @@ def test_study_points_converge_their_observable_pressures():
     own = parse_study({"base": {"contact": {**phys, "resolve_pressures": ["5kPa"]}},
                        "axes": {"contact.W": ["54mJ/m2"]}}, source="t")
     assert own.points[0].contact["resolve_pressures"] == ["5kPa"]
+
+
+def test_why_names_the_observable_that_moved_most():
+    assert resolve._why({}) == "one grid only"
+    assert resolve._why({"pull_off_F": 0.02, "jump_in_D": 0.001}) == \
+        "pull_off_F changed 2.00% between the last two grids"
+    assert resolve._why({"pull_off_F": 0.02, "transition_D": math.inf}) == \
+        "transition_D exists on one of the last two grids only (NaN on the other)"

@@ -285,9 +285,7 @@ def resolve_contact(shape, tabor: float, path, dx: float | None = None, law=None
              resolve_seconds=sum(lv["seconds"] for lv in levels))
     if stop is not None:
         need = _dx_needed(levels, rich, changes, tol)
-        worst = max(changes, key=lambda n: changes[n], default=None)
-        why = (f"{worst} changed {changes[worst]:.2%} between the last two grids" if worst is not None
-               else "one grid only")
+        why = _why(changes)
         floor = levels[-1]["dx"] / NEED_FLOOR
         need_text = (f"dx ≈ {need:.3g} needed" if need >= floor else
                      f"dx below {floor:.3g} needed (the grids so far converge too irregularly to extrapolate further)")
@@ -301,6 +299,16 @@ def resolve_contact(shape, tabor: float, path, dx: float | None = None, law=None
         p["resolve_status"] = "ok"
     p["status"] = res.status
     return res
+
+
+def _why(changes: dict) -> str:
+    """What keeps the refinement from converging, in words: the observable that moved most."""
+    worst = max(changes, key=lambda n: changes[n], default=None)
+    if worst is None:
+        return "one grid only"
+    if math.isinf(changes[worst]):  # NaN on one of the two grids: a jump or transition seen on one only
+        return f"{worst} exists on one of the last two grids only (NaN on the other)"
+    return f"{worst} changed {changes[worst]:.2%} between the last two grids"
 
 
 def check_tol(v) -> float:

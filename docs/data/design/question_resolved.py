@@ -39,8 +39,11 @@ def finest(msg):
 
 
 def moved(msg):
-    m = re.search(r"; (\w+) changed ([0-9.]+)% between the last two grids", msg)
-    return (m.group(1), float(m.group(2))) if m else (None, None)
+    m = re.search(r"; (\w+) changed ([0-9.]+|inf)% between the last two grids", msg)
+    if m:
+        return m.group(1), float(m.group(2))
+    m = re.search(r"; (\w+) exists on one of the last two grids only", msg)
+    return (m.group(1), float("inf")) if m else (None, None)
 
 
 def grid_reasons(msg):
