@@ -4,6 +4,7 @@ continuation past the cap (tengsim.continuation.persist, the new behaviour).
 
     OPENBLAS_NUM_THREADS=1 python benchmarks/stiff.py bump --n 64            # the README command, ε = 1 nm
     OPENBLAS_NUM_THREADS=1 python benchmarks/stiff.py rough --sizes 256 512 1024 --tabor 3 --dx 0.5
+    OPENBLAS_NUM_THREADS=1 python benchmarks/stiff.py homotopy --sizes 128 256 512 1024 [--plain 128 256]
 
 ``bump``: the README's topography command (30 nm Gaussian bump, 2 µm periodic cell, E* = 1 MPa,
 W = 50 mJ/m², ε = 1 nm; the height map is the one tests/test_topography.py writes, on an n² grid), the
@@ -12,7 +13,12 @@ stopped at the cap and the totals.  ``rough``: one cold equilibrium per size of 
 (the ``rough`` shape: H = 0.8, rms slope 0.2, short cut-off 4 dx, seed 0, cell n dx), LJ93 law, periodic
 kernel, D = ``--d`` from the highest point; prints the pixel snap number (max Φ'' × pixel compliance)
 and, per method, converged, iterations, convolutions, seconds.  Each size runs in this process, one
-after another: on a shared machine compare the columns of one run, not runs.
+after another: on a shared machine compare the columns of one run, not runs.  ``homotopy``: the same cold
+equilibria with the 'homotopy' solver (tengsim.solvers.homotopy: laws of range 2^ℓ on grids 2^ℓ times
+coarser, then the true law on the given grid); prints every stage (grid, range factor, iterations,
+convolutions on its grid, seconds), the totals (iterations, convolutions, their fine-grid worth, wall),
+the energy and contact area (g < g_peak) of the result and its Eq. (9) residual recomputed with the true
+law; ``--plain`` sizes also get the cold fast solve (uncapped, up to ``--plain-max-iter``) for comparison.
 """
 from __future__ import annotations
 
@@ -30,6 +36,7 @@ from tengsim.kernels import make_kernel
 from tengsim.laws import LJ93
 from tengsim.shapes.rough import Rough
 from tengsim.solvers import FastSolver, Problem, State
+from tengsim.solvers.homotopy import homotopy_solve
 from tengsim.status import pixel_snap_number
 
 
@@ -98,6 +105,55 @@ def rough(args) -> None:
         sys.stdout.flush()
 
 
+def _rough_problem(n, args):
+    shape = Rough(cell=n * args.dx, hurst=0.8, rms_slope=0.2, short_cutoff=4 * args.dx, seed=args.seed)
+    grid = shape.grid(args.dx)
+    kernel = make_kernel("periodic", grid, args.tabor**1.5)
+    return Problem(shape.gap(grid) - args.d + 1.0, LJ93(), kernel)
+
+
+def _judge(problem, eq):
+    """(max|r| of Eq. (9) afresh from H with the problem's law, contact area fraction g < g_peak)."""
+    g = eq.H + 1.0
+    _, P = problem.law.evaluate(g)
+    r = float(np.max(np.abs(g - problem.g0 - problem.kernel.apply(P))))
+    return r, float(np.mean(g < problem.law.g_peak))
+
+
+def homotopy(args) -> None:
+    print(f"rough surfaces: H 0.8, rms slope 0.2, dx {args.dx} ε, tabor {args.tabor}, D = {args.d}, cold, "
+          f"tol {args.tol}; the 'homotopy' solver (stage_tol {args.stage_tol})")
+    rows = []
+    for n in args.sizes:
+        problem = _rough_problem(n, args)
+        N = problem.g0.size
+        snap = pixel_snap_number(problem.law, problem.kernel)
+        print(f"{problem.g0.shape[0]}² (n {n}), pixel snap number {snap:.3g}")
+
+        def on_stage(st):
+            print(f"   stage {st.shape[0]}² s={st.s:g}: {st.iterations} iterations, {st.n_conv} conv, "
+                  f"{st.seconds:.1f} s, max|r| {st.residual:.2e}", flush=True)
+
+        fast = FastSolver(tol=args.tol, max_iter=args.max_iter)
+        eq, stages = homotopy_solve(fast, problem, stage_tol=args.stage_tol, on_stage=on_stage)
+        fine_eq = sum(st.n_conv * np.prod(st.shape) for st in stages) / N
+        r, area = _judge(problem, eq)
+        rows.append((n, problem.g0.shape[0], snap, "homotopy", eq.converged, eq.iterations, eq.n_conv, fine_eq,
+                     stages[-1].iterations, eq.seconds, eq.energy, area, r))
+        if n in (args.plain or ()):
+            p = FastSolver(tol=args.tol, max_iter=args.plain_max_iter).solve(problem, State.zero(problem.g0.shape))
+            r2, area2 = _judge(problem, p)
+            rows.append((n, problem.g0.shape[0], snap, "fast (cold)", p.converged, p.iterations, p.n_conv,
+                         p.n_conv, p.iterations, p.seconds, p.energy, area2, r2))
+        print("| grid | snap | method | converged | iterations (all stages) | convolutions | fine-grid worth | "
+              "last stage's iterations | wall s | E (dimensionless) | area (g < g_peak) | Eq. (9) max|r| |")
+        print("|---|---|---|---|---|---|---|---|---|---|---|---|")
+        for (n_, m, sn, what, ok, it, nc, fe, last, sec, E, a, rr) in rows:
+            print(f"| {m}² | {sn:.3g} | {what} | {'yes' if ok else 'no'} | {it} | {nc} | {fe:.0f} | {last} | "
+                  f"{sec:.1f} | {E:.7g} | {a:.4f} | {rr:.1e} |")
+        sys.stdout.flush()
+
+
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     sub = ap.add_subparsers(dest="what", required=True)
@@ -112,8 +168,20 @@ def main(argv=None) -> None:
     r.add_argument("--d", type=float, default=0.5)
     r.add_argument("--tol", type=float, default=1e-6)
     r.add_argument("--seed", type=int, default=0)
+    h = sub.add_parser("homotopy")
+    h.add_argument("--sizes", type=int, nargs="+", default=[128, 256, 512, 1024])
+    h.add_argument("--plain", type=int, nargs="*", default=[], help="sizes that also get the cold fast solve")
+    h.add_argument("--plain-max-iter", type=int, default=40000)
+    h.add_argument("--max-iter", type=int, default=30000, help="per stage")
+    h.add_argument("--stage-tol", type=float, default=1e-3)
+    for a in (h,):
+        a.add_argument("--dx", type=float, default=0.5)
+        a.add_argument("--tabor", type=float, default=3.0)
+        a.add_argument("--d", type=float, default=0.5)
+        a.add_argument("--tol", type=float, default=1e-6)
+        a.add_argument("--seed", type=int, default=0)
     args = ap.parse_args(argv)
-    bump(args) if args.what == "bump" else rough(args)
+    {"bump": bump, "rough": rough, "homotopy": homotopy}[args.what](args)
 
 
 if __name__ == "__main__":

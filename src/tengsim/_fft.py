@@ -599,3 +599,21 @@ def mirror_spectrum(coeff, modes):
         else:
             raise ValueError(f"mirror_spectrum: no transform for mode {m!r}")
     return np.ascontiguousarray(a)
+
+
+def fourier_resample(a: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
+    """Resample a periodic real field to ``shape`` by truncating or zero-padding its spectrum.
+
+    Keeps the wavenumbers |k| below both grids' Nyquist limits (the Nyquist row/column is dropped),
+    so the mean and every resolved harmonic are preserved exactly.
+    """
+    n0, n1 = a.shape
+    m0, m1 = shape
+    A = np.fft.rfft2(a)
+    B = np.zeros((m0, m1 // 2 + 1), complex)
+    k0 = min(n0, m0) // 2
+    k1 = min(n1, m1) // 2
+    B[:k0, :k1] = A[:k0, :k1]
+    if k0 > 1:
+        B[-(k0 - 1):, :k1] = A[-(k0 - 1):, :k1]
+    return np.fft.irfft2(B, s=shape) * (m0 * m1 / (n0 * n1))

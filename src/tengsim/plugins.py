@@ -17,6 +17,7 @@ import tengsim.laws  # noqa: F401  (registers 'lj93', 'repulsive', 'md', 'exp')
 import tengsim.observers  # noqa: F401  (registers 'summary', 'array_area')
 import tengsim.shapes  # noqa: F401  (registers every built-in shape)
 import tengsim.solvers  # noqa: F401  (registers 'fast', 'vsr')
+import tengsim.solvers.homotopy  # noqa: F401  (registers 'homotopy')
 from tengsim.errors import TengsimError
 from tengsim.registry import KERNELS, LAWS, OBSERVERS, SHAPES, SOLVERS
 
