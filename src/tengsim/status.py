@@ -476,6 +476,9 @@ def problems(result) -> list[tuple[str, str]]:
             if p.get("load_not_met"):  # load control: the outer solve on D missed a load (tengsim.loadpath)
                 text += f" or load not met to f_tol = {p.get('f_tol', '?')}"
             text += f" {where}"
+            if _snaps(snap) and p.get("solver", "fast") == "fast":  # stiff at the pixel: the homotopy's case
+                text += (f" (pixel snap number {snap:.3g}: a cold start of a law stiffer than a pixel converges "
+                         "faster with solver = 'homotopy')")
         elif kind == OUT_OF_LAW_RANGE:
             text = (f"gaps below the law's safe limit g_safe = {p.get('g_safe', '?')} {where} (compressed "
                     "beyond the physical law; with the periodic kernel this happens once the whole cell is "
