@@ -1,9 +1,10 @@
 """The range homotopy for cold equilibria of stiff laws (issue 23, item 3; tengsim.solvers.homotopy).
 
-The stiff case: the ``rough`` benchmark surface of docs/benchmarks.md ("Stiff laws"; H 0.8, rms slope 0.2,
-short cut-off 2 ε, dx 0.5 ε, μ = 3: pixel snap number ≈ 3.4, LJ93, D = 0.5 from the highest point,
-periodic) on a 32 ε cell (65²).  Cold, the fast solver needs 862 iterations; the homotopy (range 2 on
-the 32² grid, then the true law on 65²) 632 in all, and settles in an equilibrium of the true law."""
+The stiff case: a surface like the ``rough`` benchmark surface of docs/benchmarks.md ("Stiff laws"; H 0.8,
+rms slope 0.2, short cut-off 2 ε, dx ≈ 0.5 ε, μ = 3: pixel snap number ≈ 3.5, LJ93, D = 0.5 from the highest
+point, periodic) on a 32 ε cell (65²), drawn by NumPy so that it is one surface with every library version.
+Cold, the fast solver needs 1524–1620 iterations; the homotopy (range 2 on the 32² grid, then the true law on
+65²) 630–659 in all, and settles in an equilibrium of the true law."""
 import numpy as np
 import pytest
 
@@ -33,8 +34,29 @@ def _eq9_residual(problem, eq):
     return float(np.max(np.abs(w - problem.kernel.apply(P))))
 
 
+def _numpy_rough(n=65, cell=32.0, hurst=0.8, rms_slope=0.2, short=2.0, seed=0, tabor=3.0, D=0.5):
+    """The same kind of surface drawn by NumPy alone (PSD ∝ q^-2(1+H) up to 2π/short, rms slope exact), so
+    that the surface, unlike the ``rough`` shape's (one surface per SurfaceTopography release), is the same
+    with every supported library version: the iteration counts below are of one surface."""
+    rng = np.random.default_rng(seed)
+    k = np.fft.fftfreq(n, d=1.0 / n)
+    q = 2 * np.pi * np.hypot(k[:, None], k[None, :]) / cell
+    band = (q > 0) & (q <= 2 * np.pi / short)
+    amp = np.zeros_like(q)
+    amp[band] = q[band] ** (-1 - hurst)
+    h = np.fft.ifft2(amp * (rng.standard_normal((n, n)) + 1j * rng.standard_normal((n, n)))).real
+    gx, gy = np.gradient(h, cell / n)
+    h *= rms_slope / np.sqrt(np.mean(gx**2 + gy**2))
+    from tengsim.grid import Grid
+
+    kernel = make_kernel("periodic", Grid(n, n, cell / n, cell / n), tabor**1.5)
+    return Problem(h.max() - h - D + 1.0, LJ93(), kernel)
+
+
 def test_homotopy_reaches_an_equilibrium_of_the_true_law_in_fewer_iterations():
-    pr = _rough()
+    """Measured on this surface: plain 1620 iterations (1524 with NumPy 1.24 / SciPy 1.10: the avalanche is
+    sensitive to round-off), homotopy 630 (659), fine-grid convolutions' worth 460 (496) against 1685 (1585)."""
+    pr = _numpy_rough()
     assert pixel_snap_number(pr.law, pr.kernel) > 3
     plain = FastSolver(tol=1e-6).solve(pr, State.zero(pr.g0.shape))
     eq, stages = homotopy_solve(FastSolver(tol=1e-6), pr)
@@ -43,7 +65,7 @@ def test_homotopy_reaches_an_equilibrium_of_the_true_law_in_fewer_iterations():
     assert _eq9_residual(pr, eq) <= 1e-6 * (1 + 1e-9)
     assert eq.iterations == sum(st.iterations for st in stages) < plain.iterations
     fine_eq = sum(st.n_conv * np.prod(st.shape) for st in stages) / pr.g0.size
-    assert fine_eq < 0.75 * plain.n_conv
+    assert fine_eq < 0.5 * plain.n_conv
     # a stable equilibrium too: the fast solver from it does not move
     again = FastSolver(tol=1e-6).solve(pr, eq.state)
     assert again.iterations == 0
