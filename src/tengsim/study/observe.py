@@ -255,8 +255,8 @@ def device_values(device: dict) -> tuple[float, float, float]:
     return sigma, eps_r, T
 
 
-def loaded_area(res, params: dict | None = None) -> tuple[np.ndarray, np.ndarray, list]:
-    """(F, A/S, notes) of the approach states a pressed device passes (:func:`load_control`): A/S is
+def loaded_area(res, params: dict | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray, list]:
+    """(F, Λc, A/S, notes) of the approach states a pressed device passes (:func:`load_control`): A/S is
     :func:`area_fraction` of Λc, or, for a run with the ``array_area`` observer, its
     ``area_fraction_greenwood`` column (Σ over the array's cells).  ``params`` as in :func:`area_fraction`."""
     p = res.params if params is None else params
@@ -269,7 +269,7 @@ def loaded_area(res, params: dict | None = None) -> tuple[np.ndarray, np.ndarray
         if is_array(p) and len(Fk):
             notes.append("A/S of the array from its highest cell's contact length (K × K cells alike); "
                          "observers = ['array_area'] gives the sum over its cells")
-    return Fk, A, notes
+    return Fk, Lk, A, notes
 
 
 def area_name(pressure_Pa: float) -> str:
@@ -291,7 +291,7 @@ def area_at(pressures, cfg: dict | None = None):
         if scale is None:
             return out
         params = res.params if cfg is None else {**res.params, "config": cfg}
-        Fk, A, _ = loaded_area(res, params)
+        Fk, _, A, _ = loaded_area(res, params)
         known = np.isfinite(A)
         if np.count_nonzero(known) < 2:
             return out
@@ -335,11 +335,10 @@ def observe(res, device: dict, settings: dict) -> dict:
     if math.isfinite(full):
         out["transition_D"] = res.transition_D(full, settings["transition_fraction"])
     out["hysteresis"] = res.hysteresis
-    Fk, Lk = load_control(res)
+    Fk, Lk, A, notes = loaded_area(res)
     grid = pressure_grid(settings)
     curves = {"V_OC": np.full(grid.shape, nan), "area_fraction": np.full(grid.shape, nan),
               "V_OC_at": np.full(len(settings["pressures"]), nan)}
-    _, A, notes = loaded_area(res)
     if len(Fk):
         out["area_fraction_0"] = float(A[0])
         if math.isfinite(full):
