@@ -35,9 +35,8 @@ def _eq9_residual(problem, eq):
 
 
 def _numpy_rough(n=65, cell=32.0, hurst=0.8, rms_slope=0.2, short=2.0, seed=0, tabor=3.0, D=0.5):
-    """The same kind of surface drawn by NumPy alone (PSD ∝ q^-2(1+H) up to 2π/short, rms slope exact), so
-    that the surface, unlike the ``rough`` shape's (one surface per SurfaceTopography release), is the same
-    with every supported library version: the iteration counts below are of one surface."""
+    """The same kind of surface drawn by NumPy alone (PSD ∝ q^-2(1+H) up to 2π/short, rms slope exact): the
+    iteration counts below are of this one surface, whatever SurfaceTopography draws."""
     rng = np.random.default_rng(seed)
     k = np.fft.fftfreq(n, d=1.0 / n)
     q = 2 * np.pi * np.hypot(k[:, None], k[None, :]) / cell

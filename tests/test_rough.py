@@ -29,6 +29,40 @@ def test_same_seed_same_surface_in_and_across_processes():
     assert a.min() == 0.0 and np.all(a >= 0)
 
 
+# Fourier coefficients of three surfaces, recorded with SurfaceTopography 1.27.1 / NumPy 2.4.6 and equal to
+# ~1e-15 with 1.18.2 / NumPy 1.24 (the floor), 1.19.0 / 2.0.2 and 1.24.0 / 2.4.6: the same seed draws the same
+# surface on every supported release (CI runs this file on the floors and on the newest versions).
+_RECORDED = [
+    ((16.0, 0.7, None, 0.2, 1.0, None, 5), 35, 0.0107888416069533 + 0.007831221427263663j,
+     8.318054246890529e-05 + 0.0027149794873276077j, 1.7922163752206117),
+    ((32.0, 0.8, 1.5, None, 2.0, 32.0, 1), 35, 0.0004547570544967187 - 0.0013776351820720485j,
+     0.11046599361181349 - 0.04416266373702701j, 13.454920773895449),
+    ((3.78, 0.8, 0.4, None, 0.4, None, 0), 21, -0.007103173097059352 + 0.0035857698204021637j,
+     -0.010470557166544492 - 0.004576653601425912j, 2.446074352781302),
+]
+
+
+@pytest.mark.parametrize("args, n, c12, c3m1, total", _RECORDED)
+def test_the_same_seed_draws_the_same_surface_on_every_supported_release(args, n, c12, c3m1, total):
+    from tengsim.shapes.rough import _coefficients
+
+    c, n_ref = _coefficients(*args)
+    assert n_ref == n
+    scale = float(np.abs(c).max())
+    assert abs(c[1, 2] - c12) < 1e-12 * scale and abs(c[3, -1] - c3m1) < 1e-12 * scale
+    assert float(np.abs(c).sum()) == pytest.approx(total, rel=1e-12)
+
+
+def test_the_draw_leaves_numpys_global_random_state_as_it_was():
+    from tengsim.shapes.rough import _coefficients
+
+    np.random.seed(123)
+    expected = np.random.random(3)
+    np.random.seed(123)
+    _coefficients(16.0, 0.7, None, 0.2, 1.0, None, 11)  # a seed not drawn elsewhere: not cached
+    assert np.array_equal(np.random.random(3), expected)
+
+
 def test_rms_height_and_slope_as_requested_and_the_same_surface_on_a_finer_grid():
     r = Rough(cell=32.0, hurst=0.8, rms_height=1.5, short_cutoff=2.0, seed=1)
     coarse, fine = Grid.square(32.0, 32 / 33), Grid.square(32.0, 32 / 99)  # 33 and 99 pixels: every 3rd shared

@@ -1,7 +1,8 @@
 """Self-affine random roughness: a periodic surface from SurfaceTopography's Fourier-synthesis generator.
 
 The surface is defined independently of the run's grid: SurfaceTopography's ``fourier_synthesis`` draws
-it (seeded numpy ``Generator``, PCG64: the same numbers on every machine) on a reference grid just fine
+it (seeded NumPy generators: the same numbers on every machine, and the same surface on every
+SurfaceTopography release from 1.18.2, the floor, to 1.27.1, tested) on a reference grid just fine
 enough to hold every Fourier mode below the short-wavelength cut-off, it is rescaled to the exact rms
 height (or rms slope) asked for, and it is then evaluated on the run's grid by Fourier interpolation
 (exact for a band-limited surface).  So the same ``seed`` gives the same surface, and a finer ``dx``
@@ -9,7 +10,7 @@ samples the same surface more finely.
 """
 from __future__ import annotations
 
-import inspect
+import threading
 from dataclasses import dataclass
 from functools import lru_cache
 
@@ -22,21 +23,27 @@ from tengsim.schema import Field
 from tengsim.shapes.base import Shape, _length
 
 
+_GLOBAL_RNG = threading.Lock()
+
+
 def _synthesis(fourier_synthesis, nb_grid_pts, physical_sizes, seed, **kw):
-    """SurfaceTopography's generator driven by ``seed``: its ``rng`` argument where it has one (1.19 on);
-    older releases draw amplitudes from ``amplitude_distribution`` and phases from NumPy's global RNG,
-    which is then seeded for the call and restored after it.  A seed names one surface per
-    SurfaceTopography release (the draws are the library's)."""
-    if "rng" in inspect.signature(fourier_synthesis).parameters:
-        return fourier_synthesis(nb_grid_pts, physical_sizes, rng=np.random.default_rng(seed), **kw)
+    """SurfaceTopography's generator driven by ``seed``, drawn the same way on every release from 1.18:
+    amplitudes from ``amplitude_distribution`` (a PCG64 ``Generator`` seeded with ``seed``), phases from
+    NumPy's global (MT19937) state seeded with ``seed`` for the call and restored after it, under a lock.
+
+    Every release keeps that order of draws (1.27 documents ``rng=None`` as "numpy's global random
+    state, such that np.random.seed controls the result"); its newer ``rng=`` argument would draw a
+    different surface, so it is not used.  Releases differ only in the mean and the overall scale of
+    the heights, which :func:`_coefficients` removes; tests/test_rough.py checks stored coefficients."""
     rng = np.random.default_rng(seed)
-    state = np.random.get_state()
-    np.random.seed(seed)
-    try:
-        return fourier_synthesis(nb_grid_pts, physical_sizes, amplitude_distribution=lambda n: rng.normal(size=n),
-                                 **kw)
-    finally:
-        np.random.set_state(state)
+    with _GLOBAL_RNG:
+        state = np.random.get_state()
+        np.random.seed(seed)
+        try:
+            return fourier_synthesis(nb_grid_pts, physical_sizes,
+                                     amplitude_distribution=lambda n: rng.normal(size=n), **kw)
+        finally:
+            np.random.set_state(state)
 
 
 @lru_cache(maxsize=8)
