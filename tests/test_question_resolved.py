@@ -47,3 +47,34 @@ def test_resolved_study_bad_refinement_key_exit_2_nothing_written(tmp_path, caps
     err = capsys.readouterr().err.strip()
     assert rc == 2 and len(err.splitlines()) == 1 and word in err, err
     assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("name, cap, finest", [("question_periodic_resolved_143", 21000, 143),
+                                               ("question_periodic_resolved_225", 51000, 225)])
+def test_more_grids_study_is_the_periodic_one_for_the_smooth_sided_patterns(name, cap, finest):
+    """docs/design.md, "One grid more": the periodic study's pyramid, cone and hemisphere points, nothing else
+    changed but max_pixels, which admits the grid named (the next refinement of 45², 65², 99², ...) and no
+    finer one."""
+    from tengsim.config import plan_contact
+    from tengsim.resolve import FACTOR
+    from tengsim.study.execute import validate
+    from tengsim.study.spec import load_study
+
+    s, base = load_study(DESIGN / f"{name}.toml"), load_study(DESIGN / "question_periodic_resolved.toml")
+    valid, invalid = validate(s)
+    assert valid and not invalid, invalid
+    smooth = [dict(p.contact) for p in base.points if p.contact["shape"] in ("pyramid", "cone", "hemisphere")]
+    assert len(s.points) == len(smooth) == 54
+    assert [{**dict(p.contact), "max_pixels": 10000} for p in s.points] == smooth
+    for p in s.points:
+        assert p.contact["max_pixels"] == cap
+        plan = plan_contact(dict(p.contact))
+        dx, sides = plan.dx, []
+        while True:
+            g = plan.shape.grid(dx)
+            if g.nx * g.ny > cap:
+                break
+            if not sides or g.nx != sides[-1]:
+                sides.append(g.nx)
+            dx = g.dx / FACTOR
+        assert sides[-1] == finest, sides

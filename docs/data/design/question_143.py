@@ -1,11 +1,13 @@
-"""The periodic design question's smooth-sided patterns with one grid more (143², max_pixels 21000) beside the
-same points stopped at 99² (max_pixels 10000): docs/design.md, "One grid more".
+"""The periodic design question's smooth-sided patterns with one and two grids more (143², max_pixels 21000;
+225², max_pixels 51000) beside the same points stopped at 99² (max_pixels 10000): docs/design.md, "One grid more".
 
     tengsim sweep examples/design/question_periodic_resolved_143.toml --out question_periodic_resolved_143 --workers 2
-    python docs/data/design/question_143.py question_periodic_resolved_143/study.csv docs/data/design
+    tengsim sweep examples/design/question_periodic_resolved_225.toml --out question_periodic_resolved_225 --workers 2
+    python docs/data/design/question_143.py question_periodic_resolved_143/study.csv \
+        question_periodic_resolved_225/study.csv docs/data/design
 
-Copies the study.csv to DIR/question_periodic_resolved_143.csv (if it is not already there) and writes
-DIR/question_143.md: per computation the status at 99² and at 143², and what stopped the finer run.
+Copies the study.csv files to DIR/question_periodic_resolved_143.csv and _225.csv (unless already there) and
+writes DIR/question_143.md: per computation the status at 99², 143² and 225², and what stopped each run.
 """
 import csv
 import re
@@ -38,27 +40,35 @@ def why(msg):
 
 
 def main(argv):
-    src, out = Path(argv[0]), Path(argv[1])
-    dest = out / "question_periodic_resolved_143.csv"
-    if src.resolve() != dest.resolve():
-        shutil.copyfile(src, dest)
-    new = {tuple(r[k] for k in KEY): r for r in rows(dest)}
-    old = {tuple(r[k] for k in KEY): r for r in rows(out / "question_periodic_resolved.csv")}
-    pairs = Counter((old[k]["run_status"], r["run_status"]) for k, r in new.items())
-    L = ["# The periodic design question's smooth-sided patterns: one grid more (`docs/data/design/question_143.py`)", "",
-         f"{len(new)} computations (pyramid, cone, hemisphere; 3 pitches × 2 aspects × 3 E*; the hemisphere has no aspect): "
-         f"`ok` at 99² (max_pixels 10000) {sum(1 for k in new if old[k]['run_status'] == 'ok')}, "
-         f"at 143² (max_pixels 21000) {sum(1 for r in new.values() if r['run_status'] == 'ok')}. "
-         f"Compute summed over the runs: {sum(float(r['seconds']) for r in new.values()):.0f} s with 143² "
-         f"(the 99² study's same points: {sum(float(old[k]['seconds']) for k in new):.0f} s, on a more loaded machine).", "",
-         "| status at 99² → at 143² | computations |", "|---|---|"]
-    L += [f"| {a} → {b} | {n} |" for (a, b), n in sorted(pairs.items())]
-    L += ["", "| pattern, pitch, aspect, E* | 99²: status, why | 143²: status, why |", "|---|---|---|"]
-    for k, r in new.items():
-        o = old[k]
-        L.append(f"| {' '.join(k)} | {o['run_status']}, {why(o['message'])} | {r['run_status']}, {why(r['message'])} |")
+    *srcs, out = argv
+    out = Path(out)
+    caps = ["143", "225"][:len(srcs)]
+    runs = {"99": {tuple(r[k] for k in KEY): r for r in rows(out / "question_periodic_resolved.csv")}}
+    for cap, src in zip(caps, srcs):
+        dest = out / f"question_periodic_resolved_{cap}.csv"
+        if Path(src).resolve() != dest.resolve():
+            shutil.copyfile(src, dest)
+        runs[cap] = {tuple(r[k] for k in KEY): r for r in rows(dest)}
+    keys = list(runs[caps[0]])
+    grids = ["99"] + caps
+    L = ["# The periodic design question's smooth-sided patterns: more grids (`docs/data/design/question_143.py`)", "",
+         f"{len(keys)} computations (pyramid, cone, hemisphere; 3 pitches × 2 aspects × 3 E*; the hemisphere has no "
+         "aspect). `ok` with the finest grid allowed: "
+         + ", ".join(f"{g}²: {sum(1 for k in keys if runs[g][k]['run_status'] == 'ok')}" for g in grids)
+         + ". Compute summed over the runs: "
+         + ", ".join(f"{g}²: {sum(float(runs[g][k]['seconds']) for k in keys):.0f} s" for g in grids)
+         + " (the 99² study ran on a more loaded machine).", ""]
+    for a, b in zip(grids[:-1], grids[1:]):
+        pairs = Counter((runs[a][k]["run_status"], runs[b][k]["run_status"]) for k in keys)
+        L += [f"| status up to {a}² → up to {b}² | computations |", "|---|---|"]
+        L += [f"| {x} → {y} | {n} |" for (x, y), n in sorted(pairs.items())] + [""]
+    L += ["| pattern, pitch, aspect, E* | " + " | ".join(f"up to {g}²: status, why" for g in grids) + " |",
+          "|---|" + "---|" * len(grids)]
+    for k in keys:
+        L.append(f"| {' '.join(k)} | " + " | ".join(f"{runs[g][k]['run_status']}, {why(runs[g][k]['message'])}"
+                                                 for g in grids) + " |")
     (out / "question_143.md").write_text("\n".join(L) + "\n")
-    print("\n".join(L[:9]))
+    print("\n".join(L[:12]))
 
 
 if __name__ == "__main__":
