@@ -49,32 +49,32 @@ def test_resolved_study_bad_refinement_key_exit_2_nothing_written(tmp_path, caps
     assert not (tmp_path / "out").exists()
 
 
-@pytest.mark.parametrize("name, cap, finest", [("question_periodic_resolved_143", 21000, 143),
-                                               ("question_periodic_resolved_225", 51000, 225)])
-def test_more_grids_study_is_the_periodic_one_for_the_smooth_sided_patterns(name, cap, finest):
-    """docs/design.md, "One grid more": the periodic study's pyramid, cone and hemisphere points, nothing else
-    changed but max_pixels, which admits the grid named (the next refinement of 45², 65², 99², ...) and no
-    finer one."""
+def test_more_grids_study_is_the_periodic_one_for_the_smooth_sided_patterns():
+    """docs/design.md, "More grids": the periodic study's pyramid, cone and hemisphere points, nothing else
+    changed but max_pixels, which admits the refinement 45², 65², 105², 165², 245² (each base edge a quarter
+    pixel past a pixel centre on every grid: tengsim.resolve keeps it there) and no finer grid."""
     from tengsim.config import plan_contact
-    from tengsim.resolve import FACTOR
+    from tengsim.resolve import FACTOR, _aligned, edge_phases
     from tengsim.study.execute import validate
     from tengsim.study.spec import load_study
 
-    s, base = load_study(DESIGN / f"{name}.toml"), load_study(DESIGN / "question_periodic_resolved.toml")
+    s, base = load_study(DESIGN / "question_periodic_resolved_245.toml"), load_study(DESIGN / "question_periodic_resolved.toml")
     valid, invalid = validate(s)
     assert valid and not invalid, invalid
     smooth = [dict(p.contact) for p in base.points if p.contact["shape"] in ("pyramid", "cone", "hemisphere")]
     assert len(s.points) == len(smooth) == 54
     assert [{**dict(p.contact), "max_pixels": 10000} for p in s.points] == smooth
     for p in s.points:
-        assert p.contact["max_pixels"] == cap
+        cap = p.contact["max_pixels"]
+        assert cap == 61000
         plan = plan_contact(dict(p.contact))
-        dx, sides = plan.dx, []
+        g = plan.shape.grid(plan.dx)
+        phases, sides = edge_phases(plan.shape, g), [g.nx]
+        assert phases == pytest.approx((0.25,), abs=1e-9)
         while True:
-            g = plan.shape.grid(dx)
+            g = _aligned(plan.shape, plan.shape.grid(g.dx / FACTOR), phases, cap)
             if g.nx * g.ny > cap:
                 break
-            if not sides or g.nx != sides[-1]:
-                sides.append(g.nx)
-            dx = g.dx / FACTOR
-        assert sides[-1] == finest, sides
+            sides.append(g.nx)
+            assert edge_phases(plan.shape, g) == pytest.approx(phases, abs=1e-9)
+        assert sides == [45, 65, 105, 165, 245]

@@ -313,3 +313,46 @@ def test_why_names_the_observable_that_moved_most():
         "pull_off_F changed 2.00% between the last two grids"
     assert resolve._why({"pull_off_F": 0.02, "transition_D": math.inf}) == \
         "transition_D exists on one of the last two grids only (NaN on the other)"
+
+
+# ---- edges kept in place ------------------------------------------------------------------------------
+def test_finer_grids_keep_a_shapes_edges_where_they_fell_in_the_first_grids_pixels():
+    """A pyramid of base half the cell (edge at cell/4): plain √2 refinement from 45² goes 65², 99², 143²,
+    225², the edge alternating between a quarter and three quarters of a pixel; the kept sequence is
+    45², 65², 105², 165², 245², the edge a quarter pixel past a pixel centre on each.  A shape without edges
+    (paraboloid), an edge no grid in reach can keep, and the pixel cap get the plain grid."""
+    from tengsim.grid import Grid
+    from tengsim.resolve import FACTOR, PHASE_TOL, _aligned, edge_phases
+    from tengsim.shapes import Cone, Cube, Hemisphere, Paraboloid, Pyramid
+
+    pyr = Pyramid(N=10.0, cell=40.0)
+    g = pyr.grid(40.0 / 45)
+    phases = edge_phases(pyr, g)
+    assert g.nx == 45 and phases == pytest.approx((0.25,))
+    plain, kept = [g.nx], [g.nx]
+    gp = gk = g
+    for _ in range(4):
+        gp = pyr.grid(gp.dx / FACTOR)
+        plain.append(gp.nx)
+        gk = _aligned(pyr, pyr.grid(gk.dx / FACTOR), phases, 10**8)
+        kept.append(gk.nx)
+        assert isinstance(gk, Grid) and gk.nx * gk.dx == pytest.approx(40.0, rel=1e-12)
+        assert min(abs(edge_phases(pyr, gk)[0] - 0.25), 1 - abs(edge_phases(pyr, gk)[0] - 0.25)) <= PHASE_TOL
+    assert plain == [45, 65, 99, 143, 225] and kept == [45, 65, 105, 165, 245]
+    assert [round(edge_phases(pyr, Grid(n, n, 40.0 / n, 40.0 / n))[0], 2) for n in plain] == [0.25, 0.25, 0.75, 0.75, 0.25]
+    # every shape with a kink declares it; a smooth one does not
+    assert Cone(slope=1.0, cell=10.0, height=2.5).edge_offsets() == (2.5,)
+    assert Cone(slope=1.0, cell=10.0).edge_offsets() == ()
+    assert Hemisphere(radius=2.5, cell=10.0).edge_offsets() == (2.5,)
+    assert Cube(half_width=1.5, height=5.0, cell=6.0).edge_offsets() == (1.5,)
+    sph = Paraboloid(1.0, 16.0)
+    g1 = sph.grid(16.0 / 45)
+    assert edge_phases(sph, g1) == () and _aligned(sph, sph.grid(g1.dx / FACTOR), (), 10**8).nx == 65
+    # the cap: no kept grid above max_pixels, so the plain one
+    assert _aligned(pyr, pyr.grid(40.0 / 99), phases, 100 * 100).nx == 99
+
+
+def test_a_refinement_records_its_edge_phases():
+    res = resolve.run_contact({**PYR_CFG, "max_pixels": 13 * 13})
+    assert res.params["resolve_edge_phases"] == pytest.approx([0.2524], abs=1e-3)
+    assert res.params["resolution"]["nx"] == [9, 13]

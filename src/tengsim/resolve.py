@@ -27,6 +27,16 @@ not exactly in ratio √2: the pixel counts are FFT-friendly), clipped to [:data
 two grids, or differences of opposite sign (no monotone convergence), p = 1 (conservative).  The error of
 the finest value is e = (f3 − f2)/((h2/h3)^p − 1) and the extrapolated value f3 + e.
 
+Edges kept in place: a shape with kinks (``Shape.edge_offsets``: the base edge of a pyramid, cone, hemisphere or
+punch, the wall of a cube or line) has the grid error of what is measured at them (the contact edge in full
+contact, so A/S) set by where each edge falls in its pixel, and refinement by √2 moves that place from grid to
+grid: the values then oscillate (a pyramid's A/S in full contact, 45² … 225²: 0.2531, 0.2520, 0.2534, 0.2523,
+0.2503 about its footprint 0.25), Richardson sees differences of opposite sign and cannot certify them.  So each
+finer grid is the first FFT-friendly odd one from the plain next grid up to :data:`PHASE_SPAN` × its pixels whose
+edges fall within :data:`PHASE_TOL` of a pixel of their place on the first grid (the plain next grid if none
+does; ``params['resolve_edge_phases']`` records the places): grids similar with respect to the geometry, as a
+Richardson sequence asks.
+
 Why √2: the change between the last two grids is e·(r^p − 1) for a ratio r; with r = √2 and second order
 it equals the finest grid's error, so criteria (b) and (c) ask the same; with r = 2 (b) would demand an
 error of tol/3 and a grid up to 4× larger than needed.  A level costs about twice the one before, so the
@@ -47,6 +57,7 @@ import time
 import numpy as np
 
 from tengsim.errors import TengsimError
+from tengsim.grid import Grid
 
 FACTOR = math.sqrt(2.0)
 """Refinement factor in dx between two grids (twice the pixels)."""
@@ -58,6 +69,10 @@ FLOORS = {"D": 1.0, "F": 0.01, "fraction": 0.01, "V": 0.01}
 |Δf| <= tol · max(|f|, floor)."""
 MIN_SIDE = 9
 """Fewest pixels across the cell of a default starting grid."""
+PHASE_TOL = 0.1
+"""How far (in pixels) a shape's edge may sit from its place in the first grid's pixel on a finer grid."""
+PHASE_SPAN = 1.3
+"""Largest pixel count, relative to the plain next grid's, searched for a grid that keeps the edges' places."""
 
 
 def _kind(name: str) -> str:
@@ -172,6 +187,31 @@ def default_dx(shape, law, coupling: float, boundary: str = "free") -> float:
     return dx
 
 
+def edge_phases(shape, grid) -> tuple:
+    """Where each of the shape's edges (``Shape.edge_offsets``, from the centre pixel along X) falls in its
+    pixel on ``grid``: the fractional part of offset/dx, in [0, 1)."""
+    offsets = getattr(shape, "edge_offsets", lambda: ())()
+    return tuple(float((e / grid.dx) % 1.0) for e in offsets)
+
+
+def _aligned(shape, grid, phases, max_pixels: int):
+    """``grid`` or, for a shape with edges, the first plain square grid of the same cell with FFT-friendly odd
+    pixel count between grid.nx and PHASE_SPAN × grid.nx (and within ``max_pixels``) whose edges fall where the
+    first grid's did (``phases``, to PHASE_TOL of a pixel); ``grid`` itself if none does."""
+    if not phases or type(grid) is not Grid or grid.nx != grid.ny:
+        return grid
+    from tengsim import _fft
+
+    L = grid.nx * grid.dx
+    n, top = grid.nx, min(int(PHASE_SPAN * grid.nx), int(math.isqrt(int(max_pixels))))
+    while n <= top:
+        g = Grid(n, n, L / n, L / n)
+        if all(min(abs(a - b), 1.0 - abs(a - b)) <= PHASE_TOL for a, b in zip(edge_phases(shape, g), phases)):
+            return g
+        n = _fft.fast_odd_len(n + 2)
+    return grid
+
+
 def _levels_table(levels: list, names: list) -> dict:
     cols = {k: [lv[k] for lv in levels] for k in ("dx", "nx", "ny", "seconds", "convolutions", "status")}
     for n in names:
@@ -247,9 +287,13 @@ def resolve_contact(shape, tabor: float, path, dx: float | None = None, law=None
     max_pixels = check_max_pixels(max_pixels)
     dx = default_dx(shape, law, tabor**1.5, boundary) if dx is None else positive("dx", dx)
     levels, names, res, seen = [], [], None, set()
-    stop = None
+    stop, phases = None, ()
     while True:
         grid = shape.grid(dx)
+        if levels:  # keep the shape's edges where they fell in the first grid's pixels (module doc)
+            grid = _aligned(shape, grid, phases, max_pixels)
+        else:
+            phases = edge_phases(shape, grid)
         if (grid.nx, grid.ny) in seen:  # the FFT-friendly pixel count did not change: one more step
             dx /= FACTOR
             continue
@@ -282,7 +326,7 @@ def resolve_contact(shape, tabor: float, path, dx: float | None = None, law=None
              richardson={n: {k: r[k] for k in ("order", "observed", "extrapolated", "error")}
                          | {"rel_error": r.get("rel_error", math.nan), "change": changes.get(n, math.nan)}
                          for n, r in rich.items()},
-             resolve_seconds=sum(lv["seconds"] for lv in levels))
+             resolve_seconds=sum(lv["seconds"] for lv in levels), resolve_edge_phases=list(phases))
     if stop is not None:
         need = _dx_needed(levels, rich, changes, tol)
         why = _why(changes)

@@ -102,6 +102,10 @@ class Hemisphere(Shape):
         r2 = np.minimum(X**2 + Y**2, self.radius**2)
         return self.k * (self.radius - np.sqrt(self.radius**2 - r2))
 
+    def edge_offsets(self) -> tuple:
+        """The base edge (vertical tangent), the radius from the apex."""
+        return (float(self.radius),)
+
 
 @dataclass(frozen=True)
 class Cone(Shape):
@@ -150,6 +154,10 @@ class Cone(Shape):
         X, Y = grid.mesh()
         return np.minimum(self.slope * np.hypot(X, Y), self.height)
 
+    def edge_offsets(self) -> tuple:
+        """The cap's edge, height/slope from the apex (none for an uncapped cone)."""
+        return (float(self.height / self.slope),) if np.isfinite(self.height) else ()
+
 
 @dataclass(frozen=True)
 class FlatPunch(Shape):
@@ -177,6 +185,10 @@ class FlatPunch(Shape):
     def gap(self, grid: Grid) -> np.ndarray:
         X, Y = grid.mesh()
         return np.where(np.hypot(X, Y) <= self.radius, 0.0, self.step)
+
+    def edge_offsets(self) -> tuple:
+        """The punch's rim, its radius from the centre."""
+        return (float(self.radius),)
 
 
 SHAPES.register("sphere", Paraboloid, aliases=("paraboloid",), summary="sphere, Hertz paraboloid")

@@ -39,6 +39,10 @@ class _FlatTop(Shape):
         X, Y = grid.mesh()
         return np.where(self._on_top(X, Y), 0.0, self.height)
 
+    def edge_offsets(self) -> tuple:
+        """The wall, half_width from the centre."""
+        return (float(self.half_width),)
+
 
 def _flat_top_fields(what: str):
     return (_length("half_width", f"half the {what} width"), _length("height", f"{what} height"),

@@ -36,6 +36,10 @@ class Pyramid(Shape):
                 f"pyramid base 2N = {2 * self.N:g} is wider than its cell L̄ = {self.cell:g}"
             )
 
+    def edge_offsets(self) -> tuple:
+        """The base edge, N from the apex."""
+        return (float(self.N),)
+
     @classmethod
     def from_physical(cls, pitch: float, base: float, height: float, eps: float) -> "Pyramid":
         """From pitch L, base m, height n and interaction range ε (any one length unit), Eq. (7)."""
