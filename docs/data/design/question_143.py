@@ -1,13 +1,13 @@
-"""The periodic design question's smooth-sided patterns with one and two grids more (143², max_pixels 21000;
-225², max_pixels 51000) beside the same points stopped at 99² (max_pixels 10000): docs/design.md, "One grid more".
+"""The periodic design question's smooth-sided patterns (pyramid, cone, hemisphere) on finer grids, beside the
+same points stopped at 99² (question_periodic_resolved.csv, max_pixels 10000): docs/design.md, "More grids".
 
-    tengsim sweep examples/design/question_periodic_resolved_143.toml --out question_periodic_resolved_143 --workers 2
-    tengsim sweep examples/design/question_periodic_resolved_225.toml --out question_periodic_resolved_225 --workers 2
-    python docs/data/design/question_143.py question_periodic_resolved_143/study.csv \
-        question_periodic_resolved_225/study.csv docs/data/design
+    python docs/data/design/question_143.py 143:A.csv 225:B.csv 245:C.csv docs/data/design
 
-Copies the study.csv files to DIR/question_periodic_resolved_143.csv and _225.csv (unless already there) and
-writes DIR/question_143.md: per computation the status at 99², 143² and 225², and what stopped each run.
+Each LABEL:CSV is a study.csv of those points with a larger max_pixels, labelled by its finest grid; a CSV
+outside DIR is copied to DIR/question_periodic_resolved_<LABEL>.csv.  Writes DIR/question_143.md: the `ok`
+counts, the status changes from one run to the next, and per computation each run's status and what stopped it.
+The files of this repository: 143 and 225 (plain √2 refinement, commit 0334210's study files with max_pixels
+21000 and 51000), 245 (edges kept in place, examples/design/question_periodic_resolved_245.toml).
 """
 import csv
 import re
@@ -40,24 +40,28 @@ def why(msg):
 
 
 def main(argv):
-    *srcs, out = argv
+    *specs, out = argv
     out = Path(out)
-    caps = ["143", "225"][:len(srcs)]
     runs = {"99": {tuple(r[k] for k in KEY): r for r in rows(out / "question_periodic_resolved.csv")}}
-    for cap, src in zip(caps, srcs):
-        dest = out / f"question_periodic_resolved_{cap}.csv"
+    labels = []
+    for spec in specs:
+        label, src = spec.split(":", 1)
+        dest = out / f"question_periodic_resolved_{label}.csv"
         if Path(src).resolve() != dest.resolve():
             shutil.copyfile(src, dest)
-        runs[cap] = {tuple(r[k] for k in KEY): r for r in rows(dest)}
-    keys = list(runs[caps[0]])
-    grids = ["99"] + caps
-    L = ["# The periodic design question's smooth-sided patterns: more grids (`docs/data/design/question_143.py`)", "",
+        runs[label] = {tuple(r[k] for k in KEY): r for r in rows(dest)}
+        labels.append(label)
+    keys = list(runs[labels[0]])
+    grids = ["99"] + labels
+    L = ["# The periodic design question's smooth-sided patterns on finer grids (`docs/data/design/question_143.py`)",
+         "",
          f"{len(keys)} computations (pyramid, cone, hemisphere; 3 pitches × 2 aspects × 3 E*; the hemisphere has no "
-         "aspect). `ok` with the finest grid allowed: "
+         "aspect); each run labelled by its finest grid (143², 225²: plain √2 refinement; 245²: the base edges kept "
+         "in place, grids 45², 65², 105², 165², 245²). `ok`: "
          + ", ".join(f"{g}²: {sum(1 for k in keys if runs[g][k]['run_status'] == 'ok')}" for g in grids)
          + ". Compute summed over the runs: "
          + ", ".join(f"{g}²: {sum(float(runs[g][k]['seconds']) for k in keys):.0f} s" for g in grids)
-         + " (the 99² study ran on a more loaded machine).", ""]
+         + " (shared 2-core VM; the 99² study's machine was more loaded).", ""]
     for a, b in zip(grids[:-1], grids[1:]):
         pairs = Counter((runs[a][k]["run_status"], runs[b][k]["run_status"]) for k in keys)
         L += [f"| status up to {a}² → up to {b}² | computations |", "|---|---|"]
@@ -68,7 +72,7 @@ def main(argv):
         L.append(f"| {' '.join(k)} | " + " | ".join(f"{runs[g][k]['run_status']}, {why(runs[g][k]['message'])}"
                                                  for g in grids) + " |")
     (out / "question_143.md").write_text("\n".join(L) + "\n")
-    print("\n".join(L[:12]))
+    print("\n".join(L[:16]))
 
 
 if __name__ == "__main__":
