@@ -56,6 +56,7 @@ import time
 
 import numpy as np
 
+from tengsim import _fft
 from tengsim.errors import TengsimError
 from tengsim.grid import Grid
 
@@ -200,8 +201,6 @@ def _aligned(shape, grid, phases, max_pixels: int):
     first grid's did (``phases``, to PHASE_TOL of a pixel); ``grid`` itself if none does."""
     if not phases or type(grid) is not Grid or grid.nx != grid.ny:
         return grid
-    from tengsim import _fft
-
     L = grid.nx * grid.dx
     n, top = grid.nx, min(int(PHASE_SPAN * grid.nx), int(math.isqrt(int(max_pixels))))
     while n <= top:
