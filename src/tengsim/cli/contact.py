@@ -1,76 +1,43 @@
 """``tengsim contact``: one approach–retraction run (thin shell over tengsim.contact.run_contact)."""
 from __future__ import annotations
 
+import argparse
 import sys
 from pathlib import Path
 
 from tengsim.errors import TengsimError
 
-
+SUMMARY = 'one approach–retraction run of a micro-structure against a flat plate'  # its line in `tengsim --help`
 _CLI_ONLY = ("out", "plot", "quiet")
 _ALIASES = {"maps_at": ("--maps",)}
 
 
-def _option_help():
-    """Common keys, per shape key its help text(s) and the shapes using it, and per law key its help text,
-    laws and defaults, from the [contact] schema."""
-    from tengsim.config import common_fields, contact_table, law_key_help, law_keys
+def register(sub):
+    """The parser: every key of every shape and law (from the [contact] schema) as an option; the help
+    pages (per shape, and the index) are :mod:`tengsim.cli.keyhelp`'s."""
+    from tengsim.cli.keyhelp import CLI_ONLY_HELP, HelpAction
+    from tengsim.config import common_fields, contact_table, law_keys
     from tengsim.registry import SHAPES
 
-    common = {f.name: f for f in common_fields()}
-    laws = law_keys()
-    per_key = {}
+    p = sub.add_parser("contact", help=SUMMARY, add_help=False)
+    p.add_argument("-h", "--help", action=HelpAction)
+    p.add_argument("shape", choices=SHAPES.names(), help="registered shape")
+    p.add_argument("positional", nargs="?", metavar="INPUT", help=argparse.SUPPRESS)  # topography: FILE
+    fields = {f.name: f for f in common_fields()}
     for s in SHAPES.names():
         for k, f in contact_table(s).fields.items():
-            if k not in common and k not in laws:
-                per_key.setdefault(k, {}).setdefault(f.help or k, []).append(s)
-    helps = {}
-    for k, groups in per_key.items():
-        if len(groups) == 1:
-            (h, users), = groups.items()
-            helps[k] = f"{h} [{', '.join(users)}]"
-        else:
-            helps[k] = "; ".join(f"{', '.join(users)}: {h}" for h, users in groups.items())
-    for k, entries in laws.items():
-        helps[k] = law_key_help(entries) + " (a plain number, no unit)"
-    return common, helps
-
-
-def register(sub):
-    from tengsim.config import contact_table
-    from tengsim.registry import SHAPES
-
-    p = sub.add_parser(
-        "contact",
-        help="one approach–retraction run of a micro-structure against a flat plate",
-        description="Solve the adhesive contact (paper Eq. 9) along an approach from --d-min to --d-max "
-        "and a retraction back. Dimensionless input (the shape's own numbers, e.g. --N 0.946 --cell 3.78 "
-        "--tabor 0.5) or physical input with units (e.g. pyramid --pitch 2um --base 1um --height 0.7um "
-        "--E-star 0.59MPa --W 54mJ/m2 --tabor 0.5, or --eps instead of --tabor). Shapes: " + SHAPES.help(),
-    )
-    p.add_argument("shape", choices=SHAPES.names(), help="registered shape")
-    p.add_argument("positional", nargs="?", metavar="INPUT",
-                   help="the shape's positional input, for shapes that declare one (topography: FILE)")
-    common, per_key = _option_help()
-    bools = {f.name for s in SHAPES.names() for f in contact_table(s).fields.values() if f.kind == "bool"}
-    for k, f in common.items():
+            fields.setdefault(k, f)
+    for k in law_keys():
+        fields.setdefault(k, None)
+    for k, f in fields.items():
         if k == "shape" or k in _CLI_ONLY:
             continue
-        flag = {"nargs": "?", "const": "true"} if f.kind == "bool" else {}  # --adaptive alone means true
-        p.add_argument("--" + k.replace("_", "-"), *_ALIASES.get(k, ()), dest=k, **flag,
-                       help=f.describe().split(": ", 1)[1].replace("%", "%%"))
-    for k, h in per_key.items():
-        if k in _CLI_ONLY:
-            continue
-        flag = {"nargs": "?", "const": "true"} if k in bools else {}  # '--fill-missing' alone means true
-        p.add_argument("--" + k.replace("_", "-"), dest=k, help=h.replace("%", "%%"), **flag)
-    p.add_argument("--out", required=True, help="output file: .csv (curves) or .nc (everything)")
-    p.add_argument("--plot", help="also draw F(D), Λc(D), Λc(F) to this .png/.pdf")
-    p.add_argument("--quiet", action="store_true", help="no progress bar")
-    p.add_argument("--resume", action="store_true",
-                   help="continue the interrupted run of these settings from OUT.partial.csv (rows are written "
-                   "there as they finish; the path is solved again from its start and each row already in the "
-                   "file is checked, so the result equals an uninterrupted run's)")
+        flag = {"nargs": "?", "const": "true"} if f is not None and f.kind == "bool" else {}  # --adaptive = true
+        p.add_argument("--" + k.replace("_", "-"), *_ALIASES.get(k, ()), dest=k, help=argparse.SUPPRESS, **flag)
+    p.add_argument("--out", required=True, help=CLI_ONLY_HELP["out"])
+    p.add_argument("--plot", help=CLI_ONLY_HELP["plot"])
+    p.add_argument("--quiet", action="store_true", help=CLI_ONLY_HELP["quiet"])
+    p.add_argument("--resume", action="store_true", help=CLI_ONLY_HELP["resume"])
     p.set_defaults(func=run)
 
 

@@ -13,6 +13,8 @@ from pathlib import Path
 
 from tengsim.errors import TengsimError, require
 
+SUMMARY = 'dynamic TENG output (paper Section 5)'  # its line in `tengsim --help`
+
 PRECEDENCE = "A value given as a CLI option wins over the config file, which wins over the case's default."
 CONFIG_HELP = ("TOML or JSON file with tables [device], [waveform], [run], [solver] (and [sweep] for sweep); "
                "`tengsim device fields` lists every key. " + PRECEDENCE)
@@ -36,7 +38,7 @@ _OPTIONS = {"out": ("run", "out"), "cycles": ("run", "cycles"), "t_end": ("run",
 def register(subparsers) -> None:
     from tengsim.device.params import FORCE_MODELS, INITIAL_CHARGES
 
-    p = subparsers.add_parser("device", help="dynamic TENG output (paper Section 5)", description=DESCRIPTION)
+    p = subparsers.add_parser("device", help=SUMMARY, description=DESCRIPTION)
     sub = p.add_subparsers(dest="device_command", metavar="CASE")
     p.set_defaults(func=lambda args: (p.print_help(), 2)[1])
 

@@ -12,11 +12,13 @@ from pathlib import Path
 
 from tengsim.errors import TengsimError
 
+SUMMARY = 'redraw figures from a saved result'  # its line in `tengsim --help`
+
 FIGURE_SUFFIXES = (".png", ".pdf", ".svg")
 
 
 def register(sub):
-    p = sub.add_parser("plot", help="redraw figures from a saved result",
+    p = sub.add_parser("plot", help=SUMMARY,
                        description="Draw a saved tengsim result: F(D), Λc(D), Λc(F) of a contact result "
                        "(.nc or .csv) and its pressure/gap maps (second figure OUT_maps.png, .nc with "
                        "--maps only), the time series of a device result, power and energy against R of a "
