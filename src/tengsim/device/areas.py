@@ -1,0 +1,84 @@
+"""The charged-area model from a contact result on file: a ``tengsim design`` result (``design.nc``).
+
+The design-result file holds, per nominal pressure (coordinate ``pressure``, Pa) and branch
+(``approach``, ``retraction``), the charged-area fraction A/S (``charged_area_fraction``; NaN where a
+pressure was not reached on that branch).  A pressed device follows the stable approach branch, so
+the device takes that branch: NaN rows dropped, and at a snap (the same pressure met twice) the first
+state reached at that pressure kept, so the pressures increase strictly.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from tengsim.device.params import AreaTable
+from tengsim.errors import TengsimError
+
+DESIGN_FILE = "design.nc"
+AREA_VARIABLE = "charged_area_fraction"
+
+
+def stable_branch(pressure_Pa, area_fraction, where: str = "area table"):
+    """(pressures, fractions) of an approach with the repeats of a snap removed: at a pressure met again
+    (a jump at constant load) the first state reached is kept.  A pressure that falls is an error naming
+    its row (0-based) and value, and the row before it."""
+    p = np.asarray(pressure_Pa, dtype=float).ravel()
+    a = np.asarray(area_fraction, dtype=float).ravel()
+    if p.size != a.size:
+        raise TengsimError(f"{where}: {p.size} pressures but {a.size} area fractions")
+    keep = [0] if p.size else []
+    for i in range(1, p.size):
+        last = p[keep[-1]]
+        if p[i] == last or abs(p[i] - last) <= 1e-9 * max(abs(last), abs(p[i])):
+            continue  # the landing state of a snap, at the pressure already kept
+        if p[i] < last:
+            raise TengsimError(f"{where}: pressures must increase, but row {i} holds {p[i]:.6g} Pa after "
+                               f"{last:.6g} Pa (row {keep[-1]})")
+        keep.append(i)
+    return p[keep], a[keep]
+
+
+def design_path(path) -> Path:
+    """The design.nc of ``path`` (the file, or the folder a ``tengsim design --out DIR`` wrote)."""
+    p = Path(path)
+    if p.is_dir():
+        p = p / DESIGN_FILE
+    if not p.is_file():
+        raise TengsimError(f"area: no design result {str(p)!r} (give the design.nc that `tengsim design --out "
+                           "DIR` wrote, or its folder DIR)")
+    return p
+
+
+def area_table_from_design(path) -> AreaTable:
+    """The :class:`AreaTable` A/S(P) of a design result (``DIR/design.nc`` or ``DIR``): its approach
+    branch, NaN rows dropped, one value per pressure (the first state reached at a snap's pressure)."""
+    import xarray as xr
+
+    p = design_path(path)
+    try:
+        ds = xr.load_dataset(p)
+    except (OSError, ValueError) as exc:
+        raise TengsimError(f"area: cannot read {str(p)!r} as a design result: {exc}") from None
+    if AREA_VARIABLE not in ds or "pressure" not in ds.coords:
+        raise TengsimError(f"area: {str(p)!r} is no design result (it has no {AREA_VARIABLE!r} over 'pressure')")
+    units = str(ds["pressure"].attrs.get("units", "Pa"))
+    if units != "Pa":
+        raise TengsimError(f"area: {str(p)!r}: pressure in {units!r}, expected 'Pa'")
+    frac = ds[AREA_VARIABLE]
+    if "branch" in frac.dims:
+        branches = [str(b) for b in ds["branch"].values]
+        if "approach" not in branches:
+            raise TengsimError(f"area: {str(p)!r} has no approach branch (branches: {', '.join(branches)})")
+        frac = frac.isel(branch=branches.index("approach"))
+    pres = np.asarray(ds["pressure"].values, dtype=float)
+    a = np.asarray(frac.values, dtype=float)
+    ok = np.isfinite(pres) & np.isfinite(a)
+    if ok.sum() < 2:
+        raise TengsimError(f"area: {str(p)!r}: the approach branch reached {int(ok.sum())} of {pres.size} "
+                           "pressures; the device needs at least 2")
+    pres, a = stable_branch(pres[ok], a[ok], where=f"area: {p}")
+    return AreaTable(pres, a)
+
+
+__all__ = ["area_table_from_design", "design_path", "stable_branch", "DESIGN_FILE"]
