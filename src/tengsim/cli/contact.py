@@ -55,7 +55,7 @@ def run(args) -> int:
         if cfg.get(key) not in (None, args.positional):
             raise TengsimError(f"{key} given twice: {args.positional!r} and --{key.replace('_', '-')} {cfg[key]!r}")
         cfg[key] = args.positional
-    plan_contact({**cfg, "out": args.out})  # every option checked before anything is written (maps need .nc)
+    plan = plan_contact({**cfg, "out": args.out})  # every option checked before anything is written (maps: .nc)
     out = Path(args.out)
     if out.suffix.lower() not in (".csv", ".nc"):
         raise TengsimError(f"--out {args.out}: use a .csv or .nc file")
@@ -71,11 +71,43 @@ def run(args) -> int:
     if not parallel.is_root():  # mpiexec -n N: every process solves its slab, rank 0 alone writes and reports
         run_contact(cfg)
         return 0
+    if not args.quiet and plan.scaling is not None:
+        print(f"tengsim: {physical_line(plan, 'eps' in cfg)}", file=sys.stderr)
     stream = open_stream(out, args.resume, args.quiet)
     res = run_streamed(lambda bar: run_contact(cfg, progress=bar, sink=stream), stream, args.quiet)
     if res is None:
         return 130
     return write_contact(res, out, args.plot, args.quiet, stream)
+
+
+def physical_line(plan, eps_given: bool) -> str:
+    """The line a physical run starts with: its materials, ε and the Tabor number derived (or given), the grid."""
+    from tengsim.units import format_si
+
+    sc = plan.scaling
+    how = "derived from ε, E*, W and the shape" if eps_given else "as given; ε derived from it"
+    return (f"physical run: E* = {format_si(sc.E_star, 'Pa')}, W = {sc.W * 1e3:.4g} mJ/m2, ε = "
+            f"{format_si(sc.eps, 'm')}, Tabor number μ = {sc.mu:.4g} ({how}), dx = "
+            f"{format_si(plan.dx * sc.lateral, 'm')}")
+
+
+def pull_off_text(res) -> str:
+    """'pull-off ...': the most tensile force of the retraction (N per cell and nominal Pa in a physical run);
+    under load control, where the retraction stopped at f_min before separating, says so instead."""
+    from tengsim.units import format_si
+
+    F, sc = res.pull_off_force, res.scaling
+    if res.params.get("control") == "load":
+        r = res.branch("retraction")
+        if len(r["F"]) and not bool(r["jump"][-1]):  # no separation: the lowest load is f_min, not the pull-off
+            fmin = float(res.params.get("f_min", 0.0))
+            at = f"{format_si(sc.pressure(fmin), 'Pa')}" if sc is not None and sc.cell_area else f"F = {fmin:.4g}"
+            return (f"pull-off not reached (the retraction ended at f_min = {at} still in contact; a lower "
+                    f"f_min finds it)")
+    if sc is None or not F == F:
+        return f"pull-off F = {F:.4g}"
+    p = f", {format_si(sc.pressure(F), 'Pa')} nominal" if sc.cell_area else ""
+    return f"pull-off {format_si(sc.force(F), 'N')} per cell{p} (F = {F:.4g})"
 
 
 def run_contact(cfg: dict, progress=None, sink=None):
@@ -147,8 +179,7 @@ def write_contact(res, out, plot=None, quiet=False, stream=None) -> int:
         plot_curves(res, plot)
     if not quiet:
         j = res.jumps
-        si = f" ({res.scaling.force(res.pull_off_force):.4g} N per cell)" if res.scaling is not None else ""
-        print(f"wrote {out}: {len(res.table['D'])} equilibria, pull-off F = {res.pull_off_force:.4g}{si}, "
+        print(f"wrote {out}: {len(res.table['D'])} equilibria, {pull_off_text(res)}, "
               f"{len(j)} jump(s), {res.seconds:.1f} s", file=sys.stderr)
     from tengsim.status import warning_lines
 

@@ -44,14 +44,16 @@ def _full(key: str, text: str, width: int) -> list:
     return [head.ljust(_KEY_COL) + lines[0]] + [" " * _KEY_COL + ln for ln in lines[1:]]
 
 
-def _short(field) -> str:
-    """A field's help without its kind, with its default: the text of a one-line entry."""
-    return field.help + (f" (default {field.default!r})" if field.default not in (None, (), "") else "")
+def _short(field) -> tuple:
+    """(help, ' [default …]'): a field's help without its kind, and its default (kept whole on one line)."""
+    return field.help, (f" [default {field.default!r}]" if field.default not in (None, (), "") else "")
 
 
-def _one_line(key: str, text: str, width: int, flag: bool = True) -> str:
-    """``--key`` (``key`` with ``flag`` False) and its text cut to one line (at a clause where it can)."""
-    room = width - _KEY_COL
+def _one_line(key: str, text, width: int, flag: bool = True) -> str:
+    """``--key`` (``key`` with ``flag`` False) and its text cut to one line (at a clause where it can);
+    ``text`` may be (text, tail), the tail kept whole."""
+    text, tail = text if isinstance(text, tuple) else (text, "")
+    room = width - _KEY_COL - len(tail)
     if len(text) > room:
         cut = text[: room - 1]
         for sep in ("; ", " ("):
@@ -60,7 +62,7 @@ def _one_line(key: str, text: str, width: int, flag: bool = True) -> str:
                 cut = cut[:i]
                 break
         text = cut.rstrip(" ,;") + "…"
-    return f"  {_flag(key) if flag else key:<{_KEY_COL - 3}} ".ljust(_KEY_COL) + text
+    return f"  {_flag(key) if flag else key:<{_KEY_COL - 3}} ".ljust(_KEY_COL) + text + tail
 
 
 def _keys():

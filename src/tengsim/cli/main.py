@@ -20,11 +20,12 @@ SUBCOMMANDS = ["contact", "device", "reproduce", "run", "plot", "sweep", "optimi
 
 class Parser(argparse.ArgumentParser):
     """argparse with tengsim's manners: a bad option is one line naming it (no usage wall), and a negative
-    number in any notation ('-1e+16', '-.5') is a value, not an option."""
+    number in any notation ('-1e+16', '-.5'), with or without a unit ('-5kPa'), is a value, not an option."""
 
     def __init__(self, *args, **kwargs):
         super().__init__(*args, **kwargs)
-        self._negative_number_matcher = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$|^-(inf|nan)$", re.I)
+        self._negative_number_matcher = re.compile(  # '-5kPa', '-2 N': a negative quantity with its unit
+            r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?( ?[A-Za-zµμΩ][A-Za-z0-9µμΩ/²]*)?$|^-(inf|nan)$", re.I)
 
     def error(self, message):
         self.exit(2, f"tengsim: error: {message} (see '{self.prog} --help')\n")
