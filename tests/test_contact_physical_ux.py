@@ -47,7 +47,7 @@ def test_load_control_extends_itself_to_the_pressure_asked_for(tmp_path, capsys)
 
 def test_a_load_not_reached_is_said_in_kpa_and_resume_takes_the_longer_path(tmp_path, capsys):
     out = tmp_path / "r.csv"
-    err = _run([*PYR, *LOAD, "--f-max", "50kPa", "--d-max", "12", "--quiet", "--out", str(out)], capsys, 2)
+    err = _run([*PYR, *LOAD, "--f-max", "20kPa", "--d-max", "12", "--quiet", "--out", str(out)], capsys, 2)
     line = err.strip()
     assert "\n" not in line
     m = re.search(r"load (\d+) kPa \(F = [\d.]+\) is not reached: the highest load reached is ([\d.]+) kPa "
@@ -57,10 +57,10 @@ def test_a_load_not_reached_is_said_in_kpa_and_resume_takes_the_longer_path(tmp_
     part = tmp_path / "r.csv.partial.csv"
     n_kept = sum(1 for ln in part.read_text().splitlines() if ln.startswith("approach"))
     assert n_kept > 3
-    err = _run([*PYR, *LOAD, "--f-max", "50kPa", "--d-max", "40", "--quiet", "--resume", "--out", str(out)], capsys)
+    err = _run([*PYR, *LOAD, "--f-max", "20kPa", "--d-max", "40", "--quiet", "--resume", "--out", str(out)], capsys)
     assert not part.exists()
     fresh = tmp_path / "fresh.csv"
-    _run([*PYR, *LOAD, "--f-max", "50kPa", "--d-max", "40", "--quiet", "--out", str(fresh)], capsys)
+    _run([*PYR, *LOAD, "--f-max", "20kPa", "--d-max", "40", "--quiet", "--out", str(fresh)], capsys)
     a, b = _res(out), _res(fresh)
     np.testing.assert_array_equal(a.table["D"], b.table["D"])
     np.testing.assert_allclose(a.table["F"], b.table["F"], rtol=1e-12)
