@@ -36,6 +36,22 @@ def _plot_study(src: Path, out):
     return plot_study(src, out or src / "design.png")
 
 
+def _device_period(src: Path, obj):
+    """The waveform period (s) of a device result: from its .json sidecar (a .csv) or its attributes (a
+    .nc); None when it has none (then the plot is not clipped to the settled cycles)."""
+    import json
+
+    try:
+        if src.suffix.lower() == ".csv":
+            wf = json.loads(src.with_suffix(".json").read_text()).get("waveform", {})
+        else:
+            wf = json.loads(getattr(obj, "attrs", {}).get("waveform", "{}"))
+        f = float(wf.get("frequency_Hz") or 0.0)
+    except (OSError, ValueError, TypeError, AttributeError):
+        return None
+    return 1.0 / f if f > 0 else None
+
+
 def run(args) -> int:
     from tengsim.load import load_result
 
@@ -73,7 +89,7 @@ def run(args) -> int:
     elif kind == "sweep":
         plots.plot_sweep(obj, out, title=src.name)
     else:
-        plots.plot_timeseries(obj, out, title=src.name)
+        plots.plot_timeseries(obj, out, title=src.name, period=_device_period(src, obj))
     for w in written:
         print(f"wrote {w}")
     return 0
