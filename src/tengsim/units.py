@@ -278,3 +278,11 @@ def format_si(value: float, unit: str, digits: int = 3) -> str:
     """``value`` (SI ``unit``) with an engineering prefix: ``format_si(1.23e-5, 'W')`` is '12.3 µW'."""
     f, u = si_prefix(value, unit)
     return f"{value / f:.{digits}g} {u}"
+
+
+def si_unit(dim: str) -> str:
+    """The SI unit symbol of a dimension of :func:`parse_quantity` ('length' → 'm', 'energy/area' → 'J/m2')."""
+    for base, (d, factor) in _BASE.items():
+        if d == dim and factor == 1.0:
+            return base
+    raise TengsimError(f"no SI unit for dimension {dim!r}")
