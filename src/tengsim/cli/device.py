@@ -34,8 +34,9 @@ _OPTIONS = {"out": ("run", "out"), "cycles": ("run", "cycles"), "t_end": ("run",
             "force_model": ("device", "force_model"), "initial_charge": ("device", "initial_charge"),
             "r_min": ("sweep", "r_min_ohm"), "r_max": ("sweep", "r_max_ohm"), "points": ("sweep", "points"),
             "area_from": ("device", "area")}
-AREA_FROM_HELP = ("charged-area model from a contact result: a design result DIR/design.nc (or DIR) of "
-                  "`tengsim design`, its approach branch (overrides [device] area)")
+AREA_FROM_HELP = ("charged-area model from a result on file: a design result DIR/design.nc (or DIR) of "
+                  "`tengsim design`, or a physical load-controlled `tengsim contact` result (.nc/.csv); the "
+                  "approach branch (overrides [device] area)")
 
 
 def register(subparsers) -> None:

@@ -1,4 +1,5 @@
-"""The charged-area model from a contact result on file: a ``tengsim design`` result (``design.nc``).
+"""The charged-area model from a contact result on file: a ``tengsim design`` result (``design.nc``), or a
+physical ``tengsim contact`` result (.nc or .csv; best a load-controlled one).
 
 The design-result file holds, per nominal pressure (coordinate ``pressure``, Pa) and branch
 (``approach``, ``retraction``), the charged-area fraction A/S (``charged_area_fraction``; NaN where a
@@ -81,4 +82,50 @@ def area_table_from_design(path) -> AreaTable:
     return AreaTable(pres, a)
 
 
-__all__ = ["area_table_from_design", "design_path", "stable_branch", "DESIGN_FILE"]
+def area_table_from_contact(path) -> AreaTable:
+    """The :class:`AreaTable` of a physical ``tengsim contact`` result (.nc or .csv): its approach rows at
+    nominal pressures >= 0, A/S = λc²/L² (paper Eq. 12's area: the contact length squared over the cell
+    area), one row per pressure (at a load-controlled snap the first state reached).  A displacement-
+    controlled approach, whose force falls after the jump-in, is refused at the row where it falls (run
+    it with control = load)."""
+    from tengsim.load import load_result
+
+    kind, res = load_result(path)
+    where = f"area: {path}"
+    if kind != "contact":
+        raise TengsimError(f"{where} is a {kind} result, not a contact or design result")
+    t, cell = res.table, (res.params or {}).get("cell_area_m2")
+    if "pressure_Pa" not in t or "contact_length_m" not in t or not cell:
+        raise TengsimError(f"{where} is a dimensionless contact result (no pressure_Pa): run it with physical "
+                           "input (lengths with units, E_star, W)")
+    br = np.asarray(t["branch"]).astype(str)
+    p = np.asarray(t["pressure_Pa"], float)
+    rows = np.flatnonzero((br == "approach") & (p >= 0) & np.isfinite(p))
+    if rows.size < 2:
+        raise TengsimError(f"{where}: the approach has {rows.size} state(s) at a pressure >= 0; the device "
+                           "needs at least 2")
+    frac = np.asarray(t["contact_length_m"], float)[rows] ** 2 / float(cell)
+    pres, a = stable_branch(p[rows], np.clip(frac, 0.0, 1.0), where=where + " (approach rows at p >= 0)")
+    return AreaTable(pres, a)
+
+
+def area_table_from_file(path) -> AreaTable:
+    """The area model of a result on file: a design result (DIR, DIR/design.nc) or a contact result."""
+    p = Path(path)
+    if p.is_dir() or p.suffix.lower() == ".csv":
+        return area_table_from_design(p) if p.is_dir() else area_table_from_contact(p)
+    if p.is_file():
+        import xarray as xr
+
+        try:
+            with xr.open_dataset(p) as ds:
+                design = AREA_VARIABLE in ds
+        except (OSError, ValueError) as exc:
+            raise TengsimError(f"area: cannot read {str(p)!r}: {exc}") from None
+        if not design:
+            return area_table_from_contact(p)
+    return area_table_from_design(p)
+
+
+__all__ = ["area_table_from_contact", "area_table_from_design", "area_table_from_file", "design_path",
+           "stable_branch", "DESIGN_FILE"]

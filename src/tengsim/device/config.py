@@ -16,7 +16,7 @@ from __future__ import annotations
 import dataclasses
 import math
 
-from tengsim.device.areas import area_table_from_design, stable_branch
+from tengsim.device.areas import area_table_from_file, stable_branch
 from tengsim.device.params import AreaTable, ConstantArea, DeviceParams, SolverOptions
 from tengsim.device.waveforms import WAVEFORMS
 from tengsim.errors import TengsimError
@@ -85,11 +85,11 @@ def _load_ohm(value, label):
     return Field("load_ohm", dim="resistance")._number(value, label)
 
 
-def _is_design(value: str) -> bool:
-    """A [device] area given as a path: a design result (.nc) or the folder holding one."""
+def _is_file(value: str) -> bool:
+    """A [device] area given as a path: a design result (.nc, or its folder) or a contact result (.nc, .csv)."""
     from pathlib import Path
 
-    return value.strip().lower().endswith(".nc") or Path(value).is_dir()
+    return value.strip().lower().endswith((".nc", ".csv")) or Path(value).is_dir()
 
 
 def _area(value, label):
@@ -104,8 +104,8 @@ def _area(value, label):
                            Field("area_fraction", "floats", REQUIRED)])
         v = t.parse(value, where=f"{label}.")
         return AreaTable(*stable_branch(v["pressure_Pa"], v["area_fraction"], where=label))
-    if isinstance(value, str) and _is_design(value):
-        return area_table_from_design(value)
+    if isinstance(value, str) and _is_file(value):
+        return area_table_from_file(value)
     f = Field("area", "float")._number(value, label)
     return ConstantArea(f)
 
@@ -117,8 +117,9 @@ DEVICE_TABLE = table_from_dataclass(
              "area": Field("area", "any", None, check=_area,
                            help="charged-area model: a fraction A/S (default 1), a table "
                                 "{pressure_Pa = [...], area_fraction = [...]} (A(P), linear, ends held; a "
-                                "pressure repeated at a snap keeps its first row), or a design result "
-                                "'DIR/design.nc' (its approach branch)")},
+                                "pressure repeated at a snap keeps its first row), a design result "
+                                "'DIR/design.nc' (its approach branch) or a physical contact result .nc/.csv "
+                                "(approach, A/S = λc²/L²)")},
     doc="DeviceParams fields, SI; a case (fig7, fig8, sweep) supplies any not given, `run` needs the first seven")
 REQUIRED_DEVICE = tuple(f.name for f in dataclasses.fields(DeviceParams)
                         if f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING)
