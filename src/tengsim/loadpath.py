@@ -305,8 +305,8 @@ class _LoadBranch:
         if err <= self.spec.tol_F:
             return eq
         lo, hi, how = self.bracket if self.bracket is not None else (self.D, self.D, "")
-        msg = (f"{self.name}: {what} F = {Ft:.6g} not met: |F - target| = {err:.3g} > f_tol = {self.spec.tol_F:.3g}"
-               f" (D in [{lo:.6g}, {hi:.6g}]{', ' + how if how else ''})")
+        msg = (f"{self.name}: {what} {self.spec.load_text(Ft)} not met: |F - target| = {err:.3g} > f_tol = "
+               f"{self.spec.tol_F:.3g} (D in [{lo:.6g}, {hi:.6g}]{', ' + how if how else ''})")
         self.misses.append(msg)
         return dataclasses.replace(eq, converged=False, message=msg)
 
@@ -373,7 +373,7 @@ def run_load_path(U0, law, kernel, solver, spec: LoadPathSpec, start: State | No
         res.params["d_max_reached"] = up.d_max  # the search range the approach extended itself to
     absent = rec.maps_missing([b.name for b in branches])
     if absent:  # requested, but that branch has no state at that load: said, not dropped silently
-        res.params["maps_not_made"] = "; ".join(f"{b} F = {m:g}" for b, m in absent) + (
+        res.params["maps_not_made"] = "; ".join(f"{b} {spec.load_text(m)}" for b, m in absent) + (
             " (no state at that load on that branch: below the load at rest on the approach, past the "
             "pull-off on the retraction)")
     return res

@@ -188,7 +188,10 @@ def write_contact(res, out, plot=None, quiet=False, stream=None) -> int:
     if res.params.get("resolve_message"):  # resolve = auto stopped by max_pixels: the dx reached and needed
         print(f"tengsim: warning: {res.params['resolve_message']}", file=sys.stderr)
     elif res.params.get("resolve") == "auto" and not quiet:
-        grids = ", ".join(f"{d:.4g}" for d in res.params.get("resolve_grids", ()))
+        from tengsim.units import format_si
+
+        lat = res.scaling.lateral if res.scaling is not None else None
+        grids = ", ".join(format_si(d * lat, "m", 4) if lat else f"{d:.4g}" for d in res.params.get("resolve_grids", ()))
         print(f"tengsim: resolved: dx {grids}; status {res.params.get('resolve_status')}", file=sys.stderr)
     missed = [m for m in str(res.params.get("load_not_met") or "").split("; ") if m]
     if missed:  # load control: which loads, and where the search for each ended
