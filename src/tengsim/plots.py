@@ -43,9 +43,10 @@ def _branches(ax, res, x, y, color, label, jumps=True):
             ax.plot(t[x][j - 1], t[y][j - 1], "o", color=color, ms=3, mfc="none")
 
 
-def run_title(params: dict) -> str:
+def run_title(params: dict, keys=None) -> str:
     """The shape and its parameters, then the materials, of a run (its saved params): for a physical run
-    'pyramid: pitch 10 µm, base 5 µm, height 3.5 µm; E* = 1 MPa, W = 50 mJ/m², ε = 100 nm, μ = 0.8'."""
+    'pyramid: pitch 10 µm, base 5 µm, height 3.5 µm; E* = 1 MPa, W = 50 mJ/m², ε = 100 nm, μ = 0.8'; for a
+    dimensionless one the shape's numbers as given (``keys``: the shape's own keys, to leave out the run's)."""
     from tengsim.units import format_si
 
     p = params or {}
@@ -53,7 +54,8 @@ def run_title(params: dict) -> str:
     shape = str(cfg.get("shape") or p.get("shape") or "").lower()
     mu = p.get("tabor")
     if "eps_m" not in p:  # dimensionless: the shape's own numbers as given
-        own = ", ".join(f"{k} {v}" for k, v in cfg.items() if k not in ("shape", "tabor") and not isinstance(v, dict))
+        own = ", ".join(f"{k} {v}" for k, v in cfg.items() if k not in ("shape", "tabor") and not isinstance(v, dict)
+                        and (keys is None or k in keys))
         return f"{shape}{': ' + own if own else ''}" + (f"; μ = {mu:.3g}" if isinstance(mu, (int, float)) else "")
     sizes = [f"{k[:-2].replace('_', ' ')} {format_si(v, 'm')}" for k, v in p.items()
              if k.endswith("_m") and k not in ("eps_m", "lateral_m") and isinstance(v, (int, float))]
@@ -72,7 +74,7 @@ def _scaled(values, unit):
     return v / f, u
 
 
-def plot_curves(res, path, title: str = "") -> None:
+def plot_curves(res, path, title: str = "", keys=None) -> None:
     """Pressure (or force) and contact length against the approach, and contact length against the
     pressure, of one run: approach solid, retraction dashed, jumps as dots.
 
@@ -110,7 +112,7 @@ def plot_curves(res, path, title: str = "") -> None:
         ax.set_ylabel(yl)
         ax.grid(alpha=0.3)
     axs[0].legend(fontsize=8)
-    head = run_title(params)
+    head = run_title(params, keys)
     fig.suptitle(head + (f"\n{title}" if title else ""), fontsize=10)
     save(fig, path)
 
@@ -240,7 +242,7 @@ def _map_pressure(res, m) -> float | None:
     return float(np.asarray(t["pressure_Pa"], float)[rows[0]]) if rows.size else None
 
 
-def plot_maps(res, path, title: str = "") -> None:
+def plot_maps(res, path, title: str = "", keys=None) -> None:
     """Saved pressure and gap maps of a contact result: one row per map, pressure and gap side by side,
     equal aspect, colour bars with units.  A physical run: x, y in µm, the contact pressure in kPa (or
     MPa), the gap in nm, each map titled with its nominal pressure; a dimensionless one in the units of
@@ -286,7 +288,7 @@ def plot_maps(res, path, title: str = "") -> None:
             ax.set_ylabel(yl)
             ax.set_title(f"{m['branch']}, {at.strip()}", fontsize=9)
             fig.colorbar(im, ax=ax, shrink=0.85).set_label(label)
-    fig.suptitle(run_title(p) + (f"\n{title}" if title else ""), fontsize=10)
+    fig.suptitle(run_title(p, keys) + (f"\n{title}" if title else ""), fontsize=10)
     save(fig, path)
 
 

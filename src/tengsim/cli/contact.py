@@ -176,7 +176,9 @@ def write_contact(res, out, plot=None, quiet=False, stream=None) -> int:
     if plot:
         from tengsim.plots import plot_curves
 
-        plot_curves(res, plot)
+        from tengsim.cli.keyhelp import title_keys
+
+        plot_curves(res, plot, keys=title_keys(res.params))
     if not quiet:
         j = res.jumps
         print(f"wrote {out}: {len(res.table['D'])} equilibria, {pull_off_text(res)}, "

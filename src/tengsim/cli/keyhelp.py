@@ -82,6 +82,16 @@ def shape_keys(shape: str) -> dict:
     return {k: f for k, f in contact_table(shape).fields.items() if k not in skip}
 
 
+def title_keys(params: dict):
+    """The keys of the shape a saved run was made with (for a figure's title), or None if unknown."""
+    cfg = (params or {}).get("config")
+    shape = cfg.get("shape") if isinstance(cfg, dict) else None
+    try:
+        return tuple(shape_keys(shape)) if shape else None
+    except Exception:  # noqa: BLE001 - a shape not registered here (a plugin's): every key is shown
+        return None
+
+
 def shape_help(shape: str) -> str:
     """The page of ``tengsim contact SHAPE --help``."""
     from tengsim.registry import SHAPES

@@ -78,9 +78,12 @@ def run(args) -> int:
     written = [out]
     if kind == "contact":
         maps_out = out.with_name(f"{out.stem}_maps{out.suffix}")
-        plots.plot_curves(obj, out, title=src.name)
+        from tengsim.cli.keyhelp import title_keys
+
+        keys = title_keys(obj.params)
+        plots.plot_curves(obj, out, title=src.name, keys=keys)
         if obj.maps and not args.no_maps:
-            plots.plot_maps(obj, maps_out, title=src.name)
+            plots.plot_maps(obj, maps_out, title=src.name, keys=keys)
             written.append(maps_out)
         if isinstance(obj.params.get("resolution"), dict):  # resolve = auto: the convergence over the grids
             res_out = out.with_name(f"{out.stem}_resolution{out.suffix}")
