@@ -294,8 +294,9 @@ def plot_maps(res, path, title: str = "", keys=None) -> None:
 
 def plot_sweep(data, path, title: str = "") -> None:
     """Load-resistance sweep read back from a file (columns R, energy_per_cycle, average_power): mean
-    power and energy per cycle against R on a log axis (µW, µJ: engineering prefixes), the best load marked."""
-    from tengsim.units import format_si
+    power (and the peak power, if the file has it) and energy per cycle against R on a log axis (µW, µJ:
+    engineering prefixes), the best load marked."""
+    from tengsim.units import format_si, si_prefix
 
     plt = _plt()
     R = np.asarray(data["R"], float)
@@ -307,14 +308,18 @@ def plot_sweep(data, path, title: str = "") -> None:
     fig, axs = plt.subplots(1, 2, figsize=(10, 3.8), constrained_layout=True)
     p_raw, e_raw = p, e
     (p, pu), (e, eu) = _scaled(p, "W"), _scaled(e, "J")
-    for ax, y, label in ((axs[0], p, f"mean power ({pu})"), (axs[1], e, f"energy per cycle ({eu})")):
-        ax.plot(R, y, "o-", ms=3)
+    for ax, y, label in ((axs[0], p, f"power into the load ({pu})"), (axs[1], e, f"energy per cycle ({eu})")):
+        ax.plot(R, y, "o-", ms=3, label="mean power" if ax is axs[0] else None)
         ax.set_xscale("log")
         if np.all(y[np.isfinite(y)] > 0):
             ax.set_yscale("log")
         ax.set_xlabel(r"load $R$ ($\Omega$)")
         ax.set_ylabel(label)
         ax.grid(alpha=0.3, which="both")
+        if ax is axs[0] and "peak_power" in data:  # the peak beside the mean, in the same unit
+            fp = si_prefix(float(np.nanmax(np.abs(p_raw))), "W")[0]
+            ax.plot(R, np.asarray(data["peak_power"], float)[order] / fp, "s--", ms=3, color="tab:gray",
+                    label="peak power")
         if k is not None:
             ax.axvline(R[k], color="k", ls=":", lw=1)
             ax.plot(R[k], y[k], "*", color="tab:red", ms=10,
