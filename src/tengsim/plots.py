@@ -309,21 +309,21 @@ def plot_sweep(data, path, title: str = "") -> None:
     p_raw, e_raw = p, e
     (p, pu), (e, eu) = _scaled(p, "W"), _scaled(e, "J")
     for ax, y, label in ((axs[0], p, f"power into the load ({pu})"), (axs[1], e, f"energy per cycle ({eu})")):
-        ax.plot(R, y, "o-", ms=3, label="mean power" if ax is axs[0] else None)
+        ax.plot(R, y, "o-", ms=3)
         ax.set_xscale("log")
         if np.all(y[np.isfinite(y)] > 0):
             ax.set_yscale("log")
         ax.set_xlabel(r"load $R$ ($\Omega$)")
         ax.set_ylabel(label)
         ax.grid(alpha=0.3, which="both")
-        if ax is axs[0] and "peak_power" in data:  # the peak beside the mean, in the same unit
-            fp = si_prefix(float(np.nanmax(np.abs(p_raw))), "W")[0]
-            ax.plot(R, np.asarray(data["peak_power"], float)[order] / fp, "s--", ms=3, color="tab:gray",
-                    label="peak power")
         if k is not None:
             ax.axvline(R[k], color="k", ls=":", lw=1)
             ax.plot(R[k], y[k], "*", color="tab:red", ms=10,
                     label=f"best load {R[k]:.3g} Ω: {format_si(p_raw[k], 'W')}, {format_si(e_raw[k], 'J')}/cycle")
+        if ax is axs[0] and "peak_power" in data:  # the peak beside the mean, in the same unit
+            fp = si_prefix(float(np.nanmax(np.abs(p_raw))), "W")[0]
+            ax.plot(R, np.asarray(data["peak_power"], float)[order] / fp, "s--", ms=3, color="tab:gray",
+                    label="peak power (solid: mean)")
     if k is not None:
         axs[0].legend(fontsize=8)
     if title:
