@@ -71,13 +71,34 @@ def run(args) -> int:
     if not parallel.is_root():  # mpiexec -n N: every process solves its slab, rank 0 alone writes and reports
         run_contact(cfg)
         return 0
-    if not args.quiet and plan.scaling is not None:
-        print(f"tengsim: {physical_line(plan, 'eps' in cfg)}", file=sys.stderr)
+    line = None if args.quiet or plan.scaling is None else f"tengsim: {physical_line(plan, 'eps' in cfg)}"
     stream = open_stream(out, args.resume, args.quiet)
-    res = run_streamed(lambda bar: run_contact(cfg, progress=bar, sink=stream), stream, args.quiet)
+    res = run_streamed(lambda bar: run_contact(cfg, progress=_Announced(bar, line), sink=stream), stream,
+                       args.quiet)
     if res is None:
         return 130
     return write_contact(res, out, args.plot, args.quiet, stream)
+
+
+class _Announced:
+    """The progress bar, saying ``line`` first once the run has started (its set-up passed: a bad input
+    found while building the run stays the one line of its error)."""
+
+    def __init__(self, bar, line):
+        self.bar, self.line = bar, line
+
+    def _say(self):
+        if self.line:
+            print(self.line, file=sys.stderr, flush=True)
+            self.line = None
+
+    def __call__(self, *args, **kwargs):
+        self._say()
+        return self.bar(*args, **kwargs)
+
+    def monitor(self, *args, **kwargs):
+        self._say()
+        return self.bar.monitor(*args, **kwargs)
 
 
 def physical_line(plan, eps_given: bool) -> str:
