@@ -149,3 +149,14 @@ def test_device_takes_a_load_controlled_contact_result_with_its_snap(tmp_path, c
     side = json.loads(out.with_suffix(".json").read_text())
     np.testing.assert_allclose(side["params"]["area"]["pressure_Pa"], t.pressure_Pa)
     assert "power: peak" in cap.out
+
+
+def test_a_relative_area_path_is_read_beside_the_config(tmp_path, capsys, monkeypatch):
+    design_file(tmp_path / "proj" / "d1")
+    cfg = tmp_path / "proj" / "dev.toml"
+    cfg.write_text('[device]\narea = "d1/design.nc"\n[run]\ncycles = 2\ndt_out = 1e-3\n')
+    monkeypatch.chdir(tmp_path)  # not the config's folder
+    out = tmp_path / "r.csv"
+    _run(["device", "fig7", "--config", str(cfg), "--out", str(out), "--quiet"], capsys)
+    side = json.loads(out.with_suffix(".json").read_text())
+    np.testing.assert_allclose(side["params"]["area"]["pressure_Pa"], P[1:5])

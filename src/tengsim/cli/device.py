@@ -117,6 +117,17 @@ def _typed_cli(table, values: dict) -> dict:
     return out
 
 
+def _area_beside(cfg: dict, source) -> dict:
+    """A [device] area given as a relative path that is not in the working folder but beside the config
+    file (``area = "d1/design.nc"`` next to the TOML) is read from there."""
+    dev = cfg.get("device")
+    area = dev.get("area") if isinstance(dev, dict) else None
+    if not source or not isinstance(area, str) or Path(area).is_absolute() or Path(area).exists():
+        return cfg
+    beside = Path(source).parent / area
+    return {**cfg, "device": {**dev, "area": str(beside)}} if beside.exists() else cfg
+
+
 def _out_path(run: dict, case: str) -> Path:
     """The output path (checked by suffix only: nothing is created before every input has been checked)."""
     out = run.get("out")
@@ -135,6 +146,7 @@ def execute(case: str, cfg: dict, cli: dict | None = None, quiet: bool = False, 
 
     cli = cli or {}
     dc.check_device_tables(cfg, source or "config")
+    cfg = _area_beside(cfg, source)
     ignored = []  # keys of the other command (run <-> sweep) in a config that serves both
     if "sweep" in cfg and case != "sweep":
         if case != "run":
