@@ -160,3 +160,16 @@ def test_a_relative_area_path_is_read_beside_the_config(tmp_path, capsys, monkey
     _run(["device", "fig7", "--config", str(cfg), "--out", str(out), "--quiet"], capsys)
     side = json.loads(out.with_suffix(".json").read_text())
     np.testing.assert_allclose(side["params"]["area"]["pressure_Pa"], P[1:5])
+
+
+@pytest.mark.parametrize("what, words", [("nosuch", "no design result 'nosuch'"),
+                                         ("nosuch.nc", "no design result 'nosuch.nc'"),
+                                         ("device.csv", "is a device result, not a contact or design result")])
+def test_bad_area_from_is_one_line_and_writes_nothing(tmp_path, capsys, monkeypatch, what, words):
+    monkeypatch.chdir(tmp_path)
+    if what == "device.csv":
+        _run(["device", "fig7", "--cycles", "1", "--dt", "1e-3", "--quiet", "--out", "device.csv"], capsys)
+    out = tmp_path / "x.csv"
+    assert main(["device", "fig7", "--area-from", what, "--out", str(out), "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and words in err and not out.exists()

@@ -112,6 +112,11 @@ def _typed_cli(table, values: dict) -> dict:
     names = {key: "--" + opt.replace("_", "-") for opt, (_, key) in _OPTIONS.items()}
     out = {}
     for key, raw in values.items():
+        if key == "area":  # --area-from: always a file (a design or contact result), never a number
+            from tengsim.device.areas import area_table_from_file
+
+            out[key] = area_table_from_file(raw)
+            continue
         f = dataclasses.replace(table.fields[key], name=names[key])
         out[key] = f.parse(raw)
     return out

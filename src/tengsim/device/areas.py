@@ -20,12 +20,14 @@ DESIGN_FILE = "design.nc"
 AREA_VARIABLE = "charged_area_fraction"
 
 
-def stable_branch(pressure_Pa, area_fraction, where: str = "area table"):
+def stable_branch(pressure_Pa, area_fraction, where: str = "area table", rows=None, hint: str = ""):
     """(pressures, fractions) of an approach with the repeats of a snap removed: at a pressure met again
     (a jump at constant load) the first state reached is kept.  A pressure that falls is an error naming
-    its row (0-based) and value, and the row before it."""
+    its row (0-based; ``rows``: the row numbers of the source, if the values were picked from it) and
+    value, and the row before it, then ``hint``."""
     p = np.asarray(pressure_Pa, dtype=float).ravel()
     a = np.asarray(area_fraction, dtype=float).ravel()
+    rows = np.arange(p.size) if rows is None else np.asarray(rows)
     if p.size != a.size:
         raise TengsimError(f"{where}: {p.size} pressures but {a.size} area fractions")
     keep = [0] if p.size else []
@@ -34,8 +36,8 @@ def stable_branch(pressure_Pa, area_fraction, where: str = "area table"):
         if p[i] == last or abs(p[i] - last) <= 1e-9 * max(abs(last), abs(p[i])):
             continue  # the landing state of a snap, at the pressure already kept
         if p[i] < last:
-            raise TengsimError(f"{where}: pressures must increase, but row {i} holds {p[i]:.6g} Pa after "
-                               f"{last:.6g} Pa (row {keep[-1]})")
+            raise TengsimError(f"{where}: pressures must increase, but row {rows[i]} holds {p[i]:.6g} Pa after "
+                               f"{last:.6g} Pa (row {rows[keep[-1]]}){hint}")
         keep.append(i)
     return p[keep], a[keep]
 
@@ -105,7 +107,9 @@ def area_table_from_contact(path) -> AreaTable:
         raise TengsimError(f"{where}: the approach has {rows.size} state(s) at a pressure >= 0; the device "
                            "needs at least 2")
     frac = np.asarray(t["contact_length_m"], float)[rows] ** 2 / float(cell)
-    pres, a = stable_branch(p[rows], np.clip(frac, 0.0, 1.0), where=where + " (approach rows at p >= 0)")
+    pres, a = stable_branch(p[rows], np.clip(frac, 0.0, 1.0), where=where, rows=rows,
+                            hint=" on the approach (a displacement-controlled run's force falls after a jump: "
+                                 "run it with --control load)")
     return AreaTable(pres, a)
 
 
