@@ -94,7 +94,9 @@ def plot_study(root, out, vars=MAP_VARS) -> list:
         raise TengsimError(f"{root} holds no study.nc (run tengsim sweep first)")
     ds = read_dataset(nc)
     dims = [d for d in ds["pull_off_F"].dims]
-    vars = [v for v in vars if v in ds and np.isfinite(ds[v].values.astype(float)).any()] or ["pull_off_F"]
+    have = lambda v: v in ds and np.isfinite(ds[v].values.astype(float)).any()  # noqa: E731
+    vars = [("pull_off_F" if v == "pull_off_Pa" and not have(v) else v) for v in vars]  # dimensionless: F
+    vars = [v for v in vars if have(v)] or ["pull_off_F"]
     n = len(vars)
     cols = min(3, n)
     rows = math.ceil(n / cols)
