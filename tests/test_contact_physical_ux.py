@@ -128,3 +128,13 @@ def test_d_max_help_states_the_load_control_default():
 
     f = {x.name: x for x in common_fields()}["d_max"]
     assert f.default == 4.0 and f"default {LoadPathSpec.d_max:g}" in f.help
+
+
+def test_the_path_ends_at_the_largest_load_asked_for(tmp_path, capsys):
+    """f_min = 1 kPa, f_step = 5 kPa, f_max = 20 kPa: the loads 1, 6, 11, 16 kPa and then 20 kPa (not 16)."""
+    out = tmp_path / "m.csv"
+    _run([*PYR, *LOAD, "--f-min", "1kPa", "--f-max", "20kPa", "--quiet", "--out", str(out)], capsys)
+    res = _res(out)
+    a = np.asarray(res.table["branch"]).astype(str) == "approach"
+    on = np.asarray(res.table["on_grid"]).astype(bool) & a
+    np.testing.assert_allclose(np.asarray(res.table["pressure_Pa"])[on], [1e3, 6e3, 11e3, 16e3, 20e3], rtol=2e-3)

@@ -33,15 +33,19 @@ def test_curves_of_a_physical_run_in_kpa_and_um_titled_with_the_shape(physical_l
     assert main(["plot", str(physical_load_run), "--out", "unused.png"]) == 0
     curves, maps = figs
     labels = _labels(curves)
-    assert labels[0] == ("rigid approach α (µm)", "nominal pressure p (kPa)")
+    assert labels[0] == ("rigid approach α (µm)", "force per cell f (µN)")
     assert labels[1] == ("rigid approach α (µm)", "contact length λc (µm)")
     assert labels[2] == ("nominal pressure p (kPa)", "contact length λc (µm)")
+    assert labels[3] == ("", "nominal pressure p (kPa)")  # the first panel's right-hand axis
     title = curves._suptitle.get_text()
     assert title.startswith("pyramid: pitch 10 µm, base 5 µm, height 3.5 µm; E* = 1 MPa, W = 50 mJ/m², ε = 100 nm")
-    for ax in curves.axes:  # the pressures drawn are the run's, in kPa
-        for line in ax.get_lines():
-            if ax.get_ylabel().startswith("nominal pressure"):
-                assert np.nanmax(line.get_ydata()) <= 20.01
+    res = load_result(physical_load_run)[1]
+    drawn = np.concatenate([ln.get_xdata() for ln in curves.axes[2].get_lines()])  # the run's pressures, in kPa
+    assert np.nanmax(drawn) == pytest.approx(np.nanmax(res.table["pressure_Pa"]) / 1e3, rel=1e-9)
+    lo, hi = curves.axes[0].get_ylim()  # the right-hand axis reads the same curve as a pressure
+    plo, phi = curves.axes[3].get_ylim()
+    k = float(np.nanmax(res.table["pressure_Pa"]) / 1e3 / (np.nanmax(res.table["F_N"]) * 1e6))
+    assert (plo, phi) == pytest.approx((lo * k, hi * k), rel=1e-9)
     img_axes = [ax for ax in maps.axes if ax.get_xlabel()]
     assert {ax.get_xlabel() for ax in img_axes} == {"x (µm)"} and {ax.get_ylabel() for ax in img_axes} == {"y (µm)"}
     titles = {ax.get_title() for ax in img_axes}

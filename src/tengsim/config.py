@@ -164,7 +164,7 @@ def _path_spec(vals, given, scaling):
         from tengsim.loadpath import LoadPathSpec
 
         f = {k: _load_F(k, vals[k], scaling) for k in _LOAD_KEYS if vals[k] is not None}
-        kw = {"d_min": vals["d_min"], "d_step": vals["d_step"]}
+        kw = {"d_min": vals["d_min"], "d_step": vals["d_step"], "to_max": True}  # the path ends at f_max
         if "d_max" in given:  # else LoadPathSpec's wider search range
             kw["d_max"] = vals["d_max"]
         if scaling is not None:  # a physical run: the approach extends itself to the loads asked for (no d_max
@@ -222,7 +222,8 @@ def common_fields() -> list:
         Field("f_min", "any", None, check=_load_value,
               help="control = load: first load, F of Eq. (10) per cell (default 0); in a physical run "
               "also a nominal pressure with a unit, e.g. '-2kPa'"),
-        Field("f_max", "any", None, check=_load_value, help="control = load: largest load (as f_min)"),
+        Field("f_max", "any", None, check=_load_value, help="control = load: largest load (as f_min), the "
+              "path's last (a shorter last step if f_max - f_min is no multiple of f_step)"),
         Field("f_step", "any", None, check=_load_value, help="control = load: load step (as f_min)"),
         Field("adaptive", "bool", False, help="control = approach: adaptive steps in D (d_step the largest)"),
         Field("adapt_tol", "float", None, help="adaptive: force error tolerance of a step (PathSpec default 0.15)"),

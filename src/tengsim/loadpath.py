@@ -72,7 +72,9 @@ class LoadPathSpec:
     extend: bool = False
     pa_per_F: float | None = None
     eps_m: float | None = None
-    """``extend``: the approach's search in D goes on past ``d_max`` (the span d_max - d_min doubled at each
+    to_max: bool = False
+    """``to_max``: f_max is a load of the path even where f_max - f_min is no multiple of f_step (the last
+    step is then shorter), so the path ends at the load asked for.  ``extend``: the approach's search in D goes on past ``d_max`` (the span d_max - d_min doubled at each
     reach, up to :data:`EXTEND_LIMIT` times the first span) until the load is met, so no d_max is to be
     guessed.  ``pa_per_F`` (Pa per unit of F) and ``eps_m`` (m per ε): a physical run's units, in which
     its errors name the loads and D."""
@@ -109,7 +111,10 @@ class LoadPathSpec:
 
     def targets(self) -> np.ndarray:
         k = int(np.floor((self.f_max - self.f_min) / self.f_step + 1e-9))
-        return self.f_min + self.f_step * np.arange(k + 1)
+        t = self.f_min + self.f_step * np.arange(k + 1)
+        if self.to_max and t[-1] < self.f_max - 1e-9 * self.f_step:
+            t = np.append(t, self.f_max)
+        return t
 
     def path_targets(self) -> list:
         """The loads the path visits, in increasing order: [(F, on the f_step lattice)], the lattice and the

@@ -75,43 +75,50 @@ def _scaled(values, unit):
 
 
 def plot_curves(res, path, title: str = "", keys=None) -> None:
-    """Pressure (or force) and contact length against the approach, and contact length against the
-    pressure, of one run: approach solid, retraction dashed, jumps as dots.
+    """Force per cell and contact length against the approach, and contact length against the force
+    (or the nominal pressure), of one run: approach solid, retraction dashed, jumps as dots.
 
     A physical run (columns F_N, contact_length_m, and pressure_Pa with a cell area) is drawn in physical
-    units with engineering prefixes (nm/µm, kPa, µN), titled with its shape, sizes and materials; a
-    dimensionless one in the units of Eq. (7), titled with its shape's numbers.
+    units: lengths with an engineering prefix (nm/µm), the force per cell in µN with the nominal pressure
+    (kPa) on a right-hand axis, the last panel against the pressure; titled with its shape, sizes and
+    materials.  A dimensionless one in the units of Eq. (7), titled with its shape's numbers.
     """
     plt = _plt()
     t = res.table
     params = res.params or {}
     eps = params.get("eps_m")
     physical = "F_N" in t and "contact_length_m" in t and eps
+    pressure = physical and "pressure_Pa" in t
     if physical:
         D, du = _scaled(np.asarray(t["D"], float) * eps, "m")
-        if "pressure_Pa" in t:
-            F, fu = _scaled(t["pressure_Pa"], "Pa")
-            fl = f"nominal pressure p ({fu})"
-        else:
-            F, fu = _scaled(t["F_N"], "N")
-            fl = f"force per cell f ({fu})"
-        L, lu = _scaled(t["contact_length_m"], "m")
-        view = type(res)(table={**t, "D": D, "F": F, "contact_length": L}, grid=res.grid)
-        dl, ll = f"rigid approach α ({du})", f"contact length λc ({lu})"
+        L, lu = np.asarray(t["contact_length_m"], float) * 1e6, "µm"  # the structures' own scale
+        fN = np.asarray(t["F_N"], float) * 1e6  # force per cell in µN (left axis of the first panel)
+        view = type(res)(table={**t, "D": D, "F": fN, "contact_length": L}, grid=res.grid)
+        dl, fl, ll = f"rigid approach α ({du})", "force per cell f (µN)", f"contact length λc ({lu})"
+        if pressure:
+            pk, pu = _scaled(t["pressure_Pa"], "Pa")
+            pl = f"nominal pressure p ({pu})"
+            pview = type(res)(table={**t, "D": D, "F": pk, "contact_length": L}, grid=res.grid)
     else:
         view = res
         unit = params.get("lateral_unit") or "ℓ"
         dl, fl, ll = "rigid approach D (ε)", "force per cell F (3π W ℓ²/ε)", f"contact length Λc ({unit})"
-    labels = [(dl, fl), (dl, ll), (fl, ll)]
-    fig, axs = plt.subplots(1, 3, figsize=(12, 3.9))
+    labels = [(dl, fl), (dl, ll), (pl if pressure else fl, ll)]
+    fig, axs = plt.subplots(1, 3, figsize=(12.5, 3.9), constrained_layout=True)
     _branches(axs[0], view, "D", "F", "k", "")
     _branches(axs[1], view, "D", "contact_length", "k", "")
-    _branches(axs[2], view, "F", "contact_length", "k", "")
+    _branches(axs[2], pview if pressure else view, "F", "contact_length", "k", "")
     for ax, (xl, yl) in zip(axs, labels):
         ax.set_xlabel(xl)
         ax.set_ylabel(yl)
         ax.grid(alpha=0.3)
     axs[0].legend(fontsize=8)
+    if pressure:  # the same curve read as a nominal pressure: a right-hand axis (p = f / cell area)
+        per = float(np.nanmax(np.abs(pk)) / np.nanmax(np.abs(fN))) if np.nanmax(np.abs(fN)) > 0 else 1.0
+        right = axs[0].twinx()
+        lo, hi = axs[0].get_ylim()
+        right.set_ylim(lo * per, hi * per)
+        right.set_ylabel(pl)
     head = run_title(params, keys)
     fig.suptitle(head + (f"\n{title}" if title else ""), fontsize=10)
     save(fig, path)
