@@ -16,15 +16,17 @@ APPROACH = np.array([np.nan, 0.05, 0.12, 0.2, 0.31, np.nan])  # 0 Pa and 80 kPa 
 RETRACTION = np.array([0.4, 0.45, 0.5, 0.55, 0.6, np.nan])
 
 
-def design_file(folder, approach=APPROACH, pressures=P):
-    """A design.nc written to the contract of `tengsim design` (CF-1.10 names, SI units)."""
+def design_file(folder, approach=APPROACH, pressures=P, dim="pressure"):
+    """A design.nc written to the contract of `tengsim design` (CF-1.10 names, SI units); ``dim``: the
+    pressure dimension's name ('applied_pressure': the coordinate ``pressure`` on it, the branch names
+    stored as a char array, as the design writer does)."""
     folder.mkdir(parents=True, exist_ok=True)
-    bv = lambda a, r: (("branch", "pressure"), np.vstack([a, r]))  # noqa: E731
+    bv = lambda a, r: (("branch", dim), np.vstack([a, r]))  # noqa: E731
     ds = xr.Dataset(
         {"charged_area_fraction": bv(approach, RETRACTION), "repulsive_area_fraction": bv(approach / 2, RETRACTION / 2),
          "voc_eq12": bv(approach * 100, RETRACTION * 100), "voc_eq17": bv(approach * 90, RETRACTION * 90),
          "dvoc_dp": bv(approach * 1e-3, RETRACTION * 1e-3)},
-        coords={"pressure": ("pressure", pressures, {"units": "Pa", "long_name": "nominal pressure"}),
+        coords={"pressure": (dim, pressures, {"units": "Pa", "long_name": "nominal pressure"}),
                 "branch": ("branch", np.array(["approach", "retraction"], dtype=object))},
         attrs={"Conventions": "CF-1.10", "title": "synthetic design", "shape": "pyramid",
                "shape_params": json.dumps({"pitch_m": 1e-5, "base_m": 5e-6, "height_m": 3.5e-6}), "E_star_Pa": 1e6,
@@ -33,12 +35,15 @@ def design_file(folder, approach=APPROACH, pressures=P):
                "charged_area_definition": "gap below the LJ93 force peak"})
     for k in ("charged_area_fraction", "repulsive_area_fraction"):
         ds[k].attrs["units"] = "1"
+    if dim != "pressure":
+        ds["branch"].encoding["dtype"] = "S1"
     ds.to_netcdf(folder / "design.nc", engine="h5netcdf")
     return folder / "design.nc"
 
 
-def test_area_table_from_design_takes_the_approach_branch(tmp_path):
-    path = design_file(tmp_path / "d1")
+@pytest.mark.parametrize("dim", ["pressure", "applied_pressure"])
+def test_area_table_from_design_takes_the_approach_branch(tmp_path, dim):
+    path = design_file(tmp_path / "d1", dim=dim)
     for where in (path, tmp_path / "d1", str(path)):
         t = area_table_from_design(where)
         assert isinstance(t, AreaTable)

@@ -70,7 +70,7 @@ def area_table_from_design(path) -> AreaTable:
         raise TengsimError(f"area: {str(p)!r}: pressure in {units!r}, expected 'Pa'")
     frac = ds[AREA_VARIABLE]
     if "branch" in frac.dims:
-        branches = [str(b) for b in ds["branch"].values]
+        branches = [b.decode() if isinstance(b, bytes) else str(b) for b in ds["branch"].values]
         if "approach" not in branches:
             raise TengsimError(f"area: {str(p)!r} has no approach branch (branches: {', '.join(branches)})")
         frac = frac.isel(branch=branches.index("approach"))
