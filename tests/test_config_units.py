@@ -177,7 +177,13 @@ def test_cli_help_from_registry_and_schema(capsys):
     for name in SHAPES.names():
         assert name in out
     assert "default 0.5" in out and "no default" in out  # --tabor
-    assert "--half-width" in out and "--k" in out and "--wavelength" in out
+    pages = {}
+    for shape in ("cube", "hemisphere", "sinusoid"):  # a shape's keys: on its own page
+        with pytest.raises(SystemExit):
+            main(["contact", shape, "--help"])
+        pages[shape] = " ".join(capsys.readouterr().out.split())
+    assert "--half-width" in pages["cube"] and "--k" in pages["hemisphere"] and "--wavelength" in pages["sinusoid"]
+    assert "--half-width" not in pages["sinusoid"]
 
 
 def test_contact_table_lists_the_shape_keys():

@@ -302,11 +302,18 @@ def test_sweep_cli_warns_and_flags_edge(tmp_path, capsys):
     assert _strict(out.with_suffix(".json").read_text())["optimum_at_edge"] is True
 
 
-def test_sweep_refuses_a_load_it_would_ignore(tmp_path, capsys):
+def test_sweep_names_the_load_it_ignores(tmp_path, capsys):
+    """Issue 29: one config serves `device run` and `device sweep`; the sweep says, in one line, that it
+    does not use [device] load_ohm, and its loads are the [sweep] range's."""
     cfg = tmp_path / "c.toml"
-    cfg.write_text("[device]\nload_ohm = 1e6\n")
-    assert main(["device", "sweep", "--out", str(tmp_path / "s.csv"), "--config", str(cfg), "--quiet"]) == 2
-    assert "load_ohm" in capsys.readouterr().err
+    cfg.write_text("[device]\nload_ohm = 1e6\n[sweep]\nr_min_ohm = 1e4\nr_max_ohm = 1e8\npoints = 2\nsteady = false\n"
+                   "[run]\ncycles = 2\ndt_out = 1e-3\n")
+    assert main(["device", "sweep", "--out", str(tmp_path / "s.csv"), "--config", str(cfg)]) == 0
+    err = capsys.readouterr().err
+    assert [ln for ln in err.splitlines() if "load_ohm" in ln] == [
+        "tengsim: note: the sweep does not use [device] load_ohm (used by `tengsim device run`)"]
+    names, data = _body(tmp_path / "s.csv")
+    np.testing.assert_allclose(data[:, names.index("R")], [1e4, 1e8])
 
 
 def test_device_run_says_where_it_wrote(tmp_path, capsys):

@@ -97,7 +97,9 @@ def test_plot_maps_axes_labels_aspect_colourbars(result_files, monkeypatch):
     cbars = [ax for ax in fig.axes if not ax.get_xlabel()]
     assert len(main_axes) == 2 * len(res.maps) == 4  # P and H at D = 0.5 on both branches
     for ax in main_axes:
-        assert ax.get_xlabel() == "$X$ (dimensionless)" and ax.get_ylabel() == "$Y$ (dimensionless)"
+        unit = res.params["lateral_unit"]  # the run's lateral unit in words (issue 29: no "(dimensionless)")
+        assert ax.get_xlabel() == f"X ({unit})" and ax.get_ylabel() == f"Y ({unit})"
+        assert "dimensionless" not in ax.get_xlabel()
         assert ax.get_aspect() == 1.0
     labels = sorted(ax.get_ylabel() for ax in cbars)
     assert labels == [r"gap $H$ ($\varepsilon$)"] * 2 + [r"pressure $P$ ($W_{ad}/\varepsilon$, Eq. 7)"] * 2

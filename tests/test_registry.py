@@ -276,7 +276,7 @@ out = "{out2}"
     assert "law lj93 has no key 'factor' (its keys: none)" in capsys.readouterr().err
     with pytest.raises(SystemExit):
         main(["contact", "--help"])
-    assert "--factor FACTOR parameter of law half_lj, in units of W and ε [law half_lj: default 0.5]" in " ".join(
+    assert "--factor parameter of law half_lj, in units of W and ε [law half_lj: default 0.5]" in " ".join(
         capsys.readouterr().out.split())
 
 

@@ -7,23 +7,71 @@ is extended (:mod:`tengsim.registry`, filled by :mod:`tengsim.plugins`).  No ten
 this one: it is the user's entry point only.
 """
 from tengsim._version import __version__
-from tengsim.analysis import contact_length, force, repulsive_area
-from tengsim.contact import simulate, simulate_pyramid
-from tengsim.errors import TengsimError
-from tengsim.grid import Grid
-from tengsim.kernels import FreeKernel, PeriodicKernel
-from tengsim.laws import LJ93, Exponential, MaugisDugdale, Repulsive
-from tengsim.loadpath import LoadPathSpec, run_load_path
-from tengsim.observers import Summary
-from tengsim.path import PathSpec, run_path
-from tengsim.plugins import KERNELS, LAWS, OBSERVERS, SHAPES, SOLVERS
-from tengsim.resolve import resolve_contact
-from tengsim.results import ContactResult, Jump
-from tengsim.shapes import (Array, Cone, Cube, FlatPunch, HeightMap, Hemisphere, Line, Paraboloid, Pyramid,
-                            Sinusoid1D, Topography, random_rough)
-from tengsim.solvers import Equilibrium, FastSolver, Problem, State, VSRSolver
-from tengsim.status import ResultStatusError
-from tengsim.units import Scaling, parse_quantity
+
+_WHERE = {  # public name -> the module defining it, imported on first use (PEP 562): 'import tengsim'
+    # and the command line's start stay light (no numpy until something numerical is asked for)
+    "contact_length": "tengsim.analysis",
+    "force": "tengsim.analysis",
+    "repulsive_area": "tengsim.analysis",
+    "simulate": "tengsim.contact",
+    "simulate_pyramid": "tengsim.contact",
+    "TengsimError": "tengsim.errors",
+    "Grid": "tengsim.grid",
+    "FreeKernel": "tengsim.kernels",
+    "PeriodicKernel": "tengsim.kernels",
+    "LJ93": "tengsim.laws",
+    "Exponential": "tengsim.laws",
+    "MaugisDugdale": "tengsim.laws",
+    "Repulsive": "tengsim.laws",
+    "LoadPathSpec": "tengsim.loadpath",
+    "run_load_path": "tengsim.loadpath",
+    "Summary": "tengsim.observers",
+    "PathSpec": "tengsim.path",
+    "run_path": "tengsim.path",
+    "KERNELS": "tengsim.plugins",
+    "LAWS": "tengsim.plugins",
+    "OBSERVERS": "tengsim.plugins",
+    "SHAPES": "tengsim.plugins",
+    "SOLVERS": "tengsim.plugins",
+    "resolve_contact": "tengsim.resolve",
+    "ContactResult": "tengsim.results",
+    "Jump": "tengsim.results",
+    "Array": "tengsim.shapes",
+    "Cone": "tengsim.shapes",
+    "Cube": "tengsim.shapes",
+    "FlatPunch": "tengsim.shapes",
+    "HeightMap": "tengsim.shapes",
+    "Hemisphere": "tengsim.shapes",
+    "Line": "tengsim.shapes",
+    "Paraboloid": "tengsim.shapes",
+    "Pyramid": "tengsim.shapes",
+    "Sinusoid1D": "tengsim.shapes",
+    "Topography": "tengsim.shapes",
+    "random_rough": "tengsim.shapes",
+    "Equilibrium": "tengsim.solvers",
+    "FastSolver": "tengsim.solvers",
+    "Problem": "tengsim.solvers",
+    "State": "tengsim.solvers",
+    "VSRSolver": "tengsim.solvers",
+    "ResultStatusError": "tengsim.status",
+    "Scaling": "tengsim.units",
+    "parse_quantity": "tengsim.units",
+}
+
+
+def __getattr__(name):
+    mod = _WHERE.get(name)
+    if mod is None:
+        raise AttributeError(f"module 'tengsim' has no attribute {name!r}")
+    import importlib
+
+    value = getattr(importlib.import_module(mod), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__():
+    return sorted(set(globals()) | set(_WHERE))
 
 
 def run_contact(cfg: dict, progress=None, sink=None, observe=None):

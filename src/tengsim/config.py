@@ -164,9 +164,12 @@ def _path_spec(vals, given, scaling):
         from tengsim.loadpath import LoadPathSpec
 
         f = {k: _load_F(k, vals[k], scaling) for k in _LOAD_KEYS if vals[k] is not None}
-        kw = {"d_min": vals["d_min"], "d_step": vals["d_step"]}
+        kw = {"d_min": vals["d_min"], "d_step": vals["d_step"], "to_max": True}  # the path ends at f_max
         if "d_max" in given:  # else LoadPathSpec's wider search range
             kw["d_max"] = vals["d_max"]
+        if scaling is not None:  # a physical run: the approach extends itself to the loads asked for (no d_max
+            # to guess), and its errors name loads in Pa and D in metres
+            kw.update(extend="d_max" not in given, pa_per_F=scaling.pressure(1.0), eps_m=scaling.eps)
         return LoadPathSpec(f.get("f_min", 0.0), f["f_max"], f["f_step"], refine_levels=vals["refine_levels"],
                             maps_at=_maps_at(vals, scaling, control), **kw)
     bad = [k for k in _LOAD_KEYS if k in given]
@@ -191,6 +194,8 @@ def _check_maps_out(maps_at, out) -> None:
 
 def common_fields() -> list:
     """The [contact] keys every shape has (choices and help read from the registries)."""
+    from tengsim.loadpath import LoadPathSpec
+
     return [
         Field("shape", "str", "pyramid", check=SHAPES.canonical,
               help="registered shape: " + SHAPES.help()),
@@ -202,7 +207,8 @@ def common_fields() -> list:
               help="interaction range ε (physical run; or give tabor; a bare number is m, 1e-12 to 1)"),
         Field("dx", "any", 0.1, help="grid spacing in X units; in a physical run also a length, e.g. '20nm'"),
         Field("d_min", default=-1.0, help="first rigid approach D of the path, in ε"),
-        Field("d_max", default=4.0, help="last rigid approach D, in ε"),
+        Field("d_max", default=4.0, help="last rigid approach D, in ε (control = load: the search range of D, "
+              f"default {LoadPathSpec.d_max:g}; a physical run without d_max extends it until the loads are met)"),
         Field("d_step", default=0.05, help="step in D, in ε"),
         Field("refine_levels", "int", 4, help="step bisections before a change is called a jump"),
         Field("maps_at", "any", (), check=_maps_values,
@@ -216,7 +222,8 @@ def common_fields() -> list:
         Field("f_min", "any", None, check=_load_value,
               help="control = load: first load, F of Eq. (10) per cell (default 0); in a physical run "
               "also a nominal pressure with a unit, e.g. '-2kPa'"),
-        Field("f_max", "any", None, check=_load_value, help="control = load: largest load (as f_min)"),
+        Field("f_max", "any", None, check=_load_value, help="control = load: largest load (as f_min), the "
+              "path's last (a shorter last step if f_max - f_min is no multiple of f_step)"),
         Field("f_step", "any", None, check=_load_value, help="control = load: load step (as f_min)"),
         Field("adaptive", "bool", False, help="control = approach: adaptive steps in D (d_step the largest)"),
         Field("adapt_tol", "float", None, help="adaptive: force error tolerance of a step (PathSpec default 0.15)"),

@@ -69,6 +69,15 @@ class LoadPathSpec:
     f_tol: float | None = None
     retract: bool = True
     maps_at: tuple = ()
+    extend: bool = False
+    pa_per_F: float | None = None
+    eps_m: float | None = None
+    to_max: bool = False
+    """``to_max``: f_max is a load of the path even where f_max - f_min is no multiple of f_step (the last
+    step is then shorter), so the path ends at the load asked for.  ``extend``: the approach's search in D goes on past ``d_max`` (the span d_max - d_min doubled at each
+    reach, up to :data:`EXTEND_LIMIT` times the first span) until the load is met, so no d_max is to be
+    guessed.  ``pa_per_F`` (Pa per unit of F) and ``eps_m`` (m per ε): a physical run's units, in which
+    its errors name the loads and D."""
 
     def __post_init__(self):
         finite("f_min", self.f_min)
@@ -102,7 +111,10 @@ class LoadPathSpec:
 
     def targets(self) -> np.ndarray:
         k = int(np.floor((self.f_max - self.f_min) / self.f_step + 1e-9))
-        return self.f_min + self.f_step * np.arange(k + 1)
+        t = self.f_min + self.f_step * np.arange(k + 1)
+        if self.to_max and t[-1] < self.f_max - 1e-9 * self.f_step:
+            t = np.append(t, self.f_max)
+        return t
 
     def path_targets(self) -> list:
         """The loads the path visits, in increasing order: [(F, on the f_step lattice)], the lattice and the
@@ -112,6 +124,22 @@ class LoadPathSpec:
         extra = [(f, False) for f in sorted(set(self.maps_at)) if all(abs(f - g) > tol for g, _ in lattice)]
         return sorted(lattice + extra)
 
+    def load_text(self, F: float) -> str:
+        """A load as the user gave it: 'p kPa (F = f)' in a physical run, 'F = f' otherwise."""
+        if self.pa_per_F is None:
+            return f"F = {F:.6g}"
+        from tengsim.units import format_si
+
+        return f"{format_si(F * self.pa_per_F, 'Pa', 4)} (F = {F:.6g})"
+
+    def d_text(self, D: float) -> str:
+        """D in ε, with its length in a physical run."""
+        if self.eps_m is None:
+            return f"{D:.6g}"
+        from tengsim.units import format_si
+
+        return f"{D:.6g} ε ({format_si(D * self.eps_m, 'm', 4)})"
+
     def extra_params(self) -> dict:
         return {"control": "load", "f_min": self.f_min, "f_max": self.f_max, "f_step": self.f_step,
                 "f_tol": self.tol_F}
@@ -119,6 +147,10 @@ class LoadPathSpec:
     def d_spec(self) -> PathSpec:
         return PathSpec(self.d_min, self.d_max, self.d_step, refine_levels=self.refine_levels,
                         jump_h=self.jump_h)
+
+
+EXTEND_LIMIT = 64
+"""With ``extend``, the D search of a load stops at d_min + EXTEND_LIMIT (d_max - d_min)."""
 
 
 class _Out(Exception):
@@ -139,6 +171,8 @@ class _LoadBranch:
         self.walker = Branch(U0, law, kernel, solver, spec.d_spec(),
                               lambda D, eq, on_grid, jump: self.trail.append((D, eq, jump)))
         self.h_min = spec.d_step / 2 ** int(spec.refine_levels)
+        self.d_max = spec.d_max  # with spec.extend, raised as the approach needs (_walk)
+        self.d_limit = spec.d_min + EXTEND_LIMIT * (spec.d_max - spec.d_min) if spec.extend else spec.d_max
 
     def F(self, eq) -> float:
         return force(eq.P, self.grid)
@@ -151,7 +185,9 @@ class _LoadBranch:
         """One D step in direction s from the current end of the walk; returns its new points."""
         D0, eq0 = self.pts[-1][0], self.pts[-1][1]
         D1 = D0 + s * self.spec.d_step
-        if D1 < self.spec.d_min - 1e-12 or D1 > self.spec.d_max + 1e-12:
+        while D1 > self.d_max + 1e-12 and self.d_max < self.d_limit:  # extend: the span doubled, to the limit
+            self.d_max = min(self.d_limit, self.d_max + (self.d_max - self.spec.d_min))
+        if D1 < self.spec.d_min - 1e-12 or D1 > self.d_max + 1e-12:
             raise _Out()
         self.trail = []
         self.walker.advance(D0, eq0, D1, 0, False)
@@ -274,8 +310,8 @@ class _LoadBranch:
         if err <= self.spec.tol_F:
             return eq
         lo, hi, how = self.bracket if self.bracket is not None else (self.D, self.D, "")
-        msg = (f"{self.name}: {what} F = {Ft:.6g} not met: |F - target| = {err:.3g} > f_tol = {self.spec.tol_F:.3g}"
-               f" (D in [{lo:.6g}, {hi:.6g}]{', ' + how if how else ''})")
+        msg = (f"{self.name}: {what} {self.spec.load_text(Ft)} not met: |F - target| = {err:.3g} > f_tol = "
+               f"{self.spec.tol_F:.3g} (D in [{lo:.6g}, {hi:.6g}]{', ' + how if how else ''})")
         self.misses.append(msg)
         return dataclasses.replace(eq, converged=False, message=msg)
 
@@ -286,6 +322,16 @@ class _LoadBranch:
             self.set(D, eq)
             self.emit(D, eq, False, True)
         return False
+
+
+def _not_reached(spec: LoadPathSpec, branch: _LoadBranch, Ft: float) -> str:
+    """The error of a load the approach did not reach: the load, the highest reached, and the D range."""
+    best = max((p[2] for p in getattr(branch, "pts", ())), default=branch.Fc)
+    best = max(best, branch.Fc)
+    how = (f"the search in D was extended to {spec.d_text(branch.d_max)} (the limit, {EXTEND_LIMIT} times the "
+           f"first range)" if spec.extend else f"within d_max = {spec.d_text(spec.d_max)}; raise d_max")
+    return (f"load {spec.load_text(Ft)} is not reached: the highest load reached is {spec.load_text(best)}, "
+            f"{how}")
 
 
 def run_load_path(U0, law, kernel, solver, spec: LoadPathSpec, start: State | None = None,
@@ -312,7 +358,7 @@ def run_load_path(U0, law, kernel, solver, spec: LoadPathSpec, start: State | No
         if Ft < up.Fc - spec.tol_F and up.D == spec.d_min:
             continue  # a load pulling harder than the far field: the body stays away
         if not up.to(Ft, on_lattice, map_at(Ft)):
-            raise TengsimError(f"load F={Ft:g} is not reached within d_max={spec.d_max:g}; raise d_max")
+            raise TengsimError(_not_reached(spec, up, Ft))
     branches = [up]
     if spec.retract:
         down = _LoadBranch(U0, law, kernel, solver, spec, rec.on_row("retraction"), "retraction")
@@ -328,9 +374,11 @@ def run_load_path(U0, law, kernel, solver, spec: LoadPathSpec, start: State | No
     misses = [m for b in branches for m in b.misses]
     if misses:
         res.params["load_not_met"] = "; ".join(misses)
+    if up.d_max > spec.d_max:
+        res.params["d_max_reached"] = up.d_max  # the search range the approach extended itself to
     absent = rec.maps_missing([b.name for b in branches])
     if absent:  # requested, but that branch has no state at that load: said, not dropped silently
-        res.params["maps_not_made"] = "; ".join(f"{b} F = {m:g}" for b, m in absent) + (
+        res.params["maps_not_made"] = "; ".join(f"{b} {spec.load_text(m)}" for b, m in absent) + (
             " (no state at that load on that branch: below the load at rest on the approach, past the "
             "pull-off on the retraction)")
     return res

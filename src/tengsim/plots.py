@@ -43,35 +43,84 @@ def _branches(ax, res, x, y, color, label, jumps=True):
             ax.plot(t[x][j - 1], t[y][j - 1], "o", color=color, ms=3, mfc="none")
 
 
-def plot_curves(res, path, title: str = "") -> None:
-    """F(D), Λc(D) and Λc(F) of one run, approach solid and retraction dashed, jumps as dots.
+def run_title(params: dict, keys=None) -> str:
+    """The shape and its parameters, then the materials, of a run (its saved params): for a physical run
+    'pyramid: pitch 10 µm, base 5 µm, height 3.5 µm; E* = 1 MPa, W = 50 mJ/m², ε = 100 nm, μ = 0.8'; for a
+    dimensionless one the shape's numbers as given (``keys``: the shape's own keys, to leave out the run's)."""
+    from tengsim.units import format_si
 
-    A physical run (columns F_N and contact_length_m, D in ε from its scaling) is drawn in
-    µN, µm and nm; a dimensionless one in the units of Eq. (7).
+    p = params or {}
+    cfg = p.get("config") if isinstance(p.get("config"), dict) else {}
+    shape = str(cfg.get("shape") or p.get("shape") or "").lower()
+    mu = p.get("tabor")
+    if "eps_m" not in p:  # dimensionless: the shape's own numbers as given
+        own = ", ".join(f"{k} {v}" for k, v in cfg.items() if k not in ("shape", "tabor") and not isinstance(v, dict)
+                        and (keys is None or k in keys))
+        return f"{shape}{': ' + own if own else ''}" + (f"; μ = {mu:.3g}" if isinstance(mu, (int, float)) else "")
+    sizes = [f"{k[:-2].replace('_', ' ')} {format_si(v, 'm')}" for k, v in p.items()
+             if k.endswith("_m") and k not in ("eps_m", "lateral_m") and isinstance(v, (int, float))]
+    mats = [f"E* = {format_si(p['E_star_Pa'], 'Pa')}", f"W = {1e3 * p['W_J_m2']:.3g} mJ/m²",
+            f"ε = {format_si(p['eps_m'], 'm')}"] + ([f"μ = {mu:.3g}"] if isinstance(mu, (int, float)) else [])
+    return f"{shape}: {', '.join(sizes)}; {', '.join(mats)}"
+
+
+def _scaled(values, unit):
+    """(values in an engineering-prefixed unit, that unit): µm, kPa, µN, ... chosen from the largest value."""
+    from tengsim.units import si_prefix
+
+    v = np.asarray(values, dtype=float)
+    big = float(np.nanmax(np.abs(v))) if v.size and np.isfinite(v).any() else 0.0
+    f, u = si_prefix(big, unit)
+    return v / f, u
+
+
+def plot_curves(res, path, title: str = "", keys=None) -> None:
+    """Force per cell and contact length against the approach, and contact length against the force
+    (or the nominal pressure), of one run: approach solid, retraction dashed, jumps as dots.
+
+    A physical run (columns F_N, contact_length_m, and pressure_Pa with a cell area) is drawn in physical
+    units: lengths with an engineering prefix (nm/µm), the force per cell in µN with the nominal pressure
+    (kPa) on a right-hand axis, the last panel against the pressure; titled with its shape, sizes and
+    materials.  A dimensionless one in the units of Eq. (7), titled with its shape's numbers.
     """
     plt = _plt()
     t = res.table
-    eps = (res.params or {}).get("eps_m")
+    params = res.params or {}
+    eps = params.get("eps_m")
     physical = "F_N" in t and "contact_length_m" in t and eps
+    pressure = physical and "pressure_Pa" in t
     if physical:
-        view = type(res)(table={**t, "D": t["D"] * eps * 1e9, "F": t["F_N"] * 1e6,
-                                "contact_length": t["contact_length_m"] * 1e6}, grid=res.grid)
-        labels = [("approach α (nm)", "force per cell f (µN)"), ("approach α (nm)", r"contact length $\lambda_c$ (µm)"),
-                  ("force per cell f (µN)", r"contact length $\lambda_c$ (µm)")]
+        D, du = _scaled(np.asarray(t["D"], float) * eps, "m")
+        L, lu = np.asarray(t["contact_length_m"], float) * 1e6, "µm"  # the structures' own scale
+        fN = np.asarray(t["F_N"], float) * 1e6  # force per cell in µN (left axis of the first panel)
+        view = type(res)(table={**t, "D": D, "F": fN, "contact_length": L}, grid=res.grid)
+        dl, fl, ll = f"rigid approach α ({du})", "force per cell f (µN)", f"contact length λc ({lu})"
+        if pressure:
+            pk, pu = _scaled(t["pressure_Pa"], "Pa")
+            pl = f"nominal pressure p ({pu})"
+            pview = type(res)(table={**t, "D": D, "F": pk, "contact_length": L}, grid=res.grid)
     else:
         view = res
-        labels = [("D", "F"), ("D", r"$\Lambda_c$"), ("F", r"$\Lambda_c$")]
-    fig, axs = plt.subplots(1, 3, figsize=(12, 3.6))
+        unit = params.get("lateral_unit") or "ℓ"
+        dl, fl, ll = "rigid approach D (ε)", "force per cell F (3π W ℓ²/ε)", f"contact length Λc ({unit})"
+    labels = [(dl, fl), (dl, ll), (pl if pressure else fl, ll)]
+    fig, axs = plt.subplots(1, 3, figsize=(12.5, 3.9), constrained_layout=True)
     _branches(axs[0], view, "D", "F", "k", "")
     _branches(axs[1], view, "D", "contact_length", "k", "")
-    _branches(axs[2], view, "F", "contact_length", "k", "")
+    _branches(axs[2], pview if pressure else view, "F", "contact_length", "k", "")
     for ax, (xl, yl) in zip(axs, labels):
         ax.set_xlabel(xl)
         ax.set_ylabel(yl)
         ax.grid(alpha=0.3)
     axs[0].legend(fontsize=8)
-    if title:
-        fig.suptitle(title)
+    if pressure:  # the same curve read as a nominal pressure: a right-hand axis (p = f / cell area)
+        per = float(np.nanmax(np.abs(pk)) / np.nanmax(np.abs(fN))) if np.nanmax(np.abs(fN)) > 0 else 1.0
+        right = axs[0].twinx()
+        lo, hi = axs[0].get_ylim()
+        right.set_ylim(lo * per, hi * per)
+        right.set_ylabel(pl)
+    head = run_title(params, keys)
+    fig.suptitle(head + (f"\n{title}" if title else ""), fontsize=10)
     save(fig, path)
 
 
@@ -143,60 +192,119 @@ def plot_fig5(curves: dict, path) -> None:
     save(fig, path)
 
 
-def plot_timeseries(data, path, title: str = "") -> None:
-    """Device time series read back from a file (columns t, y, Q, I, V, V_oc, I_sc)."""
+_SERIES = (("y", "displacement y", "m"), ("Q", "charge Q", "C"), ("I", "current I", "A"), ("V", "voltage V", "V"),
+           ("power", "power into the load", "W"), ("V_oc", "open-circuit voltage $V_{OC}$", "V"),
+           ("I_sc", "short-circuit current $I_{SC}$", "A"))
+
+
+def plot_timeseries(data, path, title: str = "", period: float | None = None) -> None:
+    """Device time series read back from a file (columns t, y, Q, I, V, V_oc, I_sc, power): one panel per
+    series in engineering-prefixed units (mm, nC, µA, V, µW), no axis offsets; the power panel from
+    V·I where the file has no power column.  With the waveform's ``period`` (s), each panel is scaled to
+    the settled cycles and the first period (the start transient of Q(0) = 0) is shaded, clipped."""
     plt = _plt()
-    names = [("y", "y (m)"), ("Q", "Q (C)"), ("I", "I (A)"), ("V", "V (V)"), ("V_oc", "$V_{OC}$ (V)"),
-             ("I_sc", "$I_{SC}$ (A)")]
-    have = [(k, lab) for k, lab in names if k in data]
-    fig, axs = plt.subplots(len(have), 1, figsize=(7, 1.6 * len(have)), sharex=True, squeeze=False)
-    t = np.asarray(data["t"])
-    for ax, (k, lab) in zip(axs[:, 0], have):
-        ax.plot(t, np.asarray(data[k]), lw=0.8)
-        ax.set_ylabel(lab)
+    data = {k: np.asarray(data[k]) for k in ("t", *(k for k, _, _ in _SERIES)) if k in data}  # a Dataset too
+    if "power" not in data and "V" in data and "I" in data:
+        data["power"] = np.asarray(data["V"], float) * np.asarray(data["I"], float)
+    have = [(k, word, u) for k, word, u in _SERIES if k in data]
+    fig, axs = plt.subplots(len(have), 1, figsize=(7, 1.7 * len(have)), sharex=True, squeeze=False,
+                            constrained_layout=True)
+    from tengsim.units import si_prefix
+
+    t_s = np.asarray(data["t"], float)
+    t, tu = _scaled(t_s, "s")
+    settled = t_s >= t_s[0] + period - 1e-12 if period and t_s[-1] - t_s[0] >= 2 * period - 1e-12 else None
+    clipped = False
+    for ax, (k, word, unit) in zip(axs[:, 0], have):
+        raw = np.asarray(data[k], float)
+        shown = raw if settled is None else raw[settled]  # the prefix suits what the panel shows
+        f, u = si_prefix(float(np.nanmax(np.abs(shown))) if shown.size else 0.0, unit)
+        y = raw / f
+        ax.plot(t, y, lw=0.8)
+        if settled is not None and np.ptp(y[settled]) > 0:
+            lo, hi = float(np.min(y[settled])), float(np.max(y[settled]))
+            pad = 0.08 * (hi - lo)
+            if np.min(y) < lo - pad or np.max(y) > hi + pad:  # the start spike would hide the cycles
+                ax.set_ylim(lo - pad, hi + pad)
+                ax.axvspan(t[0], t[np.argmax(settled)], color="0.9", zorder=0)
+                clipped = True
+        ax.set_ylabel(f"{word}\n({u})", fontsize=8)
+        ax.ticklabel_format(axis="y", useOffset=False, style="plain")
         ax.grid(alpha=0.3)
-    axs[-1, 0].set_xlabel("t (s)")
-    if title:
-        fig.suptitle(title)
+    axs[-1, 0].set_xlabel(f"time t ({tu})")
+    note = "grey: first period, the start transient of Q(0) = 0, clipped" if clipped else ""
+    if title or note:
+        fig.suptitle("\n".join(x for x in (title, note) if x), fontsize=10)
     save(fig, path)
 
 
-def plot_maps(res, path, title: str = "") -> None:
-    """Saved pressure and gap maps of a contact result: one row per map, P (Eq. 8) and H side by side,
-    on the cell's X, Y axes (for the pyramid in units of ε m/n, Eq. 7), equal aspect, colour bars with
-    units (P in W/ε, H in ε)."""
+def _map_pressure(res, m) -> float | None:
+    """The nominal pressure (Pa) of the row a map was saved at (same branch, same D), or None."""
+    t = res.table
+    if "pressure_Pa" not in t:
+        return None
+    br = np.asarray(t["branch"]).astype(str)
+    D = np.asarray(t["D"], float)
+    rows = np.flatnonzero((br == str(m["branch"])) & np.isclose(D, float(m["D"]), rtol=1e-9, atol=1e-9))
+    return float(np.asarray(t["pressure_Pa"], float)[rows[0]]) if rows.size else None
+
+
+def plot_maps(res, path, title: str = "", keys=None) -> None:
+    """Saved pressure and gap maps of a contact result: one row per map, pressure and gap side by side,
+    equal aspect, colour bars with units.  A physical run: x, y in µm, the contact pressure in kPa (or
+    MPa), the gap in nm, each map titled with its nominal pressure; a dimensionless one in the units of
+    Eq. (7) (P in W/ε, H in ε)."""
     from tengsim.errors import TengsimError
+    from tengsim.units import format_si
 
     if not res.maps:
         raise TengsimError("the result holds no maps (run with --maps D1,D2,...)")
     if res.grid is None:
         raise TengsimError("the result has no grid, so its maps cannot be placed")
     plt = _plt()
-    g = res.grid
-    unit = r"$\varepsilon m/n$" if res.params.get("shape") == "Pyramid" else "dimensionless"  # Eq. 7
-    ext = [g.x[0] - g.dx / 2, g.x[-1] + g.dx / 2, g.y[0] - g.dy / 2, g.y[-1] + g.dy / 2]
+    g, p = res.grid, res.params or {}
+    eps, lat = p.get("eps_m"), p.get("lateral_m")
+    physical = bool(eps and lat and p.get("W_J_m2"))
+    ext = np.array([g.x[0] - g.dx / 2, g.x[-1] + g.dx / 2, g.y[0] - g.dy / 2, g.y[-1] + g.dy / 2])
+    if physical:
+        ext, xu = _scaled(ext * lat, "m")
+        xl, yl = f"x ({xu})", f"y ({xu})"
+    else:
+        unit = p.get("lateral_unit") or "ℓ"
+        xl, yl = f"X ({unit})", f"Y ({unit})"
     n = len(res.maps)
     fig, axs = plt.subplots(n, 2, figsize=(9.0, 3.6 * n), squeeze=False, constrained_layout=True)
     for i, m in enumerate(res.maps):
         P, H = np.asarray(m["P"], float), np.asarray(m["H"], float)
+        if physical:
+            P, pu = _scaled(P * p["W_J_m2"] / eps, "Pa")
+            H, hu = _scaled(H * eps, "m")
+            plab, hlab = f"contact pressure ({pu}; compressive > 0)", f"gap ({hu})"
+            pn = _map_pressure(res, m)
+            at = (f"p = {format_si(pn, 'Pa')}" if pn is not None else "") + \
+                f" (α = {format_si(float(m['D']) * eps, 'm')})"
+        else:
+            plab, hlab = r"pressure $P$ ($W_{ad}/\varepsilon$, Eq. 7)", r"gap $H$ ($\varepsilon$)"
+            at = f"D = {float(m['D']):g} ε"
         lim = max(1e-12, float(np.nanpercentile(np.abs(P), 99.5)))
-        panels = [(P, "RdBu_r", -lim, lim, r"pressure $P$ ($W_{ad}/\varepsilon$, Eq. 7)"),
-                  (H, "viridis", float(np.nanmin(H)), float(np.nanmax(H)), r"gap $H$ ($\varepsilon$)")]
+        panels = [(P, "RdBu_r", -lim, lim, plab), (H, "viridis", float(np.nanmin(H)), float(np.nanmax(H)), hlab)]
         for ax, (field, cmap, lo, hi, label) in zip(axs[i], panels):
             im = ax.imshow(field.T, origin="lower", extent=ext, cmap=cmap, vmin=lo, vmax=hi, interpolation="nearest")
             ax.set_aspect("equal")
-            ax.set_xlabel(f"$X$ ({unit})")
-            ax.set_ylabel(f"$Y$ ({unit})")
-            ax.set_title(f"{m['branch']}, D = {m['D']:g}", fontsize=9)
+            ax.set_xlabel(xl)
+            ax.set_ylabel(yl)
+            ax.set_title(f"{m['branch']}, {at.strip()}", fontsize=9)
             fig.colorbar(im, ax=ax, shrink=0.85).set_label(label)
-    if title:
-        fig.suptitle(title)
+    fig.suptitle(run_title(p, keys) + (f"\n{title}" if title else ""), fontsize=10)
     save(fig, path)
 
 
 def plot_sweep(data, path, title: str = "") -> None:
     """Load-resistance sweep read back from a file (columns R, energy_per_cycle, average_power): mean
-    power and energy per cycle against R on a log axis, the best load marked."""
+    power (and the peak power, if the file has it) and energy per cycle against R on a log axis (µW, µJ:
+    engineering prefixes), the best load marked."""
+    from tengsim.units import format_si, si_prefix
+
     plt = _plt()
     R = np.asarray(data["R"], float)
     p = np.asarray(data["average_power"], float)
@@ -205,7 +313,9 @@ def plot_sweep(data, path, title: str = "") -> None:
     R, p, e = R[order], p[order], e[order]
     k = int(np.nanargmax(p)) if np.isfinite(p).any() else None
     fig, axs = plt.subplots(1, 2, figsize=(10, 3.8), constrained_layout=True)
-    for ax, y, label in ((axs[0], p, "mean power (W)"), (axs[1], e, "energy per cycle (J)")):
+    p_raw, e_raw = p, e
+    (p, pu), (e, eu) = _scaled(p, "W"), _scaled(e, "J")
+    for ax, y, label in ((axs[0], p, f"power into the load ({pu})"), (axs[1], e, f"energy per cycle ({eu})")):
         ax.plot(R, y, "o-", ms=3)
         ax.set_xscale("log")
         if np.all(y[np.isfinite(y)] > 0):
@@ -216,7 +326,11 @@ def plot_sweep(data, path, title: str = "") -> None:
         if k is not None:
             ax.axvline(R[k], color="k", ls=":", lw=1)
             ax.plot(R[k], y[k], "*", color="tab:red", ms=10,
-                    label=f"best load {R[k]:.3g} Ω: {p[k]:.3g} W, {e[k]:.3g} J/cycle")
+                    label=f"best load {R[k]:.3g} Ω: {format_si(p_raw[k], 'W')}, {format_si(e_raw[k], 'J')}/cycle")
+        if ax is axs[0] and "peak_power" in data:  # the peak beside the mean, in the same unit
+            fp = si_prefix(float(np.nanmax(np.abs(p_raw))), "W")[0]
+            ax.plot(R, np.asarray(data["peak_power"], float)[order] / fp, "s--", ms=3, color="tab:gray",
+                    label="peak power (solid: mean)")
     if k is not None:
         axs[0].legend(fontsize=8)
     if title:

@@ -369,6 +369,18 @@ class ContactResult:
 PARTIAL_SUFFIX = ".partial.csv"
 _STREAM_KEYS = ("complete", "partial_of", "run_digest")  # the stream's own header lines
 _RESUME_RTOL = 1e-5  # a re-solved row and the file's row agree in F to this, relative to max(1, |F|)
+_PATH_ENDS = ("d_max", "f_max")  # a resumed run may raise these: the same path, longer (its start is kept)
+
+
+def _longer_path(now: dict, header: dict) -> bool:
+    """True when the run ``now`` differs from the partial file's run only by a longer path (a larger d_max
+    or f_max), so the file's rows up to where the paths part are this run's too."""
+    keys = {k for k in [*now, *header] if k not in _STREAM_KEYS}
+    diff = [k for k in keys if now.get(k) != header.get(k)]
+    try:
+        return bool(diff) and all(k in _PATH_ENDS and float(now[k]) >= float(header[k]) for k in diff)
+    except (KeyError, TypeError, ValueError):
+        return False
 
 
 def partial_path(out):
@@ -425,7 +437,7 @@ class RowStream:
         self.resume = resume
         self.fsync_seconds = fsync_seconds
         self.fh, self.columns, self.n, self.maps = None, None, 0, []
-        self._old, self._head = {}, None
+        self._old, self._head, self._longer = {}, None, False
         if resume is not None:
             header, cols = resume
             self._old = cols
@@ -447,19 +459,36 @@ class RowStream:
         digest = run_digest(params)
         if self.resume is not None:
             header = self.resume[0]
-            if header.get("run_digest") != digest:
-                now = io.jsonable(params)
+            self._truncate_torn_line()
+            now = io.jsonable(params)
+            self._longer = header.get("run_digest") != digest and _longer_path(now, header)
+            if self._longer:  # the file takes this run's header; its rows are checked as they come
+                self._head = {"complete": False, "partial_of": str(self.out), "run_digest": digest, **params}
+                self._rewrite(self.n_old)
+            elif header.get("run_digest") != digest:
                 keys = [k for k in [*now, *header] if k not in _STREAM_KEYS]
                 diff = next((k for k in keys if now.get(k) != header.get(k)), None)
                 what = (f"{diff}: {header.get(diff)!r} there, {now.get(diff)!r} now" if diff
                         else "its run digest differs")
                 raise TengsimError(f"--resume: {self.path} was written by another run ({what}); "
                                    "delete it to start afresh")
-            self._truncate_torn_line()
-            self.fh = open(self.path, "a", newline="")
+            if self.fh is None:
+                self.fh = open(self.path, "a", newline="")
         else:  # written with the first row: a run that fails before it leaves nothing behind
             self._head = {"complete": False, "partial_of": str(self.out), "run_digest": digest, **params}
         self._synced = time.monotonic()
+
+    def _rewrite(self, keep: int) -> None:
+        """The partial file again, whole (atomically): this run's header, the column names and its first
+        ``keep`` rows (a longer path resumed: the rows past where the paths part are dropped)."""
+        from tengsim import io
+
+        if self.fh is not None:
+            self.fh.close()
+        lines = [ln for ln in open(self.path, newline="").read().splitlines(keepends=True) if not ln.startswith("#")]
+        body = "".join(lines[:1 + keep]) if lines else ""
+        io.write_text(self.path, io.header_lines(self._head) + body)
+        self.fh = open(self.path, "a", newline="")
 
     def _truncate_torn_line(self) -> None:
         """Cut a last line that a kill left half written (no newline): the reader skipped it too."""
@@ -507,6 +536,14 @@ class RowStream:
                 and bool(float(old["on_grid"])) == bool(row["on_grid"])
                 and bool(float(old["jump"])) == bool(row["jump"])
                 and abs(float(old["F"]) - float(row["F"])) <= _RESUME_RTOL * max(1.0, abs(float(row["F"]))))
+        if not same and self._longer:  # the longer path parts from the file's here: the rest is solved anew
+            self._rewrite(i)
+            self.n_old = i
+            from tengsim import io
+
+            self.fh.write(io.csv_row([row[k] for k in self.columns]))
+            self.fh.flush()
+            return
         if not same:
             raise TengsimError(
                 f"--resume: row {i + 1} of {self.path} ({old['branch']}, D={float(old['D']):.10g}, "

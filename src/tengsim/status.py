@@ -458,6 +458,15 @@ def _where(table: dict, mask: np.ndarray) -> str:
     return ", ".join(parts)
 
 
+def _length_text(scaling):
+    """In-plane lengths (X units) as the run's user gave them: with a unit in a physical run."""
+    if scaling is None:
+        return lambda x: f"{x:.3g}"
+    from tengsim.units import format_si
+
+    return lambda x: format_si(x * scaling.lateral, "m") if np.isfinite(x) else "nan"
+
+
 def problems(result) -> list[tuple[str, str]]:
     """(kind, one-line description naming where) for each problem kind present, worst first."""
     t, dx, p = result.table, result.grid.dx, result.params
@@ -485,23 +494,24 @@ def problems(result) -> list[tuple[str, str]]:
                     "flattened)")
         else:
             parts = []
+            L = _length_text(getattr(result, "scaling", None))
             narrow = m & narrow_zone(t, dx)
             if narrow.any():
                 pz = float(np.nanmin(np.asarray(t["process_zone"], dtype=float)[narrow]))
                 est = p.get("process_zone_estimate", float("nan"))
-                parts.append(f"process zone {pz:.3g} < {RESOLUTION:g} dx = {RESOLUTION * dx:.3g} (dx = {dx:.3g}; "
+                parts.append(f"process zone {L(pz)} < {RESOLUTION:g} dx = {L(RESOLUTION * dx)} (dx = {L(dx)}; "
                              f"cohesive window g* → g0 + h0 at the narrowest contact edge; a-priori Dugdale "
-                             f"estimate {est:.3g}; "
-                             f"resolved for dx <= {pz / RESOLUTION:.3g})")
+                             f"estimate {L(est)}; "
+                             f"resolved for dx <= {L(pz / RESOLUTION)})")
             if snapping(t, snap).any():
                 parts.append(f"the law softens faster than one pixel is stiff (max dP/dg × pixel compliance = "
                              f"{snap:.3g} > {SNAP_LIMIT:g}): pixels snap one at a time and the contact edge is "
-                             f"pinned to the grid; refine dx to about {dx * SNAP_LIMIT / snap:.3g} or below, or soften "
+                             f"pinned to the grid; refine dx to about {L(dx * SNAP_LIMIT / snap)} or below, or soften "
                              "the law (md: a larger smoothing)")
             if coarse_faces(t, face).any():
                 parts.append(f"a flat face bounded by walls is known to {100 * face:.2g} % of its area > "
                              f"{100 * FACE_LIMIT:g} % (each wall lies somewhere within half a pixel); refine dx to "
-                             f"about {dx * FACE_LIMIT / face:.3g} or below")
+                             f"about {L(dx * FACE_LIMIT / face)} or below")
             text = "; ".join(parts) + f" {where}"
         out.append((kind, f"{_LABEL[kind]}: {text}"))
     return out

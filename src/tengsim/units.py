@@ -255,3 +255,34 @@ def eps_for_tabor(lateral, E_star: float, W: float, mu: float) -> float:
         raise TengsimError(f"no interaction range ε in [1e-15 m, 1 m] gives tabor = {mu:g}")
     t = brentq(f, a, b, xtol=1e-14, rtol=1e-15, maxiter=200)
     return math.exp(t)
+
+
+_ENG = ((1e9, "G"), (1e6, "M"), (1e3, "k"), (1.0, ""), (1e-3, "m"), (1e-6, "µ"), (1e-9, "n"), (1e-12, "p"),
+        (1e-15, "f"))
+
+
+def si_prefix(magnitude: float, unit: str) -> tuple[float, str]:
+    """(factor, prefixed unit) that shows numbers of about ``magnitude`` (in ``unit``, SI) between 1 and
+    1000: ``si_prefix(3e-6, 'W')`` is (1e-6, 'µW'); 0 or a non-finite magnitude keeps the plain unit.
+    A pressure stays in kPa or MPa style, a length in m…nm; ``unit`` 'kg' is not prefixed."""
+    m = abs(float(magnitude))
+    if not (m > 0 and math.isfinite(m)) or unit in ("kg", "1", ""):
+        return 1.0, unit
+    for f, p in _ENG:
+        if m >= f * 0.9995:
+            return f, p + unit
+    return _ENG[-1][0], _ENG[-1][1] + unit
+
+
+def format_si(value: float, unit: str, digits: int = 3) -> str:
+    """``value`` (SI ``unit``) with an engineering prefix: ``format_si(1.23e-5, 'W')`` is '12.3 µW'."""
+    f, u = si_prefix(value, unit)
+    return f"{value / f:.{digits}g} {u}"
+
+
+def si_unit(dim: str) -> str:
+    """The SI unit symbol of a dimension of :func:`parse_quantity` ('length' → 'm', 'energy/area' → 'J/m2')."""
+    for base, (d, factor) in _BASE.items():
+        if d == dim and factor == 1.0:
+            return base
+    raise TengsimError(f"no SI unit for dimension {dim!r}")

@@ -1,76 +1,43 @@
 """``tengsim contact``: one approach–retraction run (thin shell over tengsim.contact.run_contact)."""
 from __future__ import annotations
 
+import argparse
 import sys
 from pathlib import Path
 
 from tengsim.errors import TengsimError
 
-
+SUMMARY = 'one approach–retraction run of a micro-structure against a flat plate'  # its line in `tengsim --help`
 _CLI_ONLY = ("out", "plot", "quiet")
 _ALIASES = {"maps_at": ("--maps",)}
 
 
-def _option_help():
-    """Common keys, per shape key its help text(s) and the shapes using it, and per law key its help text,
-    laws and defaults, from the [contact] schema."""
-    from tengsim.config import common_fields, contact_table, law_key_help, law_keys
+def register(sub):
+    """The parser: every key of every shape and law (from the [contact] schema) as an option; the help
+    pages (per shape, and the index) are :mod:`tengsim.cli.keyhelp`'s."""
+    from tengsim.cli.keyhelp import CLI_ONLY_HELP, HelpAction
+    from tengsim.config import common_fields, contact_table, law_keys
     from tengsim.registry import SHAPES
 
-    common = {f.name: f for f in common_fields()}
-    laws = law_keys()
-    per_key = {}
+    p = sub.add_parser("contact", help=SUMMARY, add_help=False)
+    p.add_argument("-h", "--help", action=HelpAction)
+    p.add_argument("shape", choices=SHAPES.names(), help="registered shape")
+    p.add_argument("positional", nargs="?", metavar="INPUT", help=argparse.SUPPRESS)  # topography: FILE
+    fields = {f.name: f for f in common_fields()}
     for s in SHAPES.names():
         for k, f in contact_table(s).fields.items():
-            if k not in common and k not in laws:
-                per_key.setdefault(k, {}).setdefault(f.help or k, []).append(s)
-    helps = {}
-    for k, groups in per_key.items():
-        if len(groups) == 1:
-            (h, users), = groups.items()
-            helps[k] = f"{h} [{', '.join(users)}]"
-        else:
-            helps[k] = "; ".join(f"{', '.join(users)}: {h}" for h, users in groups.items())
-    for k, entries in laws.items():
-        helps[k] = law_key_help(entries) + " (a plain number, no unit)"
-    return common, helps
-
-
-def register(sub):
-    from tengsim.config import contact_table
-    from tengsim.registry import SHAPES
-
-    p = sub.add_parser(
-        "contact",
-        help="one approach–retraction run of a micro-structure against a flat plate",
-        description="Solve the adhesive contact (paper Eq. 9) along an approach from --d-min to --d-max "
-        "and a retraction back. Dimensionless input (the shape's own numbers, e.g. --N 0.946 --cell 3.78 "
-        "--tabor 0.5) or physical input with units (e.g. pyramid --pitch 2um --base 1um --height 0.7um "
-        "--E-star 0.59MPa --W 54mJ/m2 --tabor 0.5, or --eps instead of --tabor). Shapes: " + SHAPES.help(),
-    )
-    p.add_argument("shape", choices=SHAPES.names(), help="registered shape")
-    p.add_argument("positional", nargs="?", metavar="INPUT",
-                   help="the shape's positional input, for shapes that declare one (topography: FILE)")
-    common, per_key = _option_help()
-    bools = {f.name for s in SHAPES.names() for f in contact_table(s).fields.values() if f.kind == "bool"}
-    for k, f in common.items():
+            fields.setdefault(k, f)
+    for k in law_keys():
+        fields.setdefault(k, None)
+    for k, f in fields.items():
         if k == "shape" or k in _CLI_ONLY:
             continue
-        flag = {"nargs": "?", "const": "true"} if f.kind == "bool" else {}  # --adaptive alone means true
-        p.add_argument("--" + k.replace("_", "-"), *_ALIASES.get(k, ()), dest=k, **flag,
-                       help=f.describe().split(": ", 1)[1].replace("%", "%%"))
-    for k, h in per_key.items():
-        if k in _CLI_ONLY:
-            continue
-        flag = {"nargs": "?", "const": "true"} if k in bools else {}  # '--fill-missing' alone means true
-        p.add_argument("--" + k.replace("_", "-"), dest=k, help=h.replace("%", "%%"), **flag)
-    p.add_argument("--out", required=True, help="output file: .csv (curves) or .nc (everything)")
-    p.add_argument("--plot", help="also draw F(D), Λc(D), Λc(F) to this .png/.pdf")
-    p.add_argument("--quiet", action="store_true", help="no progress bar")
-    p.add_argument("--resume", action="store_true",
-                   help="continue the interrupted run of these settings from OUT.partial.csv (rows are written "
-                   "there as they finish; the path is solved again from its start and each row already in the "
-                   "file is checked, so the result equals an uninterrupted run's)")
+        flag = {"nargs": "?", "const": "true"} if f is not None and f.kind == "bool" else {}  # --adaptive = true
+        p.add_argument("--" + k.replace("_", "-"), *_ALIASES.get(k, ()), dest=k, help=argparse.SUPPRESS, **flag)
+    p.add_argument("--out", required=True, help=CLI_ONLY_HELP["out"])
+    p.add_argument("--plot", help=CLI_ONLY_HELP["plot"])
+    p.add_argument("--quiet", action="store_true", help=CLI_ONLY_HELP["quiet"])
+    p.add_argument("--resume", action="store_true", help=CLI_ONLY_HELP["resume"])
     p.set_defaults(func=run)
 
 
@@ -88,7 +55,7 @@ def run(args) -> int:
         if cfg.get(key) not in (None, args.positional):
             raise TengsimError(f"{key} given twice: {args.positional!r} and --{key.replace('_', '-')} {cfg[key]!r}")
         cfg[key] = args.positional
-    plan_contact({**cfg, "out": args.out})  # every option checked before anything is written (maps need .nc)
+    plan = plan_contact({**cfg, "out": args.out})  # every option checked before anything is written (maps: .nc)
     out = Path(args.out)
     if out.suffix.lower() not in (".csv", ".nc"):
         raise TengsimError(f"--out {args.out}: use a .csv or .nc file")
@@ -104,11 +71,64 @@ def run(args) -> int:
     if not parallel.is_root():  # mpiexec -n N: every process solves its slab, rank 0 alone writes and reports
         run_contact(cfg)
         return 0
+    line = None if args.quiet or plan.scaling is None else f"tengsim: {physical_line(plan, 'eps' in cfg)}"
     stream = open_stream(out, args.resume, args.quiet)
-    res = run_streamed(lambda bar: run_contact(cfg, progress=bar, sink=stream), stream, args.quiet)
+    res = run_streamed(lambda bar: run_contact(cfg, progress=_Announced(bar, line), sink=stream), stream,
+                       args.quiet)
     if res is None:
         return 130
     return write_contact(res, out, args.plot, args.quiet, stream)
+
+
+class _Announced:
+    """The progress bar, saying ``line`` first once the run has started (its set-up passed: a bad input
+    found while building the run stays the one line of its error)."""
+
+    def __init__(self, bar, line):
+        self.bar, self.line = bar, line
+
+    def _say(self):
+        if self.line:
+            print(self.line, file=sys.stderr, flush=True)
+            self.line = None
+
+    def __call__(self, *args, **kwargs):
+        self._say()
+        return self.bar(*args, **kwargs)
+
+    def monitor(self, *args, **kwargs):
+        self._say()
+        return self.bar.monitor(*args, **kwargs)
+
+
+def physical_line(plan, eps_given: bool) -> str:
+    """The line a physical run starts with: its materials, ε and the Tabor number derived (or given), the grid."""
+    from tengsim.units import format_si
+
+    sc = plan.scaling
+    how = "derived from ε, E*, W and the shape" if eps_given else "as given; ε derived from it"
+    return (f"physical run: E* = {format_si(sc.E_star, 'Pa')}, W = {sc.W * 1e3:.4g} mJ/m2, ε = "
+            f"{format_si(sc.eps, 'm')}, Tabor number μ = {sc.mu:.4g} ({how}), dx = "
+            f"{format_si(plan.dx * sc.lateral, 'm')}")
+
+
+def pull_off_text(res) -> str:
+    """'pull-off ...': the most tensile force of the retraction (N per cell and nominal Pa in a physical run);
+    under load control, where the retraction stopped at f_min before separating, says so instead."""
+    from tengsim.units import format_si
+
+    F, sc = res.pull_off_force, res.scaling
+    if res.params.get("control") == "load":
+        r = res.branch("retraction")
+        if len(r["F"]) and not bool(r["jump"][-1]):  # no separation: the lowest load is f_min, not the pull-off
+            fmin = float(res.params.get("f_min", 0.0))
+            at = f"{format_si(sc.pressure(fmin), 'Pa')}" if sc is not None and sc.cell_area else f"F = {fmin:.4g}"
+            return (f"pull-off not reached (the retraction ended at f_min = {at} still in contact; a lower "
+                    f"f_min finds it)")
+    if sc is None or not F == F:
+        return f"pull-off F = {F:.4g}"
+    p = f", {format_si(sc.pressure(F), 'Pa')} nominal" if sc.cell_area else ""
+    return f"pull-off {format_si(sc.force(F), 'N')} per cell{p} (F = {F:.4g})"
 
 
 def run_contact(cfg: dict, progress=None, sink=None):
@@ -177,11 +197,12 @@ def write_contact(res, out, plot=None, quiet=False, stream=None) -> int:
     if plot:
         from tengsim.plots import plot_curves
 
-        plot_curves(res, plot)
+        from tengsim.cli.keyhelp import title_keys
+
+        plot_curves(res, plot, keys=title_keys(res.params))
     if not quiet:
         j = res.jumps
-        si = f" ({res.scaling.force(res.pull_off_force):.4g} N per cell)" if res.scaling is not None else ""
-        print(f"wrote {out}: {len(res.table['D'])} equilibria, pull-off F = {res.pull_off_force:.4g}{si}, "
+        print(f"wrote {out}: {len(res.table['D'])} equilibria, {pull_off_text(res)}, "
               f"{len(j)} jump(s), {res.seconds:.1f} s", file=sys.stderr)
     from tengsim.status import warning_lines
 
@@ -190,7 +211,10 @@ def write_contact(res, out, plot=None, quiet=False, stream=None) -> int:
     if res.params.get("resolve_message"):  # resolve = auto stopped by max_pixels: the dx reached and needed
         print(f"tengsim: warning: {res.params['resolve_message']}", file=sys.stderr)
     elif res.params.get("resolve") == "auto" and not quiet:
-        grids = ", ".join(f"{d:.4g}" for d in res.params.get("resolve_grids", ()))
+        from tengsim.units import format_si
+
+        lat = res.scaling.lateral if res.scaling is not None else None
+        grids = ", ".join(format_si(d * lat, "m", 4) if lat else f"{d:.4g}" for d in res.params.get("resolve_grids", ()))
         print(f"tengsim: resolved: dx {grids}; status {res.params.get('resolve_status')}", file=sys.stderr)
     missed = [m for m in str(res.params.get("load_not_met") or "").split("; ") if m]
     if missed:  # load control: which loads, and where the search for each ended

@@ -13,6 +13,8 @@ from pathlib import Path
 
 from tengsim.errors import TengsimError, require
 
+SUMMARY = 'dynamic TENG output (paper Section 5)'  # its line in `tengsim --help`
+
 PRECEDENCE = "A value given as a CLI option wins over the config file, which wins over the case's default."
 CONFIG_HELP = ("TOML or JSON file with tables [device], [waveform], [run], [solver] (and [sweep] for sweep); "
                "`tengsim device fields` lists every key. " + PRECEDENCE)
@@ -30,13 +32,17 @@ DEFAULT_CYCLES = {"fig7": 5, "run": 5, "sweep": 3}
 _OPTIONS = {"out": ("run", "out"), "cycles": ("run", "cycles"), "t_end": ("run", "t_end"), "dt": ("run", "dt_out"),
             "quick": ("run", "quick"), "load_ohm": ("device", "load_ohm"), "damping": ("device", "damping_ratio"),
             "force_model": ("device", "force_model"), "initial_charge": ("device", "initial_charge"),
-            "r_min": ("sweep", "r_min_ohm"), "r_max": ("sweep", "r_max_ohm"), "points": ("sweep", "points")}
+            "r_min": ("sweep", "r_min_ohm"), "r_max": ("sweep", "r_max_ohm"), "points": ("sweep", "points"),
+            "area_from": ("device", "area")}
+AREA_FROM_HELP = ("charged-area model from a result on file: a design result DIR/design.nc (or DIR) of "
+                  "`tengsim design`, or a physical load-controlled `tengsim contact` result (.nc/.csv); the "
+                  "approach branch (overrides [device] area)")
 
 
 def register(subparsers) -> None:
     from tengsim.device.params import FORCE_MODELS, INITIAL_CHARGES
 
-    p = subparsers.add_parser("device", help="dynamic TENG output (paper Section 5)", description=DESCRIPTION)
+    p = subparsers.add_parser("device", help=SUMMARY, description=DESCRIPTION)
     sub = p.add_subparsers(dest="device_command", metavar="CASE")
     p.set_defaults(func=lambda args: (p.print_help(), 2)[1])
 
@@ -48,6 +54,7 @@ def register(subparsers) -> None:
         sp.add_argument("--dt", help="output time step in s or with a unit, e.g. 0.1ms (overrides [run] dt_out)")
         sp.add_argument("--config", default=None, help=CONFIG_HELP)
         sp.add_argument("--quiet", action="store_true", help="no progress or summary output")
+        sp.add_argument("--area-from", metavar="DESIGN", help=AREA_FROM_HELP)
         if sweep:
             return
         sp.add_argument("--load-ohm", help="load R in ohm or with a unit, e.g. 10MOhm (0 = short, inf = open)")
@@ -105,9 +112,25 @@ def _typed_cli(table, values: dict) -> dict:
     names = {key: "--" + opt.replace("_", "-") for opt, (_, key) in _OPTIONS.items()}
     out = {}
     for key, raw in values.items():
+        if key == "area":  # --area-from: always a file (a design or contact result), never a number
+            from tengsim.device.areas import area_table_from_file
+
+            out[key] = area_table_from_file(raw)
+            continue
         f = dataclasses.replace(table.fields[key], name=names[key])
         out[key] = f.parse(raw)
     return out
+
+
+def _area_beside(cfg: dict, source) -> dict:
+    """A [device] area given as a relative path that is not in the working folder but beside the config
+    file (``area = "d1/design.nc"`` next to the TOML) is read from there."""
+    dev = cfg.get("device")
+    area = dev.get("area") if isinstance(dev, dict) else None
+    if not source or not isinstance(area, str) or Path(area).is_absolute() or Path(area).exists():
+        return cfg
+    beside = Path(source).parent / area
+    return {**cfg, "device": {**dev, "area": str(beside)}} if beside.exists() else cfg
 
 
 def _out_path(run: dict, case: str) -> Path:
@@ -128,9 +151,20 @@ def execute(case: str, cfg: dict, cli: dict | None = None, quiet: bool = False, 
 
     cli = cli or {}
     dc.check_device_tables(cfg, source or "config")
+    cfg = _area_beside(cfg, source)
+    ignored = []  # keys of the other command (run <-> sweep) in a config that serves both
     if "sweep" in cfg and case != "sweep":
-        raise TengsimError(f"[sweep] is used only by the sweep case, not {case}")
-    run = {**dc.parse_run(cfg.get("run", {}), case), **_typed_cli(dc.RUN_TABLE, cli.get("run", {}))}
+        if case != "run":
+            raise TengsimError(f"[sweep] is used only by the sweep case, not {case}")
+        ignored.append("[sweep]")
+    run = {**dc.parse_run(cfg.get("run", {}), case, ignored), **_typed_cli(dc.RUN_TABLE, cli.get("run", {}))}
+    if case == "sweep" and "load_ohm" in cfg.get("device", {}):
+        ignored.append("[device] load_ohm")
+        cfg = {**cfg, "device": {k: v for k, v in cfg["device"].items() if k != "load_ohm"}}
+    if ignored and not quiet:
+        other = "run" if case == "sweep" else "sweep"
+        print(f"tengsim: note: the {case} does not use {', '.join(ignored)} (used by `tengsim device {other}`)",
+              file=sys.stderr)
     dev_cli = _typed_cli(dc.DEVICE_TABLE, cli.get("device", {}))
     solver = dc.parse_solver(cfg.get("solver", {}))
     out = _out_path(run, case)
@@ -148,7 +182,7 @@ def execute(case: str, cfg: dict, cli: dict | None = None, quiet: bool = False, 
         require(cycles <= n, f"cycles = {cycles} but the staircase has {n} steps (give at most {n})")
         wf = dataclasses.replace(wf, amplitudes_Pa=wf.amplitudes_Pa[:cycles])
         check_writable(out)
-        if "area" not in cfg.get("device", {}):  # the slow contact engine runs only after every check
+        if "area" not in cfg.get("device", {}) and "area" not in dev_cli:  # the slow engine: after every check
             params = params.replace(area=fig8_area_table(bool(run.get("quick", False))))
         res = simulate(params, wf, wf.duration, dt_out=run.get("dt_out", 1e-4), options=solver, progress=not quiet)
         summary = fig8_summary(res)
@@ -219,8 +253,23 @@ def _write(result, out: Path, summary: dict, quiet: bool, provenance: dict) -> i
         where = f"{out} (+ {side.name})"
     if not quiet:
         print(json.dumps(summary, indent=1))
+        line = power_line(summary)
+        if line:
+            print(line)
         print(f"wrote {where}", file=sys.stderr)
     return 0
+
+
+def power_line(summary: dict) -> str:
+    """'power: peak 12.3 µW, mean 4.56 µW (W: 1.23e-05, 4.56e-06)' from a run's summary ('' if it has none)."""
+    from tengsim.units import format_si
+
+    peak, mean = summary.get("peak_power_W"), summary.get("average_power_W")
+    if peak is None:
+        return ""
+    if mean is None:
+        return f"power: peak {format_si(peak, 'W')} ({peak:.4g} W); mean: no settled cycle"
+    return f"power: peak {format_si(peak, 'W')}, mean {format_si(mean, 'W')} (W: {peak:.4g}, {mean:.4g})"
 
 
 def _sweep(cfg, cli, run, dev_cli, solver, out, quiet, source) -> int:
@@ -230,8 +279,6 @@ def _sweep(cfg, cli, run, dev_cli, solver, out, quiet, source) -> int:
     from tengsim.device import resistance_sweep
     from tengsim.io import write_csv, write_json
 
-    require("load_ohm" not in cfg.get("device", {}),
-            "[device] load_ohm is not used by a sweep: the loads come from [sweep] r_min_ohm, r_max_ohm, points")
     sw_cfg = {**dc.SWEEP_TABLE.parse(cfg.get("sweep", {})), **_typed_cli(dc.SWEEP_TABLE, cli.get("sweep", {}))}
     r_min, r_max, points = sw_cfg["r_min_ohm"], sw_cfg["r_max_ohm"], sw_cfg["points"]
     require(0 < r_min < r_max, f"need 0 < r_min < r_max, got {r_min!r}, {r_max!r}")
@@ -247,11 +294,14 @@ def _sweep(cfg, cli, run, dev_cli, solver, out, quiet, source) -> int:
                           options=solver, progress=not quiet)
     from tengsim.io import jsonable
 
+    k_opt = int(np.nanargmax(sw.average_power_W))  # the optimum's row
     head = jsonable({"params": params.to_dict(), "waveform": wf.to_dict(), "optimum_ohm": sw.optimum_ohm,
-                    "optimum_power_W": sw.optimum_power_W, "optimum_at_edge": sw.optimum_at_edge,
+                    "optimum_power_W": sw.optimum_power_W,
+                    "optimum_peak_power_W": float(sw.peak_power_W[k_opt]), "optimum_at_edge": sw.optimum_at_edge,
                     "run": {"case": "sweep", "cycles": cycles, "config": cfg, "config_file": source}})
     write_csv(out, {"R": sw.load_ohm, "energy_per_cycle": sw.energy_per_cycle_J, "average_power": sw.average_power_W,
-                    "peak_voltage": sw.peak_voltage_V, "peak_current": sw.peak_current_A}, head)
+                    "peak_voltage": sw.peak_voltage_V, "peak_current": sw.peak_current_A,
+                    "peak_power": sw.peak_power_W}, head)
     side = out.with_suffix(".json")
     write_json(side, head)
     if sw.optimum_at_edge:
@@ -260,7 +310,8 @@ def _sweep(cfg, cli, run, dev_cli, solver, out, quiet, source) -> int:
               file=sys.stderr)
     if not quiet:
         what = "largest mean power in the range (at its edge)" if sw.optimum_at_edge else "optimum load"
-        print(f"{what}: R = {sw.optimum_ohm:.4g} ohm, mean power {sw.optimum_power_W:.4g} W")
+        print(f"{what}: R = {sw.optimum_ohm:.4g} ohm, "
+              + power_line({"peak_power_W": sw.peak_power_W[k_opt], "average_power_W": sw.optimum_power_W}))
         print(f"wrote {out} (+ {side.name})", file=sys.stderr)
     return 0
 

@@ -1,7 +1,10 @@
 """Entry point ``tengsim``: dispatches to one module per subcommand.
 
 Each subcommand module defines ``register(subparsers)`` which adds its parser and sets
-``func`` (called with the parsed namespace, returns an exit code).
+``func`` (called with the parsed namespace, returns an exit code), and ``SUMMARY`` (its one-line help).
+Only the subcommand named on the command line is registered in full; the others appear in
+``tengsim --help`` by their ``SUMMARY`` alone, so neither ``--version`` nor ``--help`` imports a
+subcommand's numerical modules (a module without ``SUMMARY`` is registered in full).
 """
 from __future__ import annotations
 
@@ -17,17 +20,27 @@ SUBCOMMANDS = ["contact", "device", "reproduce", "run", "plot", "sweep", "optimi
 
 class Parser(argparse.ArgumentParser):
     """argparse with tengsim's manners: a bad option is one line naming it (no usage wall), and a negative
-    number in any notation ('-1e+16', '-.5') is a value, not an option."""
+    number in any notation ('-1e+16', '-.5'), with or without a unit ('-5kPa'), is a value, not an option."""
 
     def __init__(self, *args, **kwargs):
         super().__init__(*args, **kwargs)
-        self._negative_number_matcher = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$|^-(inf|nan)$", re.I)
+        self._negative_number_matcher = re.compile(  # '-5kPa', '-2 N': a negative quantity with its unit
+            r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?( ?[A-Za-zµμΩ][A-Za-z0-9µμΩ/²]*)?$|^-(inf|nan)$", re.I)
 
     def error(self, message):
         self.exit(2, f"tengsim: error: {message} (see '{self.prog} --help')\n")
 
 
-def build_parser() -> argparse.ArgumentParser:
+def chosen_command(argv) -> str | None:
+    """The subcommand named in ``argv`` (the first word that is not an option), or None."""
+    for word in argv:
+        if not word.startswith("-"):
+            return word if word in SUBCOMMANDS else None
+    return None
+
+
+def build_parser(command: str | None = "*") -> argparse.ArgumentParser:
+    """The parser; ``command``: the one subcommand to register in full ('*': every one, None: none)."""
     from tengsim._version import __version__
 
     p = Parser(
@@ -43,7 +56,11 @@ def build_parser() -> argparse.ArgumentParser:
             if exc.name != f"tengsim.cli.{name}":
                 raise
             continue
-        mod.register(sub)
+        summary = getattr(mod, "SUMMARY", None)
+        if command in ("*", name) or summary is None:
+            mod.register(sub)
+        else:
+            sub.add_parser(name, help=summary, add_help=False)
     return p
 
 
@@ -102,14 +119,16 @@ def main(argv=None) -> int:
 
 
 def _main(argv=None) -> int:
-    from tengsim.plugins import load_plugins
+    command = chosen_command(sys.argv[1:] if argv is None else [str(a) for a in argv])
+    if command is not None:
+        from tengsim.plugins import load_plugins
 
-    try:
-        load_plugins()  # user shapes, laws, kernels, solvers, observers: before the parser lists them
-    except TengsimError as exc:
-        print(f"tengsim: error: {exc}", file=sys.stderr)
-        return 2
-    parser = build_parser()
+        try:
+            load_plugins()  # user shapes, laws, kernels, solvers, observers: before the parser lists them
+        except TengsimError as exc:
+            print(f"tengsim: error: {exc}", file=sys.stderr)
+            return 2
+    parser = build_parser(command)
     try:
         args = parser.parse_args(argv)
     except SystemExit as exc:  # a bad option: one line already printed (--help and --version exit as usual)

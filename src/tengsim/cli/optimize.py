@@ -14,9 +14,11 @@ import sys
 
 from tengsim.cli.sweep import add_study_options, load_study_args
 
+SUMMARY = "optimise an observable over a study's range axes, on Dask"  # its line in `tengsim --help`
+
 
 def register(sub):
-    p = sub.add_parser("optimize", help="optimise an observable over a study's range axes, on Dask",
+    p = sub.add_parser("optimize", help=SUMMARY,
                        description=__doc__.split("\n\n", 1)[1])
     p.add_argument("study", help="study TOML file with range [axes] and an [objective] table")
     add_study_options(p)

@@ -12,11 +12,13 @@ from pathlib import Path
 
 from tengsim.errors import TengsimError
 
+SUMMARY = 'redraw figures from a saved result'  # its line in `tengsim --help`
+
 FIGURE_SUFFIXES = (".png", ".pdf", ".svg")
 
 
 def register(sub):
-    p = sub.add_parser("plot", help="redraw figures from a saved result",
+    p = sub.add_parser("plot", help=SUMMARY,
                        description="Draw a saved tengsim result: F(D), Λc(D), Λc(F) of a contact result "
                        "(.nc or .csv) and its pressure/gap maps (second figure OUT_maps.png, .nc with "
                        "--maps only), the time series of a device result, power and energy against R of a "
@@ -32,6 +34,22 @@ def _plot_study(src: Path, out):
     from tengsim.study.plot import plot_study
 
     return plot_study(src, out or src / "design.png")
+
+
+def _device_period(src: Path, obj):
+    """The waveform period (s) of a device result: from its .json sidecar (a .csv) or its attributes (a
+    .nc); None when it has none (then the plot is not clipped to the settled cycles)."""
+    import json
+
+    try:
+        if src.suffix.lower() == ".csv":
+            wf = json.loads(src.with_suffix(".json").read_text()).get("waveform", {})
+        else:
+            wf = json.loads(getattr(obj, "attrs", {}).get("waveform", "{}"))
+        f = float(wf.get("frequency_Hz") or 0.0)
+    except (OSError, ValueError, TypeError, AttributeError):
+        return None
+    return 1.0 / f if f > 0 else None
 
 
 def run(args) -> int:
@@ -60,9 +78,12 @@ def run(args) -> int:
     written = [out]
     if kind == "contact":
         maps_out = out.with_name(f"{out.stem}_maps{out.suffix}")
-        plots.plot_curves(obj, out, title=src.name)
+        from tengsim.cli.keyhelp import title_keys
+
+        keys = title_keys(obj.params)
+        plots.plot_curves(obj, out, title=src.name, keys=keys)
         if obj.maps and not args.no_maps:
-            plots.plot_maps(obj, maps_out, title=src.name)
+            plots.plot_maps(obj, maps_out, title=src.name, keys=keys)
             written.append(maps_out)
         if isinstance(obj.params.get("resolution"), dict):  # resolve = auto: the convergence over the grids
             res_out = out.with_name(f"{out.stem}_resolution{out.suffix}")
@@ -71,7 +92,7 @@ def run(args) -> int:
     elif kind == "sweep":
         plots.plot_sweep(obj, out, title=src.name)
     else:
-        plots.plot_timeseries(obj, out, title=src.name)
+        plots.plot_timeseries(obj, out, title=src.name, period=_device_period(src, obj))
     for w in written:
         print(f"wrote {w}")
     return 0

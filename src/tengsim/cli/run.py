@@ -13,9 +13,11 @@ from pathlib import Path
 
 from tengsim.errors import TengsimError
 
+SUMMARY = 'run what a TOML config file describes'  # its line in `tengsim --help`
+
 
 def register(sub):
-    p = sub.add_parser("run", help="run what a TOML config file describes",
+    p = sub.add_parser("run", help=SUMMARY,
                        description=__doc__.split("\n\n", 1)[1])
     p.add_argument("config", help="TOML file with a [contact], [device] or [reproduce] table")
     p.add_argument("--quiet", action="store_true", help="no progress output")

@@ -17,9 +17,11 @@ import sys
 
 from tengsim.errors import TengsimError
 
+SUMMARY = 'design study: a grid or sample of runs on Dask, resumable'  # its line in `tengsim --help`
+
 
 def register(sub):
-    p = sub.add_parser("sweep", help="design study: a grid or sample of runs on Dask, resumable",
+    p = sub.add_parser("sweep", help=SUMMARY,
                        description=__doc__.split("\n\n", 1)[1])
     p.add_argument("study", help="study TOML file ([base.contact], [axes], optional [base.shapes.<name>], [base.var], "
                    "[study], [observables])")

@@ -9,6 +9,7 @@ from tengsim.device.params import (EPS0, AreaFunction, AreaTable, ConstantArea, 
                                    area_model)
 from tengsim.device.result import DeviceResult
 from tengsim.device.waveforms import WAVEFORMS, Sine, SquareWave, Staircase, TableWaveform
+from tengsim.device.areas import area_table_from_design
 from tengsim.device.config import parse_device, parse_waveform
 from tengsim.device.formulas import (CMEOCycle, cmeo_cycle, eq20_force, electrostatic_energy, field_force,
                                      fom_structural, isc_apart, qsc_apart, voc_apart,

@@ -73,6 +73,7 @@ class ResistanceSweep:
     average_power_W: np.ndarray
     peak_voltage_V: np.ndarray
     peak_current_A: np.ndarray
+    peak_power_W: np.ndarray
     optimum_ohm: float
     optimum_power_W: float
     optimum_at_edge: bool = False
@@ -84,7 +85,8 @@ class ResistanceSweep:
         v = {"energy_per_cycle": ("R", self.energy_per_cycle_J, {"units": "J"}),
              "average_power": ("R", self.average_power_W, {"units": "W"}),
              "peak_voltage": ("R", self.peak_voltage_V, {"units": "V"}),
-             "peak_current": ("R", self.peak_current_A, {"units": "A"})}
+             "peak_current": ("R", self.peak_current_A, {"units": "A"}),
+             "peak_power": ("R", self.peak_power_W, {"units": "W"})}
         return xr.Dataset(v, coords={"R": ("R", self.load_ohm, {"units": "ohm"})},
                           attrs={"optimum_ohm": self.optimum_ohm, "optimum_power_W": self.optimum_power_W,
                                  "optimum_at_edge": int(self.optimum_at_edge)})
@@ -128,15 +130,16 @@ def resistance_sweep(params: DeviceParams, waveform, loads_ohm, *, cycles: int =
         res = simulate(pr, waveform, int(cycles) * per, dt_out=dt_out, options=options, q0_C=q0)
         s = res.summary(skip_cycles)
         rows.append(tuple(math.nan if s[k] is None else s[k]
-                          for k in ("energy_per_cycle_J", "average_power_W", "peak_voltage_V", "peak_current_A")))
+                          for k in ("energy_per_cycle_J", "average_power_W", "peak_voltage_V", "peak_current_A",
+                                    "peak_power_W")))
         if progress:
             print(f"tengsim device: R = {r:.3g} ohm ({i + 1}/{loads.size}), P = {s['average_power_W']:.3g} W",
                   file=sys.stderr, flush=True)
-    e, p, v, c = (np.array(col, dtype=float) for col in zip(*rows))
+    e, p, v, c, pk = (np.array(col, dtype=float) for col in zip(*rows))
     require(bool(np.any(np.isfinite(p))), "no load gave a settled cycle: raise cycles")
     k = int(np.nanargmax(p))
     edge = loads.size > 1 and k in (int(np.argmin(loads)), int(np.argmax(loads)))
-    return ResistanceSweep(loads, e, p, v, c, float(loads[k]), float(p[k]), bool(edge))
+    return ResistanceSweep(loads, e, p, v, c, pk, float(loads[k]), float(p[k]), bool(edge))
 
 
 # --- V-Q cycle and the structural figure of merit (Zi et al. 2015) ---

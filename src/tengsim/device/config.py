@@ -16,6 +16,7 @@ from __future__ import annotations
 import dataclasses
 import math
 
+from tengsim.device.areas import area_table_from_file, stable_branch
 from tengsim.device.params import AreaTable, ConstantArea, DeviceParams, SolverOptions
 from tengsim.device.waveforms import WAVEFORMS
 from tengsim.errors import TengsimError
@@ -84,6 +85,13 @@ def _load_ohm(value, label):
     return Field("load_ohm", dim="resistance")._number(value, label)
 
 
+def _is_file(value: str) -> bool:
+    """A [device] area given as a path: a design result (.nc, or its folder) or a contact result (.nc, .csv)."""
+    from pathlib import Path
+
+    return value.strip().lower().endswith((".nc", ".csv")) or Path(value).is_dir()
+
+
 def _area(value, label):
     if isinstance(value, dict):
         kind = value.get("kind", "table" if "pressure_Pa" in value else "constant")
@@ -95,7 +103,9 @@ def _area(value, label):
                            Field("pressure_Pa", "floats", REQUIRED, dim="pressure"),
                            Field("area_fraction", "floats", REQUIRED)])
         v = t.parse(value, where=f"{label}.")
-        return AreaTable(v["pressure_Pa"], v["area_fraction"])
+        return AreaTable(*stable_branch(v["pressure_Pa"], v["area_fraction"], where=label))
+    if isinstance(value, str) and _is_file(value):
+        return area_table_from_file(value)
     f = Field("area", "float")._number(value, label)
     return ConstantArea(f)
 
@@ -105,8 +115,11 @@ DEVICE_TABLE = table_from_dataclass(
     special={"load_ohm": Field("load_ohm", "any", 1.0e6, check=_load_ohm,
                                help="load R in ohm (unit string such as '10MOhm' read); 0 = short, 'inf' = open"),
              "area": Field("area", "any", None, check=_area,
-                           help="charged-area model: a fraction A/S (default 1), or a table "
-                                "{pressure_Pa = [...], area_fraction = [...]} (A(P), linear, ends held)")},
+                           help="charged-area model: a fraction A/S (default 1), a table "
+                                "{pressure_Pa = [...], area_fraction = [...]} (A(P), linear, ends held; a "
+                                "pressure repeated at a snap keeps its first row), a design result "
+                                "'DIR/design.nc' (its approach branch) or a physical contact result .nc/.csv "
+                                "(approach, A/S = λc²/L²)")},
     doc="DeviceParams fields, SI; a case (fig7, fig8, sweep) supplies any not given, `run` needs the first seven")
 REQUIRED_DEVICE = tuple(f.name for f in dataclasses.fields(DeviceParams)
                         if f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING)
@@ -200,15 +213,27 @@ SWEEP_TABLE = Table("sweep", [
 ], "load-resistance sweep (case sweep only; CLI options override)")
 
 
-def parse_run(mapping: dict, case: str) -> dict:
-    """Typed [run] values; keys the case does not use are refused with their name."""
+MODES = ("run", "sweep")  # one config serves both commands: each accepts the other's keys and ignores them
+
+
+def parse_run(mapping: dict, case: str, ignored: list | None = None) -> dict:
+    """Typed [run] values; keys the case does not use are refused with their name, except, for the run and
+    sweep commands, the other one's keys (and its [run] case), which are dropped and named in ``ignored``."""
     v = RUN_TABLE.parse(mapping, defaults=False)
+    other = {k for c in MODES if c != case for k in RUN_KEYS[c]} if case in MODES else set()
     unused = [k for k in v if k not in RUN_KEYS[case]]
-    if unused:
-        raise TengsimError(f"[run] key(s) {', '.join(map(repr, unused))} not used by the {case} case "
+    refused = [k for k in unused if k not in other]
+    if refused:
+        raise TengsimError(f"[run] key(s) {', '.join(map(repr, refused))} not used by the {case} case "
                            f"(it uses: {', '.join(RUN_KEYS[case])})")
     if "case" in v and v["case"] != case:
-        raise TengsimError(f"[run] case = {v['case']!r} but the command runs {case!r}")
+        if not (case in MODES and v["case"] in MODES):
+            raise TengsimError(f"[run] case = {v['case']!r} but the command runs {case!r}")
+        unused.append("case")
+    for k in unused:
+        v.pop(k, None)
+        if ignored is not None:
+            ignored.append(f"[run] {k}")
     return v
 
 
@@ -231,6 +256,6 @@ def fields_help() -> str:
     return "\n\n".join(parts)
 
 
-__all__ = ["TABLES", "CASES", "RUN_KEYS", "DEVICE_TABLE", "SOLVER_TABLE", "RUN_TABLE", "SWEEP_TABLE", "dim_of",
+__all__ = ["TABLES", "CASES", "MODES", "RUN_KEYS", "DEVICE_TABLE", "SOLVER_TABLE", "RUN_TABLE", "SWEEP_TABLE", "dim_of",
            "table_from_dataclass", "parse_device", "parse_waveform", "parse_solver", "parse_run", "waveform_table",
            "check_device_tables", "fields_help"]

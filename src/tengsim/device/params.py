@@ -76,7 +76,11 @@ class AreaTable:
         require(p.size >= 2, f"area table needs at least 2 points, got {p.size}")
         require(p.size == a.size, f"area table: {p.size} pressures but {a.size} area fractions")
         require(bool(np.all(np.isfinite(p)) and np.all(np.isfinite(a))), "area table holds non-finite values")
-        require(bool(np.all(np.diff(p) > 0)), "area table pressures must be strictly increasing")
+        bad = np.flatnonzero(np.diff(p) <= 0)
+        if bad.size:
+            i = int(bad[0]) + 1
+            raise TengsimError(f"area table pressures must be strictly increasing: row {i} holds {p[i]:.6g} Pa "
+                               f"after {p[i - 1]:.6g} Pa (row {i - 1})")
         bad = a[(a < 0) | (a > 1)]
         require(bad.size == 0, f"area fractions must be in [0, 1], got {bad[:3].tolist()}")
         p.setflags(write=False)

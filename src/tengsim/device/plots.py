@@ -32,9 +32,9 @@ def plot_fig7(result, path) -> None:
     t = result.t * 1e3
     S = result.params.area_m2
     panels = [("applied force (N)", result.P_a * S), ("displacement y (mm)", result.y * 1e3),
-              ("velocity (m/s)", result.ydot), ("charge Q (nC)", result.Q * 1e9), ("current I (uA)", result.I * 1e6),
-              ("voltage V (V)", result.V), ("I_SC (uA)", result.I_sc * 1e6), ("V_OC (V)", result.V_oc),
-              ("power (uW)", result.power * 1e6)]
+              ("velocity (m/s)", result.ydot), ("charge Q (nC)", result.Q * 1e9), ("current I (µA)", result.I * 1e6),
+              ("voltage V (V)", result.V), ("short-circuit current I_SC (µA)", result.I_sc * 1e6),
+              ("open-circuit voltage V_OC (V)", result.V_oc), ("power into the load (µW)", result.power * 1e6)]
     settled = result.t >= result.waveform.period  # the first period holds the Q(0) = 0 start spike
     for a, (label, y) in zip(ax.ravel(), panels):
         a.plot(t, y, lw=0.8)
@@ -99,16 +99,22 @@ def plot_vq_cycle(result, path, cycle: int = -1) -> None:
 
 def plot_resistance_sweep(sweep, path) -> None:
     """Mean power and energy per cycle against load R, optimum marked."""
+    from tengsim.units import si_prefix
+
     plt, fig, ax = _figure(1, 2, (11, 4.5))
-    ax[0, 0].loglog(sweep.load_ohm, sweep.average_power_W, "o-")
+    fp, pu = si_prefix(float(np.nanmax(sweep.average_power_W)), "W")
+    ax[0, 0].loglog(sweep.load_ohm, sweep.average_power_W / fp, "o-", label="mean")
+    peak = getattr(sweep, "peak_power_W", None)
+    if peak is not None:
+        ax[0, 0].loglog(sweep.load_ohm, peak / fp, "s--", ms=4, label="peak")
     ax[0, 0].axvline(sweep.optimum_ohm, color="k", ls=":",
                      label="largest in range (at its edge)" if getattr(sweep, "optimum_at_edge", False)
                      else "optimum")
     ax[0, 0].legend()
-    ax[0, 0].set_xlabel("load R (ohm)")
-    ax[0, 0].set_ylabel("mean power (W)")
-    ax[0, 1].loglog(sweep.load_ohm, sweep.peak_voltage_V, "o-", label="peak V (V)")
-    ax[0, 1].loglog(sweep.load_ohm, sweep.peak_current_A * 1e6, "s-", label="peak I (uA)")
-    ax[0, 1].set_xlabel("load R (ohm)")
+    ax[0, 0].set_xlabel("load R (Ω)")
+    ax[0, 0].set_ylabel(f"power into the load ({pu})")
+    ax[0, 1].loglog(sweep.load_ohm, sweep.peak_voltage_V, "o-", label="peak voltage (V)")
+    ax[0, 1].loglog(sweep.load_ohm, sweep.peak_current_A * 1e6, "s-", label="peak current (µA)")
+    ax[0, 1].set_xlabel("load R (Ω)")
     ax[0, 1].legend()
     _save(plt, fig, path)

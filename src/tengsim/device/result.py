@@ -131,6 +131,7 @@ class DeviceResult:
         return {
             "peak_voltage_V": float(np.max(np.abs(self.V[m]))),
             "peak_current_A": float(np.max(np.abs(self.I[m]))),
+            "peak_power_W": float(np.max(np.abs(self.power[m]))),
             "voc_V": float(np.max(self.V_oc[m])),
             "isc_A": float(np.max(np.abs(self.I_sc[m]))),
             "qsc_C": float(np.max(self.Q_sc[m])),

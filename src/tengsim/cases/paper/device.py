@@ -80,8 +80,8 @@ def run_fig8(area_table=None, *, params: DeviceParams | None = None, waveform: S
 def fig7_summary(result: DeviceResult, skip_cycles: int = 1) -> dict:
     """Peak V, peak I, V_OC and I_SC over settled cycles (the first ``skip_cycles`` dropped); None if missing."""
     s = result.summary(skip_cycles)
-    keys = ("peak_voltage_V", "peak_current_A", "voc_V", "isc_A", "energy_per_cycle_J", "average_power_W",
-            "net_charge_per_cycle_C", "settled_cycles")
+    keys = ("peak_voltage_V", "peak_current_A", "voc_V", "isc_A", "peak_power_W", "energy_per_cycle_J",
+            "average_power_W", "net_charge_per_cycle_C", "settled_cycles")
     return jsonable({k: s[k] for k in keys})
 
 

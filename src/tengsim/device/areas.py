@@ -1,0 +1,135 @@
+"""The charged-area model from a contact result on file: a ``tengsim design`` result (``design.nc``), or a
+physical ``tengsim contact`` result (.nc or .csv; best a load-controlled one).
+
+The design-result file holds, per nominal pressure (coordinate ``pressure``, Pa) and branch
+(``approach``, ``retraction``), the charged-area fraction A/S (``charged_area_fraction``; NaN where a
+pressure was not reached on that branch).  A pressed device follows the stable approach branch, so
+the device takes that branch: NaN rows dropped, and at a snap (the same pressure met twice) the first
+state reached at that pressure kept, so the pressures increase strictly.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from tengsim.device.params import AreaTable
+from tengsim.errors import TengsimError
+
+DESIGN_FILE = "design.nc"
+AREA_VARIABLE = "charged_area_fraction"
+
+
+def stable_branch(pressure_Pa, area_fraction, where: str = "area table", rows=None, hint: str = ""):
+    """(pressures, fractions) of an approach with the repeats of a snap removed: at a pressure met again
+    (a jump at constant load) the first state reached is kept.  A pressure that falls is an error naming
+    its row (0-based; ``rows``: the row numbers of the source, if the values were picked from it) and
+    value, and the row before it, then ``hint``."""
+    p = np.asarray(pressure_Pa, dtype=float).ravel()
+    a = np.asarray(area_fraction, dtype=float).ravel()
+    rows = np.arange(p.size) if rows is None else np.asarray(rows)
+    if p.size != a.size:
+        raise TengsimError(f"{where}: {p.size} pressures but {a.size} area fractions")
+    keep = [0] if p.size else []
+    for i in range(1, p.size):
+        last = p[keep[-1]]
+        if p[i] == last or abs(p[i] - last) <= 1e-9 * max(abs(last), abs(p[i])):
+            continue  # the landing state of a snap, at the pressure already kept
+        if p[i] < last:
+            raise TengsimError(f"{where}: pressures must increase, but row {rows[i]} holds {p[i]:.6g} Pa after "
+                               f"{last:.6g} Pa (row {rows[keep[-1]]}){hint}")
+        keep.append(i)
+    return p[keep], a[keep]
+
+
+def design_path(path) -> Path:
+    """The design.nc of ``path`` (the file, or the folder a ``tengsim design --out DIR`` wrote)."""
+    p = Path(path)
+    if p.is_dir():
+        p = p / DESIGN_FILE
+    if not p.is_file():
+        raise TengsimError(f"area: no design result {str(p)!r} (give the design.nc that `tengsim design --out "
+                           "DIR` wrote, or its folder DIR)")
+    return p
+
+
+def area_table_from_design(path) -> AreaTable:
+    """The :class:`AreaTable` A/S(P) of a design result (``DIR/design.nc`` or ``DIR``): its approach
+    branch, NaN rows dropped, one value per pressure (the first state reached at a snap's pressure)."""
+    import xarray as xr
+
+    p = design_path(path)
+    try:
+        ds = xr.load_dataset(p)
+    except (OSError, ValueError) as exc:
+        raise TengsimError(f"area: cannot read {str(p)!r} as a design result: {exc}") from None
+    if AREA_VARIABLE not in ds or "pressure" not in ds.coords:
+        raise TengsimError(f"area: {str(p)!r} is no design result (it has no {AREA_VARIABLE!r} over 'pressure')")
+    units = str(ds["pressure"].attrs.get("units", "Pa"))
+    if units != "Pa":
+        raise TengsimError(f"area: {str(p)!r}: pressure in {units!r}, expected 'Pa'")
+    frac = ds[AREA_VARIABLE]
+    if "branch" in frac.dims:
+        branches = [b.decode() if isinstance(b, bytes) else str(b) for b in ds["branch"].values]
+        if "approach" not in branches:
+            raise TengsimError(f"area: {str(p)!r} has no approach branch (branches: {', '.join(branches)})")
+        frac = frac.isel(branch=branches.index("approach"))
+    pres = np.asarray(ds["pressure"].values, dtype=float)
+    a = np.asarray(frac.values, dtype=float)
+    ok = np.isfinite(pres) & np.isfinite(a)
+    if ok.sum() < 2:
+        raise TengsimError(f"area: {str(p)!r}: the approach branch reached {int(ok.sum())} of {pres.size} "
+                           "pressures; the device needs at least 2")
+    pres, a = stable_branch(pres[ok], a[ok], where=f"area: {p}")
+    return AreaTable(pres, a)
+
+
+def area_table_from_contact(path) -> AreaTable:
+    """The :class:`AreaTable` of a physical ``tengsim contact`` result (.nc or .csv): its approach rows at
+    nominal pressures >= 0, A/S = λc²/L² (paper Eq. 12's area: the contact length squared over the cell
+    area), one row per pressure (at a load-controlled snap the first state reached).  A displacement-
+    controlled approach, whose force falls after the jump-in, is refused at the row where it falls (run
+    it with control = load)."""
+    from tengsim.load import load_result
+
+    kind, res = load_result(path)
+    where = f"area: {path}"
+    if kind != "contact":
+        raise TengsimError(f"{where} is a {kind} result, not a contact or design result")
+    t, cell = res.table, (res.params or {}).get("cell_area_m2")
+    if "pressure_Pa" not in t or "contact_length_m" not in t or not cell:
+        raise TengsimError(f"{where} is a dimensionless contact result (no pressure_Pa): run it with physical "
+                           "input (lengths with units, E_star, W)")
+    br = np.asarray(t["branch"]).astype(str)
+    p = np.asarray(t["pressure_Pa"], float)
+    rows = np.flatnonzero((br == "approach") & (p >= 0) & np.isfinite(p))
+    if rows.size < 2:
+        raise TengsimError(f"{where}: the approach has {rows.size} state(s) at a pressure >= 0; the device "
+                           "needs at least 2")
+    frac = np.asarray(t["contact_length_m"], float)[rows] ** 2 / float(cell)
+    pres, a = stable_branch(p[rows], np.clip(frac, 0.0, 1.0), where=where, rows=rows,
+                            hint=" on the approach (a displacement-controlled run's force falls after a jump: "
+                                 "run it with --control load)")
+    return AreaTable(pres, a)
+
+
+def area_table_from_file(path) -> AreaTable:
+    """The area model of a result on file: a design result (DIR, DIR/design.nc) or a contact result."""
+    p = Path(path)
+    if p.is_dir() or p.suffix.lower() == ".csv":
+        return area_table_from_design(p) if p.is_dir() else area_table_from_contact(p)
+    if p.is_file():
+        import xarray as xr
+
+        try:
+            with xr.open_dataset(p) as ds:
+                design = AREA_VARIABLE in ds
+        except (OSError, ValueError) as exc:
+            raise TengsimError(f"area: cannot read {str(p)!r}: {exc}") from None
+        if not design:
+            return area_table_from_contact(p)
+    return area_table_from_design(p)
+
+
+__all__ = ["area_table_from_contact", "area_table_from_design", "area_table_from_file", "design_path",
+           "stable_branch", "DESIGN_FILE"]
