@@ -414,27 +414,28 @@ def test_line_search_accepts_a_wolfe_point_and_leaves_it_in_its_buffers():
 @pytest.mark.parametrize("how", ["no binding", "binding disagrees"])
 def test_fft_fallback_is_announced_once_and_recorded(monkeypatch, how):
     """Without scipy's pocketfft binding (or when it disagrees with scipy.fft) the kernels use the
-    public scipy.fft path: one FFTBackendWarning per process, ``_fft.BACKEND`` says "scipy.fft",
+    public scipy.fft path: one FFTBackendWarning per process, ``tengsim.backend.fft.BACKEND`` says "scipy.fft",
     and the convolution gives the direct path's numbers to round-off."""
     import warnings
 
-    from tengsim import _fft
+    from tengsim.backend import fft as _bf
+    from tengsim.kernels import convolve
     from tengsim.grid import Grid
     from tengsim.kernels import PeriodicKernel
 
     grid = Grid(24, 20, 0.3, 0.25)
     p = np.random.default_rng(1).standard_normal(grid.shape)
     ref = FreeKernel(grid, 0.8).apply(p), PeriodicKernel(grid, 0.8).apply(p)
-    assert _fft.BACKEND == ("pocketfft" if _fft._pp is not None else "scipy.fft")
-    monkeypatch.setattr(_fft, "BACKEND", _fft.BACKEND)
-    monkeypatch.setattr(_fft, "_warned", False)
+    assert _bf.BACKEND == ("pocketfft" if _bf.has_direct() else "scipy.fft")
+    monkeypatch.setattr(_bf, "BACKEND", _bf.BACKEND)
+    monkeypatch.setattr(_bf, "_warned", False)
     if how == "no binding":
-        monkeypatch.setattr(_fft, "_pp", None)
+        monkeypatch.setattr(_bf, "_pp", None)
     else:
-        monkeypatch.setattr(_fft, "_checked", lambda conv, shape: False)
-    with pytest.warns(_fft.FFTBackendWarning, match="scipy.fft"):
+        monkeypatch.setattr(convolve, "_checked", lambda conv, shape: False)
+    with pytest.warns(_bf.FFTBackendWarning, match="scipy.fft"):
         Kf = FreeKernel(grid, 0.8)
-    assert _fft.BACKEND == "scipy.fft" and Kf._conv.backend == "scipy.fft"
+    assert _bf.BACKEND == "scipy.fft" and Kf._conv.backend == "scipy.fft"
     with warnings.catch_warnings():
         warnings.simplefilter("error")  # the second fall-back says nothing
         Kp = PeriodicKernel(grid, 0.8)

@@ -22,9 +22,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from tengsim._fft import fourier_resample  # noqa: F401  (re-exported: its home was here)
 from tengsim.errors import TengsimError
-from tengsim.grid import Grid
+from tengsim.grid import Grid, fourier_resample  # noqa: F401  (re-exported: its home was here)
 from tengsim.kernels import PeriodicKernel
 from tengsim.solvers import Equilibrium, Problem, State
 

@@ -36,7 +36,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from tengsim._fft import fourier_resample
+from tengsim.grid import fourier_resample
 from tengsim.errors import TengsimError
 from tengsim.grid import Grid
 from tengsim.registry import SOLVERS
