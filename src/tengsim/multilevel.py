@@ -132,5 +132,5 @@ def nested_solve(solver, g0: np.ndarray, law, kernel: PeriodicKernel, min_size: 
         if on_level is not None:
             on_level(stats[-1])
         q = eq.state.q
-    eq.n_conv = stats[-1].n_conv
+    eq = dataclasses.replace(eq, n_conv=stats[-1].n_conv)
     return NestedSolve(eq, stats)
