@@ -23,7 +23,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from tengsim.errors import TengsimError
-from tengsim.grid import Grid, fourier_resample  # noqa: F401  (re-exported: its home was here)
+from tengsim.grid import Grid, fourier_resample
 from tengsim.kernels import PeriodicKernel
 from tengsim.solvers import Equilibrium, Problem, State
 

@@ -1,7 +1,7 @@
 """The transforms of the seam, and their thread policy.
 
-Direct path: scipy's own pocketfft binding, called without scipy.fft's dispatch (~15 µs a call; one
-convolution measured 90 vs 186 µs on a 39² free cell), writing into ``out``: :func:`r2c`, :func:`c2c`,
+Direct path: scipy's own pocketfft binding, called without scipy.fft's per-call dispatch (the costs
+measured: docs/benchmarks.md), writing into ``out``: :func:`r2c`, :func:`c2c`,
 :func:`c2r`, :func:`dct`.  :func:`has_direct` says whether the binding is importable; a convolver that
 cannot use it calls :func:`fall_back`, which sets :data:`BACKEND` to ``"scipy.fft"`` and warns once per
 process (:class:`FFTBackendWarning`).  Public path: scipy.fft's functions (``workers=`` threads).
@@ -25,8 +25,8 @@ except Exception:  # pragma: no cover - a scipy without it: the public functions
 BACKEND = "pocketfft" if _pp is not None else "scipy.fft"
 _warned = False
 
-#: threads pay off only for large transforms (2 cores: a 384² pair ~2× slower with 2 threads, a 2048²
-#: pair ~1.5× faster); ``TENGSIM_FFT_WORKERS`` forces a count
+#: transforms of at least this many points use all cores, smaller ones one thread (threads pay off only
+#: for large transforms); ``TENGSIM_FFT_WORKERS`` forces a count
 THREAD_MIN_SIZE = 512 * 512
 _ENV = os.environ.get("TENGSIM_FFT_WORKERS")
 
