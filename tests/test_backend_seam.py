@@ -78,3 +78,24 @@ def _smooth(m, primes):
         while m % p == 0:
             m //= p
     return m == 1
+
+
+@pytest.mark.parametrize("boundary", ["free", "periodic"])
+def test_kernels_pickle_without_their_buffers(boundary):
+    """Dask workers pickle kernels: the convolvers (tengsim.kernels.convolve, .dct) travel without their
+    per-thread buffers and convolve the same afterwards."""
+    import pickle
+
+    from tengsim.grid import Grid
+    from tengsim.kernels import make_kernel, make_mirror_kernel
+
+    g = Grid(15, 15, 0.2, 0.2)
+    rng = np.random.default_rng(2)
+    full, mk = make_kernel(boundary, g, 0.7), make_mirror_kernel(boundary, g, 0.7, (0, 1))
+    for K, on in ((full, lambda k: k), (mk, lambda k: k.reduced)):
+        p = rng.standard_normal(on(K).grid.shape)
+        w = on(K).apply(p)  # the buffers are made
+        assert K._conv._tls.__dict__
+        K2 = pickle.loads(pickle.dumps(K))
+        assert not K2._conv._tls.__dict__
+        assert np.array_equal(on(K2).apply(p), w)
