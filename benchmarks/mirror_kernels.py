@@ -17,7 +17,7 @@ import tracemalloc
 
 import numpy as np
 
-from tengsim import _fft
+from tengsim import backend
 from tengsim.grid import Grid, Mirror
 from tengsim.kernels import make_kernel
 from tengsim.kernels.mirror import MirrorKernel
@@ -27,11 +27,11 @@ CASES = [  # (label, boundary, n, dx, film params)
     ("B free dx0.1", "free", 77, 0.1, {}),
     ("C free dx0.1", "free", 189, 0.1, {}),
     ("A free dx0.05", "free", 77, 0.05, {}),
-    ("C free dx0.05", "free", _fft.fast_odd_len(379), 0.05, {}),
+    ("C free dx0.05", "free", backend.fast_odd_len(379), 0.05, {}),
     ("free film (bonded 0.3)", "free", 77, 0.1, {"thickness": 1.0, "poisson": 0.3}),
-    ("periodic", "periodic", _fft.fast_odd_len(255), 0.1, {}),
-    ("periodic", "periodic", _fft.fast_odd_len(1023), 0.1, {}),
-    ("periodic film (bonded 0.49)", "periodic", _fft.fast_odd_len(255), 0.1, {"thickness": 5.0, "poisson": 0.49}),
+    ("periodic", "periodic", backend.fast_odd_len(255), 0.1, {}),
+    ("periodic", "periodic", backend.fast_odd_len(1023), 0.1, {}),
+    ("periodic film (bonded 0.49)", "periodic", backend.fast_odd_len(255), 0.1, {"thickness": 5.0, "poisson": 0.49}),
 ]
 
 

@@ -293,8 +293,7 @@ def test_fast_solver_holds_the_periodic_gauge():
     and the converged q equals P up to that constant.  (Regression: a flat line search once pushed a
     mean of ~1e6 into q and threw the iterate away from the minimum.)"""
     prob = _rough_periodic(64)
-    start = State.zero(prob.g0.shape)
-    start.q += 0.3  # any gauge: w = K q is unchanged
+    start = State(np.full(prob.g0.shape, 0.3), np.zeros(prob.g0.shape))  # any gauge: w = K q is unchanged
     eq = FastSolver(1e-9).solve(prob, start)
     assert eq.converged, eq.message
     assert eq.state.q.mean() == pytest.approx(0.3, abs=1e-12)
@@ -385,7 +384,7 @@ def test_line_search_accepts_a_wolfe_point_and_leaves_it_in_its_buffers():
     approximate) Wolfe conditions of its docstring, E(α) equals the energy recomputed from scratch
     at q + α d, and the trial buffers hold g + α K d and P(g + α K d)."""
     from tengsim.solvers._workspace import Workspace
-    from tengsim.solvers import _Descent
+    from tengsim.solvers.fast import _Descent
 
     grid, U0, K = _group_a(dx=0.2)
     law = LJ93()
@@ -414,30 +413,47 @@ def test_line_search_accepts_a_wolfe_point_and_leaves_it_in_its_buffers():
 @pytest.mark.parametrize("how", ["no binding", "binding disagrees"])
 def test_fft_fallback_is_announced_once_and_recorded(monkeypatch, how):
     """Without scipy's pocketfft binding (or when it disagrees with scipy.fft) the kernels use the
-    public scipy.fft path: one FFTBackendWarning per process, ``_fft.BACKEND`` says "scipy.fft",
+    public scipy.fft path: one FFTBackendWarning per process, ``tengsim.backend.fft.BACKEND`` says "scipy.fft",
     and the convolution gives the direct path's numbers to round-off."""
     import warnings
 
-    from tengsim import _fft
+    from tengsim.backend import fft as _bf
+    from tengsim.kernels import convolve
     from tengsim.grid import Grid
     from tengsim.kernels import PeriodicKernel
 
     grid = Grid(24, 20, 0.3, 0.25)
     p = np.random.default_rng(1).standard_normal(grid.shape)
     ref = FreeKernel(grid, 0.8).apply(p), PeriodicKernel(grid, 0.8).apply(p)
-    assert _fft.BACKEND == ("pocketfft" if _fft._pp is not None else "scipy.fft")
-    monkeypatch.setattr(_fft, "BACKEND", _fft.BACKEND)
-    monkeypatch.setattr(_fft, "_warned", False)
+    assert _bf.BACKEND == ("pocketfft" if _bf.has_direct() else "scipy.fft")
+    monkeypatch.setattr(_bf, "BACKEND", _bf.BACKEND)
+    monkeypatch.setattr(_bf, "_warned", False)
     if how == "no binding":
-        monkeypatch.setattr(_fft, "_pp", None)
+        monkeypatch.setattr(_bf, "_pp", None)
     else:
-        monkeypatch.setattr(_fft, "_checked", lambda conv, shape: False)
-    with pytest.warns(_fft.FFTBackendWarning, match="scipy.fft"):
+        monkeypatch.setattr(convolve, "_checked", lambda conv, shape: False)
+    with pytest.warns(_bf.FFTBackendWarning, match="scipy.fft"):
         Kf = FreeKernel(grid, 0.8)
-    assert _fft.BACKEND == "scipy.fft" and Kf._conv.backend == "scipy.fft"
+    assert _bf.BACKEND == "scipy.fft" and Kf._conv.backend == "scipy.fft"
     with warnings.catch_warnings():
         warnings.simplefilter("error")  # the second fall-back says nothing
         Kp = PeriodicKernel(grid, 0.8)
     assert Kp._conv.backend == "scipy.fft"
     for K, w in zip((Kf, Kp), ref):
         assert np.allclose(K.apply(p), w, rtol=0, atol=1e-13 * np.abs(w).max())
+
+
+def test_solver_values_are_frozen():
+    """Problem, State and Equilibrium are values (issue 28): a changed one is built with replace."""
+    import dataclasses
+
+    from tengsim.solvers import Equilibrium, Problem
+
+    prob = _rough_periodic(16)
+    eq = FastSolver(1e-6).solve(prob, State.zero(prob.g0.shape))
+    for obj, name in ((prob, "g0"), (eq.state, "q"), (eq, "n_conv")):
+        with pytest.raises(dataclasses.FrozenInstanceError):
+            setattr(obj, name, None)
+    again = dataclasses.replace(eq, n_conv=eq.n_conv + 1)
+    assert isinstance(again, Equilibrium) and again.n_conv == eq.n_conv + 1 and again.H is eq.H
+    assert isinstance(prob, Problem)

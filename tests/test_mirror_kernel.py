@@ -143,9 +143,9 @@ def test_pickles_and_memory_is_a_fraction():
 def test_chunked_even_transforms(monkeypatch, lines):
     """The periodic kernel transforms its lines in chunks on large grids, two lines per complex FFT:
     force tiny chunks here (odd and even counts)."""
-    from tengsim import _fft
+    from tengsim.kernels import dct
 
-    monkeypatch.setattr(_fft.MirrorConvolver, "_lines", property(lambda self: lines))
+    monkeypatch.setattr(dct.MirrorConvolver, "_lines", property(lambda self: lines))
     for g in GRIDS:
         full = make_kernel("periodic", g, 0.8, thickness=0.9, poisson=0.3)
         for axes in AXES:
@@ -159,9 +159,9 @@ def test_chunked_even_transforms(monkeypatch, lines):
 def test_split_and_plain_dct1_agree(monkeypatch, split):
     """The free kernel's DCT-I runs split in half-length transforms on large grids, plain on small ones:
     force each here, on every mirror, half-space and a film."""
-    from tengsim import _fft
+    from tengsim.kernels import dct
 
-    monkeypatch.setattr(_fft.MirrorConvolver, "SPLIT_MIN", 1 if split else 10**9)
+    monkeypatch.setattr(dct.MirrorConvolver, "SPLIT_MIN", 1 if split else 10**9)
     for g in GRIDS[1:]:
         for fp in ({}, FILMS[3]):
             full = make_kernel("free", g, 0.8, **fp)

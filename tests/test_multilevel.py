@@ -5,10 +5,10 @@ import pytest
 
 from tengsim.errors import TengsimError
 from tengsim.shapes import random_rough
-from tengsim.grid import Grid
+from tengsim.grid import Grid, fourier_resample
 from tengsim.laws import LJ93
 from tengsim.kernels import FreeKernel, PeriodicKernel
-from tengsim.multilevel import coarse_levels, fourier_resample, nested_solve
+from tengsim.multilevel import coarse_levels, nested_solve
 from tengsim.solvers import FastSolver, Problem, State
 
 

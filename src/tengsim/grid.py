@@ -6,6 +6,8 @@ from functools import cached_property
 
 import numpy as np
 
+from tengsim import backend
+from tengsim.backend import fft as _bf
 from tengsim.errors import TengsimError, positive
 
 
@@ -37,11 +39,9 @@ class Grid:
         dx = positive("dx", dx)
         if dx > length / 3:
             raise TengsimError(f"dx={dx} is too coarse for a cell of length {length} (need >= 3 pixels)")
-        from tengsim import _fft
-
         n = max(3, int(round(length / dx)))
         # FFT-friendly pixel counts (small prime factors), odd so that a pixel sits on the apex
-        n = _fft.fast_odd_len(n) if odd else _fft.fast_len(n)
+        n = backend.fast_odd_len(n) if odd else backend.fast_len(n)
         return cls(n, n, length / n, length / n)
 
     @property
@@ -151,3 +151,21 @@ class Mirror:
         a = np.asarray(a, dtype=float)
         scale = max(float(np.max(np.abs(a))) if a.size else 0.0, 1e-300)
         return all(float(np.max(np.abs(a - np.flip(a, axis=k)))) <= rtol * scale for k in self.axes)
+
+
+def fourier_resample(a: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
+    """Resample a periodic real field to ``shape`` by truncating or zero-padding its spectrum.
+
+    Keeps the wavenumbers |k| below both grids' Nyquist limits (the Nyquist row/column is dropped),
+    so the mean and every resolved harmonic are preserved exactly.
+    """
+    n0, n1 = a.shape
+    m0, m1 = shape
+    A = _bf.np_rfft2(a)
+    B = np.zeros((m0, m1 // 2 + 1), complex)
+    k0 = min(n0, m0) // 2
+    k1 = min(n1, m1) // 2
+    B[:k0, :k1] = A[:k0, :k1]
+    if k0 > 1:
+        B[-(k0 - 1):, :k1] = A[-(k0 - 1):, :k1]
+    return _bf.np_irfft2(B, s=shape) * (m0 * m1 / (n0 * n1))

@@ -22,9 +22,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from tengsim._fft import fourier_resample  # noqa: F401  (re-exported: its home was here)
 from tengsim.errors import TengsimError
-from tengsim.grid import Grid
+from tengsim.grid import Grid, fourier_resample
 from tengsim.kernels import PeriodicKernel
 from tengsim.solvers import Equilibrium, Problem, State
 
@@ -133,5 +132,5 @@ def nested_solve(solver, g0: np.ndarray, law, kernel: PeriodicKernel, min_size: 
         if on_level is not None:
             on_level(stats[-1])
         q = eq.state.q
-    eq.n_conv = stats[-1].n_conv
+    eq = dataclasses.replace(eq, n_conv=stats[-1].n_conv)
     return NestedSolve(eq, stats)

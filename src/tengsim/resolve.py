@@ -56,7 +56,7 @@ import time
 
 import numpy as np
 
-from tengsim import _fft
+from tengsim import backend
 from tengsim.errors import TengsimError
 from tengsim.grid import Grid
 
@@ -207,7 +207,7 @@ def _aligned(shape, grid, phases, max_pixels: int):
         g = Grid(n, n, L / n, L / n)
         if all(min(abs(a - b), 1.0 - abs(a - b)) <= PHASE_TOL for a, b in zip(edge_phases(shape, g), phases)):
             return g
-        n = _fft.fast_odd_len(n + 2)
+        n = backend.fast_odd_len(n + 2)
     return grid
 
 

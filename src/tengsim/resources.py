@@ -37,7 +37,7 @@ def estimate_bytes(nx: int, ny: int, boundary: str = "free", solver: str = "fast
 
     ``boundary`` 'free' or 'periodic', ``solver`` 'fast' or 'vsr' (other names: counted as 'free' and
     'fast', the larger), ``memory`` the fast solver's L-BFGS pairs, ``maps`` the number of saved maps."""
-    from tengsim import _fft
+    from tengsim import backend
 
     nx, ny, n = int(nx), int(ny), int(nx) * int(ny)
     if boundary == "periodic":
@@ -45,7 +45,7 @@ def estimate_bytes(nx: int, ny: int, boundary: str = "free", solver: str = "fast
         build = KERNEL_BUILD_PERIODIC * half
         kept = 3.0 * half  # real multiplier + complex buffer
     else:
-        px, py = _fft.fast_len(2 * nx - 1), _fft.fast_len(2 * ny - 1)
+        px, py = backend.fast_len(2 * nx - 1), backend.fast_len(2 * ny - 1)
         P = px * py
         build = KERNEL_BUILD_FREE * P
         kept = 2.0 * P + 2.0 * nx * py

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from tengsim import _fft
+from tengsim.backend import fft as _bf
 from tengsim.errors import TengsimError, positive
 from tengsim.grid import Grid
 from tengsim.kernels.film import _Film
@@ -98,24 +98,24 @@ class SlabPeriodicKernel(_Film):
         if p.shape != self.local_shape:
             raise TengsimError(f"field of shape {p.shape} is not this rank's slab {self.local_shape}")
         nl, ny = self.local_shape
-        w = _fft.workers_for((self.grid.nx, ny))
-        spec = _fft.rfft_rows(p, w)                                      # (nl, nyh)
+        w = _bf.workers((self.grid.nx, ny))
+        spec = _bf.rfft(p, axis=1, workers=w)                                      # (nl, nyh)
         off = 0
         for a, b in self.col_slabs:                                      # pack: block j = my rows × cols_j
             k = nl * (b - a)
             self._send[off:off + k] = spec[:, a:b].ravel()
             off += k
         self._exchange(self._send, self._cols.reshape(-1), self._fwd)   # → all rows × my cols
-        cols = _fft.fft_cols(self._cols, w)
+        cols = _bf.fft(self._cols, axis=0, workers=w, overwrite_x=True)
         cols *= self._mult
-        cols = _fft.ifft_cols(cols, w)
+        cols = _bf.ifft(cols, axis=0, workers=w, overwrite_x=True)
         self._exchange(np.ascontiguousarray(cols).reshape(-1), self._recv, self._bwd)  # → my rows × all cols
         off = 0
         for a, b in self.col_slabs:
             k = nl * (b - a)
             spec[:, a:b] = self._recv[off:off + k].reshape(nl, b - a)
             off += k
-        res = _fft.irfft_rows(spec, ny, w)
+        res = _bf.irfft(spec, n=ny, axis=1, workers=w)
         if out is None:
             return res
         np.copyto(out, res)

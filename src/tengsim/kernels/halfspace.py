@@ -24,10 +24,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from tengsim import _fft
+from tengsim import backend
+from tengsim.backend import fft as _bf
 from tengsim.errors import positive
 from tengsim.grid import Grid
 from tengsim.kernels import film
+from tengsim.kernels.convolve import PaddedConvolver, PeriodicConvolver
 from tengsim.kernels.base import pixel_influence
 from tengsim.kernels.film import _Film, film_pixel_correction
 from tengsim.registry import KERNELS
@@ -48,7 +50,7 @@ class FreeKernel(_Film):
         positive("coupling", self.coupling)
         self._init_film()
         g = self.grid
-        self.padded_shape = (_fft.fast_len(2 * g.nx - 1), _fft.fast_len(2 * g.ny - 1))
+        self.padded_shape = (backend.fast_len(2 * g.nx - 1), backend.fast_len(2 * g.ny - 1))
         px, py = self.padded_shape
         ix = np.arange(px)
         iy = np.arange(py)
@@ -59,8 +61,8 @@ class FreeKernel(_Film):
         if self.film:
             coeff += film_pixel_correction(X, Y, g.dx, g.dy, self.thickness, self.poisson, self.substrate)
         coeff *= self.coupling / np.pi
-        self._spectrum = _fft.rfft2(coeff)
-        self._conv = _fft.PaddedConvolver(g.shape, self.padded_shape, self._spectrum)
+        self._spectrum = _bf.rfft2(coeff)
+        self._conv = PaddedConvolver(g.shape, self.padded_shape, self._spectrum)
         self.periodic = False
         self.pinned_mean = False
 
@@ -76,8 +78,8 @@ def periodic_multiplier(body, grid: Grid, cols: slice = slice(None)) -> np.ndarr
     """The periodic kernel's Fourier multiplier on the rfft2 layout of ``grid`` (its ``cols`` of the
     last axis only): 2κ/|q|, times the film's C(|q| T, ν), mean mode 0 or the film's mean compliance.
     ``body``: an object with ``coupling`` and the film fields (``film``, ``thickness``, ``poisson``, ``substrate``)."""
-    qx = 2 * np.pi * np.fft.fftfreq(grid.nx, d=grid.dx)
-    qy = (2 * np.pi * np.fft.rfftfreq(grid.ny, d=grid.dy))[cols]
+    qx = 2 * np.pi * _bf.fftfreq(grid.nx, d=grid.dx)
+    qy = (2 * np.pi * _bf.rfftfreq(grid.ny, d=grid.dy))[cols]
     q = np.hypot(*np.meshgrid(qx, qy, indexing="ij"))
     with np.errstate(divide="ignore"):
         mult = np.where(q > 0, 2 * body.coupling / np.where(q > 0, q, 1.0), 0.0)
@@ -106,7 +108,7 @@ class PeriodicKernel(_Film):
         self.mean_compliance = float(mult[0, 0])
         self.pinned_mean = not self.mean_compliance > 0
         self._spectrum = mult
-        self._conv = _fft.PeriodicConvolver(g.shape, mult)
+        self._conv = PeriodicConvolver(g.shape, mult)
         self.padded_shape = g.shape
         self.periodic = True
 

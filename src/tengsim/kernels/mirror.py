@@ -21,16 +21,17 @@ from the unfolded lines, only the block's lines being transformed, two real line
 transforms are real, so they separate exactly), and the multiplier 2κ/|q| (times the film's C(|q| T))
 is tabulated on the c + 1 non-negative wave numbers of each mirrored axis.  The spectra are real and
 about a quarter of the full kernel's entries; nothing of the full grid's size is built.
-See :class:`tengsim._fft.MirrorConvolver` and docs/benchmarks.md for the costs measured.
+See :class:`tengsim.kernels.dct.MirrorConvolver` and docs/benchmarks.md for the costs measured.
 """
 from __future__ import annotations
 
 import numpy as np
 
-from tengsim import _fft
+from tengsim import backend
+from tengsim.backend import fft as _bf
 from tengsim.errors import TengsimError, positive
 from tengsim.grid import Grid, Mirror
-from tengsim.kernels import film
+from tengsim.kernels import dct, film
 from tengsim.kernels.base import pixel_influence
 from tengsim.kernels.film import _Film, film_pixel_correction
 
@@ -86,7 +87,7 @@ class MirrorKernel(_Film):
             modes, lengths, spectrum = self._free()
             self.pinned_mean = False
         self.modes, self.lengths = modes, lengths
-        self._conv = _fft.MirrorConvolver(mirror.reduced_shape, modes, lengths, spectrum)
+        self._conv = dct.MirrorConvolver(mirror.reduced_shape, modes, lengths, spectrum)
         self.reduced = ReducedKernel(self, self._conv)
 
     # --- construction ---------------------------------------------------------------------------
@@ -95,11 +96,11 @@ class MirrorKernel(_Film):
         modes, lengths, offsets = [], [], []
         for k, (n, h) in enumerate(zip(g.shape, (g.dx, g.dy))):
             if k in self.mirror.axes:
-                L = _fft.mirror_dct1_len(red[k])  # M = L − 1 >= 2c + 2 = n + 1
+                L = dct.mirror_dct1_len(red[k])  # M = L − 1 >= 2c + 2 = n + 1
                 modes.append("dct1")
                 offsets.append(np.arange(L) * h)
             else:
-                L = _fft.fast_len(2 * n - 1)
+                L = backend.fast_len(2 * n - 1)
                 modes.append("pad")
                 i = np.arange(L)
                 offsets.append(np.minimum(i, L - i) * h)  # even layout: its rfft is real
@@ -110,7 +111,7 @@ class MirrorKernel(_Film):
             coeff += film_pixel_correction(X, Y, g.dx, g.dy, self.thickness, self.poisson, self.substrate)
         coeff *= self.coupling / np.pi
         del X, Y
-        spectrum = _fft.mirror_spectrum(coeff, modes)
+        spectrum = dct.mirror_spectrum(coeff, modes)
         norm = 1.0
         for m, L in zip(modes, lengths):
             norm *= 2 * (L - 1) if m == "dct1" else L
@@ -122,8 +123,8 @@ class MirrorKernel(_Film):
         modes = tuple("even" if k in self.mirror.axes else "periodic" for k in (0, 1))
         # both layouts hold the wave numbers 2πk/L, k = 0 … n // 2: the mirrored axis by evenness, the
         # other as the rfft's half spectrum
-        qx = 2 * np.pi * np.fft.rfftfreq(g.nx, d=g.dx)
-        qy = 2 * np.pi * np.fft.rfftfreq(g.ny, d=g.dy)
+        qx = 2 * np.pi * _bf.rfftfreq(g.nx, d=g.dx)
+        qy = 2 * np.pi * _bf.rfftfreq(g.ny, d=g.dy)
         q = np.hypot(*np.meshgrid(qx, qy, indexing="ij"))
         with np.errstate(divide="ignore"):
             mult = np.where(q > 0, 2 * self.coupling / np.where(q > 0, q, 1.0), 0.0)

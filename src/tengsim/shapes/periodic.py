@@ -5,6 +5,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from tengsim.backend import fft as _bf
 from tengsim.errors import positive
 from tengsim.grid import Grid
 from tengsim.registry import SHAPES
@@ -45,13 +46,13 @@ def random_rough(n: int, cell: float, hurst: float = 0.8, rms_height: float = 1.
                  short_cutoff: float | None = None, seed: int = 0) -> HeightMap:
     """Periodic self-affine random surface (power spectrum C(q) ~ q^{-2(1+H)}) with given rms height."""
     rng = np.random.default_rng(seed)
-    qx = 2 * np.pi * np.fft.fftfreq(n, d=cell / n)
+    qx = 2 * np.pi * _bf.fftfreq(n, d=cell / n)
     q = np.hypot(*np.meshgrid(qx, qx, indexing="ij"))
     q0 = 2 * np.pi / cell
     qs = 2 * np.pi / short_cutoff if short_cutoff else np.inf
     amp = np.where((q >= q0) & (q <= qs), np.maximum(q, q0) ** (-(1 + hurst)), 0.0)
     spec = amp * np.exp(2j * np.pi * rng.random((n, n)))
-    z = np.fft.ifft2(spec).real
+    z = _bf.np_ifft2(spec).real
     z *= rms_height / z.std()
     return HeightMap(z, cell)
 

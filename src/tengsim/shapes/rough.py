@@ -16,6 +16,7 @@ from functools import lru_cache
 
 import numpy as np
 
+from tengsim.backend import fft as _bf
 from tengsim.errors import TengsimError, positive
 from tengsim.grid import Grid
 from tengsim.registry import KERNELS, SHAPES
@@ -55,9 +56,9 @@ def _coefficients(cell, hurst, rms_height, rms_slope, short_cutoff, long_cutoff,
     n = 2 * int(np.floor(cell / short_cutoff + 1e-9)) + 3  # odd: every mode |k| <= cell/short_cutoff fits
     topo = _synthesis(fourier_synthesis, (n, n), (cell, cell), seed, hurst=hurst, rms_height=1.0,
                       short_cutoff=short_cutoff, long_cutoff=long_cutoff)
-    c = np.fft.fft2(np.asarray(topo.heights(), dtype=float)) / n**2
+    c = _bf.np_fft2(np.asarray(topo.heights(), dtype=float)) / n**2
     c[0, 0] = 0.0
-    q = 2 * np.pi * np.fft.fftfreq(n, d=1.0 / n) / cell
+    q = 2 * np.pi * _bf.fftfreq(n, d=1.0 / n) / cell
     q2 = q[:, None] ** 2 + q[None, :] ** 2
     power = np.sum(np.abs(c) ** 2 * (q2 if rms_slope is not None else 1.0))  # Parseval: <h²> or <|∇h|²>
     if not power > 0:
@@ -71,7 +72,7 @@ def _coefficients(cell, hurst, rms_height, rms_slope, short_cutoff, long_cutoff,
 def _interpolate(c: np.ndarray, n_ref: int, cell: float, grid: Grid) -> np.ndarray:
     """The band-limited surface of coefficients ``c`` (reference grid of ``n_ref`` pixels) on ``grid``."""
     n = grid.nx
-    k = np.fft.fftfreq(n_ref, d=1.0 / n_ref).round().astype(int)
+    k = _bf.fftfreq(n_ref, d=1.0 / n_ref).round().astype(int)
     keep = np.abs(k) <= (n_ref - 3) // 2  # the modes that can be nonzero (below the short cut-off)
     if (n_ref - 3) // 2 > (n - 1) // 2:  # pragma: no cover - the grid check refuses this first
         raise TengsimError(f"rough: a {n}×{n} grid cannot hold the surface's modes")
@@ -82,7 +83,7 @@ def _interpolate(c: np.ndarray, n_ref: int, cell: float, grid: Grid) -> np.ndarr
     shift = np.exp(2j * np.pi * k * (grid.dx - cell / n_ref) / 2 / cell)
     spec = np.zeros((n, n), dtype=complex)
     spec[np.ix_(idx, idx)] = c * shift[:, None] * shift[None, :]
-    return np.fft.ifft2(spec).real * n * n
+    return _bf.np_ifft2(spec).real * n * n
 
 
 @dataclass(frozen=True)

@@ -248,12 +248,12 @@ class Topography:
         g = self.native_grid()
         if dx is None or abs(positive("dx", dx) - g.dx) <= 1e-9 * g.dx:
             return g
-        from tengsim import _fft
+        from tengsim import backend
 
         lx, ly = self.size
         if dx > min(lx, ly) / 3:
             raise TengsimError(f"dx={dx:g} is too coarse for a topography of {lx:g}×{ly:g} (need >= 3 pixels)")
-        nx, ny = (_fft.fast_len(max(3, int(round(s / dx)))) for s in (lx, ly))
+        nx, ny = (backend.fast_len(max(3, int(round(s / dx)))) for s in (lx, ly))
         return Grid(nx, ny, lx / nx, ly / ny)
 
     def gap(self, grid: Grid) -> np.ndarray:

@@ -26,6 +26,8 @@ from __future__ import annotations
 import numpy as np
 from scipy.linalg.lapack import dtrtrs
 
+from tengsim import backend
+
 
 class KMetricLBFGS:
     """Ring of m pairs (s, y) and images (K s, K y); slot j lives in rows 2j, 2j + 1."""
@@ -33,15 +35,15 @@ class KMetricLBFGS:
     def __init__(self, memory: int, n: int, dA: float):
         self.m, self.dA = int(memory), float(dA)
         m = self.m
-        self.B = np.empty((2 * m, n))     # s_j, y_j
-        self.KB = np.empty((2 * m, n))    # K s_j, K y_j
-        self.SY = np.zeros((m, m))  # SY[i, j] = <s_i, y_j>, by slot
-        self.YY = np.zeros((m, m))  # YY[i, j] = <y_i, y_j>
-        self.pS = np.zeros(m)       # <s_i, G> for the current gradient G
-        self.pY = np.zeros(m)       # <y_i, G>
+        self.B = backend.empty((2 * m, n))     # s_j, y_j
+        self.KB = backend.empty((2 * m, n))    # K s_j, K y_j
+        self.SY = backend.zeros((m, m))  # SY[i, j] = <s_i, y_j>, by slot
+        self.YY = backend.zeros((m, m))  # YY[i, j] = <y_i, y_j>
+        self.pS = backend.zeros(m)       # <s_i, G> for the current gradient G
+        self.pY = backend.zeros(m)       # <y_i, G>
         self.order: list[int] = []  # slots, oldest first; the active slots are always 0 .. k-1
-        self._last = (1.0, np.zeros(0), np.zeros(0))
-        self._perm = np.zeros(0, int)   # active slots in age order (oldest first), as an index array
+        self._last = (1.0, backend.zeros(0), backend.zeros(0))
+        self._perm = backend.zeros(0, int)   # active slots in age order (oldest first), as an index array
         self.lines = None  # a weighted problem's deficit pixels (tengsim.solvers._weights): m-weighted products
         self.red = None    # a distributed solve's sums over all ranks (tengsim.solvers._reduce)
 
@@ -51,8 +53,8 @@ class KMetricLBFGS:
 
     def reset(self) -> None:
         self.order = []
-        self._perm = np.zeros(0, int)
-        self._last = (1.0, np.zeros(0), np.zeros(0))
+        self._perm = backend.zeros(0, int)
+        self._last = (1.0, backend.zeros(0), backend.zeros(0))
 
     def refresh(self, r) -> None:
         """Recompute <s_i, G>, <y_i, G> exactly from r = K G (one pass over the rows)."""
@@ -71,7 +73,7 @@ class KMetricLBFGS:
         c is None while the memory is empty (H = identity)."""
         k = len(self.order)
         if not k:
-            self._last = (1.0, np.zeros(0), np.zeros(0))
+            self._last = (1.0, backend.zeros(0), backend.zeros(0))
             return 1.0, None
         act = self._perm
         new = act[-1]
@@ -84,11 +86,11 @@ class KMetricLBFGS:
         u = dtrtrs(SYa, self.pS[act], lower=0)[0]
         top = dtrtrs(SYa, np.diag(SYa) * u + gamma * (self.YY[act[:, None], act] @ u) - gamma * self.pY[act],
                      lower=0, trans=1)[0]
-        cS = np.empty(k)
-        cY = np.empty(k)
+        cS = backend.empty(k)
+        cY = backend.empty(k)
         cS[act] = top
         cY[act] = -gamma * u
-        c = np.empty(2 * k)
+        c = backend.empty(2 * k)
         c[0::2], c[1::2] = cS, cY
         self._last = (gamma, cS, cY)
         return gamma, c

@@ -1,6 +1,6 @@
 """The fast solver's workspace: every array an iteration touches, preallocated for one grid.
 
-An iteration allocates nothing: the current and trial gap and pressure, the direction and its image,
+Its arrays come from the seam (tengsim.backend).  An iteration allocates nothing: the current and trial gap and pressure, the direction and its image,
 residual, gradient and their next values, the new pair (y, K y), the convolution's output, the
 sweeper with its per-thread scratch (tengsim.solvers._sweep) and the L-BFGS rows (tengsim.solvers._lbfgs).  A
 workspace holds no result: the state a solve returns (q, w, P) lives in arrays of its own, so one
@@ -9,8 +9,7 @@ solver, see :class:`Spare`).
 """
 from __future__ import annotations
 
-import numpy as np
-
+from tengsim import backend
 from tengsim.solvers import _sweep
 from tengsim.solvers._lbfgs import KMetricLBFGS
 from tengsim.solvers._sweep import Sweeper
@@ -29,7 +28,7 @@ class Workspace:
         self.n = int(n)
         self.key = Workspace.key_for(n, memory, dA)
         for name in _ARRAYS:
-            setattr(self, name, np.empty(self.n))
+            setattr(self, name, backend.empty(self.n))
         self.sweeper = Sweeper(self.n)
         self.memory = KMetricLBFGS(memory, self.n, dA)
 

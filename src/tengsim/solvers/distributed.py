@@ -11,12 +11,13 @@ place instead — docs/benchmarks.md, the plan for 32768² and 65536².)
 """
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
 
 from tengsim.errors import TengsimError
-from tengsim.solvers import Equilibrium, Problem, State
+from tengsim.solvers.types import Equilibrium, Problem, State
 
 
 @dataclass(frozen=True)
@@ -47,9 +48,8 @@ class SlabSolver:
         local = Problem(self._local(problem.g0, K), problem.law, K)
         st = State(self._local(start.q, K), self._local(start.w, K))
         eq = self.inner.solve(local, st)
-        eq.H, eq.P = K.gather(eq.H), K.gather(eq.P)
-        eq.residual = K.comm.allreduce(eq.residual, op=_max_op())
-        return eq
+        return dataclasses.replace(eq, H=K.gather(eq.H), P=K.gather(eq.P),
+                                   residual=K.comm.allreduce(eq.residual, op=_max_op()))
 
 
 def _max_op():

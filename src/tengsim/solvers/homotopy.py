@@ -36,11 +36,12 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from tengsim._fft import fourier_resample
+from tengsim.grid import fourier_resample
 from tengsim.errors import TengsimError
 from tengsim.grid import Grid
 from tengsim.registry import SOLVERS
-from tengsim.solvers import Equilibrium, FastSolver, Problem, State
+from tengsim.solvers.fast import FastSolver
+from tengsim.solvers.types import Equilibrium, Problem, State
 from tengsim.solvers._reduce import for_kernel
 
 

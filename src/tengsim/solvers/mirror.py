@@ -22,7 +22,7 @@ from dataclasses import replace
 import numpy as np
 
 from tengsim.errors import TengsimError
-from tengsim.solvers import Equilibrium, Problem, State
+from tengsim.solvers.types import Equilibrium, Problem, State
 
 
 class MirrorSolver:

@@ -1,0 +1,56 @@
+"""The one seam for arrays and FFTs: every array the solvers allocate and every Fourier transform of
+the package goes through here (NumPy arrays, scipy's pocketfft today; a GPU backend plugs in here).
+
+- the array namespace :data:`xp` and its allocators :func:`empty`, :func:`zeros`; :func:`to_host` turns
+  a backend scalar into a host float (the one place a solve syncs);
+- the thread policy :func:`workers` / :func:`threads` (``TENGSIM_FFT_WORKERS`` forces a count);
+- FFT-friendly lengths :func:`fast_len`, :func:`fast_odd_len`;
+- the transforms (:mod:`tengsim.backend.fft`): the direct ``r2c``/``c2c``/``c2r``/``dct`` writing into
+  ``out`` (scipy's pocketfft binding), the public scipy.fft functions they fall back to, and NumPy's
+  own transforms where a result is defined by them (surface synthesis, resampling).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from tengsim.backend import fft
+from tengsim.backend.fft import THREAD_MIN_SIZE, FFTBackendWarning, threads, workers
+
+#: the array namespace
+xp = np
+
+def empty(shape, dtype=float):
+    """An uninitialised backend array."""
+    return xp.empty(shape, dtype=dtype)
+
+
+def zeros(shape, dtype=float):
+    """A zero-filled backend array."""
+    return xp.zeros(shape, dtype=dtype)
+
+
+def to_host(x) -> float:
+    """A backend scalar as a host float."""
+    return float(x)
+
+
+def fast_len(n: int) -> int:
+    """Smallest size >= n whose prime factors are 2, 3, 5 (and 7, 11, as scipy allows)."""
+    return fft.next_fast_len(int(n))
+
+
+def fast_odd_len(n: int) -> int:
+    """Smallest odd size >= n with prime factors 3, 5, 7, 11, 13 only (an FFT-friendly odd count)."""
+    m = max(3, int(n) | 1)
+    while True:
+        k = m
+        for p in (3, 5, 7, 11, 13):
+            while k % p == 0:
+                k //= p
+        if k == 1:
+            return m
+        m += 2
+
+
+__all__ = ["FFTBackendWarning", "THREAD_MIN_SIZE", "empty", "fast_len", "fast_odd_len", "fft", "threads",
+           "to_host", "workers", "xp", "zeros"]

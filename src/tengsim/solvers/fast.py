@@ -1,0 +1,398 @@
+"""The fast solver: L-BFGS on E(q) in the metric of the elastic kernel (see :class:`FastSolver`)."""
+from __future__ import annotations
+
+import functools
+import inspect
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from tengsim.errors import TengsimError
+from tengsim.solvers._linesearch import Ray, Trial, WolfeLineSearch
+from tengsim.solvers._reduce import for_kernel
+from tengsim.solvers._weights import Weights
+from tengsim.solvers._workspace import Spare
+from tengsim.solvers.types import Equilibrium, Problem, State, finish
+
+
+@dataclass(frozen=True)
+class FastSolver:
+    """L-BFGS on E(q) in the metric of the elastic kernel (K-preconditioned), Wolfe line search.
+
+    Cost in convolutions (FFT pairs, the unit of ``Equilibrium.n_conv``): one to start (K P at the
+    start state), one per iteration (K P(g) at the new state), and one more every ``resync``
+    iterations to re-anchor w = K q; one solve of k iterations spends 1 + k + ⌊k / resync⌋.  Nothing
+    else convolves: the direction's image K d is assembled from stored images (K s = Δw, K y = Δr,
+    K G = r) by the compact L-BFGS form (tengsim.solvers._lbfgs), and the line search along d needs only
+    element-wise work, since g(α) = g + α K d (tengsim.solvers._linesearch).  Converged when max|r| <= ``tol``.
+    ``monitor(iteration, max|r|, energy)``, if given, is called every ``monitor_every`` iterations
+    (progress on long solves).
+
+    The arrays of an iteration live in a workspace (tengsim.solvers._workspace), allocated once per grid and,
+    on grids up to 512² points, kept by the solver for its next solve (a path's equilibria share one).
+    """
+
+    tol: float = 1e-6
+    max_iter: int = 3000
+    memory: int = 10
+    resync: int = 25
+    name: str = "fast"
+    monitor: object = None
+    monitor_every: int = 100
+
+    def __post_init__(self):
+        if not self.tol > 0:
+            raise TengsimError(f"tol must be > 0, got {self.tol!r}")
+        if int(self.memory) < 1:
+            raise TengsimError(f"memory must be >= 1, got {self.memory!r}")
+        if int(self.monitor_every) < 1:
+            raise TengsimError(f"monitor_every must be >= 1, got {self.monitor_every!r}")
+        # the spare workspace is no field: not in fields(), repr, ==, hash or replace()
+        object.__setattr__(self, "_spare", Spare())
+
+    def __getstate__(self):  # copies and pickles start without a spare workspace
+        return {k: v for k, v in self.__dict__.items() if k != "_spare"}
+
+    def __setstate__(self, state):
+        self.__dict__.update(state, _spare=Spare())
+
+    def solve(self, problem: Problem, start: State) -> Equilibrium:
+        t0 = time.perf_counter()
+        lines = None if problem.weights is None else Weights(problem.weights, np.shape(problem.g0))
+        dA = problem.dA if lines is None else problem.dA * lines.scale
+        ws = self._spare.take(np.size(problem.g0), self.memory, dA)
+        ws.memory.lines = lines
+        ws.memory.red = red = for_kernel(problem.kernel)  # a slab-distributed kernel: sums over all ranks
+        if red is not None and lines is not None:
+            raise TengsimError("a distributed solve cannot also be a weighted (mirror) one")
+        try:
+            return self._descend(_Descent(problem, start, ws, lines), t0)
+        finally:
+            self._spare.give(ws)
+
+    def _descend(self, run: "_Descent", t0: float) -> Equilibrium:
+        search = run.search
+        for it in range(self.max_iter + 1):
+            if not math.isfinite(run.rmax):
+                return run.finish(False, it, "non-finite residual", t0)
+            if run.rmax <= self.tol:
+                return run.finish(True, it, "converged", t0)
+            if it == self.max_iter:
+                break
+            if self.monitor is not None and it % self.monitor_every == 0:
+                self.monitor(it, run.rmax, run.E)
+            ray = run.direction()
+            alpha0 = search.first_step(ray.Kd) if run.mem.empty else 1.0
+            trial = search.search(alpha0, ray, run.lowest_energy())
+            if trial is None:
+                return run.finish(False, it, "line search failed", t0)
+            resync = (it + 1) % self.resync == 0
+            run.accept(trial, ray, resync)                     # E at the new point (re-anchor w = K q)
+            pair = run.new_residual(trial.alpha, resync)       # one convolution: r, G, y, K y
+            run.remember(trial.alpha, ray, pair, resync)       # the L-BFGS memory
+        return run.finish(False, self.max_iter, f"not converged in {self.max_iter} iterations", t0)
+
+
+class _Descent:
+    """One FastSolver solve: the iterate and what is carried with it, and its steps.
+
+    Carried: q and w = K q (the solve's own arrays, returned in the State); g = g0 + w, P = P(g),
+    the residual r = w − K P, the K-metric gradient G = q − P, its next values rn, Gn, and the
+    scalars E, q·w, ΣΦ, ΣP, the mean of q, max|r| and the lowest E so far.  All other arrays are
+    the workspace's.
+
+    A periodic kernel has K(0) = 0: the mean of q is a gauge (E and w do not see it), and the K
+    metric cannot control it.  Left alone, a near-flat line search (near round-off) can push a huge
+    mean into q, which then spoils q·w and G in floating point and throws the iterate away from the
+    minimum it had reached.  So the mean of q is held fixed and G = q − P is used without its mean
+    (the K-metric gradient is the same); ΣP comes with the law's sweeps and Σd with the direction's,
+    so this costs no extra pass.
+
+    A weighted problem (``lines``, tengsim.solvers._weights): the sweeps' plain sums are corrected on
+    the few pixels whose weight differs from the interior one, and ΔA carries the interior weight.
+    """
+
+    def __init__(self, problem: Problem, start: State, ws, lines=None):
+        K = problem.kernel
+        self.problem, self.law, self.dA = problem, problem.law, problem.dA
+        self.lines = lines
+        if lines is not None:
+            self.dA = problem.dA * lines.scale
+        self.shape = problem.g0.shape
+        self.g0 = np.ascontiguousarray(problem.g0, dtype=float).ravel()
+        self.n = self.g0.size
+        self.nw = self.n if lines is None else lines.total  # the (weighted) pixel count
+        self.red = red = for_kernel(K)  # None, or the sums and maxima over the ranks of a distributed solve
+        if red is not None:
+            self.nw = red.sum([float(self.n)])[0]
+        self.q = np.array(start.q, dtype=float).ravel()
+        self.w = np.array(start.w, dtype=float).ravel()
+        self.sw, self.mem, self.cP = ws.sweeper, ws.memory, ws.cP
+        self.g, self.P, self.d, self.Kd = ws.g, ws.P, ws.d, ws.Kd
+        self.r, self.rn, self.G, self.Gn, self.y, self.ky = ws.r, ws.rn, ws.G, ws.Gn, ws.y, ws.ky
+        # a film's periodic kernel has a finite mean compliance, K(0) > 0: it says pinned_mean = False
+        self.proj = bool(getattr(K, "pinned_mean", getattr(K, "periodic", False)))
+        self.search = WolfeLineSearch(problem.law, ws.sweeper, self.dA, ws.gt, ws.Pt, sum_p=self.proj,
+                                      lines=lines, red=red)
+        self._apply, self._takes_out = K.apply, _takes_out(K.apply)
+        # the start: g, P, ΣΦ, r (one convolution), G, E
+        np.add(self.g0, self.w, out=self.g)
+        self.phis, self.sum_p = self.law_sweep()
+        np.subtract(self.w, self.convolve(self.P), out=self.r)
+        self.n_conv = 1
+        if red is not None:
+            self.mean_q = red.sum([float(self.q.sum())])[0] / self.nw
+        elif lines is None:
+            self.mean_q = float(self.q.mean())
+        else:
+            self.mean_q = (float(self.q.sum()) - lines.sum(self.q)) / self.nw
+        np.subtract(self.q, self.P, out=self.G)
+        if self.proj:
+            self.G -= self.mean_q - self.sum_p / self.nw
+        self.qw = self._dot(self.q, self.w)
+        self.E = self.dA * (0.5 * self.qw + self.phis)
+        self.rmax = max(float(self.r.max()), -float(self.r.min()))
+        if red is not None:
+            self.rmax = red.max(self.rmax)
+        self.E_best = self.E
+        self.sum_d = 0.0
+        self.corr = None
+
+    # ---- the pieces ---------------------------------------------------------------------------
+    def _dot(self, a, b) -> float:
+        """a·b, m-weighted (in units of the interior weight) for a weighted problem."""
+        v = float(np.vdot(a, b))
+        if self.red is not None:
+            return self.red.sum([v])[0]
+        return v if self.lines is None else v - self.lines.dot(a, b)
+
+    def convolve(self, x):
+        """K x into the workspace's output array (one convolution; not counted here)."""
+        out, shape = self.cP, self.shape
+        if self._takes_out:
+            self._apply(x.reshape(shape), out=out.reshape(shape))
+        else:  # a kernel of the caller's own without ``out=``
+            out[:] = self._apply(x.reshape(shape)).ravel()
+        return out
+
+    def _law_block(self, sl, m, sc, acc):
+        buf = self.sw.buf
+        acc[0] += self.law.energy_pressure(self.g[sl], self.P[sl], (buf(sc, "a", m), buf(sc, "b", m)))
+        if self.proj:
+            acc[1] += float(self.P[sl].sum())
+
+    def law_sweep(self):
+        """ΣΦ(g) and ΣP (periodic kernels only, else 0), with P(g) written into P."""
+        acc = self.sw.sum(self._law_block, [0.0, 0.0])
+        if self.lines is not None:
+            acc = _weigh_law(self.lines, self.law, self.g, self.P, acc, self.proj)
+        if self.red is not None:
+            acc = self.red.sum(acc)
+        return acc
+
+    def lowest_energy(self) -> float:
+        """The lowest E so far: E may rise by round-off in an accepted step (approximate Wolfe);
+        measured from it, such rises cannot add up over many steps near convergence."""
+        self.E_best = min(self.E_best, self.E)
+        return self.E_best
+
+    # ---- the direction --------------------------------------------------------------------------
+    def _direction_block(self, sl, m, sc, acc, gamma, c, k2):
+        ds, kds = self.d[sl], self.Kd[sl]
+        np.multiply(self.G[sl], -gamma, out=ds)
+        np.multiply(self.r[sl], -gamma, out=kds)
+        if k2:
+            h = self.sw.buf(sc, "h", m)
+            np.matmul(c, self.mem.B[:k2, sl], out=h)
+            ds -= h
+            np.matmul(c, self.mem.KB[:k2, sl], out=h)
+            kds -= h
+        acc[0] += float(np.vdot(ds, self.w[sl]))
+        acc[1] += float(np.vdot(ds, kds))
+        acc[2] += float(np.vdot(ds, self.r[sl]))
+        if self.proj:
+            acc[3] += float(ds.sum())
+
+    def _direction(self):
+        gamma, c = self.mem.coefficients()
+        k2 = 0 if c is None else c.size
+        acc = self.sw.sum(self._direction_block, [0.0, 0.0, 0.0, 0.0], gamma, c, k2)
+        L = self.lines
+        if L is not None:  # the sweep wrote d and K d whole: correct its sums on the deficit pixels
+            cw, cKd, cr = L.dots(self.d, self.w, self.Kd, self.r)
+            acc = [acc[0] - cw, acc[1] - cKd, acc[2] - cr, acc[3] - (L.sum(self.d) if self.proj else 0.0)]
+        if self.red is not None:
+            acc = self.red.sum(acc)
+        return acc
+
+    def direction(self) -> Ray:
+        """d = −H G and K d = −K H G (one sweep), and E along d.
+
+        The slope E'(0) = ΔA (d·w − P·K d) is taken as ΔA d·r (equal, since r = w − K P and K is
+        symmetric): near convergence d·w and P·K d nearly cancel, and their difference is noise.
+        Not a descent direction (d·r >= 0): the memory is dropped, d = −G."""
+        dw, dKd, dr, sum_d = self._direction()
+        if not dr < 0:
+            self.mem.reset()
+            dw, dKd, dr, sum_d = self._direction()
+        self.sum_d = sum_d
+        return Ray(self.g, self.P, self.Kd, self.qw, dw, dKd, self.E, self.dA * dr)
+
+    # ---- the step -------------------------------------------------------------------------------
+    def accept(self, trial: Trial, ray: Ray, resync: bool) -> None:
+        """Move E, q·w, ΣΦ, ΣP, mean(q) to the accepted point (q and w themselves move in
+        :meth:`new_residual`); on a ``resync`` step q moves here and w is re-anchored (:meth:`_reanchor`)."""
+        alpha = trial.alpha
+        if resync:
+            self.corr = self._reanchor(alpha)
+            self.E_best = math.inf  # E is recomputed exactly: the bookkeeping restarts from it
+        else:
+            self.g, self.P = self.search.swap(self.g, self.P)
+            self.phis, self.sum_p = trial.phis, trial.sum_p
+            self.qw += alpha * (2.0 * ray.dw + alpha * ray.dKd)
+            self.corr = None
+        self.E = self.dA * (0.5 * self.qw + self.phis)
+        self.mean_q += alpha * self.sum_d / self.nw
+
+    def _reanchor(self, alpha):
+        """q ← q + α d and w = K q exactly (one convolution), then g, P, ΣΦ, q·w anew.
+
+        The images K d are assembled, not convolved: round-off lets w drift from K q.  The
+        correction (w = K q exactly, minus the assembled step α K d) goes to w and r only: the
+        stored pair keeps the assembled images K s = α K d, K y = K s − Δ(K P), as every other
+        pair does, so the drift is not fed back into later directions.  Returns the correction."""
+        q, w, gt, Pt = self.q, self.w, self.search.g_trial, self.search.P_trial
+        _axpy(self.d, q, alpha, gt)
+        w_exact = self.convolve(q)
+        self.n_conv += 1
+        corr = np.subtract(w_exact, w, out=gt)
+        _axpy(self.Kd, corr, -alpha, Pt)
+        w[:] = w_exact
+        np.add(self.g0, w, out=self.g)
+        self.phis, self.sum_p = self.law_sweep()
+        self.qw = self._dot(q, w)
+        return corr
+
+    def _residual_block(self, sl, m, sc, acc, alpha, step, corr, mu, k2):
+        # q ← q + α d, w ← w + α K d; r_new = w − K P; K y = Δr; G_new = q − P; y = ΔG
+        ds = self.d[sl]
+        if step:
+            tmp = self.sw.buf(sc, "t", m)
+            qs, ws = self.q[sl], self.w[sl]
+            np.multiply(ds, alpha, out=tmp)
+            qs += tmp
+            np.multiply(self.Kd[sl], alpha, out=tmp)
+            ws += tmp
+        rns, kys, Gns, ys = self.rn[sl], self.ky[sl], self.Gn[sl], self.y[sl]
+        np.subtract(self.w[sl], self.cP[sl], out=rns)
+        np.subtract(rns, self.r[sl], out=kys)
+        if corr is not None:
+            kys -= corr[sl]
+        np.subtract(self.q[sl], self.P[sl], out=Gns)
+        if self.proj:
+            Gns -= mu
+        np.subtract(Gns, self.G[sl], out=ys)
+        acc[0] += float(np.vdot(ds, kys))
+        acc[1] += float(np.vdot(ys, kys))
+        acc[2] += float(np.vdot(ds, rns))
+        acc[3] += float(np.vdot(ys, rns))
+        acc[4] = max(acc[4], float(rns.max()), -float(rns.min()))
+        if k2:
+            acc[5] = acc[5] + self.mem.B[:k2, sl] @ kys
+
+    def new_residual(self, alpha: float, resync: bool):
+        """K P at the new point (one convolution) and, in one sweep, the step of q and w (unless
+        re-anchored), the new residual and gradient, the pair y = ΔG, K y = Δr and their products.
+
+        Returns (d·K y, y·K y, d·r_new, y·r_new, B K y): what the memory update needs; sets max|r|."""
+        mu = self.mean_q - self.sum_p / self.nw if self.proj else 0.0
+        self.convolve(self.P)
+        self.n_conv += 1
+        k2 = 2 * len(self.mem.order)
+        accs = self.sw.run(self._residual_block, [0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+                           alpha, not resync, self.corr, mu, k2)
+        if len(accs) == 1:
+            dky, yky, drn, yrn, self.rmax, x = accs[0]
+        else:
+            dky, yky, drn, yrn, _, x = (sum(a[j] for a in accs) for j in range(6))
+            self.rmax = max(a[4] for a in accs)
+        L = self.lines
+        if L is not None:  # max|r| stays a plain max; the products are weighted
+            ky, rn = self.ky, self.rn
+            c_dky, c_drn = L.dots(self.d, ky, rn)
+            c_yky, c_yrn = L.dots(self.y, ky, rn)
+            dky, yky, drn, yrn = dky - c_dky, yky - c_yky, drn - c_drn, yrn - c_yrn
+            if k2:
+                x = x - L.rows(self.mem.B[:k2], ky)
+        if self.red is not None:  # every rank's partial products and max|r|
+            dky, yky, drn, yrn = self.red.sum([dky, yky, drn, yrn])
+            self.rmax = self.red.max(self.rmax)
+            if k2:
+                x = self.red.sum(np.asarray(x, dtype=float))
+        return dky, yky, drn, yrn, (x if k2 else None)
+
+    def _store_block(self, sl, m, sc, acc, alpha, slot):
+        B, KB = self.mem.B, self.mem.KB
+        np.multiply(self.d[sl], alpha, out=B[2 * slot, sl])
+        B[2 * slot + 1, sl] = self.y[sl]
+        np.multiply(self.Kd[sl], alpha, out=KB[2 * slot, sl])
+        KB[2 * slot + 1, sl] = self.ky[sl]
+
+    def remember(self, alpha: float, ray: Ray, pair, resync: bool) -> None:
+        """Update the L-BFGS memory with the pair (s = α d, y) if ⟨s, y⟩ > 0 (curvature), then make
+        the new residual and gradient current (on a re-anchored step, the memory's products anew)."""
+        dky, yky, drn, yrn, x = pair
+        dA = self.dA
+        sy = dA * alpha * dky
+        yy = dA * yky
+        sks = dA * alpha * alpha * abs(ray.dKd)
+        store = sy > 1e-14 * max(sks, 1e-300) and yy > 0
+        slot = self.mem.update(alpha, None if x is None else dA * x, sy, yy, dA * drn, dA * yrn, store)
+        if slot is not None:
+            self.sw.run(self._store_block, (), alpha, slot)
+        self.r, self.rn = self.rn, self.r
+        self.G, self.Gn = self.Gn, self.G
+        if resync:
+            self.mem.refresh(self.r)
+
+    def finish(self, ok: bool, it: int, msg: str, t0: float) -> Equilibrium:
+        st = State(self.q.reshape(self.shape), self.w.reshape(self.shape))
+        return finish(self.problem, st, self.P.reshape(self.shape).copy(), self.r, self.E, ok, it,
+                       self.n_conv, t0, msg)
+
+
+def _weigh_law(lines, law, g, P, acc, sum_p):
+    """[ΣΦ, ΣP] of a sweep, m-weighted: less the deficit pixels' share (Φ there evaluated anew)."""
+    i = lines.idx
+    phis = acc[0] - float(np.dot(lines.c, law.energy(g[i])))
+    return [phis, acc[1] - lines.sum(P) if sum_p else acc[1]]
+
+
+def _takes_out(fn) -> bool:
+    """Does ``fn`` accept an ``out=`` keyword (the package's kernels do)?  Asked once per function:
+    ``inspect.signature`` costs ~20 µs, a tenth of a warm equilibrium on group A's grid."""
+    func = getattr(fn, "__func__", fn)  # a bound method's function: the same answer for every instance
+    try:
+        return _signature_takes_out(func)
+    except TypeError:  # an unhashable callable: not cached
+        return _signature_takes_out.__wrapped__(func)
+
+
+@functools.lru_cache(maxsize=64)
+def _signature_takes_out(fn) -> bool:
+    try:
+        params = inspect.signature(fn).parameters.values()
+    except (TypeError, ValueError):
+        return False
+    return any(p.name == "out" or p.kind is p.VAR_KEYWORD for p in params)
+
+
+def _axpy(x, y, a, tmp):
+    """y ← y + a x in place, through the scratch array ``tmp`` (no allocation).
+
+    (Not BLAS daxpy: OpenBLAS threads it, and on a busy 2-core machine that cost ~1000× on small arrays.)
+    """
+    np.multiply(x, a, out=tmp)
+    np.add(y, tmp, out=y)
