@@ -94,8 +94,12 @@ def atomic_path(path: str | os.PathLike):
         os.replace(tmp, path)
         with contextlib.suppress(OSError):  # the rename itself, durable (not every platform opens a directory)
             _fsync(path.parent, os.O_DIRECTORY if hasattr(os, "O_DIRECTORY") else 0)
+    except OSError as exc:  # a full disk, no permission, a read-only file system: named by the final path
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+        raise OSError(exc.errno, exc.strerror or str(exc), str(path)) from None
     except BaseException:
-        with contextlib.suppress(FileNotFoundError):
+        with contextlib.suppress(OSError):
             os.unlink(tmp)
         raise
 
@@ -117,6 +121,30 @@ def check_writable(path) -> None:
 def write_text(path, text: str) -> None:
     with atomic_path(path) as tmp:
         tmp.write_text(text)
+
+
+def write_bytes(path, data) -> None:
+    """Write ``data`` (bytes) to ``path`` atomically: a write error (ENOSPC, EACCES, EROFS) is an OSError
+    naming ``path``, and no temporary file is left."""
+    with atomic_path(path) as tmp:
+        with open(tmp, "wb") as fh:
+            fh.write(data)
+
+
+def netcdf_bytes(ds, edit=None) -> bytes:
+    """``ds`` as NetCDF-4 bytes (h5netcdf engine), made in memory: the HDF5 library never writes to the
+    disk, so a full disk cannot fail inside it (where it fails without an OSError, and its objects
+    crash the interpreter at exit); the bytes then go through :func:`write_bytes`.  ``edit(h5py.File)``,
+    if given, may change the file (attributes) before it is closed."""
+    data = bytes(ds.to_netcdf(engine="h5netcdf"))
+    if edit is None:
+        return data
+    import h5py
+
+    buf = _stdio.BytesIO(data)
+    with h5py.File(buf, "r+") as f:
+        edit(f)
+    return buf.getvalue()
 
 
 def jsonable(x):
@@ -168,8 +196,8 @@ def cf_conventions(ds, title: str):
 
 def write_dataset(ds, path) -> None:
     """Write an xarray Dataset to NetCDF (h5netcdf engine) atomically; Ctrl-C waits for the write."""
-    with interrupts_held(), atomic_path(path) as tmp:
-        ds.to_netcdf(tmp, engine="h5netcdf")
+    with interrupts_held():
+        write_bytes(path, netcdf_bytes(ds))
 
 
 def read_dataset(path):
