@@ -34,7 +34,7 @@ def run(args) -> int:
         from tengsim.cli import device as device_cli
 
         return device_cli.run_config(cfg, args)
-    check_tables(cfg, ("contact", "reproduce"), where=str(args.config))
+    check_tables(cfg, ("contact", "device", "reproduce"), where=str(args.config))
     kinds = [k for k in ("contact", "reproduce") if k in cfg]
     if len(kinds) != 1:
         raise TengsimError(f"{args.config}: needs exactly one of [contact], [device], [reproduce]")
