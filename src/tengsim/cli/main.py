@@ -21,9 +21,15 @@ class Parser(argparse.ArgumentParser):
 
     def __init__(self, *args, **kwargs):
         super().__init__(*args, **kwargs)
-        self._negative_number_matcher = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$|^-(inf|nan)$", re.I)
+        # a negative number, or a negative quantity ('-0.59MPa', '-2 kPa', '-5um'): a value, not an option
+        self._negative_number_matcher = re.compile(
+            r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?(\s*[A-Za-zµμ][A-Za-zµμ/^²0-9]*)?$|^-(inf|nan)$", re.I)
 
     def error(self, message):
+        from tengsim.errors import SHOWN
+
+        # a hostile value echoed by argparse ('invalid int value: ...') is cut, as tengsim's own messages cut it
+        message = re.sub(r"\S{%d,}" % (SHOWN + 1), lambda m: m.group(0)[:SHOWN] + "…", message)
         self.exit(2, f"tengsim: error: {message} (see '{self.prog} --help')\n")
 
 
