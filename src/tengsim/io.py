@@ -118,6 +118,40 @@ def check_writable(path) -> None:
         raise TengsimError(f"cannot write {path}: {exc.strerror or exc}") from None
 
 
+def check_output(path, inputs=(), *, folder: bool = False, what: str = "--out") -> Path:
+    """The one place an output path is chosen: refuse, before any work, a ``path`` that resolves to one of
+    ``inputs`` (a topography read as g.csv and written to g.csv would destroy it), a file where a folder
+    is wanted (or a folder where a file is), an existing folder that cannot be written, or a place that
+    cannot be written at all (:func:`check_writable`).  Strings of ``inputs`` that are not existing files
+    are ignored (a config's other values may be passed as they are).  Returns ``path`` as a Path."""
+    from tengsim.errors import TengsimError, shown
+
+    path = Path(path)
+    target = path.resolve()
+    for inp in inputs:
+        if not isinstance(inp, (str, os.PathLike)) or len(str(inp)) > 4096:
+            continue
+        try:
+            same = Path(inp).is_file() and (Path(inp).resolve() == target or
+                                            (path.exists() and os.path.samefile(inp, path)))
+        except (OSError, ValueError):
+            continue
+        if same:
+            raise TengsimError(f"{what} {shown(str(path))[1:-1]} is also an input ({shown(str(inp))[1:-1]}): "
+                               "writing it would destroy the input; choose another output")
+    if folder:
+        if path.exists() and not path.is_dir():
+            raise TengsimError(f"{what} {path} is a file, not a folder: choose a folder (it is created)")
+        if path.is_dir() and not os.access(path, os.W_OK | os.X_OK):
+            raise TengsimError(f"cannot write {path}: permission denied")
+        check_writable(path)  # its parent: the folder itself is made when the results are
+    else:
+        if path.is_dir():
+            raise TengsimError(f"{what} {path} is a folder, not a file")
+        check_writable(path)
+    return path
+
+
 def write_text(path, text: str) -> None:
     with atomic_path(path) as tmp:
         tmp.write_text(text)

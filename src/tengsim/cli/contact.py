@@ -94,11 +94,11 @@ def run(args) -> int:
         raise TengsimError(f"--out {args.out}: use a .csv or .nc file")
     if args.plot and Path(args.plot).suffix.lower() not in (".png", ".pdf", ".svg"):
         raise TengsimError(f"--plot {args.plot}: use a .png, .pdf or .svg file")
-    from tengsim.io import check_writable
+    from tengsim.io import check_output
 
-    check_writable(out)
+    check_output(out, cfg.values())  # never over an input (a topography file)
     if args.plot:
-        check_writable(args.plot)
+        check_output(args.plot, cfg.values(), what="--plot")
     from tengsim import parallel
 
     if not parallel.is_root():  # mpiexec -n N: every process solves its slab, rank 0 alone writes and reports

@@ -49,6 +49,9 @@ def run(args) -> int:
         vals = Table("reproduce", [Field("out", "str", "tengsim-paper", help="output folder"),
                                    Field("quick", "bool", False, help="coarse grids (minutes)")]).parse(section)
         out, quick = vals["out"], vals["quick"]
+        from tengsim.io import check_output
+
+        check_output(out, [args.config], folder=True, what="out =")
         reproduce(out, quick=quick, log=None if args.quiet else (lambda m: print(m, file=sys.stderr)))
         return 0
 
@@ -68,11 +71,12 @@ def _contact(section, args) -> int:
     plot = section.get("plot")
     if plot and (not isinstance(plot, str) or Path(plot).suffix.lower() not in (".png", ".pdf", ".svg")):
         raise TengsimError(f"plot = {plot!r}: use a .png, .pdf or .svg file")
-    from tengsim.io import check_writable
+    from tengsim.io import check_output
 
-    check_writable(out)
+    inputs = [args.config, *section.values()]
+    check_output(out, inputs, what="out =")
     if plot:
-        check_writable(plot)
+        check_output(plot, inputs, what="plot =")
     stream = open_stream(out, getattr(args, "resume", False), args.quiet)
     res = run_streamed(lambda bar: run_contact(section, progress=bar, sink=stream), stream, args.quiet)
     if res is None:
