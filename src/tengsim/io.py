@@ -137,7 +137,7 @@ def check_output(path, inputs=(), *, folder: bool = False, what: str = "--out") 
         except (OSError, ValueError):
             continue
         if same:
-            raise TengsimError(f"{what} {shown(str(path))[1:-1]} is also an input ({shown(str(inp))[1:-1]}): "
+            raise TengsimError(f"{what} {shown(str(path), 300)[1:-1]} is also an input ({shown(str(inp), 300)[1:-1]}): "
                                "writing it would destroy the input; choose another output")
     if folder:
         if path.exists() and not path.is_dir():

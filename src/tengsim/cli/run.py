@@ -73,7 +73,7 @@ def _contact(section, args) -> int:
         raise TengsimError(f"plot = {plot!r}: use a .png, .pdf or .svg file")
     from tengsim.io import check_output
 
-    inputs = [args.config, *section.values()]
+    inputs = [args.config, *(v for k, v in section.items() if k not in ("out", "plot"))]
     check_output(out, inputs, what="out =")
     if plot:
         check_output(plot, inputs, what="plot =")
