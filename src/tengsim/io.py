@@ -170,7 +170,14 @@ def netcdf_bytes(ds, edit=None) -> bytes:
     disk, so a full disk cannot fail inside it (where it fails without an OSError, and its objects
     crash the interpreter at exit); the bytes then go through :func:`write_bytes`.  ``edit(h5py.File)``,
     if given, may change the file (attributes) before it is closed."""
-    data = bytes(ds.to_netcdf(engine="h5netcdf"))
+    try:  # a local write in this process: no distributed lock, even with a dask Client about
+        import dask
+
+        local = dask.config.set(scheduler="synchronous")
+    except ImportError:  # pragma: no cover - dask is a dependency
+        local = contextlib.nullcontext()
+    with local:
+        data = bytes(ds.to_netcdf(engine="h5netcdf"))
     if edit is None:
         return data
     import h5py
