@@ -43,6 +43,8 @@ def plot_study(root, out, vars=MAP_VARS) -> list:
     nc = StudyDir(root).dataset_nc
     if not nc.exists():
         raise TengsimError(f"{root} holds no study.nc (run tengsim sweep first)")
+    from tengsim.study.dataset import key_of
+
     ds = read_dataset(nc)
     dims = [d for d in ds["pull_off_F"].dims]
     vars = [v for v in vars if v in ds and np.isfinite(ds[v].values.astype(float)).any()] or ["pull_off_F"]
@@ -59,9 +61,9 @@ def plot_study(root, out, vars=MAP_VARS) -> list:
         for ax, v in zip(axs.flat, vars):
             sc = ax.scatter(px, py, c=_data(ds, v), cmap="viridis", s=30)
             fig.colorbar(sc, ax=ax, label=_LABEL.get(v, v))
-            ax.set_xlabel(params[0])
+            ax.set_xlabel(key_of(ds, params[0]))
             if len(params) > 1:
-                ax.set_ylabel(params[1])
+                ax.set_ylabel(key_of(ds, params[1]))
             if xnum and np.all(px > 0) and px.max() / px.min() > 20:
                 ax.set_xscale("log")
     else:
@@ -81,16 +83,16 @@ def plot_study(root, out, vars=MAP_VARS) -> list:
                 fig.colorbar(m, ax=ax, label=_LABEL.get(v, v))
                 ax.set_yticks(np.arange(len(y)), [str(a) for a in sub[yd].values])
                 ax.set_xticks(np.arange(len(x)), [str(a) for a in sub[xd].values], rotation=45)
-                ax.set_ylabel(yd)
+                ax.set_ylabel(key_of(ds, yd))
                 if "adhesive_full_contact" in sub:
                     full = sub["adhesive_full_contact"].transpose(yd, xd).values
                     yy, xx = np.nonzero(full == 1)
                     ax.plot(xx, yy, "wx", ms=6, label="full contact at zero load")
-            ax.set_xlabel(xd)
+            ax.set_xlabel(key_of(ds, xd))
             if len(dims) == 1 and xnum and np.all(x > 0) and x.max() / x.min() > 20:
                 ax.set_xscale("log")
         if sel:
-            fig.suptitle(", ".join(f"{d} = {ds[d].values[0]}" for d in sel), fontsize=9)
+            fig.suptitle(", ".join(f"{key_of(ds, d)} = {ds[d].values[0]}" for d in sel), fontsize=9)
     for ax in list(axs.flat)[n:]:
         ax.set_visible(False)
     fig.tight_layout()
@@ -114,7 +116,7 @@ def plot_study(root, out, vars=MAP_VARS) -> list:
             c = cmap(idx / max(1, len(cval) - 1))
             ax.plot(P, row.transpose(..., pdim).values, color=c, lw=1)
         sm = plt.cm.ScalarMappable(cmap=cmap, norm=plt.Normalize(0, max(1, len(cval) - 1)))
-        cb = fig.colorbar(sm, ax=ax, label=by)
+        cb = fig.colorbar(sm, ax=ax, label=key_of(ds, by))
         cb.set_ticks(np.arange(len(cval)), labels=[str(a) for a in ds[by].values]) if by != "point" else None
         ax.set_xlabel("pressure (kPa)")
         ax.set_ylabel("V_OC (V), Eq. (12)")
