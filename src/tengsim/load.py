@@ -195,9 +195,15 @@ def load_result(path) -> tuple[str, object]:
             return "contact", ContactResult(table=table, grid=grid, params=header, maps=_partial_maps(path, header))
         if "t" in cols:
             _require(path, cols, ("t",), "device time series")
+            if not len(cols["t"]):
+                raise TengsimError(f"{path}: a device time series with no rows")
             return "device", cols
         if "R" in cols:
             _require(path, cols, SWEEP_COLUMNS, "load sweep")
+            R = np.asarray(cols["R"], dtype=float)
+            if not len(R) or not np.all(np.isfinite(R) & (R > 0)):
+                raise TengsimError(f"{path}: a load sweep needs rows with load resistances R > 0 (finite), "
+                                   f"got {len(R)} row(s)" + ("" if not len(R) else f", R from {R.min():g}"))
             return "sweep", {**cols, "header": header}
         raise TengsimError(f"{path}: not a tengsim result (no 'branch'/'D', 't' or 'R' columns)")
     if suffix == ".nc":
