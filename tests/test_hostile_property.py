@@ -193,7 +193,7 @@ def test_generated_result_files_to_plot(tmp_path_factory, capsys, content, heade
 
 
 # ---- a few through a real process: the exit code, not only main()'s return value -----------------
-SRC = str(Path(__file__).resolve().parents[1] / "src")
+SRC = str(Path(__import__("tengsim").__file__).resolve().parents[1])  # the tengsim under test
 
 
 @pytest.mark.parametrize("args", [
