@@ -476,6 +476,8 @@ def test_c13_unknown_tables_name_device_and_a_huge_value_is_cut(tmp_path, capsys
     assert len(line) < 300 and "100002 characters" in line
     line = refused(capsys, ["sweep", str(cfg), "--workers", "x" * 100_000])
     assert len(line) < 300
+    for argv in (["contact", "pyramid", "--law", huge], ["sweep", huge], ["contact", huge]):  # the edge cuts too
+        assert len(refused(capsys, [*argv, "--out", str(tmp_path / "o.csv")], where=tmp_path, keep={"run.toml"})) < 400
 
 
 def test_c13_the_shown_value_is_cut():
