@@ -496,3 +496,10 @@ def test_cf_variable_names_are_letters_digits_underscores():
     assert cf_name("var.aspect") == "var_aspect"
     assert cf_name("group") == "group"
     assert cf_name("1x") == "v_1x"
+
+
+def test_c05_a_huge_popsize_is_refused_before_any_point(tmp_path, capsys):
+    f = _study(tmp_path, '[axes]\n"contact.N" = { start = 0.9, stop = 1.0 }\n[objective]\nminimize = "pull_off_F"\n'
+                         "popsize = 1000000000\n")
+    line = refused(capsys, ["optimize", str(f), "--out", str(tmp_path / "o"), "--workers", "1"], where=tmp_path)
+    assert "popsize" in line and "at most 100000" in line and not (tmp_path / "o").exists()
