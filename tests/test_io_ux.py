@@ -228,10 +228,10 @@ def test_ctrl_c_waits_for_a_netcdf_write_then_arrives(tmp_path, python_sigint):
 
     ds = xr.Dataset({"F": ("D", np.linspace(0.0, 1.0, 50))})
 
-    class Interrupted:  # a dataset whose write is hit by Ctrl-C half-way
-        def to_netcdf(self, path, engine):
+    class Interrupted:  # a dataset whose write is hit by Ctrl-C half-way (made in memory: path None)
+        def to_netcdf(self, path=None, engine=None):
             signal.raise_signal(signal.SIGINT)
-            ds.to_netcdf(path, engine=engine)
+            return ds.to_netcdf(path, engine=engine)
 
     before = signal.getsignal(signal.SIGINT)
     with pytest.raises(KeyboardInterrupt):

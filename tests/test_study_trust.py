@@ -425,9 +425,9 @@ def test_array_of_identical_cells_has_its_patterns_observables(tmp_path, client)
                         source="arr")
     run_study(study, tmp_path / "s", client=client, quiet=True)
     ds = xr.load_dataset(tmp_path / "s" / "study.nc")
-    pyr = ds.sel({"contact.shape": "pyramid", "contact.observers": ""})
-    arr = ds.sel({"contact.shape": "array", "contact.observers": ""})
-    obs = ds.sel({"contact.shape": "array", "contact.observers": "array_area"})
+    pyr = ds.sel({"contact_shape": "pyramid", "contact_observers": ""})
+    arr = ds.sel({"contact_shape": "array", "contact_observers": ""})
+    obs = ds.sel({"contact_shape": "array", "contact_observers": "array_area"})
     assert float(arr["pull_off_Pa"]) == pytest.approx(float(pyr["pull_off_Pa"]), rel=1e-6)
     # the summed A/S of identical cells is the pattern's; from the highest cell's Λc it is that cell's,
     # which in partial contact (low pressure) matches the single pyramid's

@@ -13,7 +13,7 @@ import dataclasses
 from dataclasses import dataclass, field
 
 from tengsim.kernels import film
-from tengsim.errors import ConfigValueError, TengsimError, finite, positive
+from tengsim.errors import ConfigValueError, TengsimError, finite, positive, shown
 from tengsim.laws import make_law
 from tengsim.path import PathSpec
 from tengsim.plugins import KERNELS, LAWS, OBSERVERS, SHAPES, SOLVERS
@@ -67,8 +67,12 @@ def _bare(v) -> bool:
     if isinstance(v, (int, float)):
         return True
     if isinstance(v, str):
+        from tengsim.units import read_number
+
         try:
-            float(v)
+            read_number(v)
+        except TengsimError:
+            return True  # a number, refused by its key's own reading
         except ValueError:
             return False
         return True
@@ -394,19 +398,25 @@ class ContactPlan:
 def _dx(raw, lateral, name="dx"):
     """A length in X units (dx, thickness): a number, or (physical runs only) a length with a unit."""
     if isinstance(raw, str):
+        from tengsim.units import read_number
+
         try:
-            number = float(raw)
+            number = read_number(raw, name)
+        except TengsimError:
+            raise
         except ValueError:
             number = None
         if number is not None:
             return positive(name, number)
         if lateral is None:
-            raise ConfigValueError(f"{name} = {raw!r} has a unit, but this run is dimensionless: give {name} in X "
+            raise ConfigValueError(f"{name} = {shown(raw)} has a unit, but this run is dimensionless: give {name} in X "
                                    "units (or the shape's physical sizes with E_star and W)")
         return positive(name, parse_quantity(raw, "length", name=name) / lateral)
     if isinstance(raw, bool) or not isinstance(raw, (int, float)):
-        raise ConfigValueError(f"{name} must be a number, got {raw!r}")
-    return positive(name, raw)
+        raise ConfigValueError(f"{name} must be a number, got {shown(raw)}")
+    from tengsim.units import read_number
+
+    return positive(name, read_number(raw, name))
 
 
 def _film(cfg, vals, lateral, extra) -> dict:
@@ -459,11 +469,14 @@ def plan_contact(cfg: dict) -> ContactPlan:
     all_law_keys = law_keys()
     unknown = [k for k in cfg if k not in full]
     if unknown:
-        others = [k for k in unknown if k in contact_keys()]
+        from tengsim.errors import listed
+
+        every = set(contact_keys())  # once: a file of 16 000 unknown keys is checked in linear time
+        others = [k for k in unknown if k in every]
         if others:
             own = [k for k in full.keys() if k not in _common_names() and k not in all_law_keys]
-            raise TengsimError(f"shape {name} has no key {', '.join(map(repr, others))} (its keys: {', '.join(own)})")
-        raise TengsimError(f"[contact] unknown key(s) {', '.join(map(repr, unknown))} "
+            raise TengsimError(f"shape {name} has no key {listed(others)} (its keys: {', '.join(own)})")
+        raise TengsimError(f"[contact] unknown key(s) {listed(unknown)} "
                            f"(known: {', '.join(full.keys())})")
     dims, phys = dimensionless_fields(cls), physical_fields(cls)
     dim_names, phys_names = [f.name for f in dims], [f.name for f in phys]

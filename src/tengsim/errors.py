@@ -12,6 +12,27 @@ class ConfigValueError(TengsimError):
     combination that cannot be built, e.g. a pyramid wider than its cell)."""
 
 
+SHOWN = 60
+"""How many characters of a value an error message echoes (:func:`shown`)."""
+
+
+def shown(value, limit: int = SHOWN) -> str:
+    """``repr(value)`` cut to ``limit`` characters plus '…' and its length: a hostile 100 KB value is
+    named, not echoed whole."""
+    text = repr(value)
+    if len(text) <= limit:
+        return text
+    return f"{text[:limit]}… ({len(text)} characters)"
+
+
+def listed(names, limit: int = 5) -> str:
+    """"'a', 'b', 'c'" of ``names``, at most ``limit`` of them (each cut as :func:`shown` cuts it), then
+    'and N more': a message about 16 000 unknown keys stays one short line."""
+    names = list(names)
+    head = ", ".join(shown(n, 40) for n in names[:limit])
+    return head + (f" and {len(names) - limit} more" if len(names) > limit else "")
+
+
 def require(condition: bool, message: str) -> None:
     """Raise :class:`TengsimError` with ``message`` unless ``condition`` holds."""
     if not condition:
@@ -23,9 +44,9 @@ def positive(name: str, value) -> float:
     try:
         v = float(value)
     except (TypeError, ValueError):
-        raise ConfigValueError(f"{name} must be a number, got {value!r}") from None
+        raise ConfigValueError(f"{name} must be a number, got {shown(value)}") from None
     if not (v > 0 and v < float("inf")):
-        raise ConfigValueError(f"{name} must be finite and > 0, got {value!r}")
+        raise ConfigValueError(f"{name} must be finite and > 0, got {shown(value)}")
     return v
 
 
@@ -34,7 +55,7 @@ def finite(name: str, value) -> float:
     try:
         v = float(value)
     except (TypeError, ValueError):
-        raise ConfigValueError(f"{name} must be a number, got {value!r}") from None
+        raise ConfigValueError(f"{name} must be a number, got {shown(value)}") from None
     if v != v or v in (float("inf"), float("-inf")):
-        raise ConfigValueError(f"{name} must be finite, got {value!r}")
+        raise ConfigValueError(f"{name} must be finite, got {shown(value)}")
     return v

@@ -39,6 +39,11 @@ class Grid:
         dx = positive("dx", dx)
         if dx > length / 3:
             raise TengsimError(f"dx={dx} is too coarse for a cell of length {length} (need >= 3 pixels)")
+        from tengsim.resources import MAX_PIXELS_PER_SIDE
+
+        if not length / dx <= MAX_PIXELS_PER_SIDE:  # before any count or allocation (also: an overflow to inf)
+            raise TengsimError(f"a cell of length {length:g} at dx={dx:g} is {length / dx:.3g} pixels per side; "
+                               f"at most {MAX_PIXELS_PER_SIDE} are allowed: use a larger dx or a smaller cell")
         n = max(3, int(round(length / dx)))
         # FFT-friendly pixel counts (small prime factors), odd so that a pixel sits on the apex
         n = backend.fast_odd_len(n) if odd else backend.fast_len(n)

@@ -94,8 +94,12 @@ def atomic_path(path: str | os.PathLike):
         os.replace(tmp, path)
         with contextlib.suppress(OSError):  # the rename itself, durable (not every platform opens a directory)
             _fsync(path.parent, os.O_DIRECTORY if hasattr(os, "O_DIRECTORY") else 0)
+    except OSError as exc:  # a full disk, no permission, a read-only file system: named by the final path
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+        raise OSError(exc.errno, exc.strerror or str(exc), str(path)) from None
     except BaseException:
-        with contextlib.suppress(FileNotFoundError):
+        with contextlib.suppress(OSError):
             os.unlink(tmp)
         raise
 
@@ -114,9 +118,74 @@ def check_writable(path) -> None:
         raise TengsimError(f"cannot write {path}: {exc.strerror or exc}") from None
 
 
+def check_output(path, inputs=(), *, folder: bool = False, what: str = "--out") -> Path:
+    """The one place an output path is chosen: refuse, before any work, a ``path`` that resolves to one of
+    ``inputs`` (a topography read as g.csv and written to g.csv would destroy it), a file where a folder
+    is wanted (or a folder where a file is), an existing folder that cannot be written, or a place that
+    cannot be written at all (:func:`check_writable`).  Strings of ``inputs`` that are not existing files
+    are ignored (a config's other values may be passed as they are).  Returns ``path`` as a Path."""
+    from tengsim.errors import TengsimError, shown
+
+    path = Path(path)
+    target = path.resolve()
+    for inp in inputs:
+        if not isinstance(inp, (str, os.PathLike)) or len(str(inp)) > 4096:
+            continue
+        try:
+            same = Path(inp).is_file() and (Path(inp).resolve() == target or
+                                            (path.exists() and os.path.samefile(inp, path)))
+        except (OSError, ValueError):
+            continue
+        if same:
+            raise TengsimError(f"{what} {shown(str(path), 300)[1:-1]} is also an input ({shown(str(inp), 300)[1:-1]}): "
+                               "writing it would destroy the input; choose another output")
+    if folder:
+        if path.exists() and not path.is_dir():
+            raise TengsimError(f"{what} {path} is a file, not a folder: choose a folder (it is created)")
+        if path.is_dir() and not os.access(path, os.W_OK | os.X_OK):
+            raise TengsimError(f"cannot write {path}: permission denied")
+        check_writable(path)  # its parent: the folder itself is made when the results are
+    else:
+        if path.is_dir():
+            raise TengsimError(f"{what} {path} is a folder, not a file")
+        check_writable(path)
+    return path
+
+
 def write_text(path, text: str) -> None:
     with atomic_path(path) as tmp:
         tmp.write_text(text)
+
+
+def write_bytes(path, data) -> None:
+    """Write ``data`` (bytes) to ``path`` atomically: a write error (ENOSPC, EACCES, EROFS) is an OSError
+    naming ``path``, and no temporary file is left."""
+    with atomic_path(path) as tmp:
+        with open(tmp, "wb") as fh:
+            fh.write(data)
+
+
+def netcdf_bytes(ds, edit=None) -> bytes:
+    """``ds`` as NetCDF-4 bytes (h5netcdf engine), made in memory: the HDF5 library never writes to the
+    disk, so a full disk cannot fail inside it (where it fails without an OSError, and its objects
+    crash the interpreter at exit); the bytes then go through :func:`write_bytes`.  ``edit(h5py.File)``,
+    if given, may change the file (attributes) before it is closed."""
+    try:  # a local write in this process: no distributed lock, even with a dask Client about
+        import dask
+
+        local = dask.config.set(scheduler="synchronous")
+    except ImportError:  # pragma: no cover - dask is a dependency
+        local = contextlib.nullcontext()
+    with local:
+        data = bytes(ds.to_netcdf(engine="h5netcdf"))
+    if edit is None:
+        return data
+    import h5py
+
+    buf = _stdio.BytesIO(data)
+    with h5py.File(buf, "r+") as f:
+        edit(f)
+    return buf.getvalue()
 
 
 def jsonable(x):
@@ -168,8 +237,8 @@ def cf_conventions(ds, title: str):
 
 def write_dataset(ds, path) -> None:
     """Write an xarray Dataset to NetCDF (h5netcdf engine) atomically; Ctrl-C waits for the write."""
-    with interrupts_held(), atomic_path(path) as tmp:
-        ds.to_netcdf(tmp, engine="h5netcdf")
+    with interrupts_held():
+        write_bytes(path, netcdf_bytes(ds))
 
 
 def read_dataset(path):

@@ -76,10 +76,28 @@ def _read_csv(path: Path, allow_empty: bool = False):
     return header, cols
 
 
-def _require(path, cols, required, what):
+def _require(path, cols, required, what, text=("branch", "status")):
+    """Refuse a file lacking a column of ``required``, or whose required column (other than the ``text``
+    ones) holds text: a hand-edited 'abc' in D is named, not a TypeError inside a plot."""
+    from tengsim.errors import shown
+
     missing = [k for k in required if k not in cols]
     if missing:
         raise TengsimError(f"{path}: {what} lacks column(s) {', '.join(missing)}")
+    for k in required:
+        a = np.asarray(cols[k])
+        if k not in text and a.dtype.kind not in "fiub":
+            row = next((i for i, v in enumerate(a.tolist()) if not _is_number(v)), 0)
+            raise TengsimError(f"{path}: column {k!r} must hold numbers, but data row {row + 1} is "
+                               f"{shown(a.tolist()[row] if len(a) else '')}")
+
+
+def _is_number(v) -> bool:
+    try:
+        float(v)
+    except (TypeError, ValueError):
+        return False
+    return True
 
 
 def _contact_table(path, cols, dx=None) -> dict:
@@ -176,9 +194,16 @@ def load_result(path) -> tuple[str, object]:
             table = _contact_table(path, cols, grid.dx if grid else None)
             return "contact", ContactResult(table=table, grid=grid, params=header, maps=_partial_maps(path, header))
         if "t" in cols:
+            _require(path, cols, ("t",), "device time series")
+            if not len(cols["t"]):
+                raise TengsimError(f"{path}: a device time series with no rows")
             return "device", cols
         if "R" in cols:
             _require(path, cols, SWEEP_COLUMNS, "load sweep")
+            R = np.asarray(cols["R"], dtype=float)
+            if not len(R) or not np.all(np.isfinite(R) & (R > 0)):
+                raise TengsimError(f"{path}: a load sweep needs rows with load resistances R > 0 (finite), "
+                                   f"got {len(R)} row(s)" + ("" if not len(R) else f", R from {R.min():g}"))
             return "sweep", {**cols, "header": header}
         raise TengsimError(f"{path}: not a tengsim result (no 'branch'/'D', 't' or 'R' columns)")
     if suffix == ".nc":

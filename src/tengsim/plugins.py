@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import importlib
 import os
+import re
 
 import tengsim.kernels  # noqa: F401  (registers 'free', 'periodic')
 import tengsim.laws  # noqa: F401  (registers 'lj93', 'repulsive', 'md', 'exp')
@@ -26,22 +27,48 @@ __all__ = ["KERNELS", "LAWS", "OBSERVERS", "SHAPES", "SOLVERS", "load_plugins"]
 _LOADED: set = set()
 
 
+_MODULE = re.compile(r"[A-Za-z_][A-Za-z0-9_]*(\.[A-Za-z_][A-Za-z0-9_]*)*")
+
+
+def _guarded(what: str, load) -> None:
+    """Run ``load()`` (one plugin's import) inside the one guard every plugin passes: whatever it raises
+    (an ImportError, any exception, a ``sys.exit``) becomes one TengsimError naming ``what``."""
+    from tengsim.errors import shown
+
+    try:
+        load()
+    except TengsimError as exc:  # e.g. a name or alias clashing with a built-in one
+        raise TengsimError(f"plugin {what}: {exc}") from None
+    except ImportError as exc:
+        raise TengsimError(f"plugin {what}: cannot import it: {shown(str(exc), 200)[1:-1]}") from None
+    except SystemExit as exc:
+        raise TengsimError(f"plugin {what} called sys.exit({shown(exc.code)}) while loading") from None
+    except Exception as exc:  # noqa: BLE001 - a broken plugin is named, never a traceback or exit 70
+        msg = " ".join(str(exc).split()) or "(no message)"
+        raise TengsimError(f"plugin {what} failed to load: {type(exc).__name__}: {shown(msg, 200)[1:-1]}") from None
+
+
 def load_plugins() -> None:
-    """Import the modules named in ``TENGSIM_PLUGINS`` and the ``tengsim.plugins`` entry points (each once)."""
+    """Import the modules named in ``TENGSIM_PLUGINS`` and the ``tengsim.plugins`` entry points (each once),
+    each inside :func:`_guarded`: a module name that is not a dotted Python name ('../../x') is refused."""
+    from tengsim.errors import shown
+
     for mod in filter(None, (m.strip() for m in os.environ.get("TENGSIM_PLUGINS", "").split(","))):
         if mod in _LOADED:
             continue
-        try:
-            importlib.import_module(mod)
-        except ImportError as exc:
-            raise TengsimError(f"TENGSIM_PLUGINS: cannot import {mod!r}: {exc}") from None
+        if not _MODULE.fullmatch(mod):
+            raise TengsimError(f"TENGSIM_PLUGINS: {shown(mod)} is not a module name (dotted Python names, "
+                               "comma-separated, e.g. mypkg.shapes)")
+
+        _guarded(f"{mod!r} (TENGSIM_PLUGINS)", lambda mod=mod: importlib.import_module(mod))
         _LOADED.add(mod)
     try:
         from importlib.metadata import entry_points
 
-        for ep in entry_points(group="tengsim.plugins"):
-            if ep.value not in _LOADED:
-                ep.load()
-                _LOADED.add(ep.value)
-    except Exception as exc:  # noqa: BLE001 - a broken plugin is reported, not a traceback
-        raise TengsimError(f"tengsim.plugins entry point failed: {exc}") from None
+        eps = list(entry_points(group="tengsim.plugins"))
+    except Exception as exc:  # noqa: BLE001 - broken package metadata
+        raise TengsimError(f"tengsim.plugins entry points cannot be listed: {exc}") from None
+    for ep in eps:
+        if ep.value not in _LOADED:
+            _guarded(f"{ep.name!r} (entry point {ep.value})", ep.load)
+            _LOADED.add(ep.value)

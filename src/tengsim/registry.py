@@ -116,6 +116,14 @@ class Registry(Generic[T]):
             key = self._key(name)
             if not replace and (key in self._items or key in self._aliases):
                 raise TengsimError(f"{self.kind} {name!r} is already registered")
+            for a in aliases:  # an alias may not take a name or alias of another entry (checked before any change)
+                ak = self._key(a)
+                owner = ak if ak in self._items else self._aliases.get(ak)
+                if owner is not None and owner != key and not replace:
+                    raise TengsimError(f"{self.kind} {name!r}: alias {a!r} is already "
+                                       + (f"the {self.kind} {owner!r}" if ak == owner else f"an alias of {owner!r}"))
+                if ak == key:
+                    raise TengsimError(f"{self.kind} {name!r}: alias {a!r} is its own name")
             self._items[key] = o
             doc = (getattr(o, "__doc__", None) or "").strip().splitlines()
             self._summary[key] = summary or (doc[0].rstrip(".") if doc else "")

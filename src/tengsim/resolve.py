@@ -264,7 +264,8 @@ def _dx_needed(levels: list, rich: dict, changes: dict, tol: float) -> float:
 
 def resolve_contact(shape, tabor: float, path, dx: float | None = None, law=None, boundary: str = "free",
                     resolve_tol: float = DEFAULT_TOL, max_pixels: int | None = None, observe=None,
-                    full_length: float | None = None, progress=None, **simulate_kw):
+                    full_length: float | None = None, progress=None, checkpoint=None, start=None,
+                    **simulate_kw):
     """Run :func:`tengsim.contact.simulate` on finer and finer grids until converged (module doc).
 
     ``dx`` the first grid's spacing (None: :func:`default_dx`), ``resolve_tol`` the relative tolerance,
@@ -272,7 +273,11 @@ def resolve_contact(shape, tabor: float, path, dx: float | None = None, law=None
     extra observables, ``full_length`` the shape's full-contact Λc (for transition_D); the other keywords go
     to ``simulate``.  Returns the finest grid's ContactResult with ``params['resolution']`` (the table: one
     row per grid), ``params['richardson']``, ``resolve``, ``resolve_tol``, ``max_pixels``, ``resolve_grids``,
-    ``resolve_status`` and, if stopped by ``max_pixels``, ``resolve_message``."""
+    ``resolve_status`` and, if stopped by ``max_pixels``, ``resolve_message``.
+
+    ``checkpoint(levels, phases, result)``, if given, is called after each finished grid (to keep it: a
+    killed refinement keeps every grid it finished, :class:`Checkpoint`); ``start = (levels, phases,
+    result)`` continues a refinement from such a record instead of computing those grids again."""
     from tengsim.contact import simulate
     from tengsim.errors import positive
     from tengsim.laws import LJ93, make_law
@@ -286,8 +291,15 @@ def resolve_contact(shape, tabor: float, path, dx: float | None = None, law=None
     max_pixels = check_max_pixels(max_pixels)
     dx = default_dx(shape, law, tabor**1.5, boundary) if dx is None else positive("dx", dx)
     levels, names, res, seen = [], [], None, set()
-    stop, phases = None, ()
-    while True:
+    stop, phases, done = None, (), False
+    if start is not None:  # a refinement kept by its checkpoint: its grids are not computed again
+        levels, phases, res = [dict(lv) for lv in start[0]], tuple(start[1]), start[2]
+        for lv in levels:
+            names.extend(k for k in lv["obs"] if k not in names)
+        seen = {(lv["nx"], lv["ny"]) for lv in levels}
+        done = _judge(levels, names, tol)[0]
+        dx = levels[-1]["dx"] / FACTOR
+    while not done:
         grid = shape.grid(dx)
         if levels:  # keep the shape's edges where they fell in the first grid's pixels (module doc)
             grid = _aligned(shape, grid, phases, max_pixels)
@@ -314,6 +326,8 @@ def resolve_contact(shape, tabor: float, path, dx: float | None = None, law=None
                        "convolutions": int(res.params.get("n_conv_spent",
                                                           np.nansum(np.asarray(res.table["n_conv"], dtype=float)))),
                        "status": res.status, "obs": obs})
+        if checkpoint is not None:
+            checkpoint(levels, phases, res)
         done, changes, rich = _judge(levels, names, tol)
         if done:
             break
@@ -389,12 +403,75 @@ def run_contact(cfg: dict, progress=None, sink=None, observe=None, full_length=N
     if plan.resolve.get("resolve", "off") != "auto":  # one grid: exactly tengsim.contact.run_contact's call
         kw = {k: v for k, v in (("progress", progress), ("sink", sink)) if v is not None}
         return contact.run_contact(cfg, **kw)
+    ck = Checkpoint.of(sink, cfg)
     res = resolve_contact(plan.shape, plan.tabor, plan.path, dx=plan.resolve.get("dx"), law=plan.law,
                           boundary=plan.boundary, resolve_tol=plan.resolve["resolve_tol"],
                           max_pixels=plan.resolve.get("max_pixels"), progress=progress,
                           full_length=None if full_length is None else full_length(plan.shape.params()),
                           observe=observe, symmetry=getattr(plan, "symmetry", "auto"),
                           solver=plan.solver, tol=plan.tol, extra_params=plan.extra, observers=plan.observers,
-                          scaling=plan.scaling, kernel_params=plan.kernel_params)
+                          scaling=plan.scaling, kernel_params=plan.kernel_params,
+                          checkpoint=None if ck is None else ck.save, start=None if ck is None else ck.load())
+    res.params.pop(Checkpoint.KEY, None)
     res.params["config"] = {k: v for k, v in cfg.items() if k not in ("out", "plot")}
     return res
+
+
+class Checkpoint:
+    """The finished grids of a refinement writing ``out`` (``resolve = 'auto'`` with a row stream), kept in
+    :func:`checkpoint_path`: after each grid, the finest grid's result (NetCDF, written atomically) with the
+    levels so far and the table's digest in its parameters; read back by ``--resume`` (the grids are not
+    computed again); removed with the partial file once the result is saved
+    (:meth:`tengsim.results.RowStream.finish`)."""
+
+    KEY = "resolve_checkpoint"
+
+    def __init__(self, path, digest: str):
+        self.path, self.digest = path, digest
+
+    @classmethod
+    def of(cls, sink, cfg: dict):
+        """The checkpoint of the run streaming to ``sink`` (a RowStream: its ``out``), None without one."""
+        import hashlib
+
+        from tengsim import io
+
+        out = getattr(sink, "out", None)
+        if out is None:
+            return None
+        cfg = {k: v for k, v in cfg.items() if k not in ("out", "plot")}
+        digest = hashlib.sha256(io.dumps(dict(sorted(cfg.items()))).encode()).hexdigest()[:16]
+        from tengsim.results import checkpoint_path
+
+        return cls(checkpoint_path(out), digest)
+
+    def save(self, levels, phases, res) -> None:
+        from tengsim import io
+
+        res.params[self.KEY] = io.dumps({"digest": self.digest, "levels": levels, "phases": list(phases)})
+        try:
+            res.save(self.path)
+        finally:
+            res.params.pop(self.KEY, None)
+
+    def load(self):
+        """(levels, phases, result) kept by an interrupted run of this table, or None if there is none."""
+        import json
+
+        from tengsim.load import load_result
+
+        if not self.path.is_file():
+            return None
+        try:
+            _, res = load_result(self.path)
+            rec = json.loads(res.params.pop(self.KEY))
+        except (TengsimError, KeyError, TypeError, ValueError) as exc:
+            raise TengsimError(f"--resume: {self.path} is not a refinement checkpoint ({exc}); delete it to "
+                               "start afresh") from None
+        if rec.get("digest") != self.digest:
+            raise TengsimError(f"--resume: {self.path} was written by another run (its [contact] table "
+                               "differs); delete it to start afresh")
+        levels = rec["levels"]
+        for lv in levels:  # strict JSON wrote NaN as null
+            lv["obs"] = {k: (math.nan if v is None else v) for k, v in lv["obs"].items()}
+        return levels, rec["phases"], res

@@ -31,6 +31,28 @@ PATH_WORK = 14               # U0, g0 and three equilibria (q, w, H, P)
 MAP_WORK = 4                 # P and H kept, and stacked once more for the file
 
 
+MAX_POINTS = 100_000
+"""The most points a study may hold (its grid's product of axis lengths, n samples, a range's num, an
+optimisation's population × generations): a sweep of 10⁵ contact runs is weeks of CPU already."""
+MAX_PIXELS_PER_SIDE = 65_536
+"""The most pixels along one side of a contact grid (65 536² floats are 32 GiB each)."""
+
+
+def check_count(count, what: str, limit: int = MAX_POINTS) -> int:
+    """``count`` if at most ``limit``, else one TengsimError naming ``what``: the one check of how many
+    points, values or workers an input asks for, made before anything is allocated or submitted."""
+    count = int(count)
+    if count > limit:
+        raise TengsimError(f"{what} asks for {count:.4g} points; at most {limit} are allowed in one run"
+                           if count >= 1e6 else f"{what} asks for {count}; at most {limit} are allowed in one run")
+    return count
+
+
+def max_workers() -> int:
+    """The most local worker processes a sweep may start: 4 per core (at least 8)."""
+    return max(8, 4 * (os.cpu_count() or 1))
+
+
 def estimate_bytes(nx: int, ny: int, boundary: str = "free", solver: str = "fast", memory: int = 10,
                    maps: int = 0) -> int:
     """Peak bytes of the arrays a contact run on an ``nx`` × ``ny`` grid allocates (see module doc).

@@ -390,6 +390,14 @@ def partial_path(out):
     return Path(str(out) + PARTIAL_SUFFIX)
 
 
+def checkpoint_path(out):
+    """Where a refinement (``resolve = 'auto'``) writing ``OUT`` keeps its finished grids, the finest one's
+    result and the levels so far: ``OUT.resolve.nc`` beside it (:class:`tengsim.resolve.Checkpoint`)."""
+    from pathlib import Path
+
+    return Path(str(out) + ".resolve.nc")
+
+
 def partial_maps_path(out):
     """The maps of a run writing to a NetCDF ``OUT``, kept as they are computed: ``OUT.partial.maps.npz``."""
     from pathlib import Path
@@ -570,6 +578,6 @@ class RowStream:
     def finish(self) -> None:
         """The whole result is saved: close and remove the partial file (and maps)."""
         self.close()
-        for p in (self.path, self.maps_path):
+        for p in (self.path, self.maps_path, checkpoint_path(self.out)):  # a refinement's grids too
             if p is not None:
                 p.unlink(missing_ok=True)

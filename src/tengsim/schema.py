@@ -13,7 +13,10 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable
 
-from tengsim.errors import ConfigValueError, TengsimError
+from tengsim.errors import ConfigValueError, TengsimError, listed, shown
+
+MAX_INT = 10**15
+"""The largest |value| of an integer key (seeds, counts): exactly representable as a float."""
 
 REQUIRED = object()
 """Marker default of a field that must be given."""
@@ -58,27 +61,32 @@ class Field:
             elif isinstance(value, str) and value.lower() in ("true", "false", "1", "0", "yes", "no"):
                 v = value.lower() in ("true", "1", "yes")
             else:
-                raise ConfigValueError(f"{label} must be true or false, got {value!r}")
+                raise ConfigValueError(f"{label} must be true or false, got {shown(value)}")
         elif k == "str":
             if not isinstance(value, str):
-                raise ConfigValueError(f"{label} must be a string, got {value!r}")
+                raise ConfigValueError(f"{label} must be a string, got {shown(value)}")
             v = value
             ch = self._choices()
             if ch:
                 key = value.strip().lower().replace("-", "_")
                 norm = {c.lower().replace("-", "_"): c for c in ch}
                 if key not in norm:
-                    raise ConfigValueError(f"{label} = {value!r} is not one of {', '.join(ch)}")
+                    raise ConfigValueError(f"{label} = {shown(value)} is not one of {', '.join(ch)}")
                 v = norm[key]
         elif k == "int":
+            from tengsim.units import read_number
+
             if isinstance(value, bool) or not isinstance(value, (int, float, str)):
-                raise ConfigValueError(f"{label} must be an integer, got {value!r}")
+                raise ConfigValueError(f"{label} must be an integer, got {shown(value)}")
             try:
-                f = float(value)
+                f = read_number(value, label)
+            except ConfigValueError:
+                raise
             except ValueError:
-                raise ConfigValueError(f"{label} must be an integer, got {value!r}") from None
-            if not math.isfinite(f) or f != int(f):
-                raise ConfigValueError(f"{label} must be an integer, got {value!r}")
+                raise ConfigValueError(f"{label} must be an integer, got {shown(value)}") from None
+            if not math.isfinite(f) or f != int(f) or abs(f) > MAX_INT:
+                raise ConfigValueError(f"{label} must be an integer" + (f" of magnitude at most {MAX_INT:.0e}"
+                                       if math.isfinite(f) and f == int(f) else "") + f", got {shown(value)}")
             v = int(f)
         elif k == "float":
             v = self._number(value, label)
@@ -89,7 +97,7 @@ class Field:
             elif isinstance(value, (int, float)) and not isinstance(value, bool):
                 items = [value]
             if not isinstance(items, (list, tuple)):
-                raise ConfigValueError(f"{label} must be a list of numbers, got {value!r}")
+                raise ConfigValueError(f"{label} must be a list of numbers, got {shown(value)}")
             v = tuple(self._number(x, label) for x in items)
         else:  # pragma: no cover - a schema bug
             raise TypeError(f"unknown field kind {k!r}")
@@ -98,24 +106,26 @@ class Field:
         return v
 
     def _number(self, value, label):
-        from tengsim.units import parse_quantity
+        from tengsim.units import parse_quantity, read_number
 
         if isinstance(value, bool):
             raise ConfigValueError(f"{label} must be a number, got {value!r}")
         if isinstance(value, str):
             s = value.strip()
             try:
-                x = float(s)
+                x = read_number(s, label)
+            except ConfigValueError:
+                raise
             except ValueError:
                 if self.dim is None:
-                    raise ConfigValueError(f"{label} is dimensionless: give a plain number, got {value!r}") from None
+                    raise ConfigValueError(f"{label} is dimensionless: give a plain number, got {shown(value)}") from None
                 x = parse_quantity(s, self.dim, name=label)
         elif isinstance(value, (int, float)):
-            x = float(value)
+            x = read_number(value, label)
         else:
-            raise ConfigValueError(f"{label} must be a number, got {value!r}")
+            raise ConfigValueError(f"{label} must be a number, got {shown(value)}")
         if not math.isfinite(x):
-            raise ConfigValueError(f"{label} must be finite, got {value!r}")
+            raise ConfigValueError(f"{label} must be finite, got {shown(value)}")
         return x
 
     def describe(self) -> str:
@@ -159,10 +169,10 @@ class Table:
         """
         where = f"[{self.name}] " if where is None else where
         if not isinstance(mapping, dict):
-            raise TengsimError(f"{where.strip() or self.name} must be a table, got {mapping!r}")
+            raise TengsimError(f"{where.strip() or self.name} must be a table, got {shown(mapping)}")
         unknown = [k for k in mapping if k not in self.fields]
         if unknown:
-            raise TengsimError(f"{where}unknown key(s) {', '.join(map(repr, unknown))} "
+            raise TengsimError(f"{where}unknown key(s) {listed(unknown)} "
                                f"(known: {', '.join(self.fields)})")
         out = {}
         for name, f in self.fields.items():
@@ -212,11 +222,11 @@ def check_tables(cfg: dict, allowed, where: str = "config") -> None:
     """Refuse top-level tables not in ``allowed`` and top-level values that are not tables."""
     unknown = [k for k in cfg if k not in allowed]
     if unknown:
-        raise TengsimError(f"{where}: unknown table(s) {', '.join(map(repr, unknown))} "
+        raise TengsimError(f"{where}: unknown table(s) {listed(unknown)} "
                            f"(known: {', '.join(allowed)})")
     for k, v in cfg.items():
         if not isinstance(v, dict):
-            raise TengsimError(f"{where}: [{k}] must be a table, got {v!r}")
+            raise TengsimError(f"{where}: [{k}] must be a table, got {shown(v)}")
 
 
 def field_kind(annotation) -> str:

@@ -5,7 +5,7 @@ import math
 import re
 from dataclasses import dataclass
 
-from tengsim.errors import TengsimError, positive
+from tengsim.errors import ConfigValueError, TengsimError, positive, shown
 
 _PREFIX = {"": 1.0, "k": 1e3, "M": 1e6, "G": 1e9, "m": 1e-3, "u": 1e-6, "µ": 1e-6, "μ": 1e-6,
            "n": 1e-9, "p": 1e-12, "c": 1e-2}
@@ -28,17 +28,63 @@ _BASE = {
 _NUM = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
 
 
+MAX_TEXT = 64
+"""The longest text read as a number or a quantity (characters): a longer one is refused unread."""
+MAX_MAGNITUDE = 1e100
+"""The largest |value| (SI) any input may have; the smallest non-zero one is its inverse.  Every
+physical input lies far inside (a Planck length is 1.6e-35 m); past it, grids and scalings overflow."""
+
+
+def bounded(x: float, text, name: str = "value") -> float:
+    """``x`` if finite and 0 or within [1/MAX_MAGNITUDE, MAX_MAGNITUDE] in magnitude, else a
+    ConfigValueError naming ``name`` and (cut) ``text``."""
+    if not math.isfinite(x):
+        raise ConfigValueError(f"{name} must be finite, got {shown(text)}")
+    if x != 0 and not (1.0 / MAX_MAGNITUDE <= abs(x) <= MAX_MAGNITUDE):
+        raise ConfigValueError(f"{name} = {shown(text)} is out of range: a value's magnitude must lie "
+                               f"between {1 / MAX_MAGNITUDE:g} and {MAX_MAGNITUDE:g} (or be 0)")
+    return x
+
+
+def read_number(text, name: str = "value") -> float:
+    """The one place where text becomes a number: '0.5', '-1e-3', 'nan' → float, bounded (:func:`bounded`).
+
+    A text longer than :data:`MAX_TEXT` characters, or holding an underscore ('0_5': Python's ``float``
+    reads it as 5, a typo for 0.5 more likely than a digit separator), is refused; so is anything
+    ``float`` does not read.  A ValueError (not a TengsimError) for text that is not a plain number, so
+    that a caller may read it as a quantity instead; a ConfigValueError for a number out of bounds."""
+    if isinstance(text, bool):
+        raise ValueError(f"{text!r} is not a number")
+    if isinstance(text, int):
+        if abs(text) > MAX_MAGNITUDE:
+            raise ConfigValueError(f"{name} = {shown(text)} is out of range: a value's magnitude must lie "
+                                   f"between {1 / MAX_MAGNITUDE:g} and {MAX_MAGNITUDE:g} (or be 0)")
+        return bounded(float(text), text, name)
+    if isinstance(text, float):
+        return bounded(text, text, name)
+    s = str(text).strip()
+    if len(s) > MAX_TEXT:
+        raise ConfigValueError(f"{name} = {shown(text)} is not a number (a number or quantity is at most "
+                               f"{MAX_TEXT} characters)")
+    if "_" in s:
+        raise ConfigValueError(f"{name} = {shown(text)}: no underscores in numbers (write 0.5, not 0_5)")
+    x = float(s)  # a ValueError for anything else
+    if math.isnan(x):
+        return x  # NaN is left to each key's own check (finite, positive), which names it
+    return bounded(x, text, name)
+
+
 def number_or_text(v, label: str, quantity: str):
     """A key that takes a plain number or, in a physical run, ``quantity`` with a unit ("5nm", "-2kPa"): the
     number as float, a numeric string as float, other text stripped (its unit is checked later)."""
     if isinstance(v, bool) or not isinstance(v, (int, float, str)):
-        raise TengsimError(f"{label} must be a number or {quantity} with a unit, got {v!r}")
-    if isinstance(v, str):
-        try:
-            return float(v)
-        except ValueError:
-            return v.strip()
-    return float(v)
+        raise TengsimError(f"{label} must be a number or {quantity} with a unit, got {shown(v)}")
+    try:
+        return read_number(v, label)
+    except ConfigValueError:
+        raise
+    except ValueError:
+        return v.strip()
 
 
 def parse_quantity(text, kind: str | None = None, name: str = "value") -> float:
@@ -47,14 +93,16 @@ def parse_quantity(text, kind: str | None = None, name: str = "value") -> float:
     Units: m, Pa, N/m2, J/m2, N/m, N, C/m2, ohm, Hz, s, g, kg, with prefixes k M G m u µ n p c
     (e.g. um, mJ/m2, uC/m2, MOhm, cm).  'm2' and '^2' are both accepted.
     """
-    if isinstance(text, (int, float)):
-        v = float(text)
+    if isinstance(text, (int, float)) and not isinstance(text, bool):
+        v = read_number(text, name)
     else:
         s = str(text).strip().replace(" ", "").replace("^2", "2").replace("²", "2")
+        if len(s) > MAX_TEXT or "_" in s:
+            read_number(s, name)  # refuses it, naming it
         m = re.fullmatch(f"({_NUM})(.*)", s)
         if not m:
-            raise TengsimError(f"cannot read {name} = {text!r} as a number with a unit")
-        v = float(m.group(1))
+            raise TengsimError(f"cannot read {name} = {shown(text)} as a number with a unit")
+        v = read_number(m.group(1), name)
         unit = m.group(2)
         if unit:
             found = None
@@ -63,13 +111,13 @@ def parse_quantity(text, kind: str | None = None, name: str = "value") -> float:
                     if unit == pre + base and (found is None or len(base) > len(found[0])):
                         found = (base, dim, f * pf)
             if found is None:
-                raise TengsimError(f"unknown unit {unit!r} in {name} = {text!r}")
+                raise TengsimError(f"unknown unit {shown(unit)} in {name} = {shown(text)}")
             _, dim, factor = found
             if kind and dim != kind:
-                raise TengsimError(f"{name} = {text!r} is a {dim}, expected a {kind}")
-            v *= factor
+                raise TengsimError(f"{name} = {shown(text)} is a {dim}, expected a {kind}")
+            v = bounded(v * factor, text, name)
     if not math.isfinite(v):
-        raise TengsimError(f"{name} must be finite, got {text!r}")
+        raise TengsimError(f"{name} must be finite, got {shown(text)}")
     return v
 
 

@@ -61,6 +61,8 @@ def table(rows, key, n=10):
 def main(study_dir, out, name="question"):
     study_dir, out = Path(study_dir), Path(out)
     ds = xr.load_dataset(study_dir / "study.nc", engine="h5netcdf")
+    # study.nc names its axes CF-style (contact_shape) with the [axes] key in 'tengsim_key': back to the keys
+    ds = ds.rename({v: ds[v].attrs["tengsim_key"] for v in ds.variables if "tengsim_key" in ds[v].attrs})
     rows = flat(ds)
     # distinct computations only (the hemisphere ignores the aspect ratio)
     seen, uniq = set(), []

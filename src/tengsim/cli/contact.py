@@ -61,11 +61,11 @@ def run(args) -> int:
         raise TengsimError(f"--out {args.out}: use a .csv or .nc file")
     if args.plot and Path(args.plot).suffix.lower() not in (".png", ".pdf", ".svg"):
         raise TengsimError(f"--plot {args.plot}: use a .png, .pdf or .svg file")
-    from tengsim.io import check_writable
+    from tengsim.io import check_output
 
-    check_writable(out)
+    check_output(out, cfg.values())  # never over an input (a topography file)
     if args.plot:
-        check_writable(args.plot)
+        check_output(args.plot, cfg.values(), what="--plot")
     from tengsim import parallel
 
     if not parallel.is_root():  # mpiexec -n N: every process solves its slab, rank 0 alone writes and reports
@@ -147,12 +147,20 @@ def open_stream(out, resume: bool, quiet: bool = False):
     from tengsim.load import read_partial
     from tengsim.results import RowStream, partial_path
 
-    part = partial_path(out)
+    from tengsim.results import checkpoint_path
+
+    part, grids = partial_path(out), checkpoint_path(out)
     maps = Path(out).suffix.lower() == ".nc"
     if not resume:
-        if part.exists():
-            raise TengsimError(f"{part} holds an interrupted run of --out {out}: add --resume to continue it, "
-                               "or delete it to start afresh")
+        for f in (part, grids):
+            if f.exists():
+                raise TengsimError(f"{f} holds an interrupted run of --out {out}: add --resume to continue it, "
+                                   "or delete it to start afresh")
+        return RowStream(out, maps=maps)
+    if grids.is_file() and not part.is_file():  # a refinement: its finished grids are read by tengsim.resolve
+        if not quiet:
+            print(f"tengsim: resuming {grids}: its finished grids are kept, the refinement goes on",
+                  file=sys.stderr)
         return RowStream(out, maps=maps)
     if not part.is_file():
         raise TengsimError(f"--resume: no partial file {part} to continue (a run writes it as it goes and "
@@ -175,8 +183,13 @@ def run_streamed(call, stream, quiet: bool):
     except KeyboardInterrupt:
         bar.close()
         stream.close()
+        from tengsim.results import checkpoint_path
+
         if stream.path.exists():
             print(f"tengsim: interrupted; {stream.n_written} finished equilibria kept in {stream.path} "
+                  "(continue with --resume)", file=sys.stderr)
+        elif checkpoint_path(stream.out).exists():
+            print(f"tengsim: interrupted; the refinement's finished grids are kept in {checkpoint_path(stream.out)} "
                   "(continue with --resume)", file=sys.stderr)
         else:
             print("tengsim: interrupted; no partial output was written", file=sys.stderr)

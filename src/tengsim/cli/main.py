@@ -24,11 +24,21 @@ class Parser(argparse.ArgumentParser):
 
     def __init__(self, *args, **kwargs):
         super().__init__(*args, **kwargs)
-        self._negative_number_matcher = re.compile(  # '-5kPa', '-2 N': a negative quantity with its unit
-            r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?( ?[A-Za-zµμΩ][A-Za-z0-9µμΩ/²]*)?$|^-(inf|nan)$", re.I)
+        # a negative number, or a negative quantity ('-0.59MPa', '-2 kPa', '-5um'): a value, not an option
+        self._negative_number_matcher = re.compile(
+            r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?(\s*[A-Za-zµμΩ][A-Za-zµμΩ/^²0-9]*)?$|^-(inf|nan)$", re.I)
 
     def error(self, message):
-        self.exit(2, f"tengsim: error: {message} (see '{self.prog} --help')\n")
+        # a hostile value echoed by argparse ('invalid int value: ...') is cut, as tengsim's own messages cut it
+        self.exit(2, f"tengsim: error: {cut(message, 60)} (see '{self.prog} --help')\n")
+
+
+def cut(message: str, longest: int = 300) -> str:
+    """``message`` with every run of more than ``longest`` non-blank characters cut to 60 plus '…': the
+    last guard (at the edge) against echoing a hostile value whole; a path of ordinary length is kept."""
+    from tengsim.errors import SHOWN
+
+    return re.sub(r"\S{%d,}" % (longest + 1), lambda m: m.group(0)[:SHOWN] + "…", str(message))
 
 
 def chosen_command(argv) -> str | None:
@@ -126,7 +136,7 @@ def _main(argv=None) -> int:
         try:
             load_plugins()  # user shapes, laws, kernels, solvers, observers: before the parser lists them
         except TengsimError as exc:
-            print(f"tengsim: error: {exc}", file=sys.stderr)
+            print(f"tengsim: error: {cut(exc)}", file=sys.stderr)
             return 2
     parser = build_parser(command)
     try:
@@ -141,11 +151,11 @@ def _main(argv=None) -> int:
     try:
         return int(args.func(args) or 0)
     except TengsimError as exc:
-        print(f"tengsim: error: {exc}", file=sys.stderr)
+        print(f"tengsim: error: {cut(exc)}", file=sys.stderr)
         return 2
-    except OSError as exc:  # a file that cannot be read or written: one line, no traceback
+    except OSError as exc:  # a file that cannot be read or written (ENOSPC, EACCES, EROFS): one line naming it
         where = f" {exc.filename}" if getattr(exc, "filename", None) else ""
-        print(f"tengsim: error:{where}: {exc.strerror or exc}", file=sys.stderr)
+        print(cut(f"tengsim: error:{where}: {exc.strerror or exc}"), file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         print("tengsim: interrupted; no partial output was written", file=sys.stderr)

@@ -65,6 +65,9 @@ def run(args) -> int:
             print(f"wrote {w}")
         return 0
     out = out or src.with_suffix(".png")
+    from tengsim.io import check_output
+
+    check_output(out, [src])
     kind, obj = load_result(src)
     from tengsim.load import incomplete_note
 

@@ -20,6 +20,9 @@ def run(args) -> int:
     from tengsim.cases.paper.reproduce import reproduce, summary_text
     from tengsim.progress import Progress
 
+    from tengsim.io import check_output
+
+    check_output(args.out, folder=True)  # an existing file or an unwritable folder: refused before computing
     log = None if args.quiet else (lambda m: print(m, file=sys.stderr, flush=True))
     summary = reproduce(args.out, quick=args.quick, log=log,
                         progress_factory=lambda label: Progress(args.quiet))

@@ -36,7 +36,7 @@ def run(args) -> int:
         from tengsim.cli import device as device_cli
 
         return device_cli.run_config(cfg, args)
-    check_tables(cfg, ("contact", "reproduce"), where=str(args.config))
+    check_tables(cfg, ("contact", "device", "reproduce"), where=str(args.config))
     kinds = [k for k in ("contact", "reproduce") if k in cfg]
     if len(kinds) != 1:
         raise TengsimError(f"{args.config}: needs exactly one of [contact], [device], [reproduce]")
@@ -51,6 +51,9 @@ def run(args) -> int:
         vals = Table("reproduce", [Field("out", "str", "tengsim-paper", help="output folder"),
                                    Field("quick", "bool", False, help="coarse grids (minutes)")]).parse(section)
         out, quick = vals["out"], vals["quick"]
+        from tengsim.io import check_output
+
+        check_output(out, [args.config], folder=True, what="out =")
         reproduce(out, quick=quick, log=None if args.quiet else (lambda m: print(m, file=sys.stderr)))
         return 0
 
@@ -70,11 +73,12 @@ def _contact(section, args) -> int:
     plot = section.get("plot")
     if plot and (not isinstance(plot, str) or Path(plot).suffix.lower() not in (".png", ".pdf", ".svg")):
         raise TengsimError(f"plot = {plot!r}: use a .png, .pdf or .svg file")
-    from tengsim.io import check_writable
+    from tengsim.io import check_output
 
-    check_writable(out)
+    inputs = [args.config, *(v for k, v in section.items() if k not in ("out", "plot"))]
+    check_output(out, inputs, what="out =")
     if plot:
-        check_writable(plot)
+        check_output(plot, inputs, what="plot =")
     stream = open_stream(out, getattr(args, "resume", False), args.quiet)
     res = run_streamed(lambda bar: run_contact(section, progress=bar, sink=stream), stream, args.quiet)
     if res is None:

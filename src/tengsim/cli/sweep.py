@@ -13,6 +13,7 @@ file.
 """
 from __future__ import annotations
 
+import math
 import sys
 
 from tengsim.errors import TengsimError
@@ -37,7 +38,7 @@ def add_study_options(p) -> None:
     """--out, --workers | --scheduler and --resume: shared by ``tengsim sweep`` and ``tengsim optimize``."""
     p.add_argument("--out", help="study directory (default: the study file's name without .toml)")
     g = p.add_argument_group("where the points run (default: a LocalCluster with one worker per core)")
-    g.add_argument("--workers", type=int, help="number of local worker processes")
+    g.add_argument("--workers", help="number of local worker processes")
     g.add_argument("--scheduler", help="address of a running dask scheduler, e.g. tcp://host:8786")
     p.add_argument("--resume", action="store_true", help="continue the study in --out (reuse finished points)")
 
@@ -50,10 +51,30 @@ def load_study_args(args):
 
     if args.workers is not None and args.scheduler is not None:
         raise TengsimError("give either --workers or --scheduler, not both")
-    if args.workers is not None and args.workers < 1:
-        raise TengsimError(f"--workers must be >= 1, got {args.workers}")
+    if args.workers is not None:
+        args.workers = _workers(args.workers)
     study = load_study(args.study)
     return study, args.out or str(Path(args.study).with_suffix(""))
+
+
+def _workers(text) -> int:
+    """--workers as a count from 1 to :func:`tengsim.resources.max_workers`, refused before any start."""
+    from tengsim.errors import shown
+    from tengsim.resources import max_workers
+    from tengsim.units import read_number
+
+    try:
+        n = read_number(text, "--workers")
+    except TengsimError:
+        raise
+    except ValueError:
+        n = math.nan
+    if not (n == n and n == int(n) and n >= 1):
+        raise TengsimError(f"--workers must be a whole number >= 1, got {shown(text)}")
+    if n > max_workers():
+        raise TengsimError(f"--workers {int(n)} is more than {max_workers()} (4 local processes per core); "
+                           "use --scheduler for a cluster")
+    return int(n)
 
 
 def run(args) -> int:

@@ -126,6 +126,15 @@ class Rough(Shape):
 
     def __post_init__(self):
         positive("cell", self.cell)
+        # implausible surfaces are refused, not solved with overflow warnings (topography.MAX_RELIEF)
+        from tengsim.shapes.topography import MAX_RELIEF
+
+        if self.rms_slope is not None and not positive("rms_slope", self.rms_slope) <= MAX_RELIEF:
+            raise TengsimError(f"rough: rms_slope = {self.rms_slope:g} is implausible (at most {MAX_RELIEF:g}, a "
+                               "slope of 84°)")
+        if self.rms_height is not None and not positive("rms_height", self.rms_height) <= MAX_RELIEF * self.cell:
+            raise TengsimError(f"rough: rms_height = {self.rms_height:g} is more than {MAX_RELIEF:g} times the "
+                               f"cell {self.cell:g}: implausible (a height in another unit?)")
         settle_spectrum(self, float(self.cell), key=lambda k: k, lead="rough: ", cell_name="the cell")
 
     @classmethod

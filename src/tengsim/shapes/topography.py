@@ -29,9 +29,22 @@ DETREND_MODES = ("none", "center", "height", "slope", "curvature")
 'height' a plane (tilt), 'slope' a plane fitted to the mean slope, 'curvature' a quadric."""
 
 
+MAX_RELIEF = 10.0
+"""A surface's peak-to-valley height may be at most this many times its smaller lateral size (and a rough
+surface's rms slope at most this): beyond it the heights are almost surely in another unit (nm read as
+m), and are refused with that advice rather than solved."""
+
+HEADERLESS = {"hgt": (".hgt",)}
+"""SurfaceTopography formats with no header or magic number (any file of the right byte count reads as
+one), accepted only from a file named as that format: 8 KiB of random bytes is not an SRTM tile."""
+
+TEXT_SUFFIXES = (".txt", ".asc", ".dat", ".csv", ".xyz", "")
+
+
 @dataclass(frozen=True)
 class Measured:
-    """A topography in SI after reading: ``heights`` (m, shape (nx, ny)), ``size`` (Lx, Ly) in m."""
+    """A topography in SI after reading: ``heights`` (m, shape (nx, ny)), ``size`` (Lx, Ly) in m;
+    ``reader`` the SurfaceTopography format that read it ('asc', 'nc', 'gwy', ...)."""
 
     heights: np.ndarray
     size: tuple
@@ -39,6 +52,7 @@ class Measured:
     source: str
     detrend: str
     filled: int
+    reader: str = ""
 
     @property
     def pixel(self) -> tuple:
@@ -82,9 +96,19 @@ def read(path, physical_size=None, unit: str | None = None, detrend: str = "heig
         channel = reader.channels[0]
         file_size, file_unit = channel.physical_sizes, channel.unit
     except Exception as exc:  # noqa: BLE001 - SurfaceTopography's errors list every reader it tried
-        first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
         raise TengsimError(f"cannot read topography file {str(path)!r}: no SurfaceTopography reader "
-                           f"recognises it ({first.rstrip(':')})") from None
+                           f"recognises it ({_why_not(exc, p)})") from None
+    fmt = _format(reader)
+    if fmt in HEADERLESS and p.suffix.lower() not in HEADERLESS[fmt]:
+        raise TengsimError(f"topography file {str(path)!r} is not a topography: only the headerless "
+                           f"'{fmt}' reader takes it (any file of that byte count does), and its name does not "
+                           f"end in {' or '.join(HEADERLESS[fmt])}")
+    from tengsim.resources import MAX_PIXELS_PER_SIDE
+
+    pts = tuple(int(n) for n in np.atleast_1d(channel.nb_grid_pts))
+    if any(n > MAX_PIXELS_PER_SIDE for n in pts):
+        raise TengsimError(f"topography file {str(path)!r} (read as '{fmt}') has {'×'.join(map(str, pts))} "
+                           f"pixels; at most {MAX_PIXELS_PER_SIDE} per side")
     if channel.dim != 2:
         raise TengsimError(f"topography file {str(path)!r} holds a {channel.dim}-D scan; a 2-D map is needed")
     kw = {}
@@ -130,7 +154,44 @@ def read(path, physical_size=None, unit: str | None = None, detrend: str = "heig
     if not np.all(np.isfinite(h)):
         raise TengsimError(f"topography file {str(path)!r} has non-finite heights after reading")
     size = tuple(float(s) * factor for s in topo.physical_sizes)
-    return Measured(h, size, bool(topo.is_periodic), str(path), detrend, filled)
+    _check_relief(h, size, str(path), fmt, file_unit or unit)
+    return Measured(h, size, bool(topo.is_periodic), str(path), detrend, filled, fmt)
+
+
+def _format(reader) -> str:
+    """The SurfaceTopography format name of ``reader`` ('asc', 'hgt', 'nc', ...), else its class name."""
+    try:
+        return str(reader.format())
+    except Exception:  # noqa: BLE001 - a reader without a format name
+        return type(reader).__name__
+
+
+def _why_not(exc, p) -> str:
+    """The cause worth naming from SurfaceTopography's list of refusals: for a text file, what its text
+    reader (AscReader) said; else the first reason given."""
+    import re
+
+    text = str(exc)
+    reasons = dict(re.findall(r"tried (\w+):\s*\n\s*(.+)", text))
+    if p.suffix.lower() in TEXT_SUFFIXES and reasons.get("AscReader"):
+        return f"as a text matrix: {reasons['AscReader'].strip()[:200]}"
+    first = next((f"{k}: {v.strip()[:200]}" for k, v in reasons.items() if v.strip()), "")
+    if first:
+        return first
+    line = text.strip().splitlines()[0] if text.strip() else type(exc).__name__
+    return line.rstrip(":")[:200]
+
+
+def _check_relief(h, size, path, fmt, unit) -> None:
+    """Refuse heights implausible for the scan: peak-to-valley more than :data:`MAX_RELIEF` times the
+    smaller lateral size (heights in nm read as m, 5e292 m), with the advice to give their unit."""
+    pv = float(np.max(h) - np.min(h))
+    side = min(size)
+    if math.isfinite(pv) and pv <= MAX_RELIEF * side:
+        return
+    raise TengsimError(f"topography file {path!r} (read as '{fmt}', heights in {unit}): its heights span {pv:.3g} m "
+                       f"over a {size[0]:.3g} m × {size[1]:.3g} m scan, more than {MAX_RELIEF:g} times its size: "
+                       "implausible; give the height unit (e.g. --unit nm) or check the file")
 
 
 def resample(z: np.ndarray, grid: Grid, size: tuple, periodic: bool) -> np.ndarray:
@@ -164,6 +225,7 @@ class Topography:
     periodic: bool = False
     source: str = ""
     detrend: str = "height"
+    reader: str = ""
 
     physical_fields = (
         Field("file", "str", REQUIRED, help="topography file (any format SurfaceTopography reads)"),
@@ -213,7 +275,7 @@ class Topography:
     @classmethod
     def from_measured(cls, m: Measured, eps: float) -> "Topography":
         eps = positive("eps", eps)
-        return cls(m.heights / eps, (m.size[0] / eps, m.size[1] / eps), m.periodic, m.source, m.detrend)
+        return cls(m.heights / eps, (m.size[0] / eps, m.size[1] / eps), m.periodic, m.source, m.detrend, m.reader)
 
     @classmethod
     def from_file(cls, path, eps: float, physical_size=None, unit=None, detrend="height",
@@ -266,7 +328,7 @@ class Topography:
         nx, ny = self.heights.shape
         return {"shape": "Topography", "file": self.source, "size_x": self.size[0], "size_y": self.size[1],
                 "native_nx": nx, "native_ny": ny, "periodic_file": self.periodic, "detrend": self.detrend,
-                "rms_height": float(self.heights.std())}
+                "rms_height": float(self.heights.std()), "reader": self.reader}
 
 
 SHAPES.register("topography", Topography, summary="measured surface from a file (SurfaceTopography)")

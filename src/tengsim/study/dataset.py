@@ -1,7 +1,8 @@
 """Assembling DIR/study.nc and DIR/study.csv from DIR/study.json and DIR/points/ (idempotent).
 
 study.nc is indexed by the axes for a full grid (a zip group is one dimension, its parameters
-coordinates along it) and by ``point`` for sampled studies.  study.csv has one row per point: the axis
+coordinates along it) and by ``point`` for sampled studies; its names are CF's (:func:`cf_name`:
+'contact.tabor' → 'contact_tabor', the key kept in the attribute ``tengsim_key``).  study.csv has one row per point: the axis
 values in columns named as in [axes], ``id``, ``status`` (the one status of the point: the run's own,
 tengsim.status — ok, under_resolved, out_of_law_range, not_converged — or failed, or pending),
 ``run_status`` (the same for a computed point, empty otherwise; kept for scripts that read it), the
@@ -126,6 +127,22 @@ def _cf_units(text: str) -> dict:
     return {"units": "1", "unit_scale_text": text}
 
 
+def cf_name(key: str) -> str:
+    """The study.nc name of an axis or parameter ``key`` ('contact.tabor' → 'contact_tabor'): CF-1.10 §2.3
+    names begin with a letter and hold letters, digits and underscores; the key itself is kept in the
+    variable's ``tengsim_key`` attribute (readers: :func:`key_of`)."""
+    import re
+
+    name = re.sub(r"[^A-Za-z0-9_]", "_", str(key))
+    return name if name[:1].isalpha() else f"v_{name}"
+
+
+def key_of(ds, name: str) -> str:
+    """The [axes] key of the study.nc variable ``name`` (its ``tengsim_key``; the name itself in a file
+    written before CF names)."""
+    return str(ds[name].attrs.get("tengsim_key", name)) if name in ds.variables else name
+
+
 def _coord(values):
     vals = list(values)
     if all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in vals):
@@ -209,13 +226,17 @@ def build_study(root) -> dict:
                                    {"units": "Pa", "long_name": "named pressure"})
     # CF: 'pressure' as a dimension name is taken for air pressure (a vertical axis)
     ds = xr.Dataset(data, coords=coords).rename({"pressure": "applied_pressure"})
+    keys = [k for k in dict.fromkeys(n for a in axes for n in (a["name"], *a["members"])) if k in ds.variables]
+    ds = ds.rename({k: cf_name(k) for k in keys if cf_name(k) != k})  # CF names: 'contact.tabor' → 'contact_tabor'
+    for k in keys:
+        ds[cf_name(k)].attrs["tengsim_key"] = k
     for k, (u, long) in SCALARS.items():
         ds[k].attrs.update(_cf_units(u), long_name=long)
     for a in axes:  # the axes' coordinates: CF asks every variable for a long_name
         for m in dict.fromkeys([a["name"], *a["members"]]):
-            if m in ds.variables:
-                ds[m].attrs.setdefault("long_name", f"study axis {a['name']}" if m == a["name"] else
-                                       f"parameter {m} along study axis {a['name']}")
+            if cf_name(m) in ds.variables:
+                ds[cf_name(m)].attrs.setdefault("long_name", f"study axis {a['name']}" if m == a["name"] else
+                                                f"parameter {m} along study axis {a['name']}")
     if "point" in ds.variables:
         ds["point"].attrs.setdefault("long_name", "sampled point (study.json order)")
     ds["V_OC"].attrs.update(units="V", long_name="Eq. (12) open-circuit voltage under load control")

@@ -287,6 +287,55 @@ CONNECT_TIMEOUT_S = 3.0
 """How long :func:`connect` tries to reach a ``--scheduler`` address before it gives up (seconds)."""
 
 
+MAX_HANDSHAKE = 1 << 20
+"""The largest first message (bytes) a Dask scheduler's handshake may announce: its own is a few hundred."""
+
+
+def probe_scheduler(address: str, timeout: float) -> None:
+    """Refuse a ``tcp://host:port`` (or ``host:port``) address where no Dask scheduler answers, within
+    ``timeout`` seconds: a Dask scheduler greets a new connection at once with a short handshake (an
+    8-byte little-endian frame length, then the frame); a server that says nothing (HTTP, SSH waiting
+    for its client) or announces an absurd length is named and refused, before dask waits on it or
+    allocates what it announces.  Other schemes (tls://, inproc://, ...) are left to dask."""
+    import socket
+    import struct
+    from urllib.parse import urlsplit
+
+    from tengsim.errors import shown
+
+    text = str(address)
+    if "://" in text and not text.startswith("tcp://"):
+        return
+    try:
+        parts = urlsplit(text if "://" in text else f"tcp://{text}")
+        host, port = parts.hostname, parts.port
+    except ValueError:
+        raise TengsimError(f"--scheduler {shown(text)} is not an address host:port") from None
+    if not host or port is None:
+        raise TengsimError(f"--scheduler {shown(text)} is not an address tcp://host:port")
+    try:
+        with socket.create_connection((host, port), timeout=timeout) as sock:
+            sock.settimeout(timeout)
+            head = b""
+            while len(head) < 8:
+                chunk = sock.recv(8 - len(head))
+                if not chunk:
+                    raise TengsimError(f"cannot reach the dask scheduler at {shown(text)}: the server closed the "
+                                       "connection without a Dask greeting")
+                head += chunk
+    except TengsimError:
+        raise
+    except socket.timeout:
+        raise TengsimError(f"cannot reach the dask scheduler at {shown(text)}: the server there sent no Dask "
+                           f"greeting within {timeout:g} s (is it a Dask scheduler?)") from None
+    except OSError as exc:
+        raise TengsimError(f"cannot reach the dask scheduler at {shown(text)}: {exc.strerror or exc}") from None
+    (length,) = struct.unpack("<Q", head)
+    if not 0 < length <= MAX_HANDSHAKE:
+        raise TengsimError(f"cannot reach the dask scheduler at {shown(text)}: the server there is not a Dask "
+                           f"scheduler (its first message announces {length} bytes)")
+
+
 def connect(workers=None, scheduler=None, timeout: float | None = None):
     """A dask Client: on ``scheduler`` (an address) or on a new LocalCluster; returns (client, cluster).
 
@@ -300,6 +349,7 @@ def connect(workers=None, scheduler=None, timeout: float | None = None):
     except ImportError:  # pragma: no cover - a dependency
         raise TengsimError("tengsim sweep needs dask[distributed]: pip install 'dask[distributed]'") from None
     if scheduler is not None:
+        probe_scheduler(scheduler, timeout)
         try:
             client = Client(scheduler, timeout=f"{timeout}s")
         except (OSError, TimeoutError, ValueError) as exc:
@@ -400,9 +450,10 @@ def run_study(study, out, *, workers=None, scheduler=None, client=None, resume=F
     if sd.root.exists() and not sd.root.is_dir():
         raise TengsimError(f"--out {sd.root} is a file, not a directory")
     check_resume(study, sd, resume)
-    with PointRunner(sd, workers=workers, scheduler=scheduler, client=client) as runner:
+    with PointRunner(sd, workers=workers, scheduler=scheduler, client=client) as runner, sd.lock("sweep"):
         from tengsim.io import check_writable
 
+        check_resume(study, sd, resume)  # again, now that no other sweep can write here
         check_writable(sd.spec)
         say(f"sweep: {len(study.points)} points ({len(valid) + len(invalid)} distinct computations) on "
             f"{runner.n_workers} worker(s); dashboard {runner.client.dashboard_link}")
@@ -441,7 +492,7 @@ def run_study(study, out, *, workers=None, scheduler=None, client=None, resume=F
     import dask
 
     t0 = time.perf_counter()
-    with dask.config.set(scheduler="synchronous"):
+    with dask.config.set(scheduler="synchronous"), sd.lock("sweep"):
         summary = build_study(sd.root)
     summary.update(computed=computed, compute_phase_s=t_compute, compute_phase_start_unix=t0_unix,
                    assemble_s=time.perf_counter() - t0)

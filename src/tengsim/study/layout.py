@@ -12,6 +12,7 @@
     DIR/log.jsonl             one line per finished or failed point, in completion order
     DIR/study.nc, study.csv   the assembled dataset (tengsim.study.dataset), rebuilt at the end
     DIR/optimum.json          the best point found by ``tengsim optimize``
+    DIR/.lock                 held (flock) by the one sweep or optimisation running in DIR
 
 Both the runner (:mod:`tengsim.study.execute`, :mod:`tengsim.study.optimize`) and the assembler
 (:mod:`tengsim.study.dataset`) read the directory through :class:`StudyDir`; neither imports the other
@@ -19,6 +20,8 @@ for it.
 """
 from __future__ import annotations
 
+import contextlib
+import os
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -49,6 +52,31 @@ class StudyDir:
         for f in stale:
             f.unlink(missing_ok=True)
         return len(stale)
+
+    @contextlib.contextmanager
+    def lock(self, who: str = "sweep"):
+        """Hold ``DIR/.lock`` (an exclusive flock, released by the OS if the process dies) while the block
+        runs; a second sweep or optimisation on the same folder is refused with one TengsimError naming
+        the folder and the holder's pid, instead of computing every point twice."""
+        import fcntl
+
+        from tengsim.errors import TengsimError
+
+        self.root.mkdir(parents=True, exist_ok=True)
+        path = self.root / ".lock"
+        fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o644)
+        try:
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except OSError:
+                holder = os.pread(fd, 32, 0).decode(errors="replace").strip() or "unknown"
+                raise TengsimError(f"--out {self.root} is in use by another sweep or optimisation (pid {holder}); "
+                                   "wait for it to finish, or use another --out") from None
+            os.ftruncate(fd, 0)
+            os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
+            yield path
+        finally:
+            os.close(fd)  # closing releases the lock
 
     @property
     def spec(self) -> Path:

@@ -23,7 +23,9 @@ from pathlib import Path
 
 import numpy as np
 
-from tengsim.errors import TengsimError
+from tengsim.errors import TengsimError, shown
+from tengsim.resources import check_count
+from tengsim.units import read_number
 from tengsim.study.observe import SCALARS
 
 PENALTY = 1e6
@@ -60,12 +62,26 @@ def parse_objective(study) -> dict:
         raise TengsimError(f"[objective] {goal[0]} = {name!r} is not an observable (choose from {', '.join(SCALARS)})")
     cons = o.pop("subject_to", {}) or {}
     if not isinstance(cons, dict):
-        raise TengsimError(f"[objective] subject_to must be a table, got {cons!r}")
+        raise TengsimError(f"[objective] subject_to must be a table, got {shown(cons)}")
     for k, b in cons.items():
         if k not in SCALARS:
             raise TengsimError(f"[objective] subject_to: {k!r} is not an observable")
         if not isinstance(b, dict) or not set(b) <= {"min", "max"} or not b:
-            raise TengsimError(f"[objective] subject_to.{k} must be {{min = .., max = ..}}, got {b!r}")
+            raise TengsimError(f"[objective] subject_to.{k} must be {{min = .., max = ..}}, got {shown(b)}")
+        for side, v in b.items():  # each bound a number, read before any point is computed
+            try:
+                if isinstance(v, (bool, dict, list)):
+                    raise ValueError
+                read_number(v, f"[objective] subject_to.{k}.{side}")
+            except TengsimError:
+                raise
+            except ValueError:
+                raise TengsimError(f"[objective] subject_to.{k}.{side} = {shown(v)} is not a number") from None
+            if read_number(v) != read_number(v):
+                raise TengsimError(f"[objective] subject_to.{k}.{side} = {shown(v)} is not a number")
+        if "min" in b and "max" in b and not read_number(b["min"]) <= read_number(b["max"]):
+            raise TengsimError(f"[objective] subject_to.{k}: min = {shown(b['min'])} is above max = {shown(b['max'])}")
+    cons = {k: {side: read_number(v) for side, v in b.items()} for k, b in cons.items()}
     opts = {"maxiter": 10, "popsize": 6, "seed": 0, "tol": 0.01}
     for k in list(o):
         if k not in opts:
@@ -74,7 +90,13 @@ def parse_objective(study) -> dict:
         opts[k] = o.pop(k)
     for k in ("maxiter", "popsize", "seed"):
         if not isinstance(opts[k], int) or isinstance(opts[k], bool) or opts[k] < (0 if k == "seed" else 1):
-            raise TengsimError(f"[objective] {k} must be a positive integer, got {opts[k]!r}")
+            raise TengsimError(f"[objective] {k} must be a positive integer, got {shown(opts[k])}")
+    if opts["seed"] >= 2**63:
+        raise TengsimError(f"[objective] seed must be below 2**63, got {shown(opts['seed'])}")
+    check_count(opts["popsize"] * max(1, len(study.axes)), "[objective] popsize × the number of axes (points "
+                "per generation)")
+    check_count(opts["popsize"] * max(1, len(study.axes)) * (opts["maxiter"] + 1),
+                "[objective] popsize × axes × (maxiter + 1) (points in all)")
     bounds = []
     for a in study.axes:
         if not a.continuous or len(a.members) != 1:
@@ -133,7 +155,7 @@ def optimize_study(study, out, *, workers=None, scheduler=None, client=None, res
     evaluated: dict = {}
     scored: dict = {}  # id -> (objective + penalty, run status or 'failed', objective value)
     history = []
-    with PointRunner(sd, workers=workers, scheduler=scheduler, client=client) as runner:
+    with PointRunner(sd, workers=workers, scheduler=scheduler, client=client) as runner, sd.lock("optimize"):
         say(f"optimize: {obj['goal']} {obj['name']} over {', '.join(a.name for a in study.axes)}; "
             f"dashboard {runner.client.dashboard_link}")
         sd.points.mkdir(parents=True, exist_ok=True)

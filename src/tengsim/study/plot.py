@@ -48,8 +48,10 @@ def axis_scale(values):
 
 def axis_label(ds, dim) -> str:
     """An axis label in words with its unit ('pitch (µm)')."""
+    from tengsim.study.dataset import key_of
+
     unit = axis_scale(ds[dim].values)[0]
-    return axis_words(dim) + (f" ({unit})" if unit else "")
+    return axis_words(key_of(ds, dim)) + (f" ({unit})" if unit else "")
 
 
 def _ticks(ds, dim):
@@ -92,6 +94,8 @@ def plot_study(root, out, vars=MAP_VARS) -> list:
     nc = StudyDir(root).dataset_nc
     if not nc.exists():
         raise TengsimError(f"{root} holds no study.nc (run tengsim sweep first)")
+    from tengsim.study.dataset import key_of
+
     ds = read_dataset(nc)
     dims = [d for d in ds["pull_off_F"].dims]
     have = lambda v: v in ds and np.isfinite(ds[v].values.astype(float)).any()  # noqa: E731
@@ -110,9 +114,9 @@ def plot_study(root, out, vars=MAP_VARS) -> list:
         for ax, v in zip(axs.flat, vars):
             sc = ax.scatter(px, py, c=_data(ds, v), cmap="viridis", s=30)
             fig.colorbar(sc, ax=ax, label=_LABEL.get(v, v))
-            ax.set_xlabel(axis_words(params[0]))
+            ax.set_xlabel(axis_words(key_of(ds, params[0])))
             if len(params) > 1:
-                ax.set_ylabel(axis_words(params[1]))
+                ax.set_ylabel(axis_words(key_of(ds, params[1])))
             if xnum and np.all(px > 0) and px.max() / px.min() > 20:
                 ax.set_xscale("log")
     else:
@@ -151,7 +155,7 @@ def plot_study(root, out, vars=MAP_VARS) -> list:
             if len(dims) == 1 and xnum and np.all(x > 0) and x.max() / x.min() > 20:
                 ax.set_xscale("log")
         if sel:
-            fig.suptitle(", ".join(f"{axis_words(d)} = {_ticks(ds, d)[0]} {axis_scale(ds[d].values)[0]}".rstrip()
+            fig.suptitle(", ".join(f"{axis_words(key_of(ds, d))} = {_ticks(ds, d)[0]} {axis_scale(ds[d].values)[0]}".rstrip()
                                    for d in sel), fontsize=9)
         if seen:  # one legend for the status marks of every map
             from matplotlib.lines import Line2D
@@ -185,12 +189,13 @@ def _plot_voc(plt, ds, dims, path):
     from matplotlib.lines import Line2D
 
     from tengsim.plots import save
+    from tengsim.study.dataset import key_of
 
     pdim = "applied_pressure" if "applied_pressure" in ds.dims else "pressure"  # study.nc before CF: 'pressure'
     P = ds[pdim].values / 1e3
     fig, ax = plt.subplots(figsize=(7.5, 4.6))
     axes = [d for d in dims if d != "point"]
-    order = sorted(axes, key=lambda d: d != "contact.shape")  # the shape, if an axis, gets the colours
+    order = sorted(axes, key=lambda d: key_of(ds, d) != "contact.shape")  # the shape, if an axis, gets the colours
     styles = dict(zip(order, ("color", "ls", "marker")))
     colours = plt.get_cmap("tab10").colors
     pick = {"color": colours, "ls": LINESTYLES, "marker": MARKERS}
@@ -217,7 +222,7 @@ def _plot_voc(plt, ds, dims, path):
         for j, t in enumerate(ticks):
             kw = {"color": "k", "ls": "-", "marker": None, what: pick[what][j % len(pick[what])]}
             handles.append(Line2D([], [], lw=1.2, **kw))
-            labels.append(f"{axis_words(d)} {t}{' ' + unit if unit else ''}")
+            labels.append(f"{axis_words(key_of(ds, d))} {t}{' ' + unit if unit else ''}")
     for w in sorted(seen):
         handles.append(Line2D([], [], ls="", marker=STATUS_MARKS[w][0], mfc="none", mec=STATUS_MARKS[w][1], ms=9))
         labels.append(f"status {w.replace('_', ' ')}")

@@ -168,14 +168,13 @@ def write_point(ds, path) -> None:
 
     The file appears under its name only whole and synced to the disk (``tengsim.io.atomic_path``);
     Ctrl-C waits for the write."""
-    import h5py
+    from tengsim.io import interrupts_held, netcdf_bytes, write_bytes
 
-    from tengsim.io import atomic_path, interrupts_held
+    def sign(f):
+        f.attrs[DIGEST_ATTR] = _digest(f)
 
-    with interrupts_held(), atomic_path(path) as tmp:
-        ds.to_netcdf(tmp, engine="h5netcdf")
-        with h5py.File(tmp, "r+") as f:
-            f.attrs[DIGEST_ATTR] = _digest(f)
+    with interrupts_held():  # made in memory, then written: a full disk is an OSError naming the path
+        write_bytes(path, netcdf_bytes(ds, sign))
 
 
 def check_point(path, pid: str) -> tuple:

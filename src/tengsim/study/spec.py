@@ -39,7 +39,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from tengsim.errors import TengsimError
+from tengsim.errors import TengsimError, listed, shown
+from tengsim.resources import check_count
 
 POINT_TABLES = ("contact", "device", "var")
 """Tables of a point; an axis is named 'table.key' with table one of these ('var': free variables that
@@ -196,12 +197,13 @@ def parse_study(cfg: dict, source: str = "") -> Study:
     device.update(base_in.get("device", {}))
     bad = [k for k in device if k not in DEVICE_DEFAULTS]
     if bad:
-        raise TengsimError(f"{where}: [base.device] unknown key(s) {', '.join(map(repr, bad))} "
+        raise TengsimError(f"{where}: [base.device] unknown key(s) {listed(bad)} "
                            f"(known: {', '.join(DEVICE_DEFAULTS)})")
     var = dict(base_in.get("var", {}))
     for k, v in var.items():
         if isinstance(v, bool) or not isinstance(v, (int, float)):
-            raise TengsimError(f"{where}: [base.var] {k} must be a number, got {v!r}")
+            raise TengsimError(f"{where}: [base.var] {k} must be a number, got {shown(v)}")
+        _var_number(k, v)
     shapes = _parse_shapes(base_in.get("shapes", {}), where)
     base = {"contact": contact, "device": device, "var": var}
     if shapes:
@@ -222,12 +224,13 @@ def parse_study(cfg: dict, source: str = "") -> Study:
     n = st.pop("n", None)
     seed = st.pop("seed", 0)
     if st:
-        raise TengsimError(f"{where}: [study] unknown key(s) {', '.join(map(repr, st))} (known: sampling, n, seed)")
+        raise TengsimError(f"{where}: [study] unknown key(s) {listed(st)} (known: sampling, n, seed)")
     if sampling != "grid":
         if not isinstance(n, int) or isinstance(n, bool) or n < 1:
-            raise TengsimError(f"{where}: [study] sampling = {sampling!r} needs n = a positive integer, got {n!r}")
-        if not isinstance(seed, int) or isinstance(seed, bool):
-            raise TengsimError(f"{where}: [study] seed must be an integer, got {seed!r}")
+            raise TengsimError(f"{where}: [study] sampling = {shown(sampling)} needs n = a positive integer, got {shown(n)}")
+        check_count(n, f"{where}: [study] n")
+        if not isinstance(seed, int) or isinstance(seed, bool) or not 0 <= seed < 2**63:
+            raise TengsimError(f"{where}: [study] seed must be an integer from 0 to 2**63 - 1, got {shown(seed)}")
         if not axes:
             raise TengsimError(f"{where}: sampling = {sampling!r} needs at least one axis")
     elif n is not None:
@@ -318,6 +321,7 @@ def _values(name, spec, where):
             raise TengsimError(f"{where}: axis {name!r}: num must be an integer, got {num!r}")
         if num < 1:
             raise TengsimError(f"{where}: axis {name!r} is empty (num = {num})")
+        check_count(num, f"{where}: axis {name!r}: num")
         if num == 1:
             xs = [a]
         elif scale == "log":
@@ -332,12 +336,15 @@ def _values(name, spec, where):
 def _split_unit(v, name, where):
     if isinstance(v, bool):
         raise TengsimError(f"{where}: axis {name!r}: {v!r} is not a number")
+    from tengsim.units import parse_quantity, read_number
+
     if isinstance(v, (int, float)):
-        return float(v), ""
+        return read_number(v, f"axis {name!r}"), ""
     m = _NUM_UNIT.fullmatch(str(v))
     if not m:
-        raise TengsimError(f"{where}: axis {name!r}: cannot read {v!r} as a number with a unit")
-    return float(m.group(1)), (m.group(2) or "").strip()
+        raise TengsimError(f"{where}: axis {name!r}: cannot read {shown(v)} as a number with a unit")
+    parse_quantity(str(v), name=f"axis {name!r}")  # bounded, no underscores
+    return read_number(m.group(1), f"axis {name!r}"), (m.group(2) or "").strip()
 
 
 def _with_unit(x, unit):
@@ -443,7 +450,7 @@ def evaluate(contact: dict, var: dict) -> dict:
     if not any(isinstance(v, str) and v.startswith("=") for v in contact.values()):
         return dict(contact)
     from tengsim.config import key_dims
-    from tengsim.units import DIMENSIONS, SI_UNIT, parse_quantity, quantity_dim
+    from tengsim.units import DIMENSIONS, SI_UNIT, parse_quantity, quantity_dim, read_number
 
     zero = (0, 0, 0, 0)
     qdims = key_dims(contact)  # {} in a dimensionless run
@@ -454,7 +461,7 @@ def evaluate(contact: dict, var: dict) -> dict:
     def value(name):
         """(SI value, dimension, plain): plain for a number with no dimension of its own."""
         if name in var:
-            return float(var[name]), zero, True
+            return _var_number(name, var[name]), zero, True
         if name not in out:
             raise TengsimError(f"expression: unknown name {name!r} (a [contact] key or a [var] variable)")
         v = out[name]
@@ -484,16 +491,19 @@ def evaluate(contact: dict, var: dict) -> dict:
 
     def calc(key, text):
         src = text[1:].strip()
+        if len(src) > MAX_EXPRESSION:
+            raise TengsimError(f"{key} = {shown(text)}: an expression is at most {MAX_EXPRESSION} characters")
         try:
             tree = ast.parse(src, mode="eval")
-        except SyntaxError:
-            raise TengsimError(f"{key} = {text!r}: cannot read the expression") from None
+        except (SyntaxError, ValueError, RecursionError, MemoryError):
+            raise TengsimError(f"{key} = {shown(text)}: cannot read the expression") from None
+        text = shown(text)[1:-1] if len(text) > 60 else text
 
         def ev(n):
             if isinstance(n, ast.Expression):
                 return ev(n.body)
             if isinstance(n, ast.Constant) and isinstance(n.value, (int, float)) and not isinstance(n.value, bool):
-                return float(n.value), zero, True
+                return read_number(n.value, key), zero, True
             if isinstance(n, ast.Name):
                 return value(n.id)
             if isinstance(n, ast.UnaryOp) and isinstance(n.op, (ast.USub, ast.UAdd)):
@@ -513,7 +523,12 @@ def evaluate(contact: dict, var: dict) -> dict:
                 return a / b, tuple(x - y for x, y in zip(da, db)), pa and pb
             raise TengsimError(f"{key} = {text!r}: only numbers, names, + - * / and parentheses are allowed")
 
-        x, d, p = ev(tree)
+        try:
+            x, d, p = ev(tree)
+        except RecursionError:
+            raise TengsimError(f"{key} = {text!r}: the expression is nested too deeply") from None
+        if not math.isfinite(x):
+            raise TengsimError(f"{key} = {text!r}: the expression overflows (its value is {x})")
         want = DIMENSIONS[qdims[key][0]] if key in qdims else zero
         if not p and d != want:
             takes = f"{key} takes {_what(want)}" + ("" if key in qdims else " (it is dimensionless here)")
@@ -529,6 +544,24 @@ def evaluate(contact: dict, var: dict) -> dict:
             else:
                 out[k] = x
     return out
+
+
+MAX_EXPRESSION = 1000
+"""The longest '=' expression (characters): longer ones are refused unread (a parser's recursion)."""
+
+
+def _var_number(name, v) -> float:
+    """A [var] variable's value as a number: a string on a 'var.' axis is refused, naming it."""
+    from tengsim.units import read_number
+
+    try:
+        if isinstance(v, (bool, dict, list)):
+            raise ValueError
+        return read_number(v, f"var.{name}")
+    except TengsimError:
+        raise
+    except ValueError:
+        raise TengsimError(f"var.{name} = {shown(v)} is not a number (a [var] variable is a plain number)") from None
 
 
 def _what(vec) -> str:
@@ -548,6 +581,8 @@ def expand(study: Study) -> list:
             if not a.values:
                 raise TengsimError(f"axis {a.name!r} is a range without num (only sampling = 'lhs' or "
                                    "'sobol' may leave num out)")
+        check_count(math.prod(len(a) for a in axes), "the study's grid of points ("
+                    + " × ".join(f"{len(a)} {a.name}" for a in axes) + ")")
         pts = []
         for idx in itertools.product(*(range(len(a)) for a in axes)):
             assign, labels = {}, {}

@@ -1,0 +1,210 @@
+"""Generated hostile input (issue 30): values, strings, TOML tables and files fed to the CLI entry points.
+
+Whatever hypothesis draws, every command ends with exit 0 or 2, never 70 (an internal error) or a signal,
+with no traceback on stderr; an exit 2 is one line and writes nothing; no run outlasts its bound.  The
+commands are cheap by construction (a 13² pyramid grid, two equilibria; a study's sweep pointed at a
+port where nothing listens, so a study that parses is refused at the connection and none is computed).
+The whole module runs in about 30 s on one core (``derandomize``: the same examples every run).
+"""
+import json
+import math
+import os
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+hypothesis = pytest.importorskip("hypothesis")
+from hypothesis import HealthCheck, given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+
+from tengsim.cli.main import main  # noqa: E402
+
+BASE = ["contact", "pyramid", "--N", "0.946", "--cell", "3.78", "--dx", "0.3", "--d-min", "0", "--d-max", "0.5",
+        "--d-step", "0.5", "--tabor", "0.5", "--quiet"]
+BOUND_S = 20.0  # no single command may take longer (an exit-0 run here takes well under a second)
+NOWHERE = "tcp://127.0.0.1:9"  # the discard port: nothing listens, the connection is refused at once
+
+
+def SETTINGS(n):
+    return settings(max_examples=n, deadline=None, derandomize=True, database=None,
+                    suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow])
+
+
+def check(folder: Path, argv, capsys):
+    """Run ``argv`` in process in ``folder`` and assert the promise; returns the exit code."""
+    before = sorted(os.listdir(folder))
+    t0 = time.perf_counter()
+    rc = main([str(a) for a in argv])
+    took = time.perf_counter() - t0
+    err = capsys.readouterr().err
+    assert rc in (0, 2), (argv[:8], rc, err[-500:])
+    assert "Traceback" not in err and "internal error" not in err, err[-1000:]
+    assert took < BOUND_S, (argv[:8], took)
+    if rc == 2:
+        lines = err.strip().splitlines()
+        assert lines and lines[-1].startswith("tengsim: error:"), err[-500:]
+        assert len([l for l in lines if l.startswith("tengsim: error:")]) == 1, err[-500:]
+        assert len(lines[-1]) < 1200, lines[-1][:200]  # a hostile value is never echoed whole
+        assert sorted(os.listdir(folder)) == before, (argv[:8], set(os.listdir(folder)) - set(before))
+    return rc
+
+
+# ---- values --------------------------------------------------------------------------------------
+number_text = st.one_of(
+    st.floats(allow_nan=True, allow_infinity=True).map(repr),
+    st.integers(min_value=-10**400, max_value=10**400).map(str),
+    st.from_regex(r"-?[0-9]{1,3}_[0-9]{1,3}", fullmatch=True),
+    st.builds(lambda m, e: f"{m}e{e}", st.integers(-9, 9), st.integers(-400, 400)),
+    st.sampled_from(["0x10", "1e", ".", "-", "--", "1,5", "½", "١", "1e-320", "1e308", "5e292", "0.5 MPa",
+                     "-0.59MPa", "2um", "=1+1", "9" * 5000, "nan", "-inf", "0_5"]),
+    st.text(max_size=80),
+)
+# keys whose value moves no grid: an accepted value keeps the run cheap (dx and cell are drawn hostile only)
+CHEAP_KEYS = ["--N", "--tabor", "--d-max", "--tol", "--d-step"]
+GRID_KEYS = ["--dx", "--cell"]
+hostile_grid = st.one_of(st.floats(max_value=0.05).map(repr), st.floats(min_value=50).map(repr),
+                         st.sampled_from(["1e-320", "1e308", "0_3", "nan", "-0.3", "x"]))
+
+
+@SETTINGS(60)
+@given(key=st.sampled_from(CHEAP_KEYS), value=number_text)
+def test_generated_values_on_contact(tmp_path_factory, capsys, key, value):
+    d = tmp_path_factory.mktemp("v")
+    check(d, [*BASE, key, value, "--out", d / "o.csv"], capsys)
+
+
+@SETTINGS(25)
+@given(key=st.sampled_from(GRID_KEYS), value=hostile_grid)
+def test_generated_grid_values_are_refused_or_cheap(tmp_path_factory, capsys, key, value):
+    d = tmp_path_factory.mktemp("g")
+    check(d, [*BASE, key, value, "--out", d / "o.csv"], capsys)
+
+
+@SETTINGS(30)
+@given(opt=st.sampled_from(["--law", "--boundary", "--solver", "--E-star", "--W", "--maps", "--resolve"]),
+       value=st.text(max_size=120))
+def test_generated_strings_on_options(tmp_path_factory, capsys, opt, value):
+    d = tmp_path_factory.mktemp("s")
+    check(d, [*BASE, opt, value, "--out", d / "o.csv"], capsys)
+
+
+# ---- TOML tables ---------------------------------------------------------------------------------
+def toml_value(v) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, float):
+        return "nan" if math.isnan(v) else ("inf" if v == math.inf else "-inf" if v == -math.inf else repr(v))
+    if isinstance(v, int):
+        return str(v)
+    if isinstance(v, str):
+        return json.dumps(v)  # a JSON string is a TOML basic string
+    if isinstance(v, list):
+        return "[" + ", ".join(toml_value(x) for x in v) + "]"
+    if isinstance(v, dict):
+        return "{ " + ", ".join(f"{json.dumps(k)} = {toml_value(x)}" for k, x in v.items()) + " }"
+    raise TypeError(v)
+
+
+def toml_table(name, table) -> str:
+    return f"[{name}]\n" + "".join(f"{json.dumps(k)} = {toml_value(v)}\n" for k, v in table.items())
+
+
+scalar = st.one_of(st.booleans(), st.integers(min_value=-2**63, max_value=2**63 - 1), st.floats(),
+                   number_text, st.text(max_size=30))
+value = st.recursive(scalar, lambda inner: st.one_of(st.lists(inner, max_size=4),
+                                                     st.dictionaries(st.text(max_size=8), inner, max_size=3)),
+                     max_leaves=6)
+contact_keys = st.sampled_from(["N", "cell", "tabor", "dx", "d_min", "d_max", "d_step", "law", "boundary",
+                                "solver", "shape", "E_star", "W", "maps", "resolve", "seed", "tol"])
+some_key = st.one_of(contact_keys, st.text(max_size=12))
+BASE_TABLE = {"shape": "pyramid", "N": 0.946, "cell": 3.78, "dx": 0.3, "tabor": 0.5, "d_min": 0.0, "d_max": 0.5,
+              "d_step": 0.5}
+
+
+@SETTINGS(40)
+@given(extra=st.dictionaries(some_key, value, max_size=4))
+def test_generated_contact_tables(tmp_path_factory, capsys, extra):
+    d = tmp_path_factory.mktemp("t")
+    cfg = d / "run.toml"
+    table = {**BASE_TABLE, **extra, "out": str(d / "o.csv")}
+    cfg.write_text(toml_table("contact", table))
+    check(d, ["run", cfg, "--quiet"], capsys)
+
+
+axis_name = st.one_of(st.sampled_from(["contact.N", "contact.tabor", "contact.dx", "contact.shape", "var.k",
+                                       "device.R", "contact.nope"]), st.text(max_size=12))
+axis_spec = st.one_of(
+    st.lists(scalar, min_size=0, max_size=4),
+    st.fixed_dictionaries({"start": scalar, "stop": scalar}, optional={"num": scalar, "scale": scalar}),
+    st.fixed_dictionaries({"zip": st.dictionaries(axis_name, st.lists(scalar, max_size=3), max_size=2)}),
+    value)
+
+
+@SETTINGS(40)
+@given(axes=st.dictionaries(axis_name, axis_spec, min_size=1, max_size=2),
+       study=st.dictionaries(st.sampled_from(["sampling", "n", "seed", "x"]), scalar, max_size=2),
+       objective=st.none() | st.dictionaries(st.sampled_from(["minimize", "maximize", "subject_to", "popsize",
+                                                             "maxiter", "seed"]), value, max_size=3))
+def test_generated_study_tables(tmp_path_factory, capsys, axes, study, objective):
+    d = tmp_path_factory.mktemp("study")
+    f = d / "s.toml"
+    text = toml_table("base.contact", BASE_TABLE) + toml_table("base.var", {"k": 1.0}) + toml_table("axes", axes)
+    if study:
+        text += toml_table("study", study)
+    if objective is not None:
+        text += toml_table("objective", objective)
+    f.write_text(text)
+    cmd = "optimize" if objective is not None else "sweep"
+    rc = check(d, [cmd, f, "--out", d / "o", "--scheduler", NOWHERE, "--quiet"], capsys)
+    assert rc == 2  # a study that parses is refused at the connection: nothing is ever computed here
+
+
+# ---- files ---------------------------------------------------------------------------------------
+matrix = st.lists(st.lists(st.floats(width=32), min_size=1, max_size=20), min_size=1, max_size=20)
+
+
+@SETTINGS(30)
+@given(content=st.one_of(st.binary(max_size=3000), st.sampled_from([8192, 2 * 17 * 17, 2 * 33 * 33]).map(os.urandom),
+                         matrix.map(lambda rows: "\n".join(" ".join(repr(x) for x in r) for r in rows).encode()),
+                         st.text(max_size=500).map(str.encode)),
+       suffix=st.sampled_from([".txt", ".dat", ".asc", ".hgt", ".nc", ""]))
+def test_generated_topography_files(tmp_path_factory, capsys, content, suffix):
+    d = tmp_path_factory.mktemp("f")
+    f = d / f"surface{suffix}"
+    f.write_bytes(content)
+    check(d, ["contact", "topography", f, "--physical-size", "2um,2um", "--E-star", "1GPa", "--W", "50mJ/m2",
+              "--tabor", "1", "--d-min", "-0.5", "--d-max", "0.5", "--d-step", "0.5", "--quiet",
+              "--out", d / "o.csv"], capsys)
+
+
+@SETTINGS(25)
+@given(content=st.one_of(st.text(max_size=400), st.binary(max_size=400).map(lambda b: b.decode("latin-1"))),
+       header=st.sampled_from(["", "branch,D,F\n", "t,V\n", "R,energy_per_cycle,average_power\n"]))
+def test_generated_result_files_to_plot(tmp_path_factory, capsys, content, header):
+    d = tmp_path_factory.mktemp("p")
+    f = d / "r.csv"
+    f.write_text(header + content, encoding="utf-8", errors="surrogatepass")
+    rc = check(d, ["plot", f, "--out", d / "p.png"], capsys)
+    if rc == 0:
+        (d / "p.png").unlink()
+
+
+# ---- a few through a real process: the exit code, not only main()'s return value -----------------
+SRC = str(Path(__import__("tengsim").__file__).resolve().parents[1])  # the tengsim under test
+
+
+@pytest.mark.parametrize("args", [
+    ["--tabor", "9" * 100_000],
+    ["--E-star", "-0.59MPa"],
+    ["--dx", "1e-320"],
+])
+def test_hostile_values_through_a_process(tmp_path, args):
+    env = {**os.environ, "PYTHONPATH": SRC, "OPENBLAS_NUM_THREADS": "1", "MPLBACKEND": "Agg"}
+    p = subprocess.run([sys.executable, "-m", "tengsim.cli.main", *BASE, *args, "--out", str(tmp_path / "o.csv")],
+                       capture_output=True, text=True, env=env, timeout=60)
+    assert p.returncode == 2, p.stderr[-500:]
+    assert len(p.stderr.strip().splitlines()) == 1 and "Traceback" not in p.stderr
+    assert list(tmp_path.iterdir()) == []
