@@ -47,7 +47,7 @@ class LJ93(Law):
     def max_softening(self) -> float:
         return 4.8 * 7.5 ** (-2.0 / 3.0)                # at the inflection g = 7.5^{1/6} ≈ 1.399
 
-    def _raw(self, g, need_dp=True):
+    def _raw(self, g, need_dp=True, xp=np):
         inv = 1.0 / g
         i2 = inv * inv
         i3 = i2 * inv
