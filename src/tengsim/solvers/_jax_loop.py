@@ -11,9 +11,9 @@ What differs is only the bookkeeping JAX needs: arrays of fixed shape.  The memo
 present; a slot is active when its index is below the count k (as in the NumPy ring, the active slots
 are always 0 … k − 1), its age orders the pairs, and inactive slots are masked out of the small
 triangular solves (identity rows, zero right-hand sides), so they contribute exact zeros.  Python's
-``None`` (no bracket end yet, no best point) becomes a flag.  Scalars (energies, slopes, products) are
-accumulated in float64 even when the fields are float32 (``preferred_element_type``, an f64 convert
-fused into the reduction: no extra pass over memory).
+``None`` (no bracket end yet, no best point) becomes a flag.  Scalars (energies, slopes, inner products) are
+accumulated in float64 even when the fields are float32 (the convert fused into the reduction: no
+extra pass over memory); the rows' products B @ v and the law stay in the fields' precision.
 
 Everything here is built by :func:`build` for one static configuration (grid, kernel kind, law class,
 dtype, memory, resync); every number that varies between equilibria (g0, the start, the kernel's
@@ -28,6 +28,8 @@ from jax.scipy.linalg import solve_triangular
 
 F64 = jnp.float64
 C1, C2, MAX_EVAL, FIRST_MOVE = 1e-4, 0.9, 40, 0.25  # tengsim.solvers._linesearch.WolfeLineSearch's defaults
+#: the approximate Wolfe test's energy slack, relative: the NumPy solver's in float64; float32 fields round E at ~1e-7
+EPS_E = {"float64": 1e-11, "float32": 1e-6}
 
 
 def law_twin(cls, fields, values):
@@ -51,18 +53,39 @@ def build(shape, padded, periodic, pinned, law_cls, law_fields, dtype, memory, r
         y = jnp.fft.irfft2(jnp.fft.rfft2(x.reshape(shape), s=padded) * spec, s=padded)
         return y[:nx, :ny].astype(dt).ravel()
 
-    def dot(a, b):
-        return jnp.dot(a, b, preferred_element_type=F64)
+    def dot(a, b):  # a·b accumulated in float64 (one fused pass, no float64 copy of a float32 field)
+        return jnp.sum(a.astype(F64) * b.astype(F64))
+
+    def rows(M, v):  # M @ v over the stored rows: in the fields' precision (a float64 M @ v would copy M)
+        return jnp.matmul(M, v).astype(F64)
 
     def total(a):
         return jnp.sum(a, dtype=F64)
 
     def solve(g0, q, w, spec, law_values, tol, max_iter, dA, nw):
-        law = law_twin(law_cls, law_fields, law_values)
+        law = law_twin(law_cls, law_fields, [jnp.asarray(v, dt) for v in law_values])  # no float64 promotion
+
+        fast_sum = getattr(law, "energy_sum_xp", None)
+
+        def law_phis(g):
+            """(ΣΦ, P(g)): the law's own sum where it has one (LJ93, summed as the NumPy solver sums it)
+            and no gap is below g_safe, else Σ of evaluate_xp's Φ."""
+            def plain(g):
+                phi, P = law.evaluate_xp(g, jnp)
+                return total(phi), P.astype(dt)
+
+            if fast_sum is None:
+                return plain(g)
+
+            def own(g):
+                phis, P = fast_sum(g, jnp, total)
+                return phis, P.astype(dt)
+
+            return lax.cond(jnp.min(g) < law.g_safe, plain, own, g)
 
         def law_sweep(g):
-            phi, P = law.evaluate_xp(g, jnp)
-            return total(phi), total(P), P.astype(dt)
+            phis, P = law_phis(g)
+            return phis, total(P), P.astype(dt)
 
         def coefficients(c):
             """(γ, cS, cY) of the compact form over the m slots (zeros on inactive ones)."""
@@ -97,16 +120,15 @@ def build(shape, padded, periodic, pinned, law_cls, law_fields, dtype, memory, r
 
         def evaluate(a, g, P, Kd, qw, dw, dKd, slope):
             gt = Kd * a.astype(dt) + g
-            phi, Pt = law.evaluate_xp(gt, jnp)
+            phis, Pt = law_phis(gt)
             Pt = Pt.astype(dt)
-            phis = total(phi)
             dpk = dot(Pt - P, Kd)
             e = dA * (0.5 * qw + a * dw + 0.5 * a * a * dKd + phis)
             de = slope + dA * (a * dKd - dpk)
             return e, de, phis, total(Pt), gt, Pt
 
         def line_search(alpha0, g, P, Kd, qw, dw, dKd, E0, slope0, E_ref):
-            eps_E = 1e-11 * jnp.maximum(1.0, jnp.abs(E0))
+            eps_E = EPS_E[dt.name] * jnp.maximum(1.0, jnp.abs(E0))
             E_lo = jnp.minimum(E0, E_ref)
             ev = (g, P, Kd, qw, dw, dKd, slope0)
             z = jnp.zeros((), F64)
@@ -202,7 +224,7 @@ def build(shape, padded, periodic, pinned, law_cls, law_fields, dtype, memory, r
             y = Gn - c["G"]
             dky, yky, drn, yrn = dot(d, ky), dot(y, ky), dot(d, rn), dot(y, rn)
             rmax = jnp.max(jnp.abs(rn)).astype(F64)
-            x = dA * jnp.matmul(c["B"], ky, preferred_element_type=F64)
+            x = dA * rows(c["B"], ky)
             # the memory's update (KMetricLBFGS.update)
             sy, yy = dA * alpha * dky, dA * yky
             sks = dA * alpha * alpha * jnp.abs(dKd)
@@ -240,7 +262,7 @@ def build(shape, padded, periodic, pinned, law_cls, law_fields, dtype, memory, r
             pY = jnp.where(store, pYn, pY)
 
             def refresh(_):
-                p = dA * jnp.matmul(B, rn, preferred_element_type=F64)
+                p = dA * rows(B, rn)
                 a2 = idx < k2
                 return jnp.where(a2, p[0::2], pS), jnp.where(a2, p[1::2], pY)
 
