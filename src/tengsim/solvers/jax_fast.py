@@ -88,8 +88,8 @@ def find_device(device: str):
         found = []
     if not found:
         have = ", ".join(sorted({d.platform for d in jax.devices()}))
-        raise TengsimError(f"no {device.upper()} found by JAX (it has: {have}): install JAX with CUDA, "
-                           f"{INSTALL.split(' or ')[0]}, or use --solver jax (CPU) or fast")
+        raise TengsimError(f"device {device!r}: JAX finds no {device.upper()} (it has: {have}); install JAX with "
+                           f"CUDA, {INSTALL.split(' or ')[0]}, or use --solver jax (CPU) or fast")
     return found[0]
 
 
