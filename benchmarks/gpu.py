@@ -16,7 +16,7 @@ runs up to ``--cpu-max`` points a side; above it its time is extrapolated from t
 with the cold-solve growth N^1.52 of docs/benchmarks.md (the scaling table), and says so.
 
     python benchmarks/gpu.py                       # on a GPU machine: pip install -e '.[gpu]' first
-    python benchmarks/gpu.py --quick               # CPU, 64² and tiny paths, ~20 s (tests/test_jax_solver.py)
+    python benchmarks/gpu.py --quick               # CPU, 65² and tiny paths, ~20 s (tests/test_jax_solver.py)
     python benchmarks/gpu.py --sizes 128 256 512 --cpu-max 512 --out benchmarks/results/gpu_cpu
 """
 from __future__ import annotations
@@ -160,16 +160,16 @@ def main(argv=None) -> int:
     ap.add_argument("--cpu-max", type=int, default=1024, help="largest n the NumPy reference runs at")
     ap.add_argument("--tol", type=float, default=1e-6)
     ap.add_argument("--max-iter", type=int, default=20000)
-    ap.add_argument("--quick", action="store_true", help="CPU-sized: 64², a tiny group C path and design run")
+    ap.add_argument("--quick", action="store_true", help="CPU-sized: 65², a tiny group C path and design run")
     ap.add_argument("--out", type=Path, help="folder for gpu.json and gpu.md")
     a = ap.parse_args(argv)
     from tengsim.solvers.jax_fast import find_device
 
     dev = find_device(a.device)
-    if a.quick:
-        a.sizes, a.cpu_max = [64], max(a.cpu_max, 64)
-        group_c = [(4.73, 18.9, 0.5, 0.8, 1.0, 0.25)]
-        design = [(0.946, 3.78, mu, 0.16, 1.0, 0.25) for mu in (0.3, 0.5, 1.0)]
+    if a.quick:  # 65² and 49² pyramid cells: the grids tests/test_jax_solver.py compiles for anyway
+        a.sizes, a.cpu_max = [65], max(a.cpu_max, 65)
+        group_c = [(4.73, 18.9, 0.5, 0.4, 1.0, 0.25)]
+        design = [(0.946, 3.78, mu, 0.08, 1.0, 0.25) for mu in (0.3, 0.5, 1.0)]
     else:
         group_c = [(4.73, 18.9, 0.5, 0.1, 14.0, 0.05)]
         design = [(0.946, 3.78, mu, 0.05, 3.0, 0.05) for mu in (0.3, 0.5, 1.0)]
@@ -179,7 +179,7 @@ def main(argv=None) -> int:
         for dt in a.dtypes:
             rows.append(rough_row(n, dt, a.device, a.cpu_max, a.tol, a.max_iter, refs))
             print(table(rows[-1:]).splitlines()[-1], flush=True)
-    rows.append(path_row("group C path" + (" (dx 0.8)" if a.quick else " (dx 0.1)"), group_c, a.device))
+    rows.append(path_row("group C path" + (" (dx 0.4)" if a.quick else " (dx 0.1)"), group_c, a.device))
     rows.append(path_row("design: group A at μ 0.3, 0.5, 1", design, a.device))
     md = table(rows)
     print(md)
