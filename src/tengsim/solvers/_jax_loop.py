@@ -193,8 +193,14 @@ def build(shape, padded, periodic, pinned, law_cls, law_fields, dtype, memory, r
             found, alpha, phis_t, sp_t, gt, Pt = line_search(alpha0, c["g"], c["P"], Kd, c["qw"], dw, dKd,
                                                               c["E"], slope, E_best)
             ray = (d, Kd, dw, dKd, sum_d, gamma, cS, cY, E_best)
-            return lax.cond(found, lambda _: advance(c, alpha, phis_t, sp_t, gt, Pt, ray),
-                            lambda _: dict(c, status=jnp.int32(4)), None)
+            # a failed search takes the step α = 0 (the state unchanged, the loop then stops with status 4):
+            # no conditional around the step, which would make XLA keep a second copy of the carried arrays
+            alpha = jnp.where(found, alpha, 0.0)
+            phis_t, sp_t = jnp.where(found, phis_t, c["phis"]), jnp.where(found, sp_t, c["sum_p"])
+            gt, Pt = jnp.where(found, gt, c["g"]), jnp.where(found, Pt, c["P"])
+            out = advance(c, alpha, phis_t, sp_t, gt, Pt, ray)
+            return dict(out, status=jnp.where(found, out["status"], jnp.int32(4)),
+                        it=jnp.where(found, out["it"], c["it"]))
 
         def advance(c, alpha, phis_t, sp_t, gt, Pt, ray):
             d, Kd, dw, dKd, sum_d, gamma, cS, cY, E_best = ray
