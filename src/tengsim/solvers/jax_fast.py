@@ -19,7 +19,7 @@ the tolerance (tests/test_jax_solver.py).  float32 fields (scalars still accumul
 rows' products and the law in float32): the tolerance is raised to ``F32_TOL`` (2e-5) at least; the
 paper's LJ93 law converges there with F to ~1e-7 relative of float64 (measured, 65² rough), but a
 stiff wall (md, exp: k = 1000 W/ε²) stalls at max|r| ~ 2e-3 (k times float32's rounding of g), F to
-~1e-3: float32 is for soft laws and for memory (310 against 620 bytes per point, memory 10).
+~1e-3: float32 is for soft laws and for memory (298 against 596 bytes per point, memory 10).
 
 Compilation: one per static configuration (grid shape, kernel kind, law class, dtype, memory, resync,
 device), cached in this module and shared by every solver object and every equilibrium of a path; D
