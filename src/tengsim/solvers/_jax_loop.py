@@ -306,4 +306,4 @@ def build(shape, padded, periodic, pinned, law_cls, law_fields, dtype, memory, r
     return solve
 
 
-__all__ = ["build", "law_twin", "jax"]
+__all__ = ["build", "law_twin"]

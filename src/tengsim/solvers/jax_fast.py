@@ -187,7 +187,7 @@ class JaxSolver:
             return hit[1]
         cdt = np.complex128 if dtype == "float64" else np.complex64
         arr = jax.device_put(np.asarray(spec).astype(cdt if np.iscomplexobj(spec) else dtype), dev)
-        if len(_SPECTRA) > 8:
+        if len(_SPECTRA) >= 2:  # a path uses one kernel: keep little device memory for spectra of the past
             _SPECTRA.clear()
         _SPECTRA[key] = (spec, arr)
         return arr
