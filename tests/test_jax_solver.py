@@ -208,7 +208,9 @@ def test_refusals_name_what_is_cpu_only():
 
 
 def test_importing_tengsim_does_not_import_jax():
-    code = ("import sys, tengsim, tengsim.cli.main; from tengsim.solvers import make_solver; "
+    code = ("import contextlib, io, sys, tengsim; from tengsim.cli.main import main\n"
+            "with contextlib.redirect_stdout(io.StringIO()), contextlib.suppress(SystemExit): main(['--help'])\n"
+            "with contextlib.redirect_stdout(io.StringIO()), contextlib.suppress(SystemExit): main(['contact', '--help'])\n"
             "assert 'jax' not in sys.modules, 'jax imported'")
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
     subprocess.run([sys.executable, "-c", code], check=True, env=env)
