@@ -14,12 +14,13 @@ from hypothesis import HealthCheck, given, settings  # noqa: E402
 from hypothesis import strategies as st  # noqa: E402
 
 from tengsim.cli.main import main  # noqa: E402
+from tengsim.registry import SOLVERS  # noqa: E402
 
 BASE = ["contact", "pyramid", "--N", "0.946", "--cell", "3.78", "--dx", "0.3", "--d-min", "0", "--d-max", "0.5",
         "--d-step", "0.5", "--quiet"]
 # keys whose value must be a finite number > 0 in a dimensionless pyramid run
 POSITIVE = ["--N", "--cell", "--tabor", "--dx", "--d-step", "--tol"]
-CHOICES = {"--boundary": ("free", "periodic"), "--solver": ("fast", "vsr"), "--law": ("lj93",),
+CHOICES = {"--boundary": ("free", "periodic"), "--solver": SOLVERS.names(), "--law": ("lj93",),
            "--control": ("approach", "load"), "--substrate": ("bonded", "frictionless")}
 
 non_positive = st.floats(max_value=0.0, allow_nan=False, allow_infinity=False).map(repr)

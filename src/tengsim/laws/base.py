@@ -44,7 +44,9 @@ class Law:
     internal_fields = ("g_safe",)
     field_help = {}
 
-    def _raw(self, g, need_dp=True):  # pragma: no cover - abstract
+    def _raw(self, g, need_dp=True, xp=np):  # pragma: no cover - abstract
+        """(Φ, P, dP/dg) at g >= g_safe; ``xp`` the array namespace (numpy, or jax.numpy when traced by
+        the JAX solver, tengsim.solvers.jax_fast: a law whose ``_raw`` takes ``xp`` runs there too)."""
         raise NotImplementedError
 
     @cached_property
@@ -67,6 +69,16 @@ class Law:
         p = np.where(low, ps + dps * t, p)
         phi = np.where(low, phs - ps * t - 0.5 * dps * t * t, phi)
         return phi, p
+
+    def evaluate_xp(self, g, xp):
+        """(Φ, P) at gaps g in the array namespace ``xp`` (jax.numpy inside a jit-compiled solver): the
+        same formulas as :meth:`evaluate`, branch-free (the safe extension by ``xp.where``)."""
+        gs = self.g_safe
+        low = g < gs
+        phi, p, _ = self._raw(xp.where(low, gs, g), need_dp=False, xp=xp)
+        phs, ps, dps = self._raw(xp.full((1,), gs, dtype=g.dtype), xp=xp)
+        t = g - gs
+        return xp.where(low, phs - ps * t - 0.5 * dps * t * t, phi), xp.where(low, ps + dps * t, p)
 
     def energy_pressure(self, g: np.ndarray, out: np.ndarray, work) -> float:
         """ΣΦ(g), writing P(g) into ``out``: the solvers' hot path (``work``: two scratch arrays)."""
@@ -156,13 +168,18 @@ def _check_common(law):
         raise TengsimError(f"g_safe must lie in (0, 1), got {law.g_safe!r}")
 
 
-def _wall(g, sigma, k, phi1):
+def _sqrt(x):
+    """√x of a law parameter: a float here, a traced scalar in the JAX solver (no NumPy ufunc there)."""
+    return np.sqrt(x) if isinstance(x, (int, float, np.number)) else x ** 0.5
+
+
+def _wall(g, sigma, k, phi1, xp=np):
     """Linear wall for g < 1: P = −σ + k(1 − g), Φ = Φ(1) − σ(1 − g) + k(1 − g)²/2, dP/dg = −k.
 
     Continuous with a tension σ at g = 1; zero load at g = 1 − σ/k, where Φ = Φ(1) − σ²/(2k).
     """
     t = 1.0 - g
-    return phi1 - sigma * t + 0.5 * k * t * t, -sigma + k * t, np.full_like(g, -k)
+    return phi1 - sigma * t + 0.5 * k * t * t, -sigma + k * t, xp.zeros_like(g) - k
 
 
 def numeric_window(law):

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from tengsim.errors import positive
-from tengsim.laws.base import LJ_PEAK_TENSION, WallLaw, _check_common, _wall
+from tengsim.laws.base import LJ_PEAK_TENSION, WallLaw, _check_common, _sqrt, _wall
 from tengsim.registry import LAWS
 
 
@@ -37,7 +37,7 @@ class Exponential(WallLaw):
     @property
     def amplitude(self) -> float:
         """The depth A = −Φ(1) of the attraction, in units of W, from A + (A/ρ)²/(2k) = 1."""
-        return 2.0 / (1.0 + np.sqrt(1.0 + 2.0 / (self.wall_stiffness * self.range**2)))
+        return 2.0 / (1.0 + _sqrt(1.0 + 2.0 / (self.wall_stiffness * self.range**2)))
 
     @property
     def tension(self) -> float:
@@ -53,14 +53,14 @@ class Exponential(WallLaw):
     def max_softening(self) -> float:
         return self.amplitude / self.range**2
 
-    def _raw(self, g, need_dp=True):
+    def _raw(self, g, need_dp=True, xp=np):
         A, rho, k = self.amplitude, self.range, self.wall_stiffness
-        e = np.exp(-np.maximum(g - 1.0, 0.0) / rho)
-        phi_w, p_w, dp_w = _wall(g, A / rho, k, -A)
+        e = xp.exp(-xp.maximum(g - 1.0, 0.0) / rho)
+        phi_w, p_w, dp_w = _wall(g, A / rho, k, -A, xp)
         wall = g < 1.0
-        phi = np.where(wall, phi_w, -A * e)
-        p = np.where(wall, p_w, -(A / rho) * e)
-        dp = np.where(wall, dp_w, (A / rho**2) * e) if need_dp else None
+        phi = xp.where(wall, phi_w, -A * e)
+        p = xp.where(wall, p_w, -(A / rho) * e)
+        dp = xp.where(wall, dp_w, (A / rho**2) * e) if need_dp else None
         return phi, p, dp
 
 

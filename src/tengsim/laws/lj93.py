@@ -47,7 +47,7 @@ class LJ93(Law):
     def max_softening(self) -> float:
         return 4.8 * 7.5 ** (-2.0 / 3.0)                # at the inflection g = 7.5^{1/6} ≈ 1.399
 
-    def _raw(self, g, need_dp=True):
+    def _raw(self, g, need_dp=True, xp=np):
         inv = 1.0 / g
         i2 = inv * inv
         i3 = i2 * inv
@@ -58,6 +58,17 @@ class LJ93(Law):
         p = (8.0 / 3.0) * (i9 - i3)
         dp = (8.0 / 3.0) * (-9.0 * i9 + 3.0 * i3) * inv if need_dp else None
         return phi, p, dp
+
+    def energy_sum_xp(self, g, xp, total):
+        """(ΣΦ, P) in the array namespace ``xp``, ΣΦ summed as :meth:`energy_pressure` sums it
+        ((1/3)Σg⁻⁸ − (4/3)Σg⁻², so the JAX solver's energies round as the NumPy solver's do); None
+        below g_safe (the caller then uses :meth:`evaluate_xp`).  ``total``: the namespace's sum."""
+        inv = 1.0 / g
+        i2 = inv * inv
+        i8 = i2 * i2
+        i8 = i8 * i8
+        p = (i8 * inv - i2 * inv) * (8.0 / 3.0)
+        return total(i8) / 3.0 - (4.0 / 3.0) * total(i2), p
 
     def energy_pressure(self, g, out, work):
         """In place, no temporaries (same values as ``evaluate``); falls back below g_safe."""

@@ -62,20 +62,20 @@ class MaugisDugdale(WallLaw):
     def max_softening(self) -> float:
         return 1.5 * self.tension / self.smoothing
 
-    def _raw(self, g, need_dp=True):
+    def _raw(self, g, need_dp=True, xp=np):
         s0, k, s = self.tension, self.wall_stiffness, self.smoothing
         h0 = self.range
         ge = 1.0 + h0                                    # the range's end, centre of the ramp
         hi = ge + 0.5 * s
-        phi_w, p_w, dp_w = _wall(g, s0, k, -s0 * h0)
-        t = np.clip((hi - g) / s, 0.0, 1.0)              # 1 inside the zone, 0 beyond
-        phi_z = np.where(g > ge - 0.5 * s, -s0 * s * (t**3 - 0.5 * t**4), -s0 * (ge - g))
+        phi_w, p_w, dp_w = _wall(g, s0, k, -s0 * h0, xp)
+        t = xp.clip((hi - g) / s, 0.0, 1.0)              # 1 inside the zone, 0 beyond
+        phi_z = xp.where(g > ge - 0.5 * s, -s0 * s * (t**3 - 0.5 * t**4), -s0 * (ge - g))
         p_z = -s0 * t * t * (3.0 - 2.0 * t)               # smoothstep: P and dP/dg continuous
         dp_z = 6.0 * s0 / s * t * (1.0 - t)
         wall = g < 1.0
-        phi = np.where(wall, phi_w, phi_z)
-        p = np.where(wall, p_w, p_z)
-        dp = np.where(wall, dp_w, dp_z) if need_dp else None
+        phi = xp.where(wall, phi_w, phi_z)
+        p = xp.where(wall, p_w, p_z)
+        dp = xp.where(wall, dp_w, dp_z) if need_dp else None
         return phi, p, dp
 
 

@@ -52,7 +52,7 @@ class Repulsive(Law):
     def max_softening(self) -> float:
         return 0.0
 
-    def _raw(self, g, need_dp=True):
+    def _raw(self, g, need_dp=True, xp=None):
         k, c = self.exponent, self.scale
         gk = g ** (-k)
         p = c * gk
