@@ -23,7 +23,6 @@ def secant(s0: State, s1: State, c: float) -> State:
 
 
 PERSIST_FACTOR = 10  # a fast solve stopped at its cap goes on for up to this many times max_iter more
-PERSISTENT = ("fast", "jax", "gpu")  # the solvers that go on from a state (the fast one, and it compiled with JAX)
 
 
 def persist(solver, problem: Problem, eq):
@@ -37,7 +36,7 @@ def persist(solver, problem: Problem, eq):
     unchanged bit for bit.  Any other solver, or a solve that failed otherwise (line search, non-finite),
     is returned as it is; a continued solve that still fails says so in its message, with both counts."""
     inner = getattr(solver, "inner", solver)
-    if (PERSIST_FACTOR < 1 or getattr(inner, "name", None) not in PERSISTENT or not is_dataclass(inner)
+    if (PERSIST_FACTOR < 1 or not getattr(inner, "resumes_from_state", False) or not is_dataclass(inner)
             or not np.isfinite(eq.residual)
             or not str(eq.message).startswith("not converged")):
         return eq

@@ -6,6 +6,7 @@ import inspect
 import math
 import time
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 
@@ -39,6 +40,7 @@ class FastSolver:
     memory: int = 10
     resync: int = 25
     name: str = "fast"
+    resumes_from_state: ClassVar[bool] = True  # continuation.persist may go on from its capped state
     monitor: object = None
     monitor_every: int = 100
 

@@ -36,12 +36,13 @@ import inspect
 import threading
 import time
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 
 from tengsim.errors import TengsimError
 from tengsim.registry import SOLVERS
-from tengsim.solvers import Equilibrium, Problem, State
+from tengsim.solvers.types import Equilibrium, Problem, State
 
 F32_TOL = 2e-5  # float32 fields: the smallest tolerance it can reach reliably (max|r| in ε)
 DEVICES = ("auto", "cpu", "gpu")
@@ -140,6 +141,7 @@ class JaxSolver:
     device: str = "auto"
     dtype: str = "float64"
     name: str = "jax"
+    resumes_from_state: ClassVar[bool] = True  # continuation.persist may go on from its capped state
 
     def __post_init__(self):
         if not self.tol > 0:
