@@ -12,7 +12,7 @@ import sys
 
 from tengsim.errors import TengsimError
 
-SUBCOMMANDS = ["contact", "device", "reproduce", "run", "plot", "sweep", "optimize"]
+SUBCOMMANDS = ["contact", "design", "device", "reproduce", "run", "plot", "sweep", "optimize"]
 
 
 class Parser(argparse.ArgumentParser):
