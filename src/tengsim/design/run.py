@@ -130,13 +130,21 @@ def budget_pixels(plan, cplan, dx: float, d_max: float) -> int:
     return top
 
 
-def check_budget(plan, est: Estimate) -> None:
-    from tengsim.design.units import time_text
+def check_budget(plan, est: Estimate, fit_pixels: int | None = None) -> None:
+    """Refuse an estimate over the plan's budget, naming what to change: a max_pixels that fits (when the
+    first two grids do) or a coarser dx."""
+    from tengsim.design.units import length_text, time_text
 
-    if est.seconds > plan.budget_s:
-        raise TengsimError(f"this design is estimated at {time_text(est.seconds)}, over the budget of "
-                           f"{time_text(plan.budget_s)}: give --max-pixels (e.g. {est.grids[0][0] * est.grids[0][1]}), "
-                           f"a coarser --tol (now {plan.tol:g}), a coarser --dx, or a larger --budget")
+    if est.seconds <= plan.budget_s:
+        return
+    two = est.grids[1][0] * est.grids[1][1] if len(est.grids) > 1 else None
+    if fit_pixels and two and fit_pixels >= two:
+        what = f"--max-pixels {fit_pixels} (the grids that fit the budget)"
+    else:
+        what = f"a coarser --dx (the first grid's is {length_text(est.grids[0][2])})"
+    raise TengsimError(f"this design is estimated at {time_text(est.seconds)}, over the budget of "
+                       f"{time_text(plan.budget_s)}: give {what}, a coarser --tol (now {plan.tol:g}) or a larger "
+                       "--budget")
 
 
 def _simulate(cplan, dx, d_max, **kw):
@@ -231,7 +239,7 @@ def run_design(plan, progress=None) -> DesignResult:
                    f"lateral unit {cplan.scaling.lateral * 1e9:.3g} nm")
     for line in est.lines():
         _say(progress, line)
-    check_budget(plan, est)
+    check_budget(plan, est, plan.max_pixels or budget_pixels(plan, cplan, dx, est.d_max))
     d_max, coarse = find_d_max(plan, cplan, dx, progress)
     max_pixels = plan.max_pixels or budget_pixels(plan, cplan, dx, d_max)
     maps = map_depths(coarse, plan)

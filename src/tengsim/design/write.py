@@ -1,8 +1,8 @@
 """A design's files: DIR/design.nc (the contract below), DIR/design.csv, the figures and DIR/report.md.
 
-design.nc (CF-1.10, SI): coordinates ``pressure`` (Pa, the pressures asked for, increasing) and ``branch``
-(approach, retraction); ``charged_area_fraction``, ``repulsive_area_fraction`` (1), ``voc_eq12``, ``voc_eq17``
-(V), ``dvoc_dp`` (V Pa-1) on (branch, pressure), NaN where a branch does not reach a pressure; global attributes
+design.nc (CF-1.10, SI): coordinates ``pressure`` (Pa, the pressures asked for, increasing; along the dimension
+``applied_pressure``, :data:`PRESSURE_DIM`) and ``branch`` (approach, retraction); ``charged_area_fraction``,
+``repulsive_area_fraction`` (1), ``voc_eq12``, ``voc_eq17`` (V), ``dvoc_dp`` (V Pa-1) on (branch, pressure), NaN where a branch does not reach a pressure; global attributes
 Conventions, title, shape, shape_params (JSON), E_star_Pa, W_J_m2, eps_m, tabor, sigma_C_m2, eps_r, thickness_m,
 gap_m, status, grids, tolerance, charged_area_definition, and the per-design numbers (:mod:`tengsim.design.curves`).
 ``tengsim.device.area_table_from_design`` reads it.
@@ -16,6 +16,10 @@ from pathlib import Path
 import numpy as np
 
 BRANCHES = ("approach", "retraction")
+PRESSURE_DIM = "applied_pressure"
+"""The dimension the coordinate ``pressure`` runs along: CF takes a dimension named 'pressure' for air pressure
+(a vertical axis asking for standard_name air_pressure), so it is named as a study.nc names it; select with
+``ds.swap_dims(applied_pressure="pressure").sel(pressure=...)`` or by position."""
 VARIABLES = {
     "charged_area_fraction": ("1", "charged contact area over cell area (A/S)"),
     "repulsive_area_fraction": ("1", "repulsive contact area (P > 0) over cell area"),
@@ -43,8 +47,8 @@ def to_dataset(res, plan, summary: dict):
     data = {}
     for name, (units, long) in VARIABLES.items():
         arr = np.vstack([curves[b][_CURVE[name]] for b in BRANCHES]).astype(float)
-        data[name] = (("branch", "pressure"), arr, {"units": units, "long_name": long})
-    coords = {"pressure": ("pressure", P, {"units": "Pa", "long_name": "nominal pressure"}),
+        data[name] = (("branch", PRESSURE_DIM), arr, {"units": units, "long_name": long})
+    coords = {"pressure": (PRESSURE_DIM, P, {"units": "Pa", "long_name": "nominal pressure"}),
               "branch": ("branch", np.array(BRANCHES, dtype=object), {"long_name": "path branch"})}
     ds = xr.Dataset(data, coords=coords)
     attrs = {
@@ -59,6 +63,7 @@ def to_dataset(res, plan, summary: dict):
         if k in SUMMARY_UNITS and k != "tabor":
             attrs[k] = float(v) if v is not None and math.isfinite(float(v)) else "n/a"
     ds.attrs = attrs
+    ds["branch"].encoding["dtype"] = "S1"  # a char array: CF's checker cannot judge a string coordinate variable
     return cf_conventions(ds, f"tengsim design: {plan.name}")
 
 
