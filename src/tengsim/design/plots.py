@@ -103,16 +103,17 @@ def maps_figure(result):
 
 
 def compare_figure(results):
-    """A/S and V_OC (Eq. 12) on the approach against pressure for several designs: one colour per design, a
-    filled marker where its status is ok, an open one where it is not."""
+    """A/S and V_OC (Eq. 12) on the approach against pressure for several designs (DesignResults or design.nc
+    Datasets): one colour per design, a filled marker where its status is ok, an open one where it is not."""
     plt = _plt()
     fig, axes = plt.subplots(1, 2, figsize=(12, 4.5), constrained_layout=True)
     for i, r in enumerate(results):
-        ds = r.dataset
+        ds = getattr(r, "dataset", r)  # a DesignResult or a design.nc Dataset
         P = ds["pressure"].values / 1e3
-        ok = r.status == "ok"
+        status = str(ds.attrs.get("status", "?"))
+        ok = status == "ok"
         style = dict(color=f"C{i % 10}", marker="o" if ok else "s", ms=4, mfc=None if ok else "none")
-        label = f"{r.plan.name} (μ {r.plan.tabor:.2g}; {'ok' if ok else r.status})"
+        label = f"{ds.attrs.get('design_name', ds.attrs.get('shape'))} (μ {float(ds.attrs['tabor']):.2g}; {status})"
         axes[0].plot(P, ds["charged_area_fraction"].sel(branch="approach"), "-", label=label, **style)
         axes[1].plot(P, ds["voc_eq12"].sel(branch="approach"), "-", label=label, **style)
     axes[0].set_xlabel("nominal pressure (kPa)")
