@@ -130,3 +130,16 @@ def test_comparison_of_two_designs_one_table_one_figure(tmp_path):
     assert len(rows) == 3 and rows[1].startswith("pyramid A") and rows[2].startswith("cone B")
     assert (out / "compare.png").stat().st_size > 0
     assert (out / "pyramid_A" / "design.nc").exists() and (out / "cone_B" / "design.nc").exists()
+
+
+def test_shipped_design_examples_plan():
+    """examples/own_design/*.toml (the README's comparison) are valid designs of the issue's pyramid and cone."""
+    from pathlib import Path
+
+    from tengsim.cli.design import _read_toml
+
+    files = sorted((Path(__file__).parent.parent / "examples" / "own_design").glob("*.toml"))
+    plans = [plan_design(_read_toml(str(f))) for f in files]
+    assert {p.shape for p in plans} == {"pyramid", "cone"}
+    for p in plans:
+        assert p.shape_params["pitch_m"] == pytest.approx(10e-6) and p.eps == pytest.approx(100e-9)

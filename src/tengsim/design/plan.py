@@ -91,6 +91,20 @@ class DesignPlan:
     def shape_params_json(self) -> str:
         return json.dumps(self.shape_params, sort_keys=True)
 
+    def shape_text(self) -> str:
+        """'pitch 10 µm, base 5 µm, height 3.5 µm' (lengths in their unit, other numbers plain)."""
+        from tengsim.design.units import length_text, pressure_text
+
+        out = []
+        for k, v in self.shape_params.items():
+            if k.endswith("_m"):
+                out.append(f"{k[:-2]} {length_text(v)}")
+            elif k.endswith("_Pa"):
+                out.append(f"{k[:-3]} {pressure_text(v)}")
+            else:
+                out.append(f"{k} {v:g}" if isinstance(v, float) else f"{k} {v}")
+        return ", ".join(out)
+
 
 def _own(table: dict) -> dict:
     from tengsim.schema import Table
@@ -100,10 +114,21 @@ def _own(table: dict) -> dict:
     return t.parse(raw, where="")
 
 
-def _fmt_len(m: float) -> str:
-    from tengsim.design.units import length_text
+_SUFFIX = {"length": "_m", "pressure": "_Pa", "energy/area": "_J_m2"}
 
-    return length_text(m)
+
+def _shape_params(shape: str, extra: dict) -> dict:
+    """The shape's physical parameters as the run records them, SI with the unit in the name (pitch_m, slope)."""
+    from tengsim.plugins import SHAPES
+    from tengsim.shapes.base import physical_fields
+
+    out = {}
+    for f in physical_fields(SHAPES.get(shape)):
+        key = f.name + _SUFFIX.get(f.dim, "")
+        raw = extra.get(f.name + _SUFFIX.get(f.dim, "_input"))
+        if raw is not None:
+            out[key] = raw
+    return out
 
 
 def plan_design(table: dict, where: str = "") -> DesignPlan:
@@ -163,12 +188,10 @@ def plan_design(table: dict, where: str = "") -> DesignPlan:
     fit_max = own["fit_max"] if own["fit_max"] is not None else lo + (hi - lo) / 10
     if not lo < fit_max <= hi:
         raise ConfigValueError(f"{where}fit_max must lie above p_min and at most p_max, got {table.get('fit_max')!r}")
-    sp = {k[:-2] if k.endswith("_m") else k: v for k, v in plan.extra.items()
-          if k.endswith(("_m", "_input")) and k not in ("eps_m", "lateral_m")}
-    sp = {k.replace("_input", ""): v for k, v in sp.items()}
+    sp = _shape_params(shape, plan.extra)
     sc = plan.scaling
-    name = own["name"] or f"{shape} " + ", ".join(f"{k} {_fmt_len(v)}" for k, v in sp.items()
-                                                  if isinstance(v, float))
+    draft = DesignPlan("", shape, {}, sp, (), 0, 0, 0, 0, 0, None, None, 0, 0, 0, 0, 0, 0)
+    name = own["name"] or f"{shape} {draft.shape_text()}"
     return DesignPlan(name=name, shape=shape, contact=cfg, shape_params=sp, pressures=pressures,
                       sigma=own["sigma"], eps_r=own["eps_r"], T=own["T"], gap=own["gap"], tol=tol, dx=own["dx"],
                       max_pixels=own["max_pixels"], budget_s=own["budget"], fit_max=fit_max, E_star=sc.E_star,

@@ -41,7 +41,7 @@ def report_text(result, figures) -> str:
              f"**Status: {s['status']}**, grids: {s['grids']}; tolerance {100 * p.tol:g} % "
              f"(the grid is refined by √2 until the numbers below change by at most that between the last two "
              f"grids); {s['seconds']:.0f} s of solving.", "",
-             f"Shape {p.shape} ({', '.join(f'{k} {length_text(v)}' if isinstance(v, float) else f'{k} {v}' for k, v in p.shape_params.items())}); "
+             f"Shape {p.shape} ({p.shape_text()}); "
              f"E* = {p.E_star / 1e6:.4g} MPa, W = {p.W * 1e3:.4g} mJ/m², ε = {length_text(p.eps)}, Tabor number "
              f"μ = {s['tabor']:.3g}.",
              f"Device (Eq. 12 and Eq. 17): σ = {p.sigma * 1e6:.4g} µC/m², ε_r = {p.eps_r:.4g}, T = {length_text(p.T)}, "

@@ -225,8 +225,9 @@ def _observer(plan):
 
 
 def run_design(plan, progress=None) -> DesignResult:
-    """Run one design (module doc).  ``progress``: a :class:`tengsim.progress.Progress`-like object; one
-    with ``say(text)`` also gets the lines printed before and during the run."""
+    """Run one design (module doc).  ``progress``: a :class:`tengsim.progress.Progress`-like callable (the
+    path's progress) and/or an object with ``say(text)``, which gets the lines said before and during the run
+    (the Tabor number, the grids, memory and estimated time)."""
     from tengsim.config import plan_contact
     from tengsim.design.curves import summarize
     from tengsim.design.write import to_dataset
@@ -250,7 +251,7 @@ def run_design(plan, progress=None) -> DesignResult:
         path = PathSpec(D_MIN, d_max, D_STEP, adaptive=True, maps_at=tuple(maps))
         res = resolve_contact(cplan.shape, cplan.tabor, path, dx=dx, law=cplan.law, boundary=cplan.boundary,
                               resolve_tol=plan.tol, max_pixels=max_pixels, observe=_observer(plan),
-                              progress=progress, symmetry=cplan.symmetry, solver=cplan.solver, tol=cplan.tol,
+                              progress=progress if callable(progress) else None, symmetry=cplan.symmetry, solver=cplan.solver, tol=cplan.tol,
                               extra_params=cplan.extra, scaling=cplan.scaling, kernel_params=cplan.kernel_params)
         ok, D_hit, top, slope = _reach(res, plan.pressures[-1])
         if ok:
