@@ -143,3 +143,11 @@ def test_shipped_design_examples_plan():
     assert {p.shape for p in plans} == {"pyramid", "cone"}
     for p in plans:
         assert p.shape_params["pitch_m"] == pytest.approx(10e-6) and p.eps == pytest.approx(100e-9)
+
+
+def test_help_per_shape_is_short(capsys):
+    assert main(["design", "cone", "--help"]) == 0
+    text = capsys.readouterr().out
+    assert len(text.splitlines()) <= 100 and "--slope" in text and "--base" not in text and "--eps" in text
+    assert main(["design", "--help"]) == 0
+    assert "tengsim design SHAPE --help" in capsys.readouterr().out

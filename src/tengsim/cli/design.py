@@ -31,22 +31,65 @@ def _keys() -> dict:
     return out
 
 
+DESCRIPTION = (
+    "One design (a registered shape with its sizes, E*, W and the interaction range eps, and the pressures) or "
+    "several TOML files: the charged area A/S, V_OC (Eq. 12; Eq. 17 at the rest gap) and dV_OC/dP per pressure "
+    "on approach and retraction, and the jump-in, pull-off, full-contact pressure, linear range and hysteresis; "
+    "the grid is chosen and refined until the numbers converge to --tol. Writes OUT/design.nc, design.csv, "
+    "design.png, maps.png, report.md (several designs: OUT/NAME/..., OUT/compare.csv, compare.png).")
+USAGE = "tengsim design SHAPE --KEY VALUE ... --out DIR  |  tengsim design FILE.toml [FILE.toml ...] --out DIR"
+
+
 def register(sub):
-    p = sub.add_parser(
-        "design", allow_abbrev=False,
-        help="a micro-structure's A/S, V_OC and sensitivity against pressure, converged, in physical units",
-        description="One design (a registered shape with its sizes, E*, W and the interaction range eps, and "
-        "the pressures in kPa) or several TOML files: the charged area A/S, V_OC (Eq. 12; Eq. 17 at the rest "
-        "gap) and dV_OC/dP per pressure on approach and retraction, and the jump-in, pull-off, full-contact "
-        "pressure, linear range and hysteresis; the grid is chosen and refined until the numbers converge to "
-        "--tol. Writes OUT/design.nc, design.csv, design.png, maps.png, report.md.")
-    p.add_argument("inputs", nargs="+", metavar="SHAPE|FILE.toml",
-                   help="a registered shape (its keys as options) or one or more TOML files")
+    p = sub.add_parser("design", allow_abbrev=False, add_help=False, usage=USAGE, description=DESCRIPTION,
+                       help="a micro-structure's A/S, V_OC and sensitivity against pressure, converged, in "
+                       "physical units")
+    p.add_argument("inputs", nargs="*", metavar="SHAPE|FILE.toml")
+    p.add_argument("-h", "--help", action="store_true", dest="help")
     for k, h in _keys().items():
         p.add_argument("--" + k.replace("_", "-"), dest=k, help=str(h).replace("%", "%%"))
-    p.add_argument("--out", required=True, help="output folder (created; several designs: one subfolder each)")
+    p.add_argument("--out", help="output folder (created; several designs: one subfolder each)")
     p.add_argument("--quiet", action="store_true", help="no progress lines")
     p.set_defaults(func=run)
+
+
+def help_text(shape: str | None = None) -> str:
+    """The command's help: the design's keys, the material, then the keys of ``shape`` (all shapes' names if
+    None) and the contact options a design leaves to the user."""
+    import textwrap
+
+    from tengsim.config import common_fields, contact_table, law_key_help, law_keys
+    from tengsim.design.plan import CONTROLLED, design_fields
+    from tengsim.registry import SHAPES
+
+    def line(k, h):
+        flag = "--" + k.replace("_", "-")
+        return textwrap.fill(f"{h}", width=110, initial_indent=f"  {flag:<24}", subsequent_indent=" " * 26)
+
+    out = [f"usage: {USAGE}", "", textwrap.fill(DESCRIPTION, 110), "",
+           "the design (pressures with a unit, e.g. 100kPa; a bare number is SI):"]
+    out += [line(f.name, f.help) for f in design_fields()]
+    own = {f.name for f in design_fields()}
+    common = {f.name: f for f in common_fields()}
+    laws = law_keys()
+    out += ["", "the material (required: E_star, W, eps):"]
+    out += [line(k, common[k].help) for k in ("E_star", "W", "eps")]
+    if shape is None:
+        out += ["", f"the shape: one of {', '.join(SHAPES.names())}; its keys: tengsim design SHAPE --help"]
+    else:
+        name = SHAPES.canonical(shape)
+        table = contact_table(name, "physical").fields
+        mine = [k for k in table if k not in common and k not in laws and k not in CONTROLLED and k not in own]
+        out += ["", f"the shape {name}:"] + [line(k, table[k].help) for k in mine]
+    rest = [k for k in common if k not in CONTROLLED and k not in own and k not in ("E_star", "W", "eps", "shape")
+            and not k.startswith("roughness_")]
+    out += ["", "contact options (defaults as tengsim contact):"] + [line(k, common[k].help) for k in rest]
+    out += ["", "keys of the law (plain numbers in units of W and ε):"]
+    out += [line(k, law_key_help(v)) for k, v in laws.items()]
+    out += ["  --roughness-*            a roughness on the shape (keys as tengsim contact)",
+            "  --out DIR                output folder (required; not created on bad input)",
+            "  --quiet                  no progress lines"]
+    return "\n".join(out) + "\n"
 
 
 def _read_toml(path: str) -> dict:
@@ -128,7 +171,16 @@ class _Say:
 
 def run(args) -> int:
     from tengsim.design import plan_design, run_design, write_comparison, write_design
+    from tengsim.registry import SHAPES
 
+    if args.help:
+        first = args.inputs[0] if args.inputs else None
+        print(help_text(first if first and first.lower() in [n.lower() for n in SHAPES.names()] else None), end="")
+        return 0
+    if not args.inputs:
+        raise TengsimError("give a shape with its keys, or TOML files (tengsim design --help)")
+    if not args.out:
+        raise TengsimError("--out DIR is required (the folder the design's files go to)")
     tables = _tables(args)
     plans = [plan_design(t, where) for where, t in tables]  # every design checked before anything runs
     out = Path(args.out)

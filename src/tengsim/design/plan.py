@@ -52,7 +52,7 @@ def design_fields() -> list:
         Field("gap", default=PAPER_DEVICE["gap"], dim="length",
               help="the device's rest gap d0 for Eq. (17) (default the paper's 0.1 mm)"),
         Field("tol", default=0.01, help="relative tolerance the reported numbers are converged to (default "
-              "0.01 = 1 %%)"),
+              "0.01 = 1 %)"),
         Field("dx", default=None, dim="length", help="first grid spacing, a length such as '50nm' (default: "
               "from the shape's features and the law's process zone)"),
         Field("max_pixels", "int", None, help="largest grid nx·ny the refinement may use"),
