@@ -1,4 +1,4 @@
-"""``tengsim design``: a designer's question in one command (thin shell over :mod:`tengsim.design`).
+"""``tengsim design``: a designer's question in one command (thin shell over :mod:`tengsim.design`)::
 
     tengsim design pyramid --pitch 10um --base 5um --height 3.5um --E-star 1MPa --W 50mJ/m2 --eps 100nm \\
         --p-max 100kPa --p-step 5kPa --out d1/

@@ -1,6 +1,6 @@
 """A designer's question in one call: a micro-structure and its materials in physical units → A/S, V_OC and
 dV_OC/dP per pressure on approach and retraction, and per design the jump-in, pull-off, full-contact pressure,
-linear range and hysteresis, on a grid chosen and refined to a stated tolerance.
+linear range and hysteresis, on a grid chosen and refined to a stated tolerance::
 
     from tengsim.design import plan_design, run_design, write_design
     plan = plan_design({"shape": "pyramid", "pitch": "10um", "base": "5um", "height": "3.5um",

@@ -58,6 +58,8 @@ def design_fields() -> list:
         Field("max_pixels", "int", None, help="largest grid nx·ny the refinement may use"),
         Field("budget", default=600.0, dim="time", help="largest estimated run time before it is refused, "
               "in seconds or with a unit, e.g. 600 or '600s' (default 600 s)"),
+        Field("maps", "bool", True, help="keep contact pressure maps near 10 %, 50 % and 100 % of p_max (the "
+              "finest grid's approach walked again: about half its time); false: none"),
         Field("fit_max", default=None, dim="pressure", help="top of the low-pressure range of the linear fit "
               "of V_OC(P) (default p_min + (p_max - p_min)/10)"),
     ]
@@ -86,6 +88,7 @@ class DesignPlan:
     W: float
     eps: float
     tabor: float
+    maps: bool = True
     extra: dict = field(default_factory=dict)
 
     def shape_params_json(self) -> str:
@@ -195,7 +198,7 @@ def plan_design(table: dict, where: str = "") -> DesignPlan:
     return DesignPlan(name=name, shape=shape, contact=cfg, shape_params=sp, pressures=pressures,
                       sigma=own["sigma"], eps_r=own["eps_r"], T=own["T"], gap=own["gap"], tol=tol, dx=own["dx"],
                       max_pixels=own["max_pixels"], budget_s=own["budget"], fit_max=fit_max, E_star=sc.E_star,
-                      W=sc.W, eps=sc.eps, tabor=sc.mu)
+                      W=sc.W, eps=sc.eps, tabor=sc.mu, maps=bool(own["maps"]))
 
 
 def _pressures(own: dict, where: str) -> tuple:

@@ -73,7 +73,9 @@ def design_figure(result):
 def maps_figure(result):
     """Contact pressure maps (kPa) on the approach at the pressures the run kept maps for; None if none."""
     plt = _plt()
-    res = result.contact
+    res = result.maps
+    if res is None:
+        return None
     maps = [m for m in res.maps if str(m["branch"]) == "approach"]
     if not maps:
         return None

@@ -16,6 +16,9 @@
    fraction A/S on the approach at every asked pressure, the pull-off force and the jump D values change by
    at most tol between the last two grids (and their Richardson error is within tol).  If the finest grid
    does not reach p_max (a finer grid is softer), d_max grows and the refinement runs again (once).
+4. **Maps.**  The finest grid's approach is walked again (approach only, the same path lattice) up to the D at
+   which it reaches the asked pressures nearest 10 %, 50 % and 100 % of p_max, keeping the pressure and gap
+   maps exactly there (``maps = false``: skipped; about half the finest grid's time).
 """
 from __future__ import annotations
 
@@ -42,7 +45,8 @@ EXTEND_TRIES = 6
 class DesignResult:
     """One design's answer: ``dataset`` (the design.nc contract, :func:`tengsim.design.write.to_dataset`),
     ``summary`` (per-design numbers, SI), ``convergence`` {number: relative change between the last two grids},
-    ``contact`` (the finest grid's :class:`tengsim.results.ContactResult`) and its ``plan``."""
+    ``contact`` (the finest grid's :class:`tengsim.results.ContactResult`), its ``plan`` and ``maps`` (the run
+    holding the pressure maps near 10 %, 50 % and 100 % of p_max, or None)."""
 
     plan: object
     dataset: object
@@ -50,6 +54,8 @@ class DesignResult:
     convergence: dict
     contact: object = field(repr=False)
     notes: tuple = ()
+    maps: object = field(default=None, repr=False)
+    """The finest grid's approach again up to the map pressures, with the pressure and gap maps there (or None)."""
 
     @property
     def status(self) -> str:
@@ -192,22 +198,46 @@ MAP_FRACTIONS = (0.1, 0.5, 1.0)
 """Maps are kept at the asked pressures nearest these fractions of p_max."""
 
 
-def map_depths(coarse, plan) -> dict:
-    """{D (ε): asked pressure (Pa)}: the approach D at which the coarse grid first reaches each map pressure
-    (the asked pressures nearest :data:`MAP_FRACTIONS` of p_max, above 0); the finest grid's map at that D is
-    at a nominal pressure within the grids' difference of it (its own is shown)."""
-    a = coarse.branch("approach")
-    D, P = np.asarray(a["D"], float), np.asarray(a["pressure_Pa"], float)
+def map_depths(res, plan) -> dict:
+    """{D (ε): asked pressure (Pa)}: for the asked pressures nearest :data:`MAP_FRACTIONS` of p_max (above 0),
+    the approach D at which ``res`` (the finest grid) reaches each on its load-controlled states, linear
+    between the two states around it."""
+    from tengsim.study.observe import load_control
+
+    F, D = load_control(res, "D")
+    P = res.scaling.pressure(1.0) * F
     asked = [p for p in plan.pressures if p > 0]
     out = {}
     for f in MAP_FRACTIONS:
-        if not asked:
+        if not asked or len(P) < 2:
             break
         p = min(asked, key=lambda x: abs(x - f * plan.pressures[-1]))
-        hit = np.flatnonzero(P >= p)
-        if len(hit):
-            out[round(float(D[hit[0]]), 9)] = p
+        i = int(np.searchsorted(P, p))
+        if 0 < i < len(P) and D[i] - D[i - 1] <= D_STEP:
+            w = (p - P[i - 1]) / (P[i] - P[i - 1])
+            out[round(float(D[i - 1] + w * (D[i] - D[i - 1])), 9)] = p
+        elif 0 < i < len(P):  # states dropped between them (a snap): the state the load reaches
+            out[round(float(D[i]), 9)] = p
+        elif i == 0:
+            out[round(float(D[0]), 9)] = p
     return out
+
+
+def maps_run(res, cplan, plan):
+    """The finest grid's approach walked again up to the map depths (:func:`map_depths`), its pressure and gap
+    maps kept exactly there (the same path lattice: the same states); None if no depth is known."""
+    from tengsim.contact import simulate
+    from tengsim.path import PathSpec
+
+    depths = map_depths(res, plan)
+    if not depths:
+        return None, {}
+    top = max(depths) + D_STEP
+    path = PathSpec(D_MIN, top, D_STEP, adaptive=True, retract=False, maps_at=tuple(sorted(depths)))
+    out = simulate(cplan.shape, cplan.tabor, res.grid.dx, path, boundary=cplan.boundary, solver=cplan.solver,
+                   tol=cplan.tol, law=cplan.law, extra_params=cplan.extra, scaling=cplan.scaling, grid=res.grid,
+                   kernel_params=cplan.kernel_params, symmetry=cplan.symmetry)
+    return out, depths
 
 
 def area_name(branch: str, p: float) -> str:
@@ -243,12 +273,11 @@ def run_design(plan, progress=None) -> DesignResult:
     check_budget(plan, est, plan.max_pixels or budget_pixels(plan, cplan, dx, est.d_max))
     d_max, coarse = find_d_max(plan, cplan, dx, progress)
     max_pixels = plan.max_pixels or budget_pixels(plan, cplan, dx, d_max)
-    maps = map_depths(coarse, plan)
     res = None
     for _ in range(2):
         from tengsim.path import PathSpec
 
-        path = PathSpec(D_MIN, d_max, D_STEP, adaptive=True, maps_at=tuple(maps))
+        path = PathSpec(D_MIN, d_max, D_STEP, adaptive=True)
         res = resolve_contact(cplan.shape, cplan.tabor, path, dx=dx, law=cplan.law, boundary=cplan.boundary,
                               resolve_tol=plan.tol, max_pixels=max_pixels, observe=_observer(plan),
                               progress=progress if callable(progress) else None, symmetry=cplan.symmetry, solver=cplan.solver, tol=cplan.tol,
@@ -261,5 +290,6 @@ def run_design(plan, progress=None) -> DesignResult:
         raise TengsimError(f"the approach reached only {top / 1e3:.4g} kPa of p_max = {plan.pressures[-1] / 1e3:.4g} "
                            f"kPa on the finest grid: give a lower p_max")
     summary, conv, notes = summarize(res, plan)
-    summary["map_pressures_asked"] = tuple(maps.items())
-    return DesignResult(plan, to_dataset(res, plan, summary), summary, conv, res, tuple(notes))
+    maps, depths = maps_run(res, cplan, plan) if plan.maps else (None, {})
+    summary["map_pressures_asked"] = tuple(depths.items())
+    return DesignResult(plan, to_dataset(res, plan, summary), summary, conv, res, tuple(notes), maps)
