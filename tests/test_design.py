@@ -88,6 +88,11 @@ def test_files_cf_report_and_labels(small, tmp_path):
     assert any("(V)" in y for y in labels) and any("V/kPa" in y for y in labels)
     assert "pyramid" in fig._suptitle.get_text() and "µm" in fig._suptitle.get_text()
     assert "X (dimensionless)" not in " ".join(labels)
+    from tengsim.design.plots import maps_figure
+
+    titles = [a.get_title() for a in maps_figure(small).axes if a.get_title()]
+    assert titles and all("kPa" in t and "asked" in t for t in titles)
+    assert all(a.get_xlabel() == "x (µm)" for a in maps_figure(small).axes if a.get_title())
 
 
 @pytest.mark.parametrize("bad, words", [
@@ -120,7 +125,7 @@ def test_unknown_shape_refused(tmp_path, capsys):
 
 def test_comparison_of_two_designs_one_table_one_figure(tmp_path):
     a, b = tmp_path / "a.toml", tmp_path / "b.toml"
-    common = 'E_star = "5MPa"\nW = "20mJ/m2"\neps = "50nm"\np_max = "20kPa"\np_step = "10kPa"\ntol = 0.05\n'
+    common = 'E_star = "5MPa"\nW = "20mJ/m2"\neps = "50nm"\np_max = "20kPa"\np_step = "10kPa"\ntol = 0.05\nmaps = false\n'
     a.write_text('[design]\nname = "pyramid A"\nshape = "pyramid"\npitch = "1um"\nbase = "0.5um"\nheight = "0.2um"\n'
                  + common)
     b.write_text('[design]\nname = "cone B"\nshape = "cone"\npitch = "1um"\nslope = 0.8\nheight = "0.2um"\n' + common)
