@@ -34,8 +34,8 @@ def test_small_design_ok_and_within_1pct_of_a_grid_sqrt2_finer(small):
     from tengsim.path import PathSpec
 
     assert small.status == "ok"
-    res = small.contact
-    cplan = plan_contact(small.plan.contact)
+    res = small.finest
+    cplan = plan_contact(small.plan.contact_table)
     path = PathSpec(res.params["d_min"], res.params["d_max"], res.params["d_step"], adaptive=True)
     finer = simulate(cplan.shape, cplan.tabor, res.grid.dx / math.sqrt(2), path, law=cplan.law,
                      scaling=cplan.scaling, extra_params=cplan.extra)

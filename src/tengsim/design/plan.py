@@ -67,12 +67,12 @@ def design_fields() -> list:
 
 @dataclass(frozen=True)
 class DesignPlan:
-    """A validated design (SI throughout); ``contact`` is the [contact] table handed to
+    """A validated design (SI throughout); ``contact_table`` is the [contact] table handed to
     :func:`tengsim.config.plan_contact` (the shape's physical keys, E_star, W, eps and contact options)."""
 
     name: str
     shape: str
-    contact: dict
+    contact_table: dict
     shape_params: dict
     pressures: tuple
     sigma: float
@@ -195,7 +195,7 @@ def plan_design(table: dict, where: str = "") -> DesignPlan:
     sc = plan.scaling
     draft = DesignPlan("", shape, {}, sp, (), 0, 0, 0, 0, 0, None, None, 0, 0, 0, 0, 0, 0)
     name = own["name"] or f"{shape} {draft.shape_text()}"
-    return DesignPlan(name=name, shape=shape, contact=cfg, shape_params=sp, pressures=pressures,
+    return DesignPlan(name=name, shape=shape, contact_table=cfg, shape_params=sp, pressures=pressures,
                       sigma=own["sigma"], eps_r=own["eps_r"], T=own["T"], gap=own["gap"], tol=tol, dx=own["dx"],
                       max_pixels=own["max_pixels"], budget_s=own["budget"], fit_max=fit_max, E_star=sc.E_star,
                       W=sc.W, eps=sc.eps, tabor=sc.mu, maps=bool(own["maps"]))

@@ -50,13 +50,13 @@ def report_text(result, figures) -> str:
              "", f"Charged area: {s['charged_area_definition']}; the repulsive area (P > 0) is given beside it.", "",
              "## How converged", "", "| number | change between the last two grids |", "|---|---|"]
     lines += [f"| {k} | {_pct(v)} |" for k, v in result.convergence.items()]
-    tab = result.contact.params.get("resolution") or {}
+    tab = result.finest.params.get("resolution") or {}
     if tab:
-        lat = result.contact.scaling.lateral
+        lat = result.finest.scaling.lateral
         lines += ["", "| grid | dx | solve time | status |", "|---|---|---|---|"]
         lines += [f"| {nx}×{ny} | {length_text(dx * lat)} | {sec:.1f} s | {st} |" for nx, ny, dx, sec, st in
                   zip(tab["nx"], tab["ny"], tab["dx"], tab["seconds"], tab["status"])]
-        lines += ["", f"The finest grid's path: {len(result.contact.table['D'])} equilibria (approach and retraction)."]
+        lines += ["", f"The finest grid's path: {len(result.finest.table['D'])} equilibria (approach and retraction)."]
     lines += ["", "The per-design numbers below are read from the finest grid's curves; those from A/S (full "
               "contact, sensitivity, linear range, V_OC) move as A/S does.", "",
               "## Numbers", "", "| number | value |", "|---|---|"]

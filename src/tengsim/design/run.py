@@ -45,14 +45,14 @@ EXTEND_TRIES = 6
 class DesignResult:
     """One design's answer: ``dataset`` (the design.nc contract, :func:`tengsim.design.write.to_dataset`),
     ``summary`` (per-design numbers, SI), ``convergence`` {number: relative change between the last two grids},
-    ``contact`` (the finest grid's :class:`tengsim.results.ContactResult`), its ``plan`` and ``maps`` (the run
+    ``finest`` (the finest grid's :class:`tengsim.results.ContactResult`), its ``plan`` and ``maps`` (the run
     holding the pressure maps near 10 %, 50 % and 100 % of p_max, or None)."""
 
     plan: object
     dataset: object
     summary: dict
     convergence: dict
-    contact: object = field(repr=False)
+    finest: object = field(repr=False)
     notes: tuple = ()
     maps: object = field(default=None, repr=False)
     """The finest grid's approach again up to the map pressures, with the pressure and gap maps there (or None)."""
@@ -263,7 +263,7 @@ def run_design(plan, progress=None) -> DesignResult:
     from tengsim.design.write import to_dataset
     from tengsim.resolve import resolve_contact
 
-    cplan = plan_contact(plan.contact)
+    cplan = plan_contact(plan.contact_table)
     dx = start_dx(plan, cplan)
     est = estimate(plan, cplan, dx, 1.2 * height_eps(cplan, dx) + 2.0)
     _say(progress, f"{plan.name}: Tabor number {cplan.tabor:.3g} (from eps = {plan.eps * 1e9:.3g} nm), "

@@ -57,7 +57,7 @@ def to_dataset(res, plan, summary: dict):
         "tabor": float(summary["tabor"]), "sigma_C_m2": plan.sigma, "eps_r": plan.eps_r, "thickness_m": plan.T,
         "gap_m": plan.gap, "status": str(summary["status"]), "grids": str(summary["grids"]),
         "tolerance": float(plan.tol), "charged_area_definition": str(summary["charged_area_definition"]),
-        "contact_config": json.dumps({k: v for k, v in plan.contact.items()}, sort_keys=True, default=str),
+        "contact_config": json.dumps({k: v for k, v in plan.contact_table.items()}, sort_keys=True, default=str),
     }
     for k, v in summary.items():
         if k in SUMMARY_UNITS and k != "tabor":
