@@ -1,4 +1,6 @@
-r"""``tengsim design``: a designer's question in one command (thin shell over :mod:`tengsim.design`)::
+r"""``tengsim design``: a designer's question in one command (thin shell over :mod:`tengsim.design`).
+
+Examples::
 
     tengsim design pyramid --pitch 10um --base 5um --height 3.5um --E-star 1MPa --W 50mJ/m2 --eps 100nm \
         --p-max 100kPa --p-step 5kPa --out d1/
