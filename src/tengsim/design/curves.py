@@ -155,7 +155,7 @@ def summarize(res, plan) -> tuple[dict, dict, list]:
     curves = branch_curves(res, plan)
     app, ret = curves["approach"], curves["retraction"]
     st = states(res, plan)["approach"]
-    notes = []
+    notes = [str(res.params["resolve_message"])] if res.params.get("resolve_message") else []
     jin = next((j for j in res.jumps if j.kind == "jump-in"), None)
     full = _full_fraction(res, plan)
     full_P = math.nan
