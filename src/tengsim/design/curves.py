@@ -17,7 +17,8 @@ first jumps into contact; negative: tensile), pull-off (the most tensile load of
 and Pa), full-contact pressure (the lowest approach pressure at which A/S reaches 95 % of its full-contact
 value, the footprint's), sensitivity and linear range (V_OC of Eq. 12 on the approach: least-squares line over
 [p_min, fit_max]; the linear range is the highest asked pressure up to which V_OC stays within 10 % of that
-line), hysteresis (the energy lost per cycle ∮F dD per unit nominal area, J/m², and the largest difference of
+line's value, or of its rise over [p_min, fit_max] where that is larger), hysteresis (the energy lost per cycle
+∮F dD per unit nominal area, J/m², and the largest difference of
 A/S between retraction and approach at an asked pressure).
 """
 from __future__ import annotations
@@ -128,9 +129,10 @@ def _linear(ps, V, fit_max):
         return math.nan, math.nan
     slope, icpt = np.polyfit(ps[fit], V[fit], 1)
     line = icpt + slope * ps
+    rise = abs(slope) * (fit_max - ps[0])  # near P = 0 the line's own value is no scale: its rise over the fit
     last = math.nan
     for p, v, y, good in zip(ps, V, line, ok):
-        if not good or abs(v - y) > LINEAR_TOLERANCE * max(abs(y), 1e-12):
+        if not good or abs(v - y) > LINEAR_TOLERANCE * max(abs(y), rise, 1e-12):
             break
         last = float(p)
     return float(slope), last

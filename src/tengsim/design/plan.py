@@ -161,7 +161,7 @@ def plan_design(table: dict, where: str = "") -> DesignPlan:
     if unknown:
         raise ConfigValueError(f"{where}shape {shape} has no key {', '.join(map(repr, unknown))} (design keys: "
                                f"{', '.join(sorted(own_names))}; [contact] keys of {shape}: "
-                               f"{', '.join(k for k in contact_table(shape, 'physical').keys() if k not in CONTROLLED)})")
+                               f"{', '.join(k for k in sorted(contact_keys) if k not in CONTROLLED)})")
     if table.get("eps") in (None, ""):
         raise ConfigValueError(f"{where}eps is missing: give the interaction range ε of the law, a length such as "
                                "'50nm' (docs/design.md, 'Choosing ε')")

@@ -25,7 +25,8 @@ def title(plan, status: str | None = None) -> str:
     from tengsim.design.units import length_text
 
     sizes = plan.shape_text()
-    mat = f"E* {plan.E_star / 1e6:.3g} MPa, W {plan.W * 1e3:.3g} mJ/m², ε {length_text(plan.eps)}, μ {plan.tabor:.2g}"
+    mat = (f"E* {plan.E_star / 1e6:.3g} MPa, W {plan.W * 1e3:.3g} mJ/m², ε {length_text(plan.eps)}, "
+           f"μ {plan.tabor:.2g}")
     st = f" — status {status}" if status else ""
     return f"{plan.shape}: {sizes}\n{mat}{st}"
 

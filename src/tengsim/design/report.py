@@ -11,7 +11,8 @@ ROWS = (
     ("pull_off_Pa", "pull-off pressure", "kPa"),
     ("full_contact_Pa", "full-contact pressure (A/S reaches 95 % of the footprint's)", "kPa"),
     ("sensitivity_V_per_Pa", "sensitivity dV_OC/dP (Eq. 12, least-squares line over [p_min, fit_max])", "V/kPa"),
-    ("linear_range_Pa", "linear range (V_OC within 10 % of that line up to)", "kPa"),
+    ("linear_range_Pa", "linear range (V_OC within 10 % of that line, or of its rise over the fit range, up to)",
+     "kPa"),
     ("hysteresis_J_m2", "hysteresis: energy lost per cycle per unit nominal area (∮F dD)", "J/m²"),
     ("area_hysteresis", "hysteresis: largest |A/S retraction − A/S approach| at an asked pressure", ""),
     ("area_at_p_max", "charged area A/S at p_max (approach)", ""),
@@ -44,9 +45,11 @@ def report_text(result, figures) -> str:
              f"Shape {p.shape} ({p.shape_text()}); "
              f"E* = {p.E_star / 1e6:.4g} MPa, W = {p.W * 1e3:.4g} mJ/m², ε = {length_text(p.eps)}, Tabor number "
              f"μ = {s['tabor']:.3g}.",
-             f"Device (Eq. 12 and Eq. 17): σ = {p.sigma * 1e6:.4g} µC/m², ε_r = {p.eps_r:.4g}, T = {length_text(p.T)}, "
+             f"Device (Eq. 12 and Eq. 17): σ = {p.sigma * 1e6:.4g} µC/m², ε_r = {p.eps_r:.4g}, "
+             f"T = {length_text(p.T)}, "
              f"rest gap d0 = {length_text(p.gap)} (defaults: the paper's 5.84 µC/m², 2.40, 400 µm, 0.1 mm).",
-             f"Pressures: {pressure_text(p.pressures[0])} to {pressure_text(p.pressures[-1])}, {len(p.pressures)} values.",
+             f"Pressures: {pressure_text(p.pressures[0])} to {pressure_text(p.pressures[-1])}, "
+             f"{len(p.pressures)} values.",
              "", f"Charged area: {s['charged_area_definition']}; the repulsive area (P > 0) is given beside it.", "",
              "## How converged", "", "| number | change between the last two grids |", "|---|---|"]
     lines += [f"| {k} | {_pct(v)} |" for k, v in result.convergence.items()]

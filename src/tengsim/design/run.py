@@ -280,7 +280,8 @@ def run_design(plan, progress=None) -> DesignResult:
         path = PathSpec(D_MIN, d_max, D_STEP, adaptive=True)
         res = resolve_contact(cplan.shape, cplan.tabor, path, dx=dx, law=cplan.law, boundary=cplan.boundary,
                               resolve_tol=plan.tol, max_pixels=max_pixels, observe=_observer(plan),
-                              progress=progress if callable(progress) else None, symmetry=cplan.symmetry, solver=cplan.solver, tol=cplan.tol,
+                              progress=progress if callable(progress) else None, symmetry=cplan.symmetry,
+                              solver=cplan.solver, tol=cplan.tol,
                               extra_params=cplan.extra, scaling=cplan.scaling, kernel_params=cplan.kernel_params)
         ok, D_hit, top, slope = _reach(res, plan.pressures[-1])
         if ok:

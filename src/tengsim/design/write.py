@@ -2,7 +2,8 @@
 
 design.nc (CF-1.10, SI): coordinates ``pressure`` (Pa, the pressures asked for, increasing; along the dimension
 ``applied_pressure``, :data:`PRESSURE_DIM`) and ``branch`` (approach, retraction); ``charged_area_fraction``,
-``repulsive_area_fraction`` (1), ``voc_eq12``, ``voc_eq17`` (V), ``dvoc_dp`` (V Pa-1) on (branch, pressure), NaN where a branch does not reach a pressure; global attributes
+``repulsive_area_fraction`` (1), ``voc_eq12``, ``voc_eq17`` (V), ``dvoc_dp`` (V Pa-1) on (branch, pressure), NaN
+where a branch does not reach a pressure; global attributes
 Conventions, title, shape, shape_params (JSON), E_star_Pa, W_J_m2, eps_m, tabor, sigma_C_m2, eps_r, thickness_m,
 gap_m, status, grids, tolerance, charged_area_definition, and the per-design numbers (:mod:`tengsim.design.curves`).
 ``tengsim.device.area_table_from_design`` reads it.
