@@ -156,3 +156,11 @@ def test_help_per_shape_is_short(capsys):
     assert len(text.splitlines()) <= 100 and "--slope" in text and "--base" not in text and "--eps" in text
     assert main(["design", "--help"]) == 0
     assert "tengsim design SHAPE --help" in capsys.readouterr().out
+
+
+def test_refinement_message_in_the_users_units():
+    from tengsim.design.curves import physical_message
+
+    msg = physical_message("stopped by max_pixels = 9 at dx = 0.1 (3×3; next 5×5); A_S_app_5000Pa changed 2% between "
+                           "the last two grids, dx ≈ 0.05 needed", 200e-9)
+    assert "dx = 20 nm" in msg and "dx ≈ 10 nm" in msg and "A/S at 5 kPa (approach)" in msg

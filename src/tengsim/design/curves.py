@@ -157,7 +157,8 @@ def summarize(res, plan) -> tuple[dict, dict, list]:
     curves = branch_curves(res, plan)
     app, ret = curves["approach"], curves["retraction"]
     st = states(res, plan)["approach"]
-    notes = [str(res.params["resolve_message"])] if res.params.get("resolve_message") else []
+    notes = [physical_message(str(res.params["resolve_message"]), sc.lateral)] if res.params.get("resolve_message") \
+        else []
     jin = next((j for j in res.jumps if j.kind == "jump-in"), None)
     full = _full_fraction(res, plan)
     full_P = math.nan
@@ -191,6 +192,21 @@ def summarize(res, plan) -> tuple[dict, dict, list]:
     }
     conv = convergence(res)
     return summary, conv, notes
+
+
+def physical_message(text: str, lateral: float) -> str:
+    """The refinement's message in the user's units: dx values (X units) as lengths, A/S observables named."""
+    import re
+
+    from tengsim.design.units import length_text
+
+    def dx(m):
+        return f"dx {m.group(1)} {length_text(float(m.group(2)) * lateral)}"
+
+    text = re.sub(r"dx (=|≈|below) ([0-9.]+(?:e[-+]?[0-9]+)?)", dx, text)
+    return re.sub(r"A_S_(app|ret)_([0-9p.e+]+)Pa",
+                  lambda m: f"A/S at {float(m.group(2).replace('p', '.')) / 1e3:g} kPa "
+                            f"({'approach' if m.group(1) == 'app' else 'retraction'})", text)
 
 
 def convergence(res) -> dict:
