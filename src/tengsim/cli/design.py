@@ -1,0 +1,217 @@
+r"""``tengsim design``: a designer's question in one command (thin shell over :mod:`tengsim.design`).
+
+Examples::
+
+    tengsim design pyramid --pitch 10um --base 5um --height 3.5um --E-star 1MPa --W 50mJ/m2 --eps 100nm \
+        --p-max 100kPa --p-step 5kPa --out d1/
+    tengsim design d1.toml --out d1/                  # the same keys in a TOML file ([design] or top level)
+    tengsim design a.toml b.toml --out cmp/           # each in cmp/NAME/, plus cmp/compare.csv and compare.png
+"""
+from __future__ import annotations
+
+import os
+import re
+import sys
+from pathlib import Path
+
+from tengsim.errors import TengsimError
+
+SUMMARY = "your own design: charged area, V_OC and pull-off against pressure, in physical units"  # its line in `tengsim --help`
+
+
+def _keys() -> dict:
+    """{key: help} of every option: the design's own keys, then every shape's physical [contact] keys that a
+    design leaves to the user (from the registry and the schema)."""
+    from tengsim.config import contact_table
+    from tengsim.design.plan import CONTROLLED, design_fields
+    from tengsim.registry import SHAPES
+
+    out = {f.name: f.help for f in design_fields()}
+    for s in SHAPES.names():
+        for k, f in contact_table(s, "physical").fields.items():
+            if k in CONTROLLED or k in out or k == "shape":
+                continue
+            out[k] = f.help or k
+    return out
+
+
+DESCRIPTION = (
+    "One design (a registered shape with its sizes, E*, W and the interaction range eps, and the pressures) or "
+    "several TOML files: the charged area A/S, V_OC (Eq. 12; Eq. 17 at the rest gap) and dV_OC/dP per pressure "
+    "on approach and retraction, and the jump-in, pull-off, full-contact pressure, linear range and hysteresis; "
+    "the grid is chosen and refined until the numbers converge to --tol. Writes OUT/design.nc, design.csv, "
+    "design.png, maps.png, report.md (several designs: OUT/NAME/..., OUT/compare.csv, compare.png).")
+USAGE = "tengsim design SHAPE --KEY VALUE ... --out DIR  |  tengsim design FILE.toml [FILE.toml ...] --out DIR"
+
+
+def register(sub):
+    p = sub.add_parser("design", allow_abbrev=False, add_help=False, usage=USAGE, description=DESCRIPTION,
+                       help="a micro-structure's A/S, V_OC and sensitivity against pressure, converged, in "
+                       "physical units")
+    p.add_argument("inputs", nargs="*", metavar="SHAPE|FILE.toml")
+    p.add_argument("-h", "--help", action="store_true", dest="help")
+    for k, h in _keys().items():
+        p.add_argument("--" + k.replace("_", "-"), dest=k, help=str(h).replace("%", "%%"))
+    p.add_argument("--out", help="output folder (created; several designs: one subfolder each)")
+    p.add_argument("--quiet", action="store_true", help="no progress lines")
+    p.set_defaults(func=run)
+
+
+def help_text(shape: str | None = None) -> str:
+    """The command's help: the design's keys, the material, then the keys of ``shape`` (all shapes' names if
+    None) and the contact options a design leaves to the user."""
+    import textwrap
+
+    from tengsim.config import common_fields, contact_table, law_key_help, law_keys
+    from tengsim.design.plan import CONTROLLED, design_fields
+    from tengsim.registry import SHAPES
+
+    def line(k, h):
+        flag = "--" + k.replace("_", "-")
+        return textwrap.fill(f"{h}", width=110, initial_indent=f"  {flag:<24}", subsequent_indent=" " * 26)
+
+    out = [f"usage: {USAGE}", "", textwrap.fill(DESCRIPTION, 110), "",
+           "the design (pressures with a unit, e.g. 100kPa; a bare number is SI):"]
+    out += [line(f.name, f.help) for f in design_fields()]
+    own = {f.name for f in design_fields()}
+    common = {f.name: f for f in common_fields()}
+    laws = law_keys()
+    out += ["", "the material (required: E_star, W, eps):"]
+    out += [line(k, common[k].help) for k in ("E_star", "W", "eps")]
+    if shape is None:
+        out += ["", f"the shape: one of {', '.join(SHAPES.names())}; its keys: tengsim design SHAPE --help"]
+    else:
+        name = SHAPES.canonical(shape)
+        table = contact_table(name, "physical").fields
+        mine = [k for k in table if k not in common and k not in laws and k not in CONTROLLED and k not in own]
+        out += ["", f"the shape {name}:"] + [line(k, table[k].help) for k in mine]
+    rest = [k for k in common if k not in CONTROLLED and k not in own and k not in ("E_star", "W", "eps", "shape")
+            and not k.startswith("roughness_")]
+    out += ["", "contact options (defaults as tengsim contact):"] + [line(k, common[k].help) for k in rest]
+    out += ["", "keys of the law (plain numbers in units of W and ε):"]
+    out += [line(k, law_key_help(v)) for k, v in laws.items()]
+    out += ["  --roughness-*            a roughness on the shape (keys as tengsim contact)",
+            "  --out DIR                output folder (required; not created on bad input)",
+            "  --quiet                  no progress lines"]
+    return "\n".join(out) + "\n"
+
+
+def _read_toml(path: str) -> dict:
+    try:
+        import tomllib
+    except ModuleNotFoundError:  # Python < 3.11
+        import tomli as tomllib
+    f = Path(path)
+    if not f.is_file():
+        raise TengsimError(f"{path}: no such file (give a registered shape or a TOML file)")
+    try:
+        data = tomllib.loads(f.read_text())
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        raise TengsimError(f"{path}: not a TOML file: {exc}") from None
+    return dict(data.get("design", data))
+
+
+def _tables(args) -> list:
+    """[(label, table)] of the designs the command line names."""
+    from tengsim.registry import SHAPES
+
+    opts = {k: getattr(args, k) for k in _keys() if getattr(args, k, None) not in (None, "")}
+    names = [s.lower() for s in SHAPES.names()]
+    first = args.inputs[0]
+    if not first.lower().endswith(".toml"):
+        if first.lower() not in names:
+            raise TengsimError(f"unknown shape {first!r} (shapes: {', '.join(SHAPES.names())}; or give TOML files)")
+        if len(args.inputs) > 1:
+            raise TengsimError(f"give one shape with its options, or TOML files: got {' '.join(args.inputs)}")
+        return [("", {"shape": first, **opts})]
+    bad = [x for x in args.inputs if not x.lower().endswith(".toml")]
+    if bad:
+        raise TengsimError(f"{bad[0]}: several inputs must all be TOML files")
+    return [(f"{x}: ", {**_read_toml(x), **opts}) for x in args.inputs]
+
+
+def _check_out(out: Path) -> None:
+    """Refuse an output folder that could not be written, without creating anything."""
+    if out.exists() and not out.is_dir():
+        raise TengsimError(f"--out {out}: exists and is not a folder")
+    parent = out
+    while not parent.exists():
+        parent = parent.parent
+    if not os.access(parent, os.W_OK):
+        raise TengsimError(f"--out {out}: {parent} is not writable")
+
+
+def _slug(name: str, taken: set) -> str:
+    s = re.sub(r"[^A-Za-z0-9._-]+", "_", name).strip("_") or "design"
+    base, i = s, 2
+    while s in taken:
+        s, i = f"{base}_{i}", i + 1
+    taken.add(s)
+    return s
+
+
+class _Say:
+    """Progress that also prints whole lines (the grids, memory and time before a run starts)."""
+
+    def __init__(self, quiet: bool):
+        from tengsim.progress import Progress
+
+        self.bar, self.quiet = Progress(quiet), quiet
+
+    def __call__(self, *a):
+        return self.bar(*a)
+
+    def monitor(self, *a, **k):
+        return self.bar.monitor(*a, **k)
+
+    def say(self, text):
+        if not self.quiet:
+            self.bar.close()
+            print(f"tengsim: {text}", file=sys.stderr)
+
+    def close(self):
+        self.bar.close()
+
+
+def run(args) -> int:
+    from tengsim.design import plan_design, run_design, write_comparison, write_design
+    from tengsim.registry import SHAPES
+
+    if args.help:
+        first = args.inputs[0] if args.inputs else None
+        print(help_text(first if first and first.lower() in [n.lower() for n in SHAPES.names()] else None), end="")
+        return 0
+    if not args.inputs:
+        raise TengsimError("give a shape with its keys, or TOML files (tengsim design --help)")
+    if not args.out:
+        raise TengsimError("--out DIR is required (the folder the design's files go to)")
+    tables = _tables(args)
+    plans = [plan_design(t, where) for where, t in tables]  # every design checked before anything runs
+    out = Path(args.out)
+    _check_out(out)
+    say = _Say(args.quiet)
+    results = []
+    try:
+        for plan in plans:
+            results.append(run_design(plan, progress=say))
+    finally:
+        say.close()
+    if len(results) == 1:
+        paths = write_design(results[0], out)
+    else:
+        taken, paths = set(), []
+        for r in results:
+            paths += write_design(r, out / _slug(r.plan.name, taken))
+        paths += write_comparison(results, out)
+    if not args.quiet:
+        for r in results:
+            s = r.summary
+            print(f"tengsim: {r.plan.name}: status {s['status']}, Tabor {s['tabor']:.3g}, grids {s['grids']}, "
+                  f"A/S at p_max {s['area_at_p_max']:.4g}, V_OC {s['voc_eq12_at_p_max_V']:.4g} V (Eq. 12), "
+                  f"{s['seconds']:.0f} s", file=sys.stderr)
+        print(f"tengsim: wrote {len(paths)} files in {out} (report: {out / 'report.md' if len(results) == 1 else out})",
+              file=sys.stderr)
+    for r in results:
+        if r.status != "ok":
+            print(f"tengsim: warning: {r.plan.name}: status {r.status} (see its report.md)", file=sys.stderr)
+    return 0

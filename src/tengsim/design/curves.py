@@ -1,0 +1,222 @@
+"""From a contact result to a design's numbers: per asked pressure on each branch, and per design.
+
+**Load-controlled branches.**  A pressed device passes, on the approach, the states whose load is above every
+earlier load (:func:`tengsim.study.observe.load_control`, the zero-load state interpolated in first); on the
+retraction, the states whose load is below every earlier one.  Each asked pressure takes the value linearly
+interpolated in pressure between the two states around it on that branch; NaN outside the pressures a branch
+reaches.  At a snap (the load drops while D grows) the branch keeps the first state reached at a pressure.
+
+**Charged area A/S** (the area that makes the charge, Eq. 12): the area inside the contact boundary, from
+Greenwood's contact length Λc (the tensile-peak length along X through the apex, :mod:`tengsim.observers`) by
+the shape of the patch (:func:`tengsim.study.observe.area_fraction`): a square patch (pyramid, cube) Λc²,
+a round patch (cone, hemisphere, sphere, flat punch) the disc π/4 Λc², a ridge (line, sinusoid) the strip
+Λc × L, over the cell area.  The repulsive area (pixels with P > 0) is reported beside it.
+
+**Per design** (:func:`summarize`): jump-in pressure (the nominal pressure on the approach just before it
+first jumps into contact; negative: tensile), pull-off (the most tensile load of the retraction, in N per cell
+and Pa), full-contact pressure (the lowest approach pressure at which A/S reaches 95 % of its full-contact
+value, the footprint's), sensitivity and linear range (V_OC of Eq. 12 on the approach: least-squares line over
+[p_min, fit_max]; the linear range is the highest asked pressure up to which V_OC stays within 10 % of that
+line's value, or of its rise over [p_min, fit_max] where that is larger), hysteresis (the energy lost per cycle
+∮F dD per unit nominal area, J/m², and the largest difference of
+A/S between retraction and approach at an asked pressure).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+LINEAR_TOLERANCE = 0.1
+FULL_CONTACT_FRACTION = 0.95
+
+DEFINITIONS = {
+    "square": "A/S = Λc²/S: the square patch of side Λc, Greenwood's contact length (the tensile-peak length "
+              "along X through the apex), over the cell area S",
+    "disc": "A/S = (π/4)Λc²/S: the disc of diameter Λc, Greenwood's contact length (the tensile-peak length "
+            "along X through the apex), over the cell area S",
+    "line": "A/S = Λc/L: the strip of width Λc, Greenwood's contact length (the tensile-peak length across the "
+            "ridge), over the cell width L",
+}
+
+
+def _params(res, plan) -> dict:
+    return {**res.params, "config": {"shape": plan.shape}}
+
+
+def definition(res, plan) -> str:
+    from tengsim.study.observe import family
+
+    return DEFINITIONS[family(_params(res, plan))]
+
+
+def _retraction_states(res, cols):
+    """Retraction states under decreasing load (each F below every earlier F), as arrays in increasing F."""
+    r = res.branch("retraction")
+    F = np.asarray(r["F"], float)
+    keep, best = [], math.inf
+    for i, f in enumerate(F):
+        if f < best:
+            keep.append(i)
+            best = f
+    keep = keep[::-1]
+    return F[keep], [np.asarray(r[c], float)[keep] for c in cols]
+
+
+def _at(P, y, ps):
+    P, y = np.asarray(P, float), np.asarray(y, float)
+    out = np.full(len(ps), np.nan)
+    if len(P) < 2:
+        return out
+    ps = np.asarray(ps, float)
+    inside = (ps >= P[0]) & (ps <= P[-1])
+    out[inside] = np.interp(ps[inside], P, y)
+    return out
+
+
+def states(res, plan) -> dict:
+    """{'approach'|'retraction': {'P' (Pa, increasing), 'area' (A/S), 'repulsive' (fraction)}} of the
+    load-controlled states (module doc)."""
+    from tengsim.study.observe import area_fraction, load_control
+
+    sc = res.scaling
+    k_p = sc.pressure(1.0)
+    cell = sc.cell_area
+    p = _params(res, plan)
+    F, L = load_control(res)
+    _, R = load_control(res, "area_repulsive")
+    out = {"approach": {"P": k_p * F, "area": area_fraction(res, L, p), "repulsive": R * sc.lateral**2 / cell}}
+    Fr, (Lr, Rr) = _retraction_states(res, ("contact_length", "area_repulsive"))
+    out["retraction"] = {"P": k_p * Fr, "area": area_fraction(res, Lr, p), "repulsive": Rr * sc.lateral**2 / cell}
+    return out
+
+
+def branch_curves(res, plan) -> dict:
+    """Per branch, at the asked pressures: 'area' (A/S), 'repulsive', 'voc_eq12', 'voc_eq17' (V), 'dvoc_dp' (V/Pa)."""
+    from tengsim.device.formulas import voc_apart, voc_polymer
+
+    ps = np.asarray(plan.pressures, float)
+    out = {}
+    for b, s in states(res, plan).items():
+        A = np.clip(_at(s["P"], s["area"], ps), 0.0, 1.0)
+        A = np.where(np.isfinite(_at(s["P"], s["area"], ps)), A, np.nan)
+        V12 = voc_polymer(A, plan.sigma, plan.eps_r, plan.T)
+        V17 = voc_apart(plan.sigma, A, plan.gap, 1.0)
+        dV = np.full(len(ps), np.nan)
+        ok = np.flatnonzero(np.isfinite(V12))
+        if len(ok) >= 2:
+            dV[ok] = np.gradient(V12[ok], ps[ok])
+        out[b] = {"area": A, "repulsive": _at(s["P"], s["repulsive"], ps), "voc_eq12": V12, "voc_eq17": V17,
+                  "dvoc_dp": dV}
+    return out
+
+
+def _full_fraction(res, plan) -> float:
+    from tengsim.study.observe import area_fraction, full_length
+
+    full = full_length(_params(res, plan))
+    if not math.isfinite(full):
+        return math.nan
+    return float(area_fraction(res, [full], _params(res, plan))[0])
+
+
+def _linear(ps, V, fit_max):
+    """(slope V/Pa, linear range Pa) of V_OC(P) on the approach (module doc)."""
+    ps, V = np.asarray(ps, float), np.asarray(V, float)
+    ok = np.isfinite(V)
+    fit = ok & (ps <= fit_max * (1 + 1e-12))
+    if np.count_nonzero(fit) < 2:
+        return math.nan, math.nan
+    slope, icpt = np.polyfit(ps[fit], V[fit], 1)
+    line = icpt + slope * ps
+    rise = abs(slope) * (fit_max - ps[0])  # near P = 0 the line's own value is no scale: its rise over the fit
+    last = math.nan
+    for p, v, y, good in zip(ps, V, line, ok):
+        if not good or abs(v - y) > LINEAR_TOLERANCE * max(abs(y), rise, 1e-12):
+            break
+        last = float(p)
+    return float(slope), last
+
+
+def _grids_text(res) -> str:
+    from tengsim.design.units import length_text
+
+    lat = res.scaling.lateral
+    tab = res.params.get("resolution") or {}
+    if not tab:
+        return f"{res.grid.nx}×{res.grid.ny} (dx {length_text(res.grid.dx * lat)})"
+    return ", ".join(f"{nx}×{ny} (dx {length_text(dx * lat)})" for nx, ny, dx in zip(tab["nx"], tab["ny"], tab["dx"]))
+
+
+def summarize(res, plan) -> tuple[dict, dict, list]:
+    """(summary {name: value}, convergence {number: relative change between the last two grids}, notes)."""
+    from tengsim.design.units import pressure_text
+
+    sc = res.scaling
+    k_p = sc.pressure(1.0)
+    curves = branch_curves(res, plan)
+    app, ret = curves["approach"], curves["retraction"]
+    st = states(res, plan)["approach"]
+    notes = [physical_message(str(res.params["resolve_message"]), sc.lateral)] if res.params.get("resolve_message") \
+        else []
+    jin = next((j for j in res.jumps if j.kind == "jump-in"), None)
+    full = _full_fraction(res, plan)
+    full_P = math.nan
+    if math.isfinite(full):
+        hit = np.flatnonzero(st["area"] >= FULL_CONTACT_FRACTION * full)
+        if len(hit):
+            full_P = float(st["P"][hit[0]])
+        else:
+            notes.append(f"full contact (A/S >= {FULL_CONTACT_FRACTION:g} × {full:.3g}) is not reached by "
+                         f"{pressure_text(plan.pressures[-1])}")
+    slope, lin = _linear(plan.pressures, app["voc_eq12"], plan.fit_max)
+    diff = ret["area"] - app["area"]
+    summary = {
+        "status": res.status,
+        "tabor": sc.mu,
+        "jump_in_Pa": k_p * jin.F_before if jin else math.nan,
+        "pull_off_N": sc.force(res.pull_off_force),
+        "pull_off_Pa": k_p * res.pull_off_force,
+        "full_contact_Pa": full_P,
+        "sensitivity_V_per_Pa": slope,
+        "linear_range_Pa": lin,
+        "hysteresis_J_m2": sc.work(res.hysteresis) / sc.cell_area,
+        "area_hysteresis": float(np.nanmax(np.abs(diff))) if np.any(np.isfinite(diff)) else math.nan,
+        "area_at_p_max": float(app["area"][-1]),
+        "voc_eq12_at_p_max_V": float(app["voc_eq12"][-1]),
+        "voc_eq17_at_p_max_V": float(app["voc_eq17"][-1]),
+        "grids": _grids_text(res),
+        "tolerance": plan.tol,
+        "charged_area_definition": definition(res, plan),
+        "seconds": float(res.params.get("resolve_seconds", res.seconds)),
+    }
+    conv = convergence(res)
+    return summary, conv, notes
+
+
+def physical_message(text: str, lateral: float) -> str:
+    """The refinement's message in the user's units: dx values (X units) as lengths, A/S observables named."""
+    import re
+
+    from tengsim.design.units import length_text
+
+    def dx(m):
+        return f"dx {m.group(1)} {length_text(float(m.group(2)) * lateral)}"
+
+    text = re.sub(r"dx (=|≈|below) ([0-9.]+(?:e[-+]?[0-9]+)?)", dx, text)
+    return re.sub(r"A_S_(app|ret)_([0-9p.e+]+)Pa",
+                  lambda m: f"A/S at {float(m.group(2).replace('p', '.')) / 1e3:g} kPa "
+                            f"({'approach' if m.group(1) == 'app' else 'retraction'})", text)
+
+
+def convergence(res) -> dict:
+    """{number: relative change between the last two grids} of the refined numbers: A/S on the approach (the
+    largest over the asked pressures), pull-off force, jump-in and jump-out D; NaN with one grid."""
+    rich = res.params.get("richardson") or {}
+    out = {}
+    areas = [r.get("change", math.nan) for n, r in rich.items() if n.startswith("A_S_app")]
+    areas = [a for a in areas if math.isfinite(a)]
+    out["charged area A/S (largest over the pressures)"] = max(areas) if areas else math.nan
+    for key, label in (("pull_off_F", "pull-off force"), ("jump_in_D", "jump-in D"), ("jump_out_D", "jump-out D")):
+        out[label] = float(rich.get(key, {}).get("change", math.nan))
+    return out

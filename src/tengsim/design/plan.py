@@ -1,0 +1,222 @@
+"""A design: one micro-structure and its materials in physical units, and the pressures asked for.
+
+:func:`plan_design` turns a [design] table (CLI options or a TOML file) into a frozen :class:`DesignPlan`.
+The table holds
+
+* the shape and its physical keys, ``E_star``, ``W``, ``eps`` (the interaction range: the material input;
+  the Tabor number is derived per shape) and the contact options a design leaves to the user (law and its
+  keys, boundary, film, solver, symmetry, roughness): the [contact] schema's own keys, checked by
+  :func:`tengsim.config.plan_contact` (nothing is retyped here);
+* the design's own keys (:func:`design_fields`): the pressures (``p_min``, ``p_max``, ``p_step``), the device
+  inputs of Eq. (12) and Eq. (17) (σ, ε_r, T, rest gap d0: the paper's values by default), the grid (``dx``
+  a length, ``max_pixels``), the convergence tolerance ``tol``, the time budget and the linear-range fit.
+
+The path (D range, steps) is not the user's: :mod:`tengsim.design.run` extends it until ``p_max`` is
+reached.
+"""
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field
+
+from tengsim.errors import ConfigValueError, TengsimError
+
+PAPER_DEVICE = {"sigma": 5.84e-6, "eps_r": 2.40, "T": 400e-6, "gap": 0.1e-3}
+"""The paper's device (Section 5, Fig. 8): σ = 5.84 µC/m², ε_r = 2.40, T = 400 µm, rest gap d0 = 0.1 mm."""
+
+CONTROLLED = ("tabor", "dx", "d_min", "d_max", "d_step", "refine_levels", "maps_at", "control", "f_min", "f_max",
+              "f_step", "adaptive", "adapt_tol", "resolve", "resolve_tol", "max_pixels", "resolve_pressures",
+              "out", "plot", "tol", "observers")
+"""[contact] keys a design sets itself (the path, the grid, the refinement) or names otherwise (tol, dx)."""
+
+
+def design_fields() -> list:
+    """The design's own keys (besides the [contact] keys of its shape)."""
+    from tengsim.schema import Field
+
+    return [
+        Field("name", "str", None, help="label of the design in tables and figures (default: the shape and "
+              "its sizes)"),
+        Field("p_min", default=0.0, dim="pressure", help="lowest nominal pressure asked for (default 0 Pa)"),
+        Field("p_max", default=None, dim="pressure", help="highest nominal pressure asked for, e.g. '100kPa' "
+              "(required)"),
+        Field("p_step", default=None, dim="pressure", help="pressure step, e.g. '5kPa' (default (p_max - "
+              "p_min)/20)"),
+        Field("sigma", default=PAPER_DEVICE["sigma"], dim="charge/area",
+              help="tribo-charge density σ (default the paper's 5.84 µC/m2)"),
+        Field("eps_r", default=PAPER_DEVICE["eps_r"], help="relative permittivity ε_r of the polymer (default "
+              "the paper's 2.40)"),
+        Field("T", default=PAPER_DEVICE["T"], dim="length", help="polymer thickness T of Eq. (12) (default the "
+              "paper's 400 µm)"),
+        Field("gap", default=PAPER_DEVICE["gap"], dim="length",
+              help="the device's rest gap d0 for Eq. (17) (default the paper's 0.1 mm)"),
+        Field("tol", default=0.01, help="relative tolerance the reported numbers are converged to (default "
+              "0.01 = 1 %)"),
+        Field("dx", default=None, dim="length", help="first grid spacing, a length such as '50nm' (default: "
+              "from the shape's features and the law's process zone)"),
+        Field("max_pixels", "int", None, help="largest grid nx·ny the refinement may use"),
+        Field("budget", default=600.0, dim="time", help="largest estimated run time before it is refused, "
+              "in seconds or with a unit, e.g. 600 or '600s' (default 600 s)"),
+        Field("maps", "bool", True, help="keep contact pressure maps near 10 %, 50 % and 100 % of p_max (the "
+              "finest grid's approach walked again: about half its time); false: none"),
+        Field("fit_max", default=None, dim="pressure", help="top of the low-pressure range of the linear fit "
+              "of V_OC(P) (default p_min + (p_max - p_min)/10)"),
+    ]
+
+
+@dataclass(frozen=True)
+class DesignPlan:
+    """A validated design (SI throughout); ``contact_table`` is the [contact] table handed to
+    :func:`tengsim.config.plan_contact` (the shape's physical keys, E_star, W, eps and contact options)."""
+
+    name: str
+    shape: str
+    contact_table: dict
+    shape_params: dict
+    pressures: tuple
+    sigma: float
+    eps_r: float
+    T: float
+    gap: float
+    tol: float
+    dx: float | None
+    max_pixels: int | None
+    budget_s: float
+    fit_max: float
+    E_star: float
+    W: float
+    eps: float
+    tabor: float
+    maps: bool = True
+    extra: dict = field(default_factory=dict)
+
+    def shape_params_json(self) -> str:
+        return json.dumps(self.shape_params, sort_keys=True)
+
+    def shape_text(self) -> str:
+        """'pitch 10 µm, base 5 µm, height 3.5 µm' (lengths in their unit, other numbers plain)."""
+        from tengsim.design.units import length_text, pressure_text
+
+        out = []
+        for k, v in self.shape_params.items():
+            if k.endswith("_m"):
+                out.append(f"{k[:-2]} {length_text(v)}")
+            elif k.endswith("_Pa"):
+                out.append(f"{k[:-3]} {pressure_text(v)}")
+            else:
+                out.append(f"{k} {v:g}" if isinstance(v, float) else f"{k} {v}")
+        return ", ".join(out)
+
+
+def _own(table: dict) -> dict:
+    from tengsim.schema import Table
+
+    t = Table("design", design_fields())
+    raw = {k: v for k, v in table.items() if k in t.fields and v not in (None, "")}
+    return t.parse(raw, where="")
+
+
+_SUFFIX = {"length": "_m", "pressure": "_Pa", "energy/area": "_J_m2"}
+
+
+def _shape_params(shape: str, extra: dict) -> dict:
+    """The shape's physical parameters as the run records them, SI with the unit in the name (pitch_m, slope)."""
+    from tengsim.plugins import SHAPES
+    from tengsim.shapes.base import physical_fields
+
+    out = {}
+    for f in physical_fields(SHAPES.get(shape)):
+        key = f.name + _SUFFIX.get(f.dim, "")
+        raw = extra.get(f.name + _SUFFIX.get(f.dim, "_input"))
+        if raw is not None:
+            out[key] = raw
+    return out
+
+
+def plan_design(table: dict, where: str = "") -> DesignPlan:
+    """Validate a [design] table and build its :class:`DesignPlan` (no solving).  A bad value raises one
+    :class:`tengsim.errors.TengsimError` line naming it in the user's units."""
+    from tengsim.config import contact_table, plan_contact
+    from tengsim.plugins import SHAPES
+
+    if not isinstance(table, dict):
+        raise TengsimError(f"{where}a design must be a table of keys, got {table!r}")
+    shape = table.get("shape")
+    if shape in (None, ""):
+        raise ConfigValueError(f"{where}give the shape (one of {', '.join(SHAPES.names())})")
+    if not isinstance(shape, str) or shape.strip().lower() not in [s.lower() for s in SHAPES.names()]:
+        raise ConfigValueError(f"{where}unknown shape {shape!r} (shapes: {', '.join(SHAPES.names())})")
+    shape = SHAPES.canonical(shape)
+    own_names = {f.name for f in design_fields()}
+    contact_keys = set(contact_table(shape, "physical").keys())
+    refused = sorted(k for k in table if k in CONTROLLED and k not in own_names and table[k] not in (None, ""))
+    if "tabor" in refused:
+        raise ConfigValueError(f"{where}a design takes eps (the interaction range, a length such as '50nm'), "
+                               "not tabor: the Tabor number is derived for each shape and printed")
+    if refused:
+        raise ConfigValueError(f"{where}{', '.join(refused)}: set by the design itself (the path extends until "
+                               "p_max is reached; the grid is refined to tol)")
+    unknown = sorted(k for k in table if k not in own_names and k not in contact_keys)
+    if unknown:
+        raise ConfigValueError(f"{where}shape {shape} has no key {', '.join(map(repr, unknown))} (design keys: "
+                               f"{', '.join(sorted(own_names))}; [contact] keys of {shape}: "
+                               f"{', '.join(k for k in sorted(contact_keys) if k not in CONTROLLED)})")
+    if table.get("eps") in (None, ""):
+        raise ConfigValueError(f"{where}eps is missing: give the interaction range ε of the law, a length such as "
+                               "'50nm' (docs/design.md, 'Choosing ε')")
+    own = _own(table)
+    cfg = {k: v for k, v in table.items() if k in contact_keys and k not in own_names and v not in (None, "")}
+    cfg["shape"] = shape
+    try:
+        plan = plan_contact(cfg)
+    except TengsimError as exc:
+        raise type(exc)(f"{where}{exc}") from None
+    if plan.scaling is None:
+        raise ConfigValueError(f"{where}a design is physical: give the sizes of {shape} with units and E_star, W")
+    pressures = _pressures(own, where)
+    for k in ("sigma", "eps_r", "T", "gap"):
+        if not own[k] > 0:
+            raise ConfigValueError(f"{where}{k} must be > 0, got {table.get(k)!r}")
+    tol = own["tol"]
+    if not 0 < tol < 0.5:
+        raise ConfigValueError(f"{where}tol must be a fraction > 0 and < 0.5 (0.01 = 1 %), got {table.get('tol')!r}")
+    if own["dx"] is not None and not own["dx"] > 0:
+        raise ConfigValueError(f"{where}dx must be a length > 0, got {table.get('dx')!r}")
+    if own["max_pixels"] is not None and own["max_pixels"] < 9:
+        raise ConfigValueError(f"{where}max_pixels must be >= 9, got {table.get('max_pixels')!r}")
+    if not own["budget"] > 0:
+        raise ConfigValueError(f"{where}budget must be a time > 0, got {table.get('budget')!r}")
+    lo, hi = pressures[0], pressures[-1]
+    fit_max = own["fit_max"] if own["fit_max"] is not None else lo + (hi - lo) / 10
+    if not lo < fit_max <= hi:
+        raise ConfigValueError(f"{where}fit_max must lie above p_min and at most p_max, got {table.get('fit_max')!r}")
+    sp = _shape_params(shape, plan.extra)
+    sc = plan.scaling
+    draft = DesignPlan("", shape, {}, sp, (), 0, 0, 0, 0, 0, None, None, 0, 0, 0, 0, 0, 0)
+    name = own["name"] or f"{shape} {draft.shape_text()}"
+    return DesignPlan(name=name, shape=shape, contact_table=cfg, shape_params=sp, pressures=pressures,
+                      sigma=own["sigma"], eps_r=own["eps_r"], T=own["T"], gap=own["gap"], tol=tol, dx=own["dx"],
+                      max_pixels=own["max_pixels"], budget_s=own["budget"], fit_max=fit_max, E_star=sc.E_star,
+                      W=sc.W, eps=sc.eps, tabor=sc.mu, maps=bool(own["maps"]))
+
+
+def _pressures(own: dict, where: str) -> tuple:
+    """The pressures asked for (Pa), increasing: p_min, p_min + p_step, ..., p_max."""
+    lo, hi, step = own["p_min"], own["p_max"], own["p_step"]
+    if hi is None:
+        raise ConfigValueError(f"{where}p_max is missing: give the highest nominal pressure, e.g. '100kPa'")
+    if not hi > 0:
+        raise ConfigValueError(f"{where}p_max must be a pressure > 0, got {hi / 1e3:g} kPa")
+    if not 0 <= lo < hi:
+        raise ConfigValueError(f"{where}p_min must be >= 0 and below p_max = {hi / 1e3:g} kPa, got {lo / 1e3:g} kPa")
+    step = (hi - lo) / 20 if step is None else step
+    if not step > 0:
+        raise ConfigValueError(f"{where}p_step must be a pressure > 0, got {step / 1e3:g} kPa")
+    n = int(math.floor((hi - lo) / step * (1 + 1e-9)))
+    if n > 400:
+        raise ConfigValueError(f"{where}p_step = {step / 1e3:g} kPa gives {n + 1} pressures: at most 401")
+    ps = [lo + i * step for i in range(n + 1)]
+    if hi - ps[-1] > 1e-9 * hi:
+        ps.append(hi)
+    return tuple(float(p) for p in ps)

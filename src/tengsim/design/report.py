@@ -1,0 +1,71 @@
+"""DIR/report.md: a design's status, grids, tolerance, how converged each number is, its numbers and figures."""
+from __future__ import annotations
+
+import math
+
+from tengsim.design.units import length_text, pressure_text
+
+ROWS = (
+    ("jump_in_Pa", "jump-in pressure (approach, just before the first jump into contact; < 0 tensile)", "kPa"),
+    ("pull_off_N", "pull-off force per cell (most tensile load on the retraction)", "N"),
+    ("pull_off_Pa", "pull-off pressure", "kPa"),
+    ("full_contact_Pa", "full-contact pressure (A/S reaches 95 % of the footprint's)", "kPa"),
+    ("sensitivity_V_per_Pa", "sensitivity dV_OC/dP (Eq. 12, least-squares line over [p_min, fit_max])", "V/kPa"),
+    ("linear_range_Pa", "linear range (V_OC within 10 % of that line, or of its rise over the fit range, up to)",
+     "kPa"),
+    ("hysteresis_J_m2", "hysteresis: energy lost per cycle per unit nominal area (∮F dD)", "J/m²"),
+    ("area_hysteresis", "hysteresis: largest |A/S retraction − A/S approach| at an asked pressure", ""),
+    ("area_at_p_max", "charged area A/S at p_max (approach)", ""),
+    ("voc_eq12_at_p_max_V", "V_OC at p_max, Eq. 12 (polymer)", "V"),
+    ("voc_eq17_at_p_max_V", "V_OC at p_max, Eq. 17 (rest gap)", "V"),
+)
+
+
+def value_text(v, unit: str) -> str:
+    if v is None or not math.isfinite(float(v)):
+        return "n/a"
+    v = float(v)
+    if unit == "kPa":
+        return f"{v / 1e3:.4g} kPa"
+    if unit == "V/kPa":
+        return f"{v * 1e3:.4g} V/kPa"
+    return f"{v:.4g} {unit}".strip()
+
+
+def _pct(x) -> str:
+    return "n/a (one grid, or not present on both)" if not math.isfinite(x) else f"{100 * x:.2g} %"
+
+
+def report_text(result, figures) -> str:
+    p, s = result.plan, result.summary
+    lines = [f"# Design: {p.name}", "",
+             f"**Status: {s['status']}**, grids: {s['grids']}; tolerance {100 * p.tol:g} % "
+             f"(the grid is refined by √2 until the numbers below change by at most that between the last two "
+             f"grids); {s['seconds']:.0f} s of solving.", "",
+             f"Shape {p.shape} ({p.shape_text()}); "
+             f"E* = {p.E_star / 1e6:.4g} MPa, W = {p.W * 1e3:.4g} mJ/m², ε = {length_text(p.eps)}, Tabor number "
+             f"μ = {s['tabor']:.3g}.",
+             f"Device (Eq. 12 and Eq. 17): σ = {p.sigma * 1e6:.4g} µC/m², ε_r = {p.eps_r:.4g}, "
+             f"T = {length_text(p.T)}, "
+             f"rest gap d0 = {length_text(p.gap)} (defaults: the paper's 5.84 µC/m², 2.40, 400 µm, 0.1 mm).",
+             f"Pressures: {pressure_text(p.pressures[0])} to {pressure_text(p.pressures[-1])}, "
+             f"{len(p.pressures)} values.",
+             "", f"Charged area: {s['charged_area_definition']}; the repulsive area (P > 0) is given beside it.", "",
+             "## How converged", "", "| number | change between the last two grids |", "|---|---|"]
+    lines += [f"| {k} | {_pct(v)} |" for k, v in result.convergence.items()]
+    tab = result.finest.params.get("resolution") or {}
+    if tab:
+        lat = result.finest.scaling.lateral
+        lines += ["", "| grid | dx | solve time | status |", "|---|---|---|---|"]
+        lines += [f"| {nx}×{ny} | {length_text(dx * lat)} | {sec:.1f} s | {st} |" for nx, ny, dx, sec, st in
+                  zip(tab["nx"], tab["ny"], tab["dx"], tab["seconds"], tab["status"])]
+        lines += ["", f"The finest grid's path: {len(result.finest.table['D'])} equilibria (approach and retraction)."]
+    lines += ["", "The per-design numbers below are read from the finest grid's curves; those from A/S (full "
+              "contact, sensitivity, linear range, V_OC) move as A/S does.", "",
+              "## Numbers", "", "| number | value |", "|---|---|"]
+    lines += [f"| {label} | {value_text(s.get(k), u)} |" for k, label, u in ROWS]
+    if result.notes:
+        lines += ["", "Notes:", *[f"- {n}" for n in result.notes]]
+    lines += ["", "## Figures", ""] + [f"![{f}]({f})" for f in figures]
+    lines += ["", "Files: design.nc (CF-1.10, SI), design.csv (one row per branch and pressure)."]
+    return "\n".join(lines) + "\n"

@@ -1,0 +1,108 @@
+"""A design's files: DIR/design.nc (the contract below), DIR/design.csv, the figures and DIR/report.md.
+
+design.nc (CF-1.10, SI): coordinates ``pressure`` (Pa, the pressures asked for, increasing; along the dimension
+``applied_pressure``, :data:`PRESSURE_DIM`) and ``branch`` (approach, retraction); ``charged_area_fraction``,
+``repulsive_area_fraction`` (1), ``voc_eq12``, ``voc_eq17`` (V), ``dvoc_dp`` (V Pa-1) on (branch, pressure), NaN
+where a branch does not reach a pressure; global attributes
+Conventions, title, shape, shape_params (JSON), E_star_Pa, W_J_m2, eps_m, tabor, sigma_C_m2, eps_r, thickness_m,
+gap_m, status, grids, tolerance, charged_area_definition, and the per-design numbers (:mod:`tengsim.design.curves`).
+``tengsim.device.area_table_from_design`` reads it.
+"""
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+
+BRANCHES = ("approach", "retraction")
+PRESSURE_DIM = "applied_pressure"
+"""The dimension the coordinate ``pressure`` runs along: CF takes a dimension named 'pressure' for air pressure
+(a vertical axis asking for standard_name air_pressure), so it is named as a study.nc names it; select with
+``ds.swap_dims(applied_pressure="pressure").sel(pressure=...)`` or by position."""
+VARIABLES = {
+    "charged_area_fraction": ("1", "charged contact area over cell area (A/S)"),
+    "repulsive_area_fraction": ("1", "repulsive contact area (P > 0) over cell area"),
+    "voc_eq12": ("V", "open-circuit voltage of the polymer, Eq. 12: sigma (A/S) T / (eps_r eps0)"),
+    "voc_eq17": ("V", "open-circuit voltage at the rest gap, Eq. 17: sigma (A/S) d0 / eps0"),
+    "dvoc_dp": ("V Pa-1", "sensitivity dV_OC/dP of voc_eq12"),
+}
+_CURVE = {"charged_area_fraction": "area", "repulsive_area_fraction": "repulsive", "voc_eq12": "voc_eq12",
+          "voc_eq17": "voc_eq17", "dvoc_dp": "dvoc_dp"}
+SUMMARY_UNITS = {"jump_in_Pa": "Pa", "pull_off_N": "N per cell", "pull_off_Pa": "Pa", "full_contact_Pa": "Pa",
+                 "sensitivity_V_per_Pa": "V/Pa", "linear_range_Pa": "Pa", "hysteresis_J_m2": "J/m2",
+                 "area_hysteresis": "1", "area_at_p_max": "1", "voc_eq12_at_p_max_V": "V",
+                 "voc_eq17_at_p_max_V": "V", "tabor": "1", "seconds": "s"}
+
+
+def to_dataset(res, plan, summary: dict):
+    """The design.nc Dataset of a finished design (module doc)."""
+    import xarray as xr
+
+    from tengsim.design.curves import branch_curves
+    from tengsim.io import cf_conventions
+
+    curves = branch_curves(res, plan)
+    P = np.asarray(plan.pressures, float)
+    data = {}
+    for name, (units, long) in VARIABLES.items():
+        arr = np.vstack([curves[b][_CURVE[name]] for b in BRANCHES]).astype(float)
+        data[name] = (("branch", PRESSURE_DIM), arr, {"units": units, "long_name": long})
+    coords = {"pressure": (PRESSURE_DIM, P, {"units": "Pa", "long_name": "nominal pressure"}),
+              "branch": ("branch", np.array(BRANCHES, dtype=object), {"long_name": "path branch"})}
+    ds = xr.Dataset(data, coords=coords)
+    attrs = {
+        "shape": plan.shape, "shape_params": json.dumps(plan.shape_params, sort_keys=True),
+        "design_name": plan.name, "E_star_Pa": plan.E_star, "W_J_m2": plan.W, "eps_m": plan.eps,
+        "tabor": float(summary["tabor"]), "sigma_C_m2": plan.sigma, "eps_r": plan.eps_r, "thickness_m": plan.T,
+        "gap_m": plan.gap, "status": str(summary["status"]), "grids": str(summary["grids"]),
+        "tolerance": float(plan.tol), "charged_area_definition": str(summary["charged_area_definition"]),
+        "contact_config": json.dumps({k: v for k, v in plan.contact_table.items()}, sort_keys=True, default=str),
+    }
+    for k, v in summary.items():
+        if k in SUMMARY_UNITS and k != "tabor":
+            attrs[k] = float(v) if v is not None and math.isfinite(float(v)) else "n/a"
+    ds.attrs = attrs
+    ds["branch"].encoding["dtype"] = "S1"  # a char array: CF's checker cannot judge a string coordinate variable
+    return cf_conventions(ds, f"tengsim design: {plan.name}")
+
+
+def csv_columns(ds) -> dict:
+    """design.csv: one row per (branch, pressure), pressures in Pa and kPa."""
+    rows = {"branch": [], "pressure_Pa": [], "pressure_kPa": []}
+    for name in VARIABLES:
+        rows[name] = []
+    for b in BRANCHES:
+        for i, p in enumerate(ds["pressure"].values):
+            rows["branch"].append(b)
+            rows["pressure_Pa"].append(float(p))
+            rows["pressure_kPa"].append(float(p) / 1e3)
+            for name in VARIABLES:
+                rows[name].append(float(ds[name].sel(branch=b).values[i]))
+    return {k: np.asarray(v) for k, v in rows.items()}
+
+
+def write_design(result, out_dir, figures: bool = True) -> list:
+    """Write design.nc, design.csv, the figures and report.md of ``result`` into ``out_dir``; returns the paths."""
+    from tengsim.io import csv_text, write_dataset, write_text
+
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    ds = result.dataset
+    write_dataset(ds, out / "design.nc")
+    header = {"design": result.plan.name, "status": result.status, "grids": result.summary["grids"],
+              "tolerance": result.plan.tol, "charged_area_definition": result.summary["charged_area_definition"]}
+    write_text(out / "design.csv", csv_text(csv_columns(ds), header, missing=""))
+    paths = [out / "design.nc", out / "design.csv"]
+    figs = []
+    if figures:
+        from tengsim.design.plots import save_design_figures
+
+        figs = save_design_figures(result, out)
+        paths += figs
+    from tengsim.design.report import report_text
+
+    write_text(out / "report.md", report_text(result, [Path(f).name for f in figs]))
+    paths.append(out / "report.md")
+    return paths

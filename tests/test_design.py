@@ -1,0 +1,166 @@
+"""tengsim design / tengsim.design: a small pyramid design, converged, checked against a grid √2 finer; its files
+(CF-1.10 NetCDF, CSV, report, figures in physical units); bad input refused in one line, nothing written; two
+designs compared."""
+import math
+
+import numpy as np
+import pytest
+
+from tengsim.cli.main import main
+from tengsim.design import plan_design, run_design, write_design
+
+SMALL = {"shape": "pyramid", "pitch": "1um", "base": "0.5um", "height": "0.2um", "E_star": "5MPa", "W": "20mJ/m2",
+         "eps": "50nm", "p_max": "50kPa", "p_step": "5kPa"}
+CLI_SMALL = ["design", "pyramid", "--pitch", "1um", "--base", "0.5um", "--height", "0.2um", "--E-star", "5MPa",
+             "--W", "20mJ/m2", "--eps", "50nm", "--p-max", "50kPa", "--p-step", "5kPa", "--quiet"]
+
+
+@pytest.fixture(scope="module")
+def small():
+    return run_design(plan_design(SMALL))
+
+
+def test_plan_physical_defaults_and_tabor():
+    p = plan_design(SMALL)
+    assert p.pressures[0] == 0 and p.pressures[-1] == pytest.approx(50e3) and len(p.pressures) == 11
+    assert (p.sigma, p.eps_r, p.T, p.gap) == (5.84e-6, 2.40, 400e-6, 0.1e-3)  # the paper's device
+    assert p.eps == pytest.approx(50e-9) and p.tabor > 0
+
+
+def test_small_design_ok_and_within_1pct_of_a_grid_sqrt2_finer(small):
+    from tengsim.config import plan_contact
+    from tengsim.contact import simulate
+    from tengsim.design.curves import branch_curves
+    from tengsim.path import PathSpec
+
+    assert small.status == "ok"
+    res = small.finest
+    cplan = plan_contact(small.plan.contact_table)
+    path = PathSpec(res.params["d_min"], res.params["d_max"], res.params["d_step"], adaptive=True)
+    finer = simulate(cplan.shape, cplan.tabor, res.grid.dx / math.sqrt(2), path, law=cplan.law,
+                     scaling=cplan.scaling, extra_params=cplan.extra)
+    assert finer.grid.nx > res.grid.nx
+    a = small.dataset["charged_area_fraction"].sel(branch="approach").values
+    b = branch_curves(finer, small.plan)["approach"]["area"]
+    assert np.all(np.isfinite(a)) and a[-1] > a[0] + 0.05  # the area grows with pressure
+    assert np.max(np.abs(a - b) / np.maximum(np.abs(b), 0.01)) <= 0.01
+    assert abs(res.pull_off_force - finer.pull_off_force) <= 0.01 * abs(finer.pull_off_force)
+
+
+def test_dataset_contract_and_physics(small):
+    ds = small.dataset
+    assert list(ds["branch"].values) == ["approach", "retraction"]
+    assert ds["pressure"].attrs["units"] == "Pa" and np.all(np.diff(ds["pressure"].values) > 0)
+    for k in ("charged_area_fraction", "repulsive_area_fraction", "voc_eq12", "voc_eq17", "dvoc_dp"):
+        assert ds[k].dims == ("branch", "applied_pressure")  # CF: a dimension 'pressure' is air pressure
+    assert ds["pressure"].dims == ("applied_pressure",)
+    for k in ("Conventions", "title", "shape", "shape_params", "E_star_Pa", "W_J_m2", "eps_m", "tabor", "sigma_C_m2",
+              "eps_r", "thickness_m", "status", "grids", "tolerance", "charged_area_definition"):
+        assert k in ds.attrs, k
+    assert ds.attrs["Conventions"] == "CF-1.10" and ds.attrs["shape"] == "pyramid"
+    A = ds["charged_area_fraction"].values
+    eps0 = 8.8541878128e-12
+    # Eq. 12 and Eq. 17 from A/S with the paper's σ, ε_r, T and rest gap
+    assert np.allclose(ds["voc_eq12"].values, 5.84e-6 * A * 400e-6 / (2.40 * eps0), equal_nan=True)
+    assert np.allclose(ds["voc_eq17"].values, 5.84e-6 * A * 0.1e-3 / eps0, equal_nan=True)
+    # a pyramid's square patch never covers more than its footprint (base²/pitch² = 0.25)
+    assert np.nanmax(A) <= 0.25 + 0.01
+
+
+def test_files_cf_report_and_labels(small, tmp_path):
+    runner = pytest.importorskip("compliance_checker.runner")
+    from tengsim.design.plots import design_figure
+
+    paths = write_design(small, tmp_path / "d1")
+    names = {p.name for p in paths}
+    assert {"design.nc", "design.csv", "report.md", "design.png"} <= names
+    cs = runner.CheckSuite()
+    cs.load_all_available_checkers()
+    results, errors = cs.run_all(cs.load_dataset(str(tmp_path / "d1" / "design.nc")), ["cf:1.10"], skip_checks=[])["cf:1.10"]
+    failed = [(r.name, r.msgs) for r in results if r.value[0] < r.value[1] and r.weight >= 2]
+    assert not failed and not errors, (failed, errors)
+    text = (tmp_path / "d1" / "report.md").read_text()
+    assert "Status: ok" in text and small.summary["grids"] in text and "tolerance 1 %" in text
+    assert "![design.png](design.png)" in text
+    fig = design_figure(small)
+    labels = [a.get_xlabel() for a in fig.axes] + [a.get_ylabel() for a in fig.axes]
+    assert all("(kPa)" in x for x in labels[:3])
+    assert any("(V)" in y for y in labels) and any("V/kPa" in y for y in labels)
+    assert "pyramid" in fig._suptitle.get_text() and "µm" in fig._suptitle.get_text()
+    assert "X (dimensionless)" not in " ".join(labels)
+    from tengsim.design.plots import maps_figure
+
+    titles = [a.get_title() for a in maps_figure(small).axes if a.get_title()]
+    assert titles and all("kPa" in t and "asked" in t for t in titles)
+    assert all(a.get_xlabel() == "x (µm)" for a in maps_figure(small).axes if a.get_title())
+
+
+@pytest.mark.parametrize("bad, words", [
+    (["--pitch", "-1um"], "pitch"),
+    (["--pitch", "10uu"], "10uu"),
+    (["--p-max", "0kPa"], "p_max"),
+    (["--eps", ""], "eps"),
+    (["--dx", "1nm"], "--dx"),  # a 1000² grid: estimated over the 10 min budget
+])
+def test_bad_input_one_line_exit_2_nothing_written(tmp_path, capsys, bad, words):
+    argv = list(CLI_SMALL)
+    if bad[0] not in argv:
+        argv += bad
+    i = argv.index(bad[0])
+    argv[i + 1] = bad[1]
+    if bad[1] == "":
+        del argv[i:i + 2]
+    out = tmp_path / "never"
+    assert main([*argv, "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and words in err, err
+    assert not out.exists()
+
+
+def test_unknown_shape_refused(tmp_path, capsys):
+    out = tmp_path / "never"
+    assert main(["design", "pyramidd", "--eps", "50nm", "--p-max", "1kPa", "--out", str(out)]) == 2
+    assert "pyramidd" in capsys.readouterr().err and not out.exists()
+
+
+def test_comparison_of_two_designs_one_table_one_figure(tmp_path):
+    a, b = tmp_path / "a.toml", tmp_path / "b.toml"
+    common = 'E_star = "5MPa"\nW = "20mJ/m2"\neps = "50nm"\np_max = "20kPa"\np_step = "10kPa"\ntol = 0.05\nmaps = false\n'
+    a.write_text('[design]\nname = "pyramid A"\nshape = "pyramid"\npitch = "1um"\nbase = "0.5um"\nheight = "0.2um"\n'
+                 + common)
+    b.write_text('[design]\nname = "cone B"\nshape = "cone"\npitch = "1um"\nslope = 0.8\nheight = "0.2um"\n' + common)
+    out = tmp_path / "cmp"
+    assert main(["design", str(a), str(b), "--out", str(out), "--quiet"]) == 0
+    rows = [r for r in (out / "compare.csv").read_text().splitlines() if not r.startswith("#")]
+    assert len(rows) == 3 and rows[1].startswith("pyramid A") and rows[2].startswith("cone B")
+    assert (out / "compare.png").stat().st_size > 0
+    assert (out / "pyramid_A" / "design.nc").exists() and (out / "cone_B" / "design.nc").exists()
+
+
+def test_shipped_design_examples_plan():
+    """examples/own_design/*.toml (the README's comparison) are valid designs of the issue's pyramid and cone."""
+    from pathlib import Path
+
+    from tengsim.cli.design import _read_toml
+
+    files = sorted((Path(__file__).parent.parent / "examples" / "own_design").glob("*.toml"))
+    plans = [plan_design(_read_toml(str(f))) for f in files]
+    assert {p.shape for p in plans} == {"pyramid", "cone"}
+    for p in plans:
+        assert p.shape_params["pitch_m"] == pytest.approx(10e-6) and p.eps == pytest.approx(100e-9)
+
+
+def test_help_per_shape_is_short(capsys):
+    assert main(["design", "cone", "--help"]) == 0
+    text = capsys.readouterr().out
+    assert len(text.splitlines()) <= 100 and "--slope" in text and "--base" not in text and "--eps" in text
+    assert main(["design", "--help"]) == 0
+    assert "tengsim design SHAPE --help" in capsys.readouterr().out
+
+
+def test_refinement_message_in_the_users_units():
+    from tengsim.design.curves import physical_message
+
+    msg = physical_message("stopped by max_pixels = 9 at dx = 0.1 (3×3; next 5×5); A_S_app_5000Pa changed 2% between "
+                           "the last two grids, dx ≈ 0.05 needed", 200e-9)
+    assert "dx = 20 nm" in msg and "dx ≈ 10 nm" in msg and "A/S at 5 kPa (approach)" in msg
