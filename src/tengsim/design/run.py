@@ -29,7 +29,7 @@ import numpy as np
 
 from tengsim.errors import TengsimError
 
-SECONDS_PER_PIXEL_ROW = 2.4e-5
+SECONDS_PER_PIXEL_ROW = 1.1e-5
 """Wall seconds per (pixel of the solved block) × (path row), one core: measured on the 2-core build machine
 (docs/benchmarks.md, 'Design time constant'); used for the printed estimate only."""
 D_MIN = -1.0
@@ -134,6 +134,22 @@ def budget_pixels(plan, cplan, dx: float, d_max: float) -> int:
         top = g.nx * g.ny
         k += 1
     return top
+
+
+def cap_line(plan, cplan, dx: float, d_max: float, cap: int) -> str:
+    """What the refinement costs at most: the grids dx, dx/√2, ... up to ``cap`` pixels, and their summed estimate."""
+    from tengsim.design.units import time_text
+
+    rows = ROWS_PER_STEP * (d_max - D_MIN) / D_STEP
+    secs, last = 0.0, None
+    for k in range(16):
+        g = cplan.shape.grid(dx / math.sqrt(2.0) ** k)
+        if g.nx * g.ny > cap and last is not None:
+            break
+        secs += SECONDS_PER_PIXEL_ROW * _blocks(cplan.shape, g) * rows
+        last = g
+    return (f"at most: refinement up to {last.nx}×{last.ny} (the budget's largest grid; --max-pixels sets it), "
+            f"about {time_text(secs)} in all")
 
 
 def check_budget(plan, est: Estimate, fit_pixels: int | None = None) -> None:
@@ -273,6 +289,7 @@ def run_design(plan, progress=None) -> DesignResult:
     check_budget(plan, est, plan.max_pixels or budget_pixels(plan, cplan, dx, est.d_max))
     d_max, coarse = find_d_max(plan, cplan, dx, progress)
     max_pixels = plan.max_pixels or budget_pixels(plan, cplan, dx, d_max)
+    _say(progress, cap_line(plan, cplan, dx, d_max, max_pixels))
     res = None
     for _ in range(2):
         from tengsim.path import PathSpec
