@@ -87,31 +87,38 @@ def test_cold_solve_follows_the_numpy_solver_step_for_step():
 
 
 def test_rough_cold_adhesive_equilibrium_equals_the_numpy_solver():
-    """65² rough periodic surface, cold adhesive solve at tol 1e-10: F to 1e-10 relative, H to 1e-8,
-    iterations within 2 % (measured 995 vs 1000)."""
+    """65² rough periodic surface, cold adhesive solve.  At tol 1e-10 F agrees to 1e-10 relative (measured
+    5e-12) but H only to ~2e-9: the two stop at different points of the tolerance ball.  Solved to tol 1e-12
+    both reach the same equilibrium: F to 1e-10 (measured 2e-14), H to 1e-10 (measured 9e-12), iterations
+    within 2 % (measured 1146 vs 1140)."""
     pb, st = _rough_problem()
     a = FastSolver(tol=TIGHT, max_iter=5000).solve(pb, st)
     b = JaxSolver(tol=TIGHT, max_iter=5000, device="cpu").solve(pb, st)
     assert a.converged and b.converged and b.residual <= TIGHT
     Fa, Fb = _force(pb, a), _force(pb, b)
     assert Fa < 0 and abs(Fa - Fb) <= 1e-10 * abs(Fa)
-    assert np.max(np.abs(a.H - b.H)) < 1e-8
+    assert abs(a.iterations - b.iterations) <= 0.02 * a.iterations
+    a = FastSolver(tol=1e-12, max_iter=5000).solve(pb, st)
+    b = JaxSolver(tol=1e-12, max_iter=5000, device="cpu").solve(pb, st)
+    assert a.converged and b.converged and b.residual <= 1e-12
+    assert abs(_force(pb, a) - _force(pb, b)) <= 1e-10 * abs(_force(pb, a))
+    assert np.max(np.abs(a.H - b.H)) < 1e-10
     assert abs(a.iterations - b.iterations) <= 0.02 * a.iterations
 
 
-@pytest.mark.slow
 def test_rough_273_cold_adhesive_equilibrium_equals_the_numpy_solver():
-    """The same surface at dx 1/16 (273², the "256²" of the issue; ~25 s on 2 cores): F to 1e-10
-    relative, H to 1e-8, iterations within 2 % (measured 999 vs 987)."""
+    """The same surface at dx 1/16 (273², the "256²" of the issue), solved to tol 1e-12 by both (~12 s and a
+    compile on 2 cores): F to 1e-10 relative (measured 6e-14), H to 1e-10 (measured 1e-11), iterations
+    within 2 % (measured 1119 vs 1127)."""
     r = Rough(cell=16.0, hurst=0.8, rms_slope=1.0, short_cutoff=0.25, seed=1)
     grid = r.grid(0.0625)
     pb = Problem(r.gap(grid) + 1.0, LJ93(), make_kernel("periodic", grid, 2.0**1.5))
     st = State.zero(grid.shape)
-    a = FastSolver(tol=TIGHT, max_iter=5000).solve(pb, st)
-    b = JaxSolver(tol=TIGHT, max_iter=5000, device="cpu").solve(pb, st)
-    assert a.converged and b.converged
+    a = FastSolver(tol=1e-12, max_iter=5000).solve(pb, st)
+    b = JaxSolver(tol=1e-12, max_iter=5000, device="cpu").solve(pb, st)
+    assert a.converged and b.converged and grid.shape == (273, 273)
     Fa, Fb = _force(pb, a), _force(pb, b)
-    assert abs(Fa - Fb) <= 1e-10 * abs(Fa) and np.max(np.abs(a.H - b.H)) < 1e-8
+    assert abs(Fa - Fb) <= 1e-10 * abs(Fa) and np.max(np.abs(a.H - b.H)) < 1e-10
     assert abs(a.iterations - b.iterations) <= 0.02 * a.iterations
 
 
