@@ -176,8 +176,19 @@ def netcdf_bytes(ds, edit=None) -> bytes:
         local = dask.config.set(scheduler="synchronous")
     except ImportError:  # pragma: no cover - dask is a dependency
         local = contextlib.nullcontext()
-    with local:
-        data = bytes(ds.to_netcdf(engine="h5netcdf"))
+    import warnings
+
+    with local, warnings.catch_warnings():
+        # dask < 2023.4 warns that a Client is active: this write is local on purpose
+        warnings.filterwarnings("ignore", message="Running on a single-machine scheduler")
+        try:
+            data = bytes(ds.to_netcdf(engine="h5netcdf"))
+        except ValueError:  # xarray < 2023.4 makes bytes with the scipy engine only: a scratch file in the
+            # temp folder instead (there a full temp disk is not kept from HDF5: the floors' price)
+            with tempfile.TemporaryDirectory(prefix="tengsim-nc-") as scratch:
+                tmp = Path(scratch) / "scratch.nc"
+                ds.to_netcdf(tmp, engine="h5netcdf")
+                data = tmp.read_bytes()
     if edit is None:
         return data
     import h5py

@@ -160,10 +160,9 @@ def check_budget(plan, est: Estimate, fit_pixels: int | None = None) -> None:
     if est.seconds <= plan.budget_s:
         return
     two = est.grids[1][0] * est.grids[1][1] if len(est.grids) > 1 else None
+    what = f"a coarser --dx (the first grid's is {length_text(est.grids[0][2])})"
     if fit_pixels and two and fit_pixels >= two:
-        what = f"--max-pixels {fit_pixels} (the grids that fit the budget)"
-    else:
-        what = f"a coarser --dx (the first grid's is {length_text(est.grids[0][2])})"
+        what = f"--max-pixels {fit_pixels} (the grids that fit the budget), {what}"
     raise TengsimError(f"this design is estimated at {time_text(est.seconds)}, over the budget of "
                        f"{time_text(plan.budget_s)}: give {what}, a coarser --tol (now {plan.tol:g}) or a larger "
                        "--budget")
