@@ -147,7 +147,7 @@ def test_shipped_design_examples_plan():
     plans = [plan_design(_read_toml(str(f))) for f in files]
     assert {p.shape for p in plans} == {"pyramid", "cone"}
     for p in plans:
-        assert p.shape_params["pitch_m"] == pytest.approx(10e-6) and p.eps == pytest.approx(100e-9)
+        assert p.shape_params["pitch_m"] == pytest.approx(10e-6) and p.eps == pytest.approx(200e-9)
 
 
 def test_help_per_shape_is_short(capsys):
