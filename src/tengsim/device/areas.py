@@ -62,7 +62,8 @@ def area_table_from_design(path) -> AreaTable:
     try:
         ds = xr.load_dataset(p)
     except (OSError, ValueError) as exc:
-        raise TengsimError(f"area: cannot read {str(p)!r} as a design result: {exc}") from None
+        raise TengsimError(f"area: cannot read {str(p)!r} as a design result (not a NetCDF file: "
+                           f"{str(exc).splitlines()[0][:80]})") from None
     if AREA_VARIABLE not in ds or "pressure" not in ds.coords:
         raise TengsimError(f"area: {str(p)!r} is no design result (it has no {AREA_VARIABLE!r} over 'pressure')")
     units = str(ds["pressure"].attrs.get("units", "Pa"))
@@ -125,7 +126,7 @@ def area_table_from_file(path) -> AreaTable:
             with xr.open_dataset(p) as ds:
                 design = AREA_VARIABLE in ds
         except (OSError, ValueError) as exc:
-            raise TengsimError(f"area: cannot read {str(p)!r}: {exc}") from None
+            raise TengsimError(f"area: cannot read {str(p)!r} as NetCDF ({str(exc).splitlines()[0][:80]})") from None
         if not design:
             return area_table_from_contact(p)
     return area_table_from_design(p)
