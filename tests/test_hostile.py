@@ -467,6 +467,21 @@ def test_c13_negative_quantity_is_a_value_not_a_missing_argument(tmp_path, capsy
     assert "E_star" in line and "> 0" in line and "expected one argument" not in line
 
 
+@pytest.mark.parametrize("key, value, words", [
+    ("--E-star", "-0.59MPa", "E_star must be > 0, got '-0.59MPa'"),
+    ("--pitch", "-2um", "pitch must be > 0, got '-2um'"),
+    ("--base", "3um", "pyramid base 3 µm is wider than its pitch 2 µm"),
+])
+def test_c13_a_bad_physical_value_is_named_as_the_user_wrote_it(tmp_path, capsys, key, value, words):
+    args = {"--pitch": "2um", "--base": "1um", "--height": "0.7um", "--E-star": "0.59MPa", "--W": "54mJ/m2"}
+    args[key] = value
+    out = tmp_path / "r.csv"
+    argv = ["contact", "pyramid", *[w for kv in args.items() for w in kv], "--tabor", "0.5", "--out", str(out)]
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert err == f"tengsim: error: {words}" and not out.exists()
+
+
 def test_c13_unknown_tables_name_device_and_a_huge_value_is_cut(tmp_path, capsys):
     cfg = tmp_path / "run.toml"
     cfg.write_text("[foo]\nx = 1\n")

@@ -34,6 +34,16 @@ _QUANTITY = {"E_star": "modulus"}
 """The plausibility range (tengsim.units.PLAUSIBLE) of a key, where it is not its dimension's."""
 
 
+def _positive_as_given(cfg, names, vals) -> None:
+    """Refuse a non-positive physical size or material constant naming the value as the user wrote it
+    ('-2um', not its SI -2e-06); a key whose field takes 0 or less is left to its own checks."""
+    for k in names:
+        v = vals.get(k)
+        raw = cfg.get(k)
+        if isinstance(raw, str) and isinstance(v, (int, float)) and not isinstance(v, bool) and v <= 0:
+            raise ConfigValueError(f"{k} must be > 0, got {shown(raw)}")
+
+
 def _physical_triggers(given, dim_names, phys_names) -> list:
     """The given keys that make a [contact] table a physical run."""
     return sorted(set(given) & (set(PHYSICAL_KEYS) | (set(phys_names) - set(dim_names))))
@@ -504,6 +514,8 @@ def plan_contact(cfg: dict) -> ContactPlan:
             raise TengsimError(f"physical {name} input needs {', '.join(missing)}")
         vals = contact_table(name, "physical", law_name).parse(cfg)
         _check_bare_numbers(cfg, phys)
+        _positive_as_given(cfg, ["E_star", "W", "eps", *(f.name for f in phys if f.dim and not (
+            isinstance(f.default, (int, float)) and not isinstance(f.default, bool) and f.default <= 0))], vals)
         E, W = positive("E_star", vals["E_star"]), positive("W", vals["W"])
         p = {f.name: vals[f.name] for f in phys}
         if vals["eps"] is not None and vals["tabor"] is not None:

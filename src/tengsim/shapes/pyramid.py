@@ -61,6 +61,11 @@ class Pyramid(Shape):
 
     @classmethod
     def from_si(cls, values, eps):
+        if values["base"] > values["pitch"] > 0:  # said in the user's units (SI with a prefix)
+            from tengsim.units import format_si
+
+            raise TengsimError(f"pyramid base {format_si(values['base'], 'm')} is wider than its pitch "
+                               f"{format_si(values['pitch'], 'm')}")
         return cls.from_physical(values["pitch"], values["base"], values["height"], eps)
 
     @classmethod
