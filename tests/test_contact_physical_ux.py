@@ -138,3 +138,16 @@ def test_the_path_ends_at_the_largest_load_asked_for(tmp_path, capsys):
     a = np.asarray(res.table["branch"]).astype(str) == "approach"
     on = np.asarray(res.table["on_grid"]).astype(bool) & a
     np.testing.assert_allclose(np.asarray(res.table["pressure_Pa"])[on], [1e3, 6e3, 11e3, 16e3, 20e3], rtol=2e-3)
+
+
+def test_refinement_stop_message_in_the_runs_lengths(tmp_path, capsys):
+    """--resolve auto stopped by max_pixels in a physical run names dx in nm/µm, not X units (issue 29)."""
+    out = tmp_path / "r.csv"
+    argv = ["contact", "sphere", "--radius", "1um", "--pitch", "2um", "--E-star", "1MPa", "--W", "50mJ/m2",
+            "--tabor", "1", "--dx", "100nm", "--d-min", "-1", "--d-max", "0.5", "--resolve", "auto",
+            "--max-pixels", "1000", "--out", str(out)]
+    assert main(argv) == 0
+    err = capsys.readouterr().err
+    line = next(ln for ln in err.splitlines() if "refinement stopped by max_pixels" in ln)
+    assert "at dx = 95.24 nm (21×21; next 33×33)" in line
+    assert " nm needed" in line or " µm needed" in line or "nm needed" in line

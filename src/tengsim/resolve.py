@@ -344,9 +344,19 @@ def resolve_contact(shape, tabor: float, path, dx: float | None = None, law=None
         need = _dx_needed(levels, rich, changes, tol)
         why = _why(changes)
         floor = levels[-1]["dx"] / NEED_FLOOR
-        need_text = (f"dx ≈ {need:.3g} needed" if need >= floor else
-                     f"dx below {floor:.3g} needed (the grids so far converge too irregularly to extrapolate further)")
-        msg = (f"under-resolved: refinement stopped by max_pixels = {max_pixels} at dx = {levels[-1]['dx']:.4g} "
+        lateral = p.get("lateral_m")  # a physical run: lengths in its units (nm, µm), else X units
+
+        def length(d, digits=3):
+            if lateral:
+                from tengsim.units import format_si
+
+                return format_si(d * lateral, "m", digits)
+            return f"{d:.{digits}g}"
+
+        need_text = (f"dx ≈ {length(need)} needed" if need >= floor else
+                     f"dx below {length(floor)} needed (the grids so far converge too irregularly to extrapolate "
+                     "further)")
+        msg = (f"under-resolved: refinement stopped by max_pixels = {max_pixels} at dx = {length(levels[-1]['dx'], 4)} "
                f"({levels[-1]['nx']}×{levels[-1]['ny']}; next {stop.nx}×{stop.ny}); {why}, "
                f"{need_text} for resolve_tol = {tol:g}")
         p["resolve_status"] = "under_resolved"
