@@ -164,3 +164,32 @@ def test_refinement_message_in_the_users_units():
     msg = physical_message("stopped by max_pixels = 9 at dx = 0.1 (3×3; next 5×5); A_S_app_5000Pa changed 2% between "
                            "the last two grids, dx ≈ 0.05 needed", 200e-9)
     assert "dx = 20 nm" in msg and "dx ≈ 10 nm" in msg and "A/S at 5 kPa (approach)" in msg
+
+
+def test_a_killed_design_resumes_from_its_kept_grids(tmp_path, small):
+    """Each finished grid is kept in the file ``keep`` (issue 30: every long-running command keeps what it
+    finished): a run of the same design takes them back and computes no grid again, giving the same numbers."""
+    keep = tmp_path / "out" / ".design-0.resolve.nc"
+    first = run_design(plan_design(SMALL), keep=keep)
+    assert keep.is_file()  # left as a killed run would leave it (the CLI removes it once the files are written)
+    lines = []
+
+    class Say:
+        def say(self, text):
+            lines.append(text)
+
+    again = run_design(plan_design(SMALL), progress=Say(), keep=keep)
+    assert any(ln.startswith("taking back ") for ln in lines), lines
+    assert again.summary["grids"] == first.summary["grids"] == small.summary["grids"]
+    a, b = first.dataset["charged_area_fraction"].values, again.dataset["charged_area_fraction"].values
+    assert np.array_equal(np.isnan(a), np.isnan(b)) and np.allclose(a[~np.isnan(a)], b[~np.isnan(b)], rtol=0, atol=0)
+    other = dict(SMALL, p_max="21kPa")  # another design: its grids are not taken, and that is said
+    lines.clear()
+    run_design(plan_design(other), progress=Say(), keep=keep)
+    assert any("holds grids of another design" in ln for ln in lines), lines
+
+
+def test_cli_removes_the_kept_grids_once_written(tmp_path):
+    out = tmp_path / "d"
+    assert main([*CLI_SMALL, "--out", str(out)]) == 0
+    assert (out / "design.nc").is_file() and not list(out.glob(".design-*.resolve.nc"))

@@ -192,8 +192,8 @@ def run(args) -> int:
     say = _Say(args.quiet)
     results = []
     try:
-        for plan in plans:
-            results.append(run_design(plan, progress=say))
+        for k, plan in enumerate(plans):  # each finished grid kept in OUT: a killed run resumes from it
+            results.append(run_design(plan, progress=say, keep=out / f".design-{k}.resolve.nc"))
     finally:
         say.close()
     if len(results) == 1:
@@ -203,6 +203,8 @@ def run(args) -> int:
         for r in results:
             paths += write_design(r, out / _slug(r.plan.name, taken))
         paths += write_comparison(results, out)
+    for k in range(len(plans)):  # the results are saved: the kept grids are no longer needed
+        (out / f".design-{k}.resolve.nc").unlink(missing_ok=True)
     if not args.quiet:
         for r in results:
             s = r.summary

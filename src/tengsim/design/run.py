@@ -269,10 +269,35 @@ def _observer(plan):
     return observe
 
 
-def run_design(plan, progress=None) -> DesignResult:
+def _checkpoint(keep, plan, d_max, progress):
+    """The refinement's checkpoint in the file ``keep`` for this plan and path (None without ``keep``): each
+    finished grid is kept there, and a run of the same design and path takes its grids back instead of computing
+    them again; one kept by another design is replaced (said)."""
+    if keep is None:
+        return None
+    import hashlib
+
+    from tengsim.errors import TengsimError as _Err
+    from tengsim.resolve import Checkpoint
+
+    ck = Checkpoint(keep, hashlib.sha256(f"{plan!r}|{d_max!r}".encode()).hexdigest()[:16])
+    try:
+        found = ck.load()
+    except _Err:
+        _say(progress, f"{keep} holds grids of another design or path: they are replaced")
+        keep.unlink()
+        found = None
+    if found is not None:
+        _say(progress, f"taking back {len(found[0])} finished grid(s) from {keep}")
+    keep.parent.mkdir(parents=True, exist_ok=True)
+    return ck, found
+
+
+def run_design(plan, progress=None, keep=None) -> DesignResult:
     """Run one design (module doc).  ``progress``: a :class:`tengsim.progress.Progress`-like callable (the
     path's progress) and/or an object with ``say(text)``, which gets the lines said before and during the run
-    (the Tabor number, the grids, memory and estimated time)."""
+    (the Tabor number, the grids, memory and estimated time).  ``keep`` (a file path, or None): where each
+    finished grid is kept (:func:`_checkpoint`), so a killed run of the same design resumes from it."""
     from tengsim.config import plan_contact
     from tengsim.design.curves import summarize
     from tengsim.design.write import to_dataset
@@ -294,11 +319,15 @@ def run_design(plan, progress=None) -> DesignResult:
         from tengsim.path import PathSpec
 
         path = PathSpec(D_MIN, d_max, D_STEP, adaptive=True)
+        ck, found = _checkpoint(keep, plan, d_max, progress) or (None, None)
         res = resolve_contact(cplan.shape, cplan.tabor, path, dx=dx, law=cplan.law, boundary=cplan.boundary,
                               resolve_tol=plan.tol, max_pixels=max_pixels, observe=_observer(plan),
                               progress=progress if callable(progress) else None, symmetry=cplan.symmetry,
                               solver=cplan.solver, tol=cplan.tol,
-                              extra_params=cplan.extra, scaling=cplan.scaling, kernel_params=cplan.kernel_params)
+                              extra_params=cplan.extra, scaling=cplan.scaling, kernel_params=cplan.kernel_params,
+                              checkpoint=None if ck is None else ck.save, start=found)
+        if res.scaling is None:  # every grid taken back from the checkpoint file, which keeps the columns only
+            res.scaling = cplan.scaling
         ok, D_hit, top, slope = _reach(res, plan.pressures[-1])
         if ok:
             break
