@@ -158,8 +158,7 @@ def _fake_result(flag_rows):
                          process_zone=0.01 if i in flag_rows["coarse"] else float("nan")))
     res = ContactResult.from_rows(rows, [], Grid(5, 5, 0.1, 0.1))
     res.params = {"tol": 1e-6, "g_safe": 0.6}
-    st.attach(res, LJ93(), 1.0)
-    return res
+    return st.attach(res, LJ93(), 1.0)
 
 
 def test_write_contact_prints_one_line_per_kind_naming_where(tmp_path, capsys):

@@ -165,7 +165,7 @@ def simulate(shape: Shape, tabor: float, dx: float, path: PathSpec, boundary: st
     res.params = {**params, **recorded}
     if scaling is not None:
         res.add_physical(scaling)
-    status.attach(res, law, kernel.coupling)  # per-row 'status' column, params['status'] (tengsim.status)
+    res = status.attach(res, law, kernel.coupling)  # per-row 'status' column, params['status'] (tengsim.status)
     if (getattr(kernel, "film", False) and getattr(kernel, "pinned_mean", False)
             and not res.table["in_law_range"].all()):
         res.params["warning"] = res.params.get("warning", "") + (

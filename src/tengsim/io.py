@@ -165,6 +165,23 @@ def write_bytes(path, data) -> None:
             fh.write(data)
 
 
+def _plain_text_attrs(ds):
+    """``ds`` with every attribute that is a ``str`` subclass (an enum such as
+    :class:`tengsim.status.Status`) as a plain ``str``, which the NetCDF engine writes; ``ds`` itself when
+    there is none (a shallow copy otherwise)."""
+    def odd(attrs):
+        return any(isinstance(v, str) and type(v) is not str for v in attrs.values())
+
+    if not (odd(ds.attrs) or any(odd(v.attrs) for v in ds.variables.values())):
+        return ds
+    ds = ds.copy(deep=False)
+    for attrs in (ds.attrs, *(v.attrs for v in ds.variables.values())):
+        for k, v in attrs.items():
+            if isinstance(v, str) and type(v) is not str:
+                attrs[k] = str(v)
+    return ds
+
+
 def netcdf_bytes(ds, edit=None) -> bytes:
     """``ds`` as NetCDF-4 bytes (h5netcdf engine), made in memory: the HDF5 library never writes to the
     disk, so a full disk cannot fail inside it (where it fails without an OSError, and its objects
@@ -178,6 +195,7 @@ def netcdf_bytes(ds, edit=None) -> bytes:
         local = contextlib.nullcontext()
     import warnings
 
+    ds = _plain_text_attrs(ds)
     with local, warnings.catch_warnings():
         # dask < 2023.4 warns that a Client is active: this write is local on purpose
         warnings.filterwarnings("ignore", message="Running on a single-machine scheduler")
