@@ -15,7 +15,7 @@ import pytest
 import xarray as xr
 
 from tengsim.cli.main import main
-from tengsim.load import load_result
+from tengsim.results.read import load_result
 
 runner = pytest.importorskip("compliance_checker.runner")
 

@@ -248,7 +248,7 @@ def test_dimensionless_units_name_the_shape_not_the_pyramid(tmp_path):
 
 def test_plot_curves_uses_physical_axes(tmp_path, monkeypatch):
     import tengsim.plots as plots
-    from tengsim.load import load_result
+    from tengsim.results.read import load_result
 
     figs = []
     monkeypatch.setattr(plots, "save", lambda fig, path: figs.append(fig))

@@ -8,7 +8,7 @@ import pytest
 import xarray as xr
 
 from tengsim.cli.main import main
-from tengsim.load import load_result
+from tengsim.results.read import load_result
 
 
 def _res(path):

@@ -130,7 +130,7 @@ def test_device_takes_a_load_controlled_contact_result_with_its_snap(tmp_path, c
     """A physical load-controlled run repeats the pressure at its snap (fold and landing rows): the device
     keeps the first state reached there, refuses nothing, and A/S is λc²/L² of the approach rows."""
     from tengsim.device.areas import area_table_from_contact
-    from tengsim.load import load_result
+    from tengsim.results.read import load_result
 
     run = tmp_path / "load.csv"
     assert main(["contact", "pyramid", "--pitch", "10um", "--base", "5um", "--height", "3.5um", "--E-star", "1MPa",

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from tengsim import io
-from tengsim.load import _read_csv
+from tengsim.results.read import _read_csv
 
 
 def _strict(text):

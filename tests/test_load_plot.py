@@ -8,7 +8,7 @@ import pytest
 from tengsim import io, plots
 from tengsim.cli.main import main
 from tengsim.errors import TengsimError
-from tengsim.load import REQUIRED_CONTACT, load_result
+from tengsim.results.read import REQUIRED_CONTACT, load_result
 from tengsim.results import CURVE_COLUMNS, ContactResult
 
 CONTACT = ["contact", "sphere", "--cell", "4", "--tabor", "1", "--dx", "0.4", "--d-min", "-0.5",

@@ -80,7 +80,7 @@ def _contact_args(cell, dx, out):
 
 
 def _compare(tmp_path, cell, dx):
-    from tengsim.load import load_result
+    from tengsim.results.read import load_result
 
     serial = tmp_path / "serial.csv"
     par = tmp_path / "par.csv"

@@ -4,7 +4,7 @@ import pytest
 
 from tengsim import plots
 from tengsim.cli.main import main
-from tengsim.load import load_result
+from tengsim.results.read import load_result
 
 PYR = ["contact", "pyramid", "--pitch", "10um", "--base", "5um", "--height", "3.5um", "--E-star", "1MPa",
        "--W", "50mJ/m2", "--eps", "100nm", "--dx", "1um", "--quiet"]

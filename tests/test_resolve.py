@@ -15,7 +15,7 @@ import pytest
 from tengsim import resolve
 from tengsim.cli.main import main
 from tengsim.errors import TengsimError
-from tengsim.load import load_result
+from tengsim.results.read import load_result
 
 PYR = ["contact", "pyramid", "--N", "0.946", "--cell", "3.78", "--tabor", "0.5", "--d-min", "-1", "--d-max", "2",
        "--d-step", "0.1", "--dx", "0.4", "--resolve", "auto", "--quiet"]

@@ -20,7 +20,7 @@ from tengsim import status as st
 from tengsim.cli.contact import write_contact
 from tengsim.grid import Grid
 from tengsim.laws import LJ93, Law, Repulsive
-from tengsim.load import load_result
+from tengsim.results.read import load_result
 from tengsim.results import CURVE_COLUMNS, ContactResult
 
 MD_TOL = 0.07  # the LJ sphere's grid-converged pull-off lies within 7 % of MD (test_engine_adhesion)
@@ -156,8 +156,7 @@ def _fake_result(flag_rows):
                          max_pressure=0.0, min_pressure=0.0, energy=0.0, seconds=0.0,
                          in_law_range=i not in flag_rows["out"],
                          process_zone=0.01 if i in flag_rows["coarse"] else float("nan")))
-    res = ContactResult.from_rows(rows, [], Grid(5, 5, 0.1, 0.1))
-    res.params = {"tol": 1e-6, "g_safe": 0.6}
+    res = ContactResult.from_rows(rows, [], Grid(5, 5, 0.1, 0.1), params={"tol": 1e-6, "g_safe": 0.6})
     return st.attach(res, LJ93(), 1.0)
 
 

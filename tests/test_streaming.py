@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 from tengsim.cli.main import main
-from tengsim.load import incomplete_note, load_result, read_partial
+from tengsim.results.read import incomplete_note, load_result, read_partial
 from tengsim.results import RowStream, partial_path
 
 TESTS = Path(__file__).parent

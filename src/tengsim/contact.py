@@ -161,16 +161,15 @@ def simulate(shape: Shape, tabor: float, dx: float, path: PathSpec, boundary: st
     if sink is not None and hasattr(sink, "begin"):
         sink.begin(dict(params))
     res = walk(U0, law, kernel, solver_obj, path, progress=progress, observers=observers, sink=sink)
-    recorded = res.params  # what the path recorded (the pixel snap number)
-    res.params = {**params, **recorded}
+    res = replace(res, params={**params, **res.params})  # and what the path recorded (the pixel snap number)
     if scaling is not None:
-        res.add_physical(scaling)
+        res = res.with_physical(scaling)
     res = status.attach(res, law, kernel.coupling)  # per-row 'status' column, params['status'] (tengsim.status)
     if (getattr(kernel, "film", False) and getattr(kernel, "pinned_mean", False)
             and not res.table["in_law_range"].all()):
-        res.params["warning"] = res.params.get("warning", "") + (
+        res = replace(res, params={**res.params, "warning": res.params.get("warning", "") + (
             "; the film is incompressible (poisson = 0.5), so its mean mode has no compliance either: give "
-            "poisson < 0.5 (PDMS ≈ 0.49) and small D steps, or drive it by load")
+            "poisson < 0.5 (PDMS ≈ 0.49) and small D steps, or drive it by load")})
     if throw:
         res.raise_for_status()
     return res
@@ -200,5 +199,4 @@ def run_contact(cfg: dict, progress=None, sink=None):
                    extra_params=plan.extra, observers=plan.observers, scaling=plan.scaling,
                    kernel_params=plan.kernel_params, check_memory_first=False,  # plan_contact checked it
                    sink=sink, symmetry=getattr(plan, "symmetry", "auto"))
-    res.params["config"] = {k: v for k, v in cfg.items() if k not in ("out", "plot")}
-    return res
+    return replace(res, params={**res.params, "config": {k: v for k, v in cfg.items() if k not in ("out", "plot")}})

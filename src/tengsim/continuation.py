@@ -54,8 +54,7 @@ def spent(res, walkers):
     """``res`` with ``params['n_conv_spent']``: the convolutions of every solve of the run, those of the
     rows (the table's ``n_conv``) and those discarded (a predicted start that jumped, solved again; a step
     refined after a jump; the adaptive walk's rejected steps)."""
-    res.params["n_conv_spent"] = int(sum(w.spent for w in walkers))
-    return res
+    return replace(res, params={**res.params, "n_conv_spent": int(sum(w.spent for w in walkers))})
 
 
 class Branch:
@@ -194,10 +193,9 @@ class Recorder:
 
     def result(self, final_state=None):
         """The :class:`tengsim.results.ContactResult` of the recorded rows."""
-        res = ContactResult.from_rows(self.rows, self.maps, self.grid, seconds=time.perf_counter() - self.t_start,
-                                      final_state=final_state, extra_columns=self.extra_cols)
+        units = {}
         for o in self.extra:
-            res.units.update(getattr(o, "units", None) or {})
-        res.params["pixel_snap_number"] = self.snap
-        res.params["face_uncertainty"] = self.edges.face
-        return res
+            units.update(getattr(o, "units", None) or {})
+        return ContactResult.from_rows(self.rows, self.maps, self.grid, seconds=time.perf_counter() - self.t_start,
+                                       final_state=final_state, extra_columns=self.extra_cols, units=units,
+                                       params={"pixel_snap_number": self.snap, "face_uncertainty": self.edges.face})

@@ -172,8 +172,8 @@ def _plain_text_attrs(ds):
     def odd(attrs):
         return any(isinstance(v, str) and type(v) is not str for v in attrs.values())
 
-    if not (odd(ds.attrs) or any(odd(v.attrs) for v in ds.variables.values())):
-        return ds
+    if not hasattr(ds, "variables") or not (odd(ds.attrs) or any(odd(v.attrs) for v in ds.variables.values())):
+        return ds  # (an object that only makes NetCDF bytes passes as it is)
     ds = ds.copy(deep=False)
     for attrs in (ds.attrs, *(v.attrs for v in ds.variables.values())):
         for k, v in attrs.items():

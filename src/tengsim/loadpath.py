@@ -372,13 +372,14 @@ def run_load_path(U0, law, kernel, solver, spec: LoadPathSpec, start: State | No
     eq_last = (down if spec.retract else up).eq
     res = spent(rec.result(eq_last.state if keep_states else None), [b.walker for b in branches])
     misses = [m for b in branches for m in b.misses]
+    more = {}
     if misses:
-        res.params["load_not_met"] = "; ".join(misses)
+        more["load_not_met"] = "; ".join(misses)
     if up.d_max > spec.d_max:
-        res.params["d_max_reached"] = up.d_max  # the search range the approach extended itself to
+        more["d_max_reached"] = up.d_max  # the search range the approach extended itself to
     absent = rec.maps_missing([b.name for b in branches])
     if absent:  # requested, but that branch has no state at that load: said, not dropped silently
-        res.params["maps_not_made"] = "; ".join(f"{b} {spec.load_text(m)}" for b, m in absent) + (
+        more["maps_not_made"] = "; ".join(f"{b} {spec.load_text(m)}" for b, m in absent) + (
             " (no state at that load on that branch: below the load at rest on the approach, past the "
             "pull-off on the retraction)")
-    return res
+    return dataclasses.replace(res, params={**res.params, **more})

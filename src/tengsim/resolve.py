@@ -51,6 +51,7 @@ is, at the pixel-snapping contact edge (the experiment is commit 422dd44 on bran
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 
@@ -333,7 +334,7 @@ def resolve_contact(shape, tabor: float, path, dx: float | None = None, law=None
             break
         dx = grid.dx / FACTOR
     _, changes, rich = _judge(levels, names, tol)
-    p = res.params
+    p = dict(res.params)  # the result's parameters, then the refinement's
     p.update(resolve="auto", resolve_tol=tol, max_pixels=int(max_pixels),
              resolve_grids=[lv["dx"] for lv in levels], resolution=_levels_table(levels, names),
              richardson={n: {k: r[k] for k in ("order", "observed", "extrapolated", "error")}
@@ -364,8 +365,8 @@ def resolve_contact(shape, tabor: float, path, dx: float | None = None, law=None
         p["warning"] = "; ".join(x for x in (p.get("warning", ""), msg) if x)
     else:
         p["resolve_status"] = "ok"
-    p["status"] = res.status
-    return res
+    res = dataclasses.replace(res, params=p)
+    return dataclasses.replace(res, params={**p, "status": res.status})
 
 
 def _why(changes: dict) -> str:
@@ -422,9 +423,9 @@ def run_contact(cfg: dict, progress=None, sink=None, observe=None, full_length=N
                           solver=plan.solver, tol=plan.tol, extra_params=plan.extra, observers=plan.observers,
                           scaling=plan.scaling, kernel_params=plan.kernel_params,
                           checkpoint=None if ck is None else ck.save, start=None if ck is None else ck.load())
-    res.params.pop(Checkpoint.KEY, None)
-    res.params["config"] = {k: v for k, v in cfg.items() if k not in ("out", "plot")}
-    return res
+    params = {k: v for k, v in res.params.items() if k != Checkpoint.KEY}
+    return dataclasses.replace(res, params={**params, "config": {k: v for k, v in cfg.items()
+                                                                 if k not in ("out", "plot")}})
 
 
 class Checkpoint:
@@ -458,23 +459,21 @@ class Checkpoint:
     def save(self, levels, phases, res) -> None:
         from tengsim import io
 
-        res.params[self.KEY] = io.dumps({"digest": self.digest, "levels": levels, "phases": list(phases)})
-        try:
-            res.save(self.path)
-        finally:
-            res.params.pop(self.KEY, None)
+        kept = {self.KEY: io.dumps({"digest": self.digest, "levels": levels, "phases": list(phases)})}
+        dataclasses.replace(res, params={**res.params, **kept}).save(self.path)
 
     def load(self):
         """(levels, phases, result) kept by an interrupted run of this table, or None if there is none."""
         import json
 
-        from tengsim.load import load_result
+        from tengsim.results.read import load_result
 
         if not self.path.is_file():
             return None
         try:
             _, res = load_result(self.path)
-            rec = json.loads(res.params.pop(self.KEY))
+            rec = json.loads(res.params[self.KEY])
+            res = dataclasses.replace(res, params={k: v for k, v in res.params.items() if k != self.KEY})
         except (TengsimError, KeyError, TypeError, ValueError) as exc:
             raise TengsimError(f"--resume: {self.path} is not a refinement checkpoint ({exc}); delete it to "
                                "start afresh") from None

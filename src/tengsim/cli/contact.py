@@ -144,7 +144,7 @@ def open_stream(out, resume: bool, quiet: bool = False):
     """The :class:`tengsim.results.RowStream` writing a run's rows to ``OUT.partial.csv`` as they finish:
     a new one (refused while a partial file of an interrupted run is there, so nothing finished is
     overwritten), or with ``resume`` one continuing that file."""
-    from tengsim.load import read_partial
+    from tengsim.results.read import read_partial
     from tengsim.results import RowStream, partial_path
 
     from tengsim.results import checkpoint_path

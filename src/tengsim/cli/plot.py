@@ -53,7 +53,7 @@ def _device_period(src: Path, obj):
 
 
 def run(args) -> int:
-    from tengsim.load import load_result
+    from tengsim.results.read import load_result
 
     src = Path(args.result)
     out = Path(args.out) if args.out else None
@@ -69,7 +69,7 @@ def run(args) -> int:
 
     check_output(out, [src])
     kind, obj = load_result(src)
-    from tengsim.load import incomplete_note
+    from tengsim.results.read import incomplete_note
 
     note = incomplete_note(kind, obj)
     if note:  # a partial file of a run cut short: drawn, and said so

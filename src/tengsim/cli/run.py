@@ -8,6 +8,7 @@ package version.
 """
 from __future__ import annotations
 
+import dataclasses
 import sys
 from pathlib import Path
 
@@ -83,5 +84,5 @@ def _contact(section, args) -> int:
     res = run_streamed(lambda bar: run_contact(section, progress=bar, sink=stream), stream, args.quiet)
     if res is None:
         return 130
-    res.params["config_file"] = str(args.config)
+    res = dataclasses.replace(res, params={**res.params, "config_file": str(args.config)})
     return write_contact(res, out, plot, args.quiet, stream)

@@ -22,6 +22,7 @@
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 
@@ -327,7 +328,7 @@ def run_design(plan, progress=None, keep=None) -> DesignResult:
                               extra_params=cplan.extra, scaling=cplan.scaling, kernel_params=cplan.kernel_params,
                               checkpoint=None if ck is None else ck.save, start=found)
         if res.scaling is None:  # every grid taken back from the checkpoint file, which keeps the columns only
-            res.scaling = cplan.scaling
+            res = dataclasses.replace(res, scaling=cplan.scaling)
         ok, D_hit, top, slope = _reach(res, plan.pressures[-1])
         if ok:
             break

@@ -91,7 +91,7 @@ def area_table_from_contact(path) -> AreaTable:
     area), one row per pressure (at a load-controlled snap the first state reached).  A displacement-
     controlled approach, whose force falls after the jump-in, is refused at the row where it falls (run
     it with control = load)."""
-    from tengsim.load import load_result
+    from tengsim.results.read import load_result
 
     kind, res = load_result(path)
     where = f"area: {path}"

@@ -14,7 +14,8 @@ import numpy as np
 
 from tengsim.errors import TengsimError
 from tengsim.grid import Grid
-from tengsim.results import CURVE_COLUMNS, ContactResult
+from tengsim.results.columns import CURVE_COLUMNS
+from tengsim.results.result import ContactResult
 
 BOOL_COLUMNS = ("converged", "on_grid", "jump", "in_law_range")
 # written by every tengsim version; later additions (in_law_range, process_zone, status) are taken when present
@@ -220,7 +221,7 @@ def load_result(path) -> tuple[str, object]:
                 raise TengsimError(f"{path}: its 'params' attribute is not JSON: {exc}") from None
             if not isinstance(params, dict):
                 raise TengsimError(f"{path}: its 'params' attribute is not a JSON object")
-            if "level" in ds.dims:  # resolve = auto: the table of the grids (ContactResult._resolution_vars)
+            if "level" in ds.dims:  # resolve = auto: the table of the grids (tengsim.results.write._resolution_vars)
                 params["resolution"] = {k[len("resolution_"):]: [None if isinstance(x, float) and x != x else x
                                                                  for x in v.values.tolist()]
                                         for k, v in ds.variables.items() if v.dims == ("level",)

@@ -130,7 +130,7 @@ def optimize_study(study, out, *, workers=None, scheduler=None, client=None, res
 
     from tengsim.config import plan_contact
     from tengsim.io import write_json
-    from tengsim.load import load_result
+    from tengsim.results.read import load_result
     from tengsim.study.dataset import build_study
     from tengsim.study.execute import PointRunner, verify_points
     from tengsim.study.layout import StudyDir
