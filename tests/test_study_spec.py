@@ -5,7 +5,8 @@ import numpy as np
 import pytest
 
 from tengsim.errors import TengsimError
-from tengsim.study.spec import parse_study, point_id
+from tengsim.study.hashing import point_id
+from tengsim.study.spec import parse_study
 
 BASE = {"shape": "pyramid", "N": 0.946, "cell": 3.78, "tabor": 0.5, "dx": 0.2, "d_min": -1.0,
         "d_max": 3.0, "d_step": 0.25, "boundary": "free"}

@@ -17,9 +17,9 @@ from tengsim.errors import TengsimError
 from tengsim.status import SEVERITY
 from tengsim.study import parse_study, run_study
 from tengsim.study.execute import check_resume, compute_point, resolved_with_provenance
+from tengsim.study.hashing import point_id
 from tengsim.study.layout import StudyDir
 from tengsim.study.points import check_point, provenance, write_point
-from tengsim.study.spec import point_id
 
 # a sphere whose status turns from ok to under_resolved between dx = 0.4 and 0.45.  Issue 22 item 2: it was
 # a Maugis–Dugdale sphere at μ = 3, whose dx 0.3 / 0.4 were 'ok' with pull-offs 6 % apart (pixel snap
@@ -270,7 +270,7 @@ def test_pick_optimum_takes_only_candidate_statuses():
 
     study = parse_study(OPT, source="opt")
     obj = parse_objective(study)
-    from tengsim.study.spec import point_at
+    from tengsim.study.sampling import point_at
 
     pts = [point_at(study, [x]) for x in (0.3, 0.35, 0.45, 0.5, 0.6)]
     pull = [-0.178, -0.168, -0.153, -0.153, -0.165]

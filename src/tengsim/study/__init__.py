@@ -5,6 +5,7 @@ spec (study file → points and ids), execute (Dask run, atomic per-point files,
 """
 from tengsim.study.dataset import build_study
 from tengsim.study.execute import run_study
-from tengsim.study.spec import load_study, parse_study, point_id
+from tengsim.study.hashing import point_id
+from tengsim.study.spec import load_study, parse_study
 
 __all__ = ["build_study", "load_study", "parse_study", "point_id", "run_study"]

@@ -217,7 +217,7 @@ def _check_same_code(old_points, lost, study, sd) -> None:
     """Stored points whose table is unchanged but whose id is not: computed by other code or from other
     input.  One TengsimError saying what changed (a resumed study never mixes their results)."""
     from tengsim.study.points import provenance, provenance_difference
-    from tengsim.study.spec import canonical
+    from tengsim.study.hashing import canonical
 
     new = {json.dumps(p.axes, sort_keys=True): p for p in study.points}
     n, why = 0, ""

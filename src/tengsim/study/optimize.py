@@ -113,7 +113,7 @@ def parse_objective(study) -> dict:
 
 
 def _point(study, x):
-    from tengsim.study.spec import point_at
+    from tengsim.study.sampling import point_at
 
     return point_at(study, x)
 

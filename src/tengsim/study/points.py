@@ -1,6 +1,6 @@
 """A study's point files: what a point's id covers, writing a point file, checking one before it is trusted.
 
-**Provenance.**  A point's id (:func:`tengsim.study.spec.point_id`) is a digest of its ``[contact]``
+**Provenance.**  A point's id (:func:`tengsim.study.hashing.point_id`) is a digest of its ``[contact]``
 table and of :func:`provenance`, everything else that determines its result:
 
 * ``format`` — :data:`FORMAT`, the point-file format (what a point file holds and how its status reads);
