@@ -62,7 +62,7 @@ def one_run(n, dx):
     import xarray as xr
 
     from tengsim.study import parse_study, run_study
-    from tengsim.study.execute import connect
+    from tengsim.study.runner import connect
 
     tmp = Path(tempfile.mkdtemp())
     t0 = time.perf_counter()

@@ -14,7 +14,7 @@ from tengsim.errors import TengsimError
 from tengsim.shapes import Paraboloid
 from tengsim.laws import LJ93, Exponential, Law, MaugisDugdale
 from tengsim.registry import LAWS, SHAPES
-from tengsim.study.execute import validate
+from tengsim.study.validate import validate
 from tengsim.study.spec import parse_study
 
 # a sphere on a 21 x 21 grid, two D values each way: a fraction of a second a run

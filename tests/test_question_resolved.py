@@ -17,7 +17,7 @@ def test_resolved_study_is_the_coarse_one_with_refinement(name, coarse):
     each point refines from the coarse grid (45², within max_pixels) with tolerance 1 %, converging A/S at
     the study's [observables] pressures too."""
     from tengsim.config import plan_contact
-    from tengsim.study.execute import validate
+    from tengsim.study.validate import validate
     from tengsim.study.spec import load_study
 
     s, c = load_study(DESIGN / f"{name}.toml"), load_study(DESIGN / f"{coarse}.toml")
@@ -55,7 +55,7 @@ def test_more_grids_study_is_the_periodic_one_for_the_smooth_sided_patterns():
     pixel past a pixel centre on every grid: tengsim.resolve keeps it there) and no finer grid."""
     from tengsim.config import plan_contact
     from tengsim.resolve import FACTOR, _aligned, edge_phases
-    from tengsim.study.execute import validate
+    from tengsim.study.validate import validate
     from tengsim.study.spec import load_study
 
     s, base = load_study(DESIGN / "question_periodic_resolved_245.toml"), load_study(DESIGN / "question_periodic_resolved.toml")

@@ -181,7 +181,7 @@ def test_issue_question_study_file_expands():
 def test_example_studies_have_no_invalid_point(name):
     from pathlib import Path
 
-    from tengsim.study.execute import validate
+    from tengsim.study.validate import validate
     from tengsim.study.spec import load_study
 
     s = load_study(Path(__file__).parents[1] / "examples" / "design" / f"{name}.toml")

@@ -108,7 +108,7 @@ def test_bad_point_fails_with_message_others_finish(tmp_path, client):
 def test_failure_at_compute_is_recorded(monkeypatch):
     """An exception inside a run becomes a failed point with its message (compute_point never raises)."""
     import tengsim.contact
-    from tengsim.study.execute import compute_point
+    from tengsim.study.worker import compute_point
 
     def boom(cfg, progress=None):
         raise FloatingPointError("overflow in the solver")
@@ -236,9 +236,9 @@ def test_cli_workers_and_scheduler_exclusive(tmp_path, capsys):
 def test_cli_unreachable_scheduler(tmp_path, capsys, monkeypatch):
     """Nothing listens at the address: exit 2, one line naming it, nothing written.  (How long the
     attempt lasts is not timed here: test_connect_gives_dask_its_timeout checks the bound handed to dask.)"""
-    from tengsim.study import execute
+    from tengsim.study import runner
 
-    monkeypatch.setattr(execute, "CONNECT_TIMEOUT_S", 0.5)  # a short attempt keeps the test quick
+    monkeypatch.setattr(runner, "CONNECT_TIMEOUT_S", 0.5)  # a short attempt keeps the test quick
     f = tmp_path / "s.toml"
     f.write_text(MINIMAL)
     rc = main(["sweep", str(f), "--out", str(tmp_path / "out"), "--scheduler", "tcp://127.0.0.1:9"])
@@ -253,7 +253,7 @@ def test_connect_gives_dask_its_timeout(monkeypatch):
     dask's Client, and turns dask's refusal into one TengsimError naming the address."""
     import dask.distributed
 
-    from tengsim.study import execute
+    from tengsim.study import runner
 
     seen = []
 
@@ -264,12 +264,12 @@ def test_connect_gives_dask_its_timeout(monkeypatch):
 
     monkeypatch.setattr(dask.distributed, "Client", Unreachable)
     # the greeting probe (tests/test_hostile.py) is not what this test is about: dask is reached here
-    monkeypatch.setattr(execute, "probe_scheduler", lambda address, timeout: None)
-    for kw, expect in [({}, f"{execute.CONNECT_TIMEOUT_S}s"), ({"timeout": 0.25}, "0.25s")]:
+    monkeypatch.setattr(runner, "probe_scheduler", lambda address, timeout: None)
+    for kw, expect in [({}, f"{runner.CONNECT_TIMEOUT_S}s"), ({"timeout": 0.25}, "0.25s")]:
         with pytest.raises(TengsimError, match=r"cannot reach the dask scheduler at 'tcp://10\.0\.0\.1:8786'"):
-            execute.connect(scheduler="tcp://10.0.0.1:8786", **kw)
+            runner.connect(scheduler="tcp://10.0.0.1:8786", **kw)
         assert seen.pop() == ("tcp://10.0.0.1:8786", expect)
-    assert 0 < execute.CONNECT_TIMEOUT_S <= 10  # a typo'd address fails in seconds, not dask's 30 s default
+    assert 0 < runner.CONNECT_TIMEOUT_S <= 10  # a typo'd address fails in seconds, not dask's 30 s default
 
 
 KILL_STUDY = """
@@ -481,7 +481,7 @@ def test_local_cluster_runs_quiet_monitors(client):
     task profiler and 20 ms tick would otherwise take CPU from the points) and pins threads."""
     import dask
 
-    from tengsim.study.execute import LOCAL_CLUSTER_CONFIG
+    from tengsim.study.runner import LOCAL_CLUSTER_CONFIG
 
     def settings():
         return ({k: dask.config.get(k) for k in LOCAL_CLUSTER_CONFIG}, os.environ.get("OPENBLAS_NUM_THREADS"))
@@ -498,7 +498,7 @@ def test_local_cluster_runs_quiet_monitors(client):
 def test_points_submitted_longest_first():
     """validate() orders the valid points by estimated cost, largest grid first; equal estimates keep
     the study's order (so a sweep ends on a short point, not a long one)."""
-    from tengsim.study.execute import estimated_cost, validate
+    from tengsim.study.validate import estimated_cost, validate
 
     study = tiny_study({"contact.dx": [0.4, 0.1, 0.2], "contact.tabor": [0.3, 0.5]})
     valid, invalid = validate(study)
@@ -574,7 +574,7 @@ def test_worker_dying_mid_point_is_a_failed_point_others_finish(tmp_path, monkey
     import distributed  # noqa: F401 - its config defaults, before the setting below
 
     from tengsim import registry
-    from tengsim.study.execute import connect
+    from tengsim.study.runner import connect
 
     name = "tengsim_bomb_" + tmp_path.name.replace("-", "_")
     (tmp_path / f"{name}.py").write_text(BOMB)
@@ -611,7 +611,7 @@ def test_sweep_progress_is_a_progress_line_per_point():
     import io
 
     from tengsim.progress import Progress
-    from tengsim.study.execute import SweepProgress
+    from tengsim.study.progress import SweepProgress
 
     s = io.StringIO()
     bar = SweepProgress(3, done=1, stream=s)

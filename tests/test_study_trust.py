@@ -16,7 +16,8 @@ from tengsim.cli.main import main
 from tengsim.errors import TengsimError
 from tengsim.status import SEVERITY
 from tengsim.study import parse_study, run_study
-from tengsim.study.execute import check_resume, compute_point, resolved_with_provenance
+from tengsim.study.resume import check_resume, resolved_with_provenance
+from tengsim.study.worker import compute_point
 from tengsim.study.hashing import point_id
 from tengsim.study.layout import StudyDir
 from tengsim.study.points import check_point, provenance, write_point

@@ -14,7 +14,7 @@
     DIR/optimum.json          the best point found by ``tengsim optimize``
     DIR/.lock                 held (flock) by the one sweep or optimisation running in DIR
 
-Both the runner (:mod:`tengsim.study.execute`, :mod:`tengsim.study.optimize`) and the assembler
+Both the runner (:mod:`tengsim.study.runner`, :mod:`tengsim.study.optimize`) and the assembler
 (:mod:`tengsim.study.dataset`) read the directory through :class:`StudyDir`; neither imports the other
 for it.
 """

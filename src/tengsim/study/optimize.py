@@ -6,7 +6,7 @@ scipy.optimize.differential_evolution calls its ``workers`` map once per generat
 the generation's new points on the Dask client (stored exactly like sweep points, DIR/points/<id>.nc),
 then evaluates the objective from the stored results.  With a fixed ``seed`` a resumed run asks for the
 same points and finds them on disk (each point file checked before it is trusted, a bad one computed
-again: tengsim.study.execute.verify_points).
+again: tengsim.study.resume.verify_points).
 
 Only points whose run status is ``ok`` are candidates (``accept`` adds others: ``--accept
 under_resolved``); any other point — another status, a failed point — counts as infeasible (a penalty),
@@ -132,7 +132,8 @@ def optimize_study(study, out, *, workers=None, scheduler=None, client=None, res
     from tengsim.io import write_json
     from tengsim.results.read import load_result
     from tengsim.study.dataset import build_study
-    from tengsim.study.execute import PointRunner, verify_points
+    from tengsim.study.resume import verify_points
+    from tengsim.study.runner import PointRunner
     from tengsim.study.layout import StudyDir
     from tengsim.study.observe import observe
 

@@ -12,7 +12,7 @@ table and of :func:`provenance`, everything else that determines its result:
 
 So a point computed by other code or from another file never has the id of this one, and a resumed
 study never takes it for this one.  A worker checks the provenance it sees against the client's
-before it computes (:func:`tengsim.study.execute.compute_point`).
+before it computes (:func:`tengsim.study.worker.compute_point`).
 
 **Point files.**  :func:`write_point` writes ``DIR/points/<id>.nc`` atomically (``tengsim.io.atomic_path``:
 fsync of the file and of its directory), with ``point_id`` and a ``content_digest`` attribute: a SHA-256
