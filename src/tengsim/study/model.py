@@ -38,7 +38,7 @@ class Axis:
         return list(self.labels) if self.labels else list(range(len(self.values)))
 
 
-@dataclass
+@dataclass(frozen=True)
 class Point:
     """One study point: its axis values (by axis member name) and resolved tables."""
 
@@ -55,9 +55,10 @@ class Point:
         return point_id(self.contact)
 
 
-@dataclass
+@dataclass(frozen=True)
 class Study:
-    """A parsed study: base tables, axes, sampling, observables and objective settings, points."""
+    """A parsed study: base tables, axes, sampling, observables and objective settings, points (frozen:
+    made whole by :func:`tengsim.study.spec.parse_study`)."""
 
     base: dict
     axes: list

@@ -34,6 +34,7 @@ made by :mod:`tengsim.study.hashing`.
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 import re
 
@@ -118,8 +119,7 @@ def parse_study(cfg: dict, source: str = "") -> Study:
     study = Study(base=base, axes=axes, sampling=sampling, n=int(n or 0), seed=int(seed),
                   observables=parse_observables(cfg.get("observables") or {}, where),
                   objective=dict(cfg.get("objective") or {}), source=source)
-    study.points = expand(study)
-    return study
+    return dataclasses.replace(study, points=expand(study))
 
 
 def _parse_shapes(tables, where) -> dict:
