@@ -106,9 +106,9 @@ class ContactResult:
         return bool(np.all(self.table["converged"]))
 
     @property
-    def status(self) -> str:
-        """Overall status, the worst row's: 'ok', 'under_resolved', 'out_of_law_range' or 'not_converged'
-        (criteria in :mod:`tengsim.status`)."""
+    def status(self) -> _status.Status:
+        """Overall status, the worst row's (a :class:`tengsim.status.Status`, equal to its text): 'ok',
+        'under_resolved', 'out_of_law_range' or 'not_converged' (criteria in :mod:`tengsim.status`)."""
         s = self.table.get("status")
         if s is None or np.asarray(s).dtype.kind not in "US":  # older files: classify from the columns
             s = _status.classify(self.table, self.grid.dx)
