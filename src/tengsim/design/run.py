@@ -10,9 +10,10 @@
    time constant"); an estimate above the plan's budget is refused (a :class:`tengsim.errors.TengsimError`
    naming max_pixels and tol) before anything is solved or written.
 2. **Path.**  An adaptive D walk (:class:`tengsim.path.PathSpec`) from D = -1 ε to a d_max found on a grid
-   twice as coarse as the first: from 1.2 × the structure's height (+2 ε), extended in chunks (the last
-   rows' dP/dD, extrapolated to 1.3 × the pressure still missing) until the approach reaches p_max, at most
-   :data:`EXTEND_TRIES` times; else an error naming the highest pressure reached, in kPa.
+   twice as coarse as the default first grid: from 1.2 × the structure's height (+2 ε), extended in chunks (the
+   last rows' dP/dD, extrapolated to 1.3 × the pressure still missing) until the approach reaches p_max, at
+   most :data:`EXTEND_TRIES` times; else an error naming the highest pressure reached, in kPa.  A finer grid's
+   walk ends a little past the D at which the grid before it reached p_max (:func:`grid_path`).
 3. **Refinement.**  :func:`tengsim.resolve.resolve_contact` on dx, dx/√2, ... until the charged-area
    fraction A/S on the approach at every asked pressure, the pull-off force and the jump D values change by
    at most tol between the last two grids (and their Richardson error is within tol).  If the finest grid
@@ -20,7 +21,7 @@
    retraction's numbers (A/S on the retraction, the hysteresis energy) are recorded per grid with their
    change and Richardson error but not judged (:func:`_watcher`); the pull-off force is judged.
 4. **Maps.**  Each grid after the first keeps the pressure and gap maps at the D where the grid before it
-   reached the asked pressures nearest 10 %, 50 % and 100 % of p_max (:func:`map_path`): the finest grid's
+   reached the asked pressures nearest 10 %, 50 % and 100 % of p_max (:func:`grid_path`): the finest grid's
    maps come from its own walk, at the coarser grid's prediction of those D (the figure titles say the
    pressure each map is at and the one asked).  ``maps = false``: none.  (Until the design speed-up the
    finest grid's approach was walked a second time for them, about a quarter of the run: :func:`maps_run`,
@@ -80,12 +81,14 @@ def _blocks(shape, grid) -> int:
     return n // (2 ** len(axes)) if axes else n
 
 
-START_ZONE_PIXELS = 8.0
+START_ZONE_PIXELS = 12.0
 """Pixels across the law's a-priori process zone ℓ_D on a design's first grid (by default).  The grid status asks
 for :data:`tengsim.status.RESOLUTION` (1.2); a design's numbers (A/S at the smallest contact of the curve, the
 pull-off) ask for far more: the issue's pyramid and cone (ℓ_D = 595 nm) converged at 35 pixels per ℓ_D (585²),
-and the refinement judges from the last three grids only, so the grids coarser than ℓ_D/8 (33² … 117², 5 of
-their 8 grids) were walked and thrown away."""
+the test suite's small pyramid (ℓ_D = 470 nm, 1 µm pitch) at 77, and the refinement judges from the last three
+grids only (its observed order; the change from the last two), so the grids coarser than ℓ_D/12 (33² … 165² of
+the issue's designs, 5 of their 8 grids) were walked and thrown away.  A design that would converge on a coarser
+grid pays for one or two grids finer than it needs."""
 
 
 def refinement_grids(shape, dx: float, count: int = 12) -> list:
@@ -293,19 +296,34 @@ def map_depths(res, plan) -> dict:
     return out
 
 
-def map_path(plan, d_max):
-    """``path_for`` of the refinement (:func:`tengsim.resolve.resolve_contact`): each grid's path keeps the
-    pressure and gap maps at the map depths of the grid before it (:func:`map_depths` of its curve; the first
-    grid none), so the finest grid's maps are recorded during its own walk (an extra row at each such D, solved
-    from the rows around it: the walk's other rows are unchanged); ``plan.maps`` false: no maps."""
+D_MARGIN = 0.03
+"""A finer grid's path ends at the D where the grid before it reached p_max, plus this fraction of that D
+(at least 2 d_step): a finer grid is softer, and between the issue's grids that D moved by less than 0.1 ε."""
+
+
+def grid_path(plan, d_max):
+    """``path_for`` of the refinement (:func:`tengsim.resolve.resolve_contact`): the first grid walks to
+    ``d_max`` (found on the coarse grid, :func:`find_d_max`); each finer grid to the D at which the grid before
+    it reached p_max, plus :data:`D_MARGIN` (on the path's lattice, never beyond ``d_max``): about 10 % of the
+    rows were past p_max.  Each finer grid's path also keeps the pressure and gap maps at the map depths of the
+    grid before it (:func:`map_depths` of its curve), so the finest grid's maps are recorded during its own walk
+    (an extra row at each such D, solved from the rows around it: the walk's other rows are unchanged);
+    ``plan.maps`` false: no maps."""
     from tengsim.path import PathSpec
 
+    def on_lattice(D):
+        return D_MIN + math.ceil((D - D_MIN) / D_STEP - 1e-9) * D_STEP
+
     def path_for(prev):
-        depths = ()
-        if plan.maps and prev is not None and prev.scaling is not None:
-            top = D_MIN + math.floor((d_max - D_MIN) / D_STEP + 1e-9) * D_STEP
-            depths = tuple(sorted(D for D in map_depths(prev, plan) if D_MIN <= D <= top))
-        return PathSpec(D_MIN, d_max, D_STEP, adaptive=True, maps_at=depths)
+        depths, top = (), d_max
+        if prev is not None and prev.scaling is not None:
+            ok, D_hit, _, _ = _reach(prev, plan.pressures[-1])
+            if ok:
+                top = min(d_max, on_lattice(D_hit + max(D_MARGIN * abs(D_hit), 2 * D_STEP)))
+            if plan.maps:
+                last = D_MIN + math.floor((top - D_MIN) / D_STEP + 1e-9) * D_STEP
+                depths = tuple(sorted(D for D in map_depths(prev, plan) if D_MIN <= D <= last))
+        return PathSpec(D_MIN, top, D_STEP, adaptive=True, maps_at=depths)
 
     return path_for
 
@@ -417,7 +435,7 @@ def run_design(plan, progress=None, keep=None) -> DesignResult:
         ck, found = _checkpoint(keep, plan, d_max, progress) or (None, None)
         res = resolve_contact(cplan.shape, cplan.tabor, path, dx=dx, law=cplan.law, boundary=cplan.boundary,
                               resolve_tol=plan.tol, max_pixels=max_pixels, observe=_observer(plan),
-                              watch=_watcher(plan), path_for=map_path(plan, d_max),
+                              watch=_watcher(plan), path_for=grid_path(plan, d_max),
                               progress=progress if callable(progress) else None, symmetry=cplan.symmetry,
                               solver=cplan.solver, tol=cplan.tol,
                               extra_params=cplan.extra, scaling=cplan.scaling, kernel_params=cplan.kernel_params,
