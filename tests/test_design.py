@@ -271,3 +271,29 @@ def test_cli_removes_the_kept_grids_once_written(tmp_path):
     out = tmp_path / "d"
     assert main([*CLI_SMALL, "--out", str(out)]) == 0
     assert (out / "design.nc").is_file() and not list(out.glob(".design-*.resolve.nc"))
+
+
+def test_budget_cap_lies_between_plain_grids():
+    """The default max_pixels is the largest grid the budget pays for, also between two grids of the plain √2
+    sequence (the refinement's grids keep a shape's edges in place and are larger than the plain ones): the issue's
+    pyramid refines to 585² from its 245² first grid within the default 10 min."""
+    from pathlib import Path
+
+    from tengsim.cli.design import _read_toml
+    from tengsim.config import plan_contact
+    from tengsim.design.run import D_MIN, D_STEP, ROWS_PER_STEP, SECONDS_PER_PIXEL_ROW, _blocks, budget_pixels
+    from tengsim.design.run import height_eps, start_dx
+
+    plan = plan_design(_read_toml(str(Path(__file__).parent.parent / "examples" / "own_design" / "pyramid.toml")))
+    cp = plan_contact(plan.contact_table)
+    dx = start_dx(plan, cp)
+    d_max = 1.2 * height_eps(cp, dx) + 2.0
+    cap = budget_pixels(plan, cp, dx, d_max)
+    assert cap >= 585 * 585
+    rows = ROWS_PER_STEP * (d_max - D_MIN) / D_STEP
+    plain = [cp.shape.grid(dx / math.sqrt(2.0) ** k) for k in range(8)]
+    below = [g for g in plain if g.nx * g.ny <= cap]
+    nxt = plain[len(below)]
+    assert nxt.nx * nxt.ny > cap  # the cap lies before the next plain grid, which the budget does not pay for
+    secs = sum(SECONDS_PER_PIXEL_ROW * _blocks(cp.shape, g) * rows for g in below)
+    assert secs <= plan.budget_s  # the plain grids up to the cap fit the budget

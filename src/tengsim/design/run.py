@@ -23,9 +23,8 @@
 4. **Maps.**  Each grid after the first keeps the pressure and gap maps at the D where the grid before it
    reached the asked pressures nearest 10 %, 50 % and 100 % of p_max (:func:`grid_path`): the finest grid's
    maps come from its own walk, at the coarser grid's prediction of those D (the figure titles say the
-   pressure each map is at and the one asked).  ``maps = false``: none.  (Until the design speed-up the
-   finest grid's approach was walked a second time for them, about a quarter of the run: :func:`maps_run`,
-   kept for a result without maps.)
+   pressure each map is at and the one asked).  ``maps = false``: none.  (The finest grid's approach walked a
+   second time for them was about a quarter of the run.)
 """
 from __future__ import annotations
 
@@ -200,8 +199,8 @@ def cap_line(plan, cplan, dx: float, d_max: float, cap: int) -> str:
         secs += SECONDS_PER_PIXEL_ROW * _blocks(cplan.shape, g) * rows
         last = g
     side = max(last.nx, math.isqrt(int(cap)))
-    if side > last.nx:  # a grid beyond the plain sequence's last (budget_pixels): the step to it, as its pixels
-        secs += SECONDS_PER_PIXEL_ROW * _blocks(cplan.shape, last) * rows * (side * side / (last.nx * last.ny) - 1)
+    if side > last.nx:  # one more grid, beyond the plain sequence's last (budget_pixels): its time as its pixels
+        secs += SECONDS_PER_PIXEL_ROW * _blocks(cplan.shape, last) * rows * side * side / (last.nx * last.ny)
     return (f"at most: refinement up to {side}×{side} (the budget's largest grid; --max-pixels sets it), "
             f"about {time_text(secs)} in all")
 
@@ -337,23 +336,6 @@ def maps_asked(res, plan) -> dict:
     return {round(D, 9): p for D, p in zip(Ds, want)} if len(Ds) == len(want) else {}
 
 
-def maps_run(res, cplan, plan):
-    """The finest grid's approach walked again up to the map depths (:func:`map_depths`), its pressure and gap
-    maps kept exactly there (the same path lattice: the same states); None if no depth is known."""
-    from tengsim.contact import simulate
-    from tengsim.path import PathSpec
-
-    depths = map_depths(res, plan)
-    if not depths:
-        return None, {}
-    top = max(depths) + D_STEP
-    path = PathSpec(D_MIN, top, D_STEP, adaptive=True, retract=False, maps_at=tuple(sorted(depths)))
-    out = simulate(cplan.shape, cplan.tabor, res.grid.dx, path, boundary=cplan.boundary, solver=cplan.solver,
-                   tol=cplan.tol, law=cplan.law, extra_params=cplan.extra, scaling=cplan.scaling, grid=res.grid,
-                   kernel_params=cplan.kernel_params, symmetry=cplan.symmetry)
-    return out, depths
-
-
 def area_name(branch: str, p: float) -> str:
     return f"A_S_{branch[:3]}_{p:.6g}Pa".replace("+", "").replace(".", "p")
 
@@ -451,7 +433,5 @@ def run_design(plan, progress=None, keep=None) -> DesignResult:
                            f"kPa on the finest grid: give a lower p_max")
     summary, conv, notes = summarize(res, plan)
     maps, depths = (res, maps_asked(res, plan)) if plan.maps and res.maps else (None, {})
-    if plan.maps and maps is None:  # none kept on the finest grid (taken back from an older checkpoint): walk again
-        maps, depths = maps_run(res, cplan, plan)
     summary["map_pressures_asked"] = tuple(depths.items())
     return DesignResult(plan, to_dataset(res, plan, summary), summary, conv, res, tuple(notes), maps)
