@@ -164,6 +164,84 @@ def test_refinement_message_in_the_users_units():
     msg = physical_message("stopped by max_pixels = 9 at dx = 0.1 (3×3; next 5×5); A_S_app_5000Pa changed 2% between "
                            "the last two grids, dx ≈ 0.05 needed", 200e-9)
     assert "dx = 20 nm" in msg and "dx ≈ 10 nm" in msg and "A/S at 5 kPa (approach)" in msg
+    # a physical run's refinement writes its lengths with their unit already: not converted a second time
+    msg = physical_message("at dx = 22 nm (455×455; next 675×675); dx ≈ 10.7 nm needed, dx below 1.2 µm", 143e-9)
+    assert "dx = 22 nm (" in msg and "dx ≈ 10.7 nm needed" in msg and "dx below 1.2 µm" in msg
+
+
+def test_first_grid_is_the_default_refinements_first_fine_enough_one():
+    """The first grid: the refinement from the default start (the cell over 9 pixels, …) less its grids coarser
+    than the process zone over START_ZONE_PIXELS, which cannot be the last (issue 29: 33² … 117² were thrown away
+    for the issue's pyramid)."""
+    from tengsim import status
+    from tengsim.config import plan_contact
+    from tengsim.design.run import START_ZONE_PIXELS, refinement_grids, start_dx
+    from tengsim.resolve import default_dx
+
+    from tengsim.cli.design import _read_toml
+    from pathlib import Path
+
+    plan = plan_design(_read_toml(str(Path(__file__).parent.parent / "examples" / "own_design" / "pyramid.toml")))
+    cp = plan_contact(plan.contact_table)
+    zone = status.process_zone_estimate(cp.law, cp.tabor**1.5)
+    dx0 = default_dx(cp.shape, cp.law, cp.tabor**1.5, cp.boundary)
+    seq = refinement_grids(cp.shape, dx0)
+    dx = start_dx(plan, cp)
+    k = [g.nx for g in seq].index(cp.shape.grid(dx).nx)
+    assert k > 0 and seq[k].dx <= zone / START_ZONE_PIXELS < seq[k - 1].dx
+    assert [g.nx for g in seq[k:k + 3]] == [245, 385, 585]  # the last grids the pyramid converged on before
+    given = plan_design(dict(_read_toml(str(Path(__file__).parent.parent / "examples" / "own_design" / "pyramid.toml")),
+                             dx="100nm"))
+    assert start_dx(given, cp) * cp.scaling.lateral == pytest.approx(100e-9)  # a dx given is the first grid's
+
+
+def test_maps_kept_during_the_finest_walk(small):
+    """The finest grid's own walk keeps the maps (no second walk), at the D where the grid before reached the
+    asked pressures: each map's nominal pressure is the one the finest grid's own depth for that pressure gives
+    (what a second walk kept, :func:`tengsim.design.run.map_depths`; after a snap, the state the load reaches)
+    to within 2 % of p_max."""
+    from tengsim.design.run import map_depths
+
+    res = small.finest
+    assert small.maps is res
+    maps = sorted((m for m in res.maps if m["branch"] == "approach"), key=lambda m: m["D"])
+    asked = dict(small.summary["map_pressures_asked"])
+    assert len(maps) == len(asked) == 3
+    a = res.branch("approach")
+    D, P = np.asarray(a["D"], float), np.asarray(a["pressure_Pa"], float)
+    own = sorted(map_depths(res, small.plan).items(), key=lambda kv: kv[1])
+    for m, (d_own, p_asked) in zip(maps, own):
+        assert asked[round(float(m["D"]), 9)] == p_asked
+        i = int(np.argmin(np.abs(D - m["D"])))
+        assert abs(D[i] - m["D"]) < 1e-9
+        j = int(np.argmin(np.abs(D - d_own)))
+        p_own = P[j] if abs(D[j] - d_own) < 1e-9 else np.interp(d_own, D, P)
+        assert abs(P[i] - p_own) <= 0.02 * small.plan.pressures[-1], (P[i], p_own, p_asked)
+
+
+def test_retraction_convergence_recorded_per_grid(small, tmp_path):
+    """design.nc records the refinement, grid by grid: A/S on both branches, the pull-off force, the hysteresis;
+    the change of each between the last two grids is an attribute and a row of the report (issue 29)."""
+    ds = small.dataset
+    tab = small.finest.params["resolution"]
+    n = ds.sizes["refinement_grid"]
+    assert n == len(tab["dx"]) >= 2 and list(ds["grid_pixels"].values) == list(tab["nx"])
+    by = ds["charged_area_fraction_by_grid"]
+    assert by.dims == ("refinement_grid", "branch", "applied_pressure")
+    # the finest grid's entries are the design's own numbers
+    np.testing.assert_allclose(by.values[-1], ds["charged_area_fraction"].values, rtol=1e-12, equal_nan=True)
+    assert float(ds["pull_off_force_by_grid"][-1]) == pytest.approx(small.summary["pull_off_N"], rel=1e-12)
+    assert float(ds["hysteresis_by_grid"][-1]) == pytest.approx(small.summary["hysteresis_J_m2"], rel=1e-12)
+    ret = by.sel(branch="retraction").values
+    both = np.isfinite(ret[-1]) & np.isfinite(ret[-2])
+    change = np.max(np.abs(ret[-1] - ret[-2])[both] / np.maximum(np.abs(ret[-1][both]), 0.01))
+    assert ds.attrs["change_charged_area_A_S_on_the_retraction"] == pytest.approx(change, rel=1e-9)
+    h = ds["hysteresis_by_grid"].values
+    assert np.all(np.isfinite(h)) and h[-1] != 0
+    assert ds.attrs["change_hysteresis_energy"] == pytest.approx(abs(h[-1] - h[-2]) / abs(h[-1]), rel=1e-9)
+    write_design(small, tmp_path / "d", figures=False)
+    text = (tmp_path / "d" / "report.md").read_text()
+    assert "hysteresis energy (recorded, not judged)" in text and "on the retraction" in text
 
 
 def test_a_killed_design_resumes_from_its_kept_grids(tmp_path, small):
@@ -193,3 +271,29 @@ def test_cli_removes_the_kept_grids_once_written(tmp_path):
     out = tmp_path / "d"
     assert main([*CLI_SMALL, "--out", str(out)]) == 0
     assert (out / "design.nc").is_file() and not list(out.glob(".design-*.resolve.nc"))
+
+
+def test_budget_cap_lies_between_plain_grids():
+    """The default max_pixels is the largest grid the budget pays for, also between two grids of the plain √2
+    sequence (the refinement's grids keep a shape's edges in place and are larger than the plain ones): the issue's
+    pyramid refines to 585² from its 245² first grid within the default 10 min."""
+    from pathlib import Path
+
+    from tengsim.cli.design import _read_toml
+    from tengsim.config import plan_contact
+    from tengsim.design.run import D_MIN, D_STEP, ROWS_PER_STEP, SECONDS_PER_PIXEL_ROW, _blocks, budget_pixels
+    from tengsim.design.run import height_eps, start_dx
+
+    plan = plan_design(_read_toml(str(Path(__file__).parent.parent / "examples" / "own_design" / "pyramid.toml")))
+    cp = plan_contact(plan.contact_table)
+    dx = start_dx(plan, cp)
+    d_max = 1.2 * height_eps(cp, dx) + 2.0
+    cap = budget_pixels(plan, cp, dx, d_max)
+    assert cap >= 585 * 585
+    rows = ROWS_PER_STEP * (d_max - D_MIN) / D_STEP
+    plain = [cp.shape.grid(dx / math.sqrt(2.0) ** k) for k in range(8)]
+    below = [g for g in plain if g.nx * g.ny <= cap]
+    nxt = plain[len(below)]
+    assert nxt.nx * nxt.ny > cap  # the cap lies before the next plain grid, which the budget does not pay for
+    secs = sum(SECONDS_PER_PIXEL_ROW * _blocks(cp.shape, g) * rows for g in below)
+    assert secs <= plan.budget_s  # the plain grids up to the cap fit the budget

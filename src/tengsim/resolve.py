@@ -266,7 +266,7 @@ def _dx_needed(levels: list, rich: dict, changes: dict, tol: float) -> float:
 def resolve_contact(shape, tabor: float, path, dx: float | None = None, law=None, boundary: str = "free",
                     resolve_tol: float = DEFAULT_TOL, max_pixels: int | None = None, observe=None,
                     full_length: float | None = None, progress=None, checkpoint=None, start=None,
-                    **simulate_kw):
+                    watch=None, path_for=None, **simulate_kw):
     """Run :func:`tengsim.contact.simulate` on finer and finer grids until converged (module doc).
 
     ``dx`` the first grid's spacing (None: :func:`default_dx`), ``resolve_tol`` the relative tolerance,
@@ -278,7 +278,12 @@ def resolve_contact(shape, tabor: float, path, dx: float | None = None, law=None
 
     ``checkpoint(levels, phases, result)``, if given, is called after each finished grid (to keep it: a
     killed refinement keeps every grid it finished, :class:`Checkpoint`); ``start = (levels, phases,
-    result)`` continues a refinement from such a record instead of computing those grids again."""
+    result)`` continues a refinement from such a record instead of computing those grids again.
+
+    ``watch(result) -> dict``: observables recorded per grid, with their change and Richardson error, but not
+    judged (they do not decide when to stop: numbers a caller reports how converged they are, e.g. a design's
+    hysteresis).  ``path_for(result) -> path``: the path of the next grid from the grid before it (None on the
+    first grid; e.g. the D at which its maps are kept, predicted from the coarser curve); default ``path``."""
     from tengsim.contact import simulate
     from tengsim.errors import positive
     from tengsim.laws import LJ93, make_law
@@ -291,14 +296,15 @@ def resolve_contact(shape, tabor: float, path, dx: float | None = None, law=None
         max_pixels = default_max_pixels(boundary, solver if isinstance(solver, str) else "fast")
     max_pixels = check_max_pixels(max_pixels)
     dx = default_dx(shape, law, tabor**1.5, boundary) if dx is None else positive("dx", dx)
-    levels, names, res, seen = [], [], None, set()
+    levels, names, res, seen, watched = [], [], None, set(), []
     stop, phases, done = None, (), False
     if start is not None:  # a refinement kept by its checkpoint: its grids are not computed again
         levels, phases, res = [dict(lv) for lv in start[0]], tuple(start[1]), start[2]
         for lv in levels:
             names.extend(k for k in lv["obs"] if k not in names)
+            watched.extend(k for k in lv.get("watched", ()) if k not in watched)
         seen = {(lv["nx"], lv["ny"]) for lv in levels}
-        done = _judge(levels, names, tol)[0]
+        done = _judge(levels, [n for n in names if n not in watched], tol)[0]
         dx = levels[-1]["dx"] / FACTOR
     while not done:
         grid = shape.grid(dx)
@@ -317,29 +323,37 @@ def resolve_contact(shape, tabor: float, path, dx: float | None = None, law=None
             break
         seen.add((grid.nx, grid.ny))
         t0 = time.perf_counter()
-        res = simulate(shape, tabor, dx, path, boundary=boundary, law=law, grid=grid, progress=progress,
+        this_path = path if path_for is None else path_for(res)
+        res = simulate(shape, tabor, dx, this_path, boundary=boundary, law=law, grid=grid, progress=progress,
                        **simulate_kw)
         obs = contact_observables(res, full_length)
         if observe is not None:
             obs.update(observe(res))
+        seen_watch = watch(res) if watch is not None else {}
+        watched.extend(k for k in seen_watch if k not in watched)
+        obs.update(seen_watch)
         names.extend(k for k in obs if k not in names)
         levels.append({"dx": grid.dx, "nx": grid.nx, "ny": grid.ny, "seconds": time.perf_counter() - t0,
                        "convolutions": int(res.params.get("n_conv_spent",
                                                           np.nansum(np.asarray(res.table["n_conv"], dtype=float)))),
-                       "status": res.status, "obs": obs})
+                       "status": res.status, "obs": obs, "watched": list(seen_watch)})
         if checkpoint is not None:
             checkpoint(levels, phases, res)
-        done, changes, rich = _judge(levels, names, tol)
+        done, changes, rich = _judge(levels, [n for n in names if n not in watched], tol)
         if done:
             break
         dx = grid.dx / FACTOR
-    _, changes, rich = _judge(levels, names, tol)
+    _, changes, rich = _judge(levels, [n for n in names if n not in watched], tol)
+    _, w_changes, w_rich = _judge(levels, watched, tol)
     p = dict(res.params)  # the result's parameters, then the refinement's
     p.update(resolve="auto", resolve_tol=tol, max_pixels=int(max_pixels),
              resolve_grids=[lv["dx"] for lv in levels], resolution=_levels_table(levels, names),
              richardson={n: {k: r[k] for k in ("order", "observed", "extrapolated", "error")}
                          | {"rel_error": r.get("rel_error", math.nan), "change": changes.get(n, math.nan)}
                          for n, r in rich.items()},
+             watched={n: {k: r[k] for k in ("order", "observed", "extrapolated", "error")}
+                      | {"rel_error": r.get("rel_error", math.nan), "change": w_changes.get(n, math.nan)}
+                      for n, r in w_rich.items()},
              resolve_seconds=sum(lv["seconds"] for lv in levels), resolve_edge_phases=list(phases))
     if stop is not None:
         need = _dx_needed(levels, rich, changes, tol)

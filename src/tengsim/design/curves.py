@@ -203,20 +203,36 @@ def physical_message(text: str, lateral: float) -> str:
     def dx(m):
         return f"dx {m.group(1)} {length_text(float(m.group(2)) * lateral)}"
 
-    text = re.sub(r"dx (=|≈|below) ([0-9.]+(?:e[-+]?[0-9]+)?)", dx, text)
+    # a number in X units only: the refinement writes a physical run's lengths with their unit already
+    text = re.sub(r"dx (=|≈|below) ([0-9.]+(?:e[-+]?[0-9]+)?)(?![0-9.e]|\s*[pnµumk]?m\b)", dx, text)
     return re.sub(r"A_S_(app|ret)_([0-9p.e+]+)Pa",
                   lambda m: f"A/S at {float(m.group(2).replace('p', '.')) / 1e3:g} kPa "
                             f"({'approach' if m.group(1) == 'app' else 'retraction'})", text)
 
 
+RETRACTION_AREA = "charged area A/S on the retraction (largest over the pressures; recorded, not judged)"
+HYSTERESIS = "hysteresis energy (recorded, not judged)"
+
+
 def convergence(res) -> dict:
-    """{number: relative change between the last two grids} of the refined numbers: A/S on the approach (the
-    largest over the asked pressures), pull-off force, jump-in and jump-out D; NaN with one grid."""
+    """{number: relative change between the last two grids}: the judged numbers, A/S on the approach (the
+    largest over the asked pressures), pull-off force, jump-in and jump-out D; then the retraction's numbers the
+    refinement records but does not judge (:func:`tengsim.design.run._watcher`): A/S on the retraction (the
+    largest over the pressures it reaches on both grids) and the hysteresis energy; NaN with one grid."""
     rich = res.params.get("richardson") or {}
+    watched = res.params.get("watched") or {}
     out = {}
-    areas = [r.get("change", math.nan) for n, r in rich.items() if n.startswith("A_S_app")]
-    areas = [a for a in areas if math.isfinite(a)]
-    out["charged area A/S (largest over the pressures)"] = max(areas) if areas else math.nan
+
+    def largest(table, prefix):
+        vals = [r.get("change", math.nan) for n, r in table.items() if n.startswith(prefix)]
+        vals = [a for a in vals if math.isfinite(a)]
+        return max(vals) if vals else math.nan
+
+    out["charged area A/S (largest over the pressures)"] = largest(rich, "A_S_app")
     for key, label in (("pull_off_F", "pull-off force"), ("jump_in_D", "jump-in D"), ("jump_out_D", "jump-out D")):
         out[label] = float(rich.get(key, {}).get("change", math.nan))
+    out[RETRACTION_AREA] = largest(watched, "A_S_ret")
+    h = [float(x) for x in (res.params.get("resolution") or {}).get("hysteresis_W", [])][-2:]
+    # relative to the finest value itself (no floor: the energy's scale is its own)
+    out[HYSTERESIS] = abs(h[1] - h[0]) / abs(h[1]) if len(h) == 2 and h[1] != 0 else math.nan
     return out

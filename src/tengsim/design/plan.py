@@ -58,8 +58,8 @@ def design_fields() -> list:
         Field("max_pixels", "int", None, help="largest grid nx·ny the refinement may use"),
         Field("budget", default=600.0, dim="time", help="largest estimated run time before it is refused, "
               "in seconds or with a unit, e.g. 600 or '600s' (default 600 s)"),
-        Field("maps", "bool", True, help="keep contact pressure maps near 10 %, 50 % and 100 % of p_max (the "
-              "finest grid's approach walked again: about half its time); false: none"),
+        Field("maps", "bool", True, help="keep contact pressure maps near 10 %, 50 % and 100 % of p_max (kept "
+              "during the finest grid's walk, at the depths the grid before it predicts); false: none"),
         Field("fit_max", default=None, dim="pressure", help="top of the low-pressure range of the linear fit "
               "of V_OC(P) (default p_min + (p_max - p_min)/10)"),
     ]

@@ -2,23 +2,29 @@
 
 :func:`run_design` (a :class:`tengsim.design.plan.DesignPlan` → :class:`DesignResult`):
 
-1. **Grid.**  The first dx is the user's (a length) or :func:`tengsim.resolve.default_dx` (the law's
-   process zone over the pixels the status asks for, and the pixel-snap limit).  Before anything runs,
+1. **Grid.**  The first dx is the user's (a length) or :func:`start_dx`: the finer of
+   :func:`tengsim.resolve.default_dx` (the law's process zone over the pixels the status asks for, and the
+   pixel-snap limit) and the process zone over :data:`START_ZONE_PIXELS`.  Before anything runs,
    :func:`estimate` prints the grids (first, and the next two of √2 refinement), the memory of the finest
    and an estimated time: :data:`SECONDS_PER_PIXEL_ROW` × pixels × rows per grid (docs/benchmarks.md, "Design
    time constant"); an estimate above the plan's budget is refused (a :class:`tengsim.errors.TengsimError`
    naming max_pixels and tol) before anything is solved or written.
 2. **Path.**  An adaptive D walk (:class:`tengsim.path.PathSpec`) from D = -1 ε to a d_max found on a grid
-   twice as coarse as the first: from 1.2 × the structure's height (+2 ε), extended in chunks (the last
-   rows' dP/dD, extrapolated to 1.3 × the pressure still missing) until the approach reaches p_max, at most
-   :data:`EXTEND_TRIES` times; else an error naming the highest pressure reached, in kPa.
+   twice as coarse as the default first grid: from 1.2 × the structure's height (+2 ε), extended in chunks (the
+   last rows' dP/dD, extrapolated to 1.3 × the pressure still missing) until the approach reaches p_max, at
+   most :data:`EXTEND_TRIES` times; else an error naming the highest pressure reached, in kPa.  A finer grid's
+   walk ends a little past the D at which the grid before it reached p_max (:func:`grid_path`).
 3. **Refinement.**  :func:`tengsim.resolve.resolve_contact` on dx, dx/√2, ... until the charged-area
    fraction A/S on the approach at every asked pressure, the pull-off force and the jump D values change by
    at most tol between the last two grids (and their Richardson error is within tol).  If the finest grid
-   does not reach p_max (a finer grid is softer), d_max grows and the refinement runs again (once).
-4. **Maps.**  The finest grid's approach is walked again (approach only, the same path lattice) up to the D at
-   which it reaches the asked pressures nearest 10 %, 50 % and 100 % of p_max, keeping the pressure and gap
-   maps exactly there (``maps = false``: skipped; about half the finest grid's time).
+   does not reach p_max (a finer grid is softer), d_max grows and the refinement runs again (once).  The
+   retraction's numbers (A/S on the retraction, the hysteresis energy) are recorded per grid with their
+   change and Richardson error but not judged (:func:`_watcher`); the pull-off force is judged.
+4. **Maps.**  Each grid after the first keeps the pressure and gap maps at the D where the grid before it
+   reached the asked pressures nearest 10 %, 50 % and 100 % of p_max (:func:`grid_path`): the finest grid's
+   maps come from its own walk, at the coarser grid's prediction of those D (the figure titles say the
+   pressure each map is at and the one asked).  ``maps = false``: none.  (The finest grid's approach walked a
+   second time for them was about a quarter of the run.)
 """
 from __future__ import annotations
 
@@ -75,13 +81,55 @@ def _blocks(shape, grid) -> int:
     return n // (2 ** len(axes)) if axes else n
 
 
+START_ZONE_PIXELS = 12.0
+"""Pixels across the law's a-priori process zone ℓ_D on a design's first grid (by default).  The grid status asks
+for :data:`tengsim.status.RESOLUTION` (1.2); a design's numbers (A/S at the smallest contact of the curve, the
+pull-off) ask for far more: the issue's pyramid and cone (ℓ_D = 595 nm) converged at 35 pixels per ℓ_D (585²),
+the test suite's small pyramid (ℓ_D = 470 nm, 1 µm pitch) at 77, and the refinement judges from the last three
+grids only (its observed order; the change from the last two), so the grids coarser than ℓ_D/12 (33² … 165² of
+the issue's designs, 5 of their 8 grids) were walked and thrown away.  A design that would converge on a coarser
+grid pays for one or two grids finer than it needs."""
+
+
+def refinement_grids(shape, dx: float, count: int = 12) -> list:
+    """The grids :func:`tengsim.resolve.resolve_contact` walks from a first grid of spacing ``dx`` (each the
+    plain √2 step, moved to keep the shape's edges in place), at most ``count``, none over the budget limit."""
+    from tengsim.resolve import FACTOR, _aligned, edge_phases
+
+    out, seen, phases = [], set(), ()
+    while len(out) < count:
+        g = shape.grid(dx)
+        if out:
+            g = _aligned(shape, g, phases, 2**40)
+        else:
+            phases = edge_phases(shape, g)
+        if (g.nx, g.ny) in seen:
+            dx /= FACTOR
+            continue
+        seen.add((g.nx, g.ny))
+        out.append(g)
+        dx = g.dx / FACTOR
+    return out
+
+
 def start_dx(plan, cplan) -> float:
-    """The first grid's dx in X units: the plan's (a length) or the default from the law's process zone."""
+    """The first grid's dx in X units: the plan's (a length), or the first grid of the refinement that
+    :func:`tengsim.resolve.default_dx` would start (the cell over 9 pixels, the status's process-zone
+    resolution, the pixel-snap limit: :func:`refinement_grids`) whose dx is at most the law's process zone over
+    :data:`START_ZONE_PIXELS`: the same grids as from the default start, less those too coarse to be the last."""
+    from tengsim import status
     from tengsim.resolve import default_dx
 
     if plan.dx is not None:
         return plan.dx / cplan.scaling.lateral
-    return default_dx(cplan.shape, cplan.law, cplan.tabor**1.5, cplan.boundary)
+    dx = default_dx(cplan.shape, cplan.law, cplan.tabor**1.5, cplan.boundary)
+    zone = status.process_zone_estimate(cplan.law, cplan.tabor**1.5)
+    if not (math.isfinite(zone) and zone > 0) or dx <= zone / START_ZONE_PIXELS:
+        return dx
+    for g in refinement_grids(cplan.shape, dx):
+        if g.dx <= zone / START_ZONE_PIXELS:
+            return g.dx
+    return zone / START_ZONE_PIXELS
 
 
 def height_eps(cplan, dx) -> float:
@@ -126,14 +174,16 @@ def budget_pixels(plan, cplan, dx: float, d_max: float) -> int:
     """The largest grid (nx·ny) the refinement may reach within the plan's time budget (the estimate summed
     over the grids dx, dx/√2, ... up to it): the default max_pixels, so no default run runs past its budget."""
     rows = ROWS_PER_STEP * (d_max - D_MIN) / D_STEP
-    secs, k, top = 0.0, 0, 9
-    while k < 12:
+    secs, top = 0.0, 9
+    for k in range(12):
         g = cplan.shape.grid(dx / math.sqrt(2.0) ** k)
-        secs += SECONDS_PER_PIXEL_ROW * _blocks(cplan.shape, g) * rows
-        if secs > plan.budget_s and k > 0:
-            break
+        cost = SECONDS_PER_PIXEL_ROW * _blocks(cplan.shape, g) * rows
+        if secs + cost > plan.budget_s and k > 0:  # the grid between the last that fits and this one that the
+            # budget still pays for (a grid's time goes as its pixels): the refinement's grids keep a shape's
+            # edges in place and so are up to resolve.PHASE_SPAN larger than the plain √2 sequence
+            return max(top, int(g.nx * g.ny * (plan.budget_s - secs) / cost))
+        secs += cost
         top = g.nx * g.ny
-        k += 1
     return top
 
 
@@ -149,7 +199,10 @@ def cap_line(plan, cplan, dx: float, d_max: float, cap: int) -> str:
             break
         secs += SECONDS_PER_PIXEL_ROW * _blocks(cplan.shape, g) * rows
         last = g
-    return (f"at most: refinement up to {last.nx}×{last.ny} (the budget's largest grid; --max-pixels sets it), "
+    side = max(last.nx, math.isqrt(int(cap)))
+    if side > last.nx:  # one more grid, beyond the plain sequence's last (budget_pixels): its time as its pixels
+        secs += SECONDS_PER_PIXEL_ROW * _blocks(cplan.shape, last) * rows * side * side / (last.nx * last.ny)
+    return (f"at most: refinement up to {side}×{side} (the budget's largest grid; --max-pixels sets it), "
             f"about {time_text(secs)} in all")
 
 
@@ -196,6 +249,10 @@ def find_d_max(plan, cplan, dx, progress=None):
 
     p_max = plan.pressures[-1]
     coarse = 2 * dx
+    if plan.dx is None:  # the default grid's (the cell over 9 pixels at most): cheap, whatever the first grid
+        from tengsim.resolve import default_dx
+
+        coarse = 2 * max(dx, default_dx(cplan.shape, cplan.law, cplan.tabor**1.5, cplan.boundary))
     d_max = 1.2 * height_eps(cplan, dx) + 2.0
     for _ in range(EXTEND_TRIES):
         res = _simulate(cplan, coarse, d_max)
@@ -239,21 +296,45 @@ def map_depths(res, plan) -> dict:
     return out
 
 
-def maps_run(res, cplan, plan):
-    """The finest grid's approach walked again up to the map depths (:func:`map_depths`), its pressure and gap
-    maps kept exactly there (the same path lattice: the same states); None if no depth is known."""
-    from tengsim.contact import simulate
+D_MARGIN = 0.03
+"""A finer grid's path ends at the D where the grid before it reached p_max, plus this fraction of that D
+(at least 2 d_step): a finer grid is softer, and between the issue's grids that D moved by less than 0.1 ε."""
+
+
+def grid_path(plan, d_max):
+    """``path_for`` of the refinement (:func:`tengsim.resolve.resolve_contact`): the first grid walks to
+    ``d_max`` (found on the coarse grid, :func:`find_d_max`); each finer grid to the D at which the grid before
+    it reached p_max, plus :data:`D_MARGIN` (on the path's lattice, never beyond ``d_max``): about 10 % of the
+    rows were past p_max.  Each finer grid's path also keeps the pressure and gap maps at the map depths of the
+    grid before it (:func:`map_depths` of its curve), so the finest grid's maps are recorded during its own walk
+    (an extra row at each such D, solved from the rows around it: the walk's other rows are unchanged);
+    ``plan.maps`` false: no maps."""
     from tengsim.path import PathSpec
 
-    depths = map_depths(res, plan)
-    if not depths:
-        return None, {}
-    top = max(depths) + D_STEP
-    path = PathSpec(D_MIN, top, D_STEP, adaptive=True, retract=False, maps_at=tuple(sorted(depths)))
-    out = simulate(cplan.shape, cplan.tabor, res.grid.dx, path, boundary=cplan.boundary, solver=cplan.solver,
-                   tol=cplan.tol, law=cplan.law, extra_params=cplan.extra, scaling=cplan.scaling, grid=res.grid,
-                   kernel_params=cplan.kernel_params, symmetry=cplan.symmetry)
-    return out, depths
+    def on_lattice(D):
+        return D_MIN + math.ceil((D - D_MIN) / D_STEP - 1e-9) * D_STEP
+
+    def path_for(prev):
+        depths, top = (), d_max
+        if prev is not None and prev.scaling is not None:
+            ok, D_hit, _, _ = _reach(prev, plan.pressures[-1])
+            if ok:
+                top = min(d_max, on_lattice(D_hit + max(D_MARGIN * abs(D_hit), 2 * D_STEP)))
+            if plan.maps:
+                last = D_MIN + math.floor((top - D_MIN) / D_STEP + 1e-9) * D_STEP
+                depths = tuple(sorted(D for D in map_depths(prev, plan) if D_MIN <= D <= last))
+        return PathSpec(D_MIN, top, D_STEP, adaptive=True, maps_at=depths)
+
+    return path_for
+
+
+def maps_asked(res, plan) -> dict:
+    """{D (ε): asked pressure (Pa)} of the approach maps ``res`` kept: the asked pressures nearest
+    :data:`MAP_FRACTIONS` of p_max, in order of D (the maps were predicted at them from the grid before)."""
+    asked = [p for p in plan.pressures if p > 0]
+    want = sorted({min(asked, key=lambda x: abs(x - f * plan.pressures[-1])) for f in MAP_FRACTIONS}) if asked else []
+    Ds = sorted(float(m["D"]) for m in (res.maps or []) if str(m["branch"]) == "approach")
+    return {round(D, 9): p for D, p in zip(Ds, want)} if len(Ds) == len(want) else {}
 
 
 def area_name(branch: str, p: float) -> str:
@@ -268,6 +349,20 @@ def _observer(plan):
         return {area_name("approach", p): float(a) for p, a in zip(plan.pressures, c["approach"]["area"])}
 
     return observe
+
+
+def _watcher(plan):
+    """The retraction's numbers, recorded per grid with their convergence but not judged (the pull-off force
+    is judged by the refinement itself): A/S on the retraction at the asked pressures and the hysteresis."""
+    from tengsim.design.curves import branch_curves
+
+    def watch(res) -> dict:
+        c = branch_curves(res, plan)
+        out = {area_name("retraction", p): float(a) for p, a in zip(plan.pressures, c["retraction"]["area"])}
+        out["hysteresis_W"] = float(res.hysteresis)
+        return out
+
+    return watch
 
 
 def _checkpoint(keep, plan, d_max, progress):
@@ -323,6 +418,7 @@ def run_design(plan, progress=None, keep=None) -> DesignResult:
         ck, found = _checkpoint(keep, plan, d_max, progress) or (None, None)
         res = resolve_contact(cplan.shape, cplan.tabor, path, dx=dx, law=cplan.law, boundary=cplan.boundary,
                               resolve_tol=plan.tol, max_pixels=max_pixels, observe=_observer(plan),
+                              watch=_watcher(plan), path_for=grid_path(plan, d_max),
                               progress=progress if callable(progress) else None, symmetry=cplan.symmetry,
                               solver=cplan.solver, tol=cplan.tol,
                               extra_params=cplan.extra, scaling=cplan.scaling, kernel_params=cplan.kernel_params,
@@ -337,6 +433,6 @@ def run_design(plan, progress=None, keep=None) -> DesignResult:
         raise TengsimError(f"the approach reached only {top / 1e3:.4g} kPa of p_max = {plan.pressures[-1] / 1e3:.4g} "
                            f"kPa on the finest grid: give a lower p_max")
     summary, conv, notes = summarize(res, plan)
-    maps, depths = maps_run(res, cplan, plan) if plan.maps else (None, {})
+    maps, depths = (res, maps_asked(res, plan)) if plan.maps and res.maps else (None, {})
     summary["map_pressures_asked"] = tuple(depths.items())
     return DesignResult(plan, to_dataset(res, plan, summary), summary, conv, res, tuple(notes), maps)

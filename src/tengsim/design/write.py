@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -64,8 +65,45 @@ def to_dataset(res, plan, summary: dict):
         if k in SUMMARY_UNITS and k != "tabor":
             attrs[k] = float(v) if v is not None and math.isfinite(float(v)) else "n/a"
     ds.attrs = attrs
+    _by_grid(ds, res, plan)
     ds["branch"].encoding["dtype"] = "S1"  # a char array: CF's checker cannot judge a string coordinate variable
     return cf_conventions(ds, f"tengsim design: {plan.name}")
+
+
+GRID_DIM = "refinement_grid"
+
+
+def _by_grid(ds, res, plan) -> None:
+    """The refinement's record, one entry per grid (coarse to fine; ``refinement_grid`` dimension): its spacing,
+    pixels per side, the charged area on both branches at the asked pressures, the pull-off force and the
+    hysteresis energy; and ``change_*`` attributes: each number's relative change between the last two grids
+    (:func:`tengsim.design.curves.convergence`).  Nothing with one grid run outside the refinement."""
+    from tengsim.design.curves import convergence
+    from tengsim.design.run import area_name
+
+    tab = res.params.get("resolution") or {}
+    if not tab:
+        return
+    sc = res.scaling
+    n = len(tab["dx"])
+    nan = [math.nan] * n
+
+    def col(name):
+        return np.asarray([math.nan if v is None else float(v) for v in tab.get(name, nan)], float)
+
+    area = np.stack([np.stack([col(area_name(b, p)) for p in plan.pressures], axis=-1) for b in BRANCHES], axis=1)
+    ds["grid_spacing"] = (GRID_DIM, sc.lateral * col("dx"), {"units": "m", "long_name": "grid spacing dx"})
+    ds["grid_pixels"] = (GRID_DIM, np.asarray(tab["nx"], dtype=np.int32),
+                         {"units": "1", "long_name": "pixels along x"})
+    ds["charged_area_fraction_by_grid"] = ((GRID_DIM, "branch", PRESSURE_DIM), area,
+                                           {"units": "1", "long_name": "charged area A/S on each grid"})
+    ds["pull_off_force_by_grid"] = (GRID_DIM, sc.force(1.0) * col("pull_off_F"),
+                                    {"units": "N", "long_name": "pull-off force per cell on each grid"})
+    ds["hysteresis_by_grid"] = (GRID_DIM, sc.work(1.0) / sc.cell_area * col("hysteresis_W"),
+                                {"units": "J m-2", "long_name": "energy lost per cycle per unit area on each grid"})
+    for label, v in convergence(res).items():
+        key = "change_" + re.sub(r"[^A-Za-z0-9]+", "_", label.split("(")[0]).strip("_")  # CF: letters, digits, _
+        ds.attrs[key] = float(v) if math.isfinite(v) else "n/a"
 
 
 def csv_columns(ds) -> dict:
