@@ -10,6 +10,7 @@ from typing import ClassVar
 
 import numpy as np
 
+from tengsim import backend
 from tengsim.errors import TengsimError
 from tengsim.solvers._linesearch import Ray, Trial, WolfeLineSearch
 from tengsim.solvers._reduce import for_kernel
@@ -123,14 +124,14 @@ class _Descent:
         if lines is not None:
             self.dA = problem.dA * lines.scale
         self.shape = problem.g0.shape
-        self.g0 = np.ascontiguousarray(problem.g0, dtype=float).ravel()
+        self.g0 = backend.xp.ascontiguousarray(problem.g0, dtype=float).ravel()
         self.n = self.g0.size
         self.nw = self.n if lines is None else lines.total  # the (weighted) pixel count
         self.red = red = for_kernel(K)  # None, or the sums and maxima over the ranks of a distributed solve
         if red is not None:
             self.nw = red.sum([float(self.n)])[0]
-        self.q = np.array(start.q, dtype=float).ravel()
-        self.w = np.array(start.w, dtype=float).ravel()
+        self.q = backend.xp.array(start.q, dtype=float).ravel()
+        self.w = backend.xp.array(start.w, dtype=float).ravel()
         self.sw, self.mem, self.cP = ws.sweeper, ws.memory, ws.cP
         self.g, self.P, self.d, self.Kd = ws.g, ws.P, ws.d, ws.Kd
         self.r, self.rn, self.G, self.Gn, self.y, self.ky = ws.r, ws.rn, ws.G, ws.Gn, ws.y, ws.ky
