@@ -11,7 +11,7 @@ import pytest
 
 from tengsim import references as ref
 from tengsim.grid import Grid
-from tengsim.laws import LJ93, Repulsive
+from tengsim.laws import LJ93, Repulsive, SafeLaw
 from tengsim.kernels import FreeKernel, PeriodicKernel, pixel_influence
 
 LAWS = [LJ93(), Repulsive(), Repulsive(scale=2.0, exponent=4.0, g_safe=0.5)]
@@ -23,7 +23,9 @@ LAWS = [LJ93(), Repulsive(), Repulsive(scale=2.0, exponent=4.0, g_safe=0.5)]
 
 @pytest.mark.parametrize("law", LAWS, ids=lambda l: type(l).__name__ + str(getattr(l, "exponent", "")))
 def test_pressure_is_minus_energy_derivative(law):
-    """P = −dΦ/dg by central differences (relative 1e-7) on both sides of g_safe."""
+    """P = −dΦ/dg by central differences (relative 1e-7) on both sides of g_safe (the law as a solve
+    evaluates it: wrapped in its safe extension)."""
+    law = SafeLaw(law)
     g = np.concatenate([np.linspace(-1.0, law.g_safe - 1e-3, 40), np.linspace(law.g_safe + 1e-3, 6.0, 200)])
     h = 1e-6
     dphi = (law.energy(g + h) - law.energy(g - h)) / (2 * h)
@@ -67,6 +69,7 @@ def test_repulsive_is_repulsive_half_of_lj93():
 @pytest.mark.parametrize("law", LAWS, ids=lambda l: type(l).__name__ + str(getattr(l, "exponent", "")))
 def test_safe_extension_continuous_and_finite(law):
     """P, Φ (and the stiffness) continuous at g_safe to O(h); finite, monotone P for g <= 0."""
+    law = SafeLaw(law)
     gs, h = law.g_safe, 1e-9
     below, above = np.array([gs - h]), np.array([gs + h])
     for f in (law.pressure, law.energy, law.stiffness):
@@ -172,9 +175,10 @@ def test_periodic_kernel_is_sum_of_images_up_to_a_constant():
     assert np.max(np.abs(diff)) < 1e-2 * np.max(np.abs(wp))
 
 
-@pytest.mark.parametrize("law", [LJ93(), Repulsive()])
+@pytest.mark.parametrize("law", [LJ93(), Repulsive(), SafeLaw(LJ93()), SafeLaw(Repulsive())], ids=repr)
 def test_energy_pressure_in_place_equals_evaluate(law):
-    """The solvers' hot path (in place, scratch buffers) gives evaluate's values, also below g_safe."""
+    """The solvers' hot path (in place, scratch buffers) gives evaluate's values, also below g_safe
+    (the law's formula, or its safe extension when wrapped)."""
     rng = np.random.default_rng(5)
     for g in (0.8 + 3 * rng.random(1000), np.linspace(-0.5, 4.0, 1001)):
         phi, p = law.evaluate(g)

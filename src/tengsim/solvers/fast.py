@@ -12,6 +12,7 @@ import numpy as np
 
 from tengsim import backend
 from tengsim.errors import TengsimError
+from tengsim.laws.safe import safe
 from tengsim.solvers._linesearch import Ray, Trial, WolfeLineSearch
 from tengsim.solvers._reduce import for_kernel
 from tengsim.solvers._weights import Weights
@@ -119,7 +120,7 @@ class _Descent:
 
     def __init__(self, problem: Problem, start: State, ws, lines=None):
         K = problem.kernel
-        self.problem, self.law, self.dA = problem, problem.law, problem.dA
+        self.problem, self.law, self.dA = problem, safe(problem.law), problem.dA  # the law, safe below g_safe
         self.lines = lines
         if lines is not None:
             self.dA = problem.dA * lines.scale
@@ -137,7 +138,7 @@ class _Descent:
         self.r, self.rn, self.G, self.Gn, self.y, self.ky = ws.r, ws.rn, ws.G, ws.Gn, ws.y, ws.ky
         # a film's periodic kernel has a finite mean compliance, K(0) > 0: it says pinned_mean = False
         self.proj = bool(getattr(K, "pinned_mean", getattr(K, "periodic", False)))
-        self.search = WolfeLineSearch(problem.law, ws.sweeper, self.dA, ws.gt, ws.Pt, sum_p=self.proj,
+        self.search = WolfeLineSearch(self.law, ws.sweeper, self.dA, ws.gt, ws.Pt, sum_p=self.proj,
                                       lines=lines, red=red)
         self._apply, self._takes_out = K.apply, _takes_out(K.apply)
         # the start: g, P, ΣΦ, r (one convolution), G, E

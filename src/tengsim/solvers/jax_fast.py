@@ -41,6 +41,7 @@ from typing import ClassVar
 import numpy as np
 
 from tengsim.errors import TengsimError
+from tengsim.laws.safe import SafeLaw
 from tengsim.registry import SOLVERS
 from tengsim.solvers.types import Equilibrium, Problem, State
 
@@ -95,7 +96,10 @@ def find_device(device: str):
 
 
 def _law_form(law):
-    """(class, field names, values) of a law the loop can trace, or TengsimError."""
+    """(class, field names, values) of a law the loop can trace (a SafeLaw's own law: the loop applies
+    the safe extension itself), or TengsimError."""
+    if isinstance(law, SafeLaw):
+        law = law.law
     cls = type(law)
     raw = getattr(cls, "_raw", None)
     ok = dataclasses.is_dataclass(law) and raw is not None and hasattr(law, "evaluate_xp")

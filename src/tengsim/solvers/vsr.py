@@ -8,6 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from tengsim.errors import TengsimError
+from tengsim.laws.safe import safe
 from tengsim.solvers.types import Equilibrium, Problem, State, finish
 
 
@@ -37,7 +38,7 @@ class VSRSolver:
 
     def solve(self, problem: Problem, start: State) -> Equilibrium:
         t0 = time.perf_counter()
-        K, law, g0, dA = problem.kernel, problem.law, problem.g0, problem.dA
+        K, law, g0, dA = problem.kernel, safe(problem.law), problem.g0, problem.dA
         m = problem.weights
         if m is None:  # uniform: plain sums
             def energy(q, w, phi):
