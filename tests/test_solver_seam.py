@@ -77,3 +77,47 @@ def test_the_fast_solver_allocates_from_the_backend(monkeypatch):
     n = len(made)
     scratch = ws.sweeper.buf(ws.sweeper._scratch[0], "a", 10)     # the sweeper's scratch, made on first use
     assert len(made) == n + 1 and np.shares_memory(scratch, made[-1])
+
+
+def test_wrapping_solvers_return_new_values():
+    """The mirror and slab solvers build the equilibrium they return complete (issue 28, item 5):
+    a FoldedEquilibrium takes its mirror at construction and refuses any later assignment; the
+    slab solver's gathered equilibrium is a new value, the inner solver's left as it was."""
+    import dataclasses
+
+    from tengsim.solvers.distributed import SlabSolver
+    from tengsim.solvers.mirror import FoldedEquilibrium
+    from tengsim.solvers.types import Equilibrium, State
+
+    z = np.zeros((2, 2))
+    eq = FoldedEquilibrium(State(z, z), z, z, 0.0, True, 1, 2, 0.0, 0.0, "ok", mirror=None)
+    for name in ("_mirror", "H", "residual"):
+        with pytest.raises(dataclasses.FrozenInstanceError):
+            setattr(eq, name, 1)
+    assert eq._mirror is None and eq.H is z
+
+    inner_eq = Equilibrium(State(z[:1], z[:1]), z[:1], z[:1], 0.5, True, 3, 4, -1.0, 0.1, "converged")
+
+    class Comm:
+        def allreduce(self, v, op=None):
+            return 2.0 * v
+
+    class Slab:  # a one-row slab of a 2-row grid, duck-typed as tengsim.kernels.distributed's
+        comm, rows, local_shape = Comm(), (0, 1), (1, 2)
+
+        class grid:
+            shape = (2, 2)
+
+        @staticmethod
+        def gather(a):
+            return np.vstack([a, a])
+
+    class Inner:
+        def solve(self, problem, start):
+            return inner_eq
+
+    pytest.importorskip("mpi4py", reason="SlabSolver reduces max|r| with MPI.MAX")
+    from tengsim.solvers.types import Problem
+    out = SlabSolver(Inner()).solve(Problem(np.ones((2, 2)), None, Slab()), State(np.zeros((2, 2)), np.zeros((2, 2))))
+    assert out is not inner_eq and out.H.shape == (2, 2) and out.residual == 1.0
+    assert inner_eq.H.shape == (1, 2) and inner_eq.residual == 0.5
