@@ -121,3 +121,103 @@ def test_wrapping_solvers_return_new_values():
     out = SlabSolver(Inner()).solve(Problem(np.ones((2, 2)), None, Slab()), State(np.zeros((2, 2)), np.zeros((2, 2))))
     assert out is not inner_eq and out.H.shape == (2, 2) and out.residual == 1.0
     assert inner_eq.H.shape == (1, 2) and inner_eq.residual == 0.5
+
+
+def _count_syncs(monkeypatch, solve):
+    """(result, syncs, line-search evaluations, checked law blocks) of ``solve()``: backend.sync is the one
+    host transfer; a checked block is SafeLaw.energy_pressure (it looks at its gaps: one sync itself),
+    run only when a sweep's unchecked pass met a gap below g_safe."""
+    from tengsim import backend
+    from tengsim.laws.safe import SafeLaw
+    from tengsim.solvers._linesearch import WolfeLineSearch
+
+    n = {"sync": 0, "trial": 0, "checked": 0}
+
+    def counting(key, fn):
+        def call(*a, **k):
+            n[key] += 1
+            return fn(*a, **k)
+        return call
+
+    monkeypatch.setattr(backend, "sync", counting("sync", backend.sync))
+    monkeypatch.setattr(WolfeLineSearch, "evaluate", counting("trial", WolfeLineSearch.evaluate))
+    monkeypatch.setattr(SafeLaw, "energy_pressure", counting("checked", SafeLaw.energy_pressure))
+    out = solve()
+    monkeypatch.undo()
+    return out, n["sync"], n["trial"], n["checked"]
+
+
+@pytest.mark.parametrize("block", [None, 29], ids=["one-block", "many-blocks"])
+def test_a_fast_solve_syncs_once_per_sweep(monkeypatch, block):
+    """Host syncs of fast solves (group A, LJ93, free kernel: a cold solve and the path's next, warm one):
+    one per sweep over the grid, however many blocks the sweep has: the direction's, one per
+    line-search trial, the new residual's, plus the start and the re-anchoring (every ``resync``
+    iterations).  (Before, each block of each sweep returned 3 to 6 host floats: ~15 per iteration on
+    one block.)  A sweep whose unchecked law pass met a gap below g_safe is swept again, checked block
+    by block (rare: a cold start or a trial far into contact); a warm solve has none."""
+    import tengsim.solvers._sweep as S
+    from tengsim.laws import LJ93
+    from tengsim.shapes import Pyramid
+    from tengsim.kernels import FreeKernel
+    from tengsim.solvers import FastSolver, Problem, State
+
+    shape = Pyramid(0.946, 3.78)
+    grid = shape.grid(0.2)
+    U0, K = shape.gap(grid), FreeKernel(grid, 0.5**1.5)
+    if block:
+        monkeypatch.setattr(S, "BLOCK", block)
+    blocks = len(S.Sweeper(grid.nx * grid.ny).groups[0])
+    assert blocks > 10 if block else blocks == 1
+    solver = FastSolver(1e-8)
+    cold, syncs, trials, checked = _count_syncs(
+        monkeypatch, lambda: solver.solve(Problem(U0 - 1.0 + 1.0, LJ93(), K), State.zero(grid.shape)))
+    warm, w_syncs, w_trials, w_checked = _count_syncs(
+        monkeypatch, lambda: solver.solve(Problem(U0 - 1.1 + 1.0, LJ93(), K), cold.state))
+    for eq, n, t, c in ((cold, syncs, trials, checked), (warm, w_syncs, w_trials, w_checked)):
+        it = eq.iterations
+        assert eq.converged and it > 10
+        # per iteration: the direction (again after a memory reset: at most once per first step), each
+        # trial, the residual; per re-anchoring: its law sweep and q·w; α for a first direction (empty
+        # memory); the start: its law sweep, mean q, q·w, max|r|; a checked block: its own sync and at
+        # most one more for its sweep
+        first = 1
+        assert n <= 2 * it + t + 2 * (it // solver.resync) + 2 * first + 4 + 2 * c, (n, it, t, c)
+    assert w_checked == 0 and checked <= 4 * blocks   # the cold start: a few sweeps checked again
+
+
+HOST = {"float", "int", "bool"}                      # conversions that wait for the device
+HOT = {"energy_pressure", "energy_pressure_unchecked", "energy_sum_xp"}
+
+
+def host_conversions(text: str, names=None) -> list[str]:
+    """float()/int()/bool() calls and .item()/.tolist() inside the block functions of a sweep (``*_block``)
+    or the laws' hot paths: "function: line" for each."""
+    import ast
+
+    hits = []
+    for fn in ast.walk(ast.parse(text)):
+        if not isinstance(fn, ast.FunctionDef) or not (fn.name.endswith("_block") or fn.name in (names or HOT)):
+            continue
+        for node in ast.walk(fn):
+            if isinstance(node, ast.Call) and (
+                    (isinstance(node.func, ast.Name) and node.func.id in HOST)
+                    or (isinstance(node.func, ast.Attribute) and node.func.attr in ("item", "tolist"))):
+                hits.append(f"{fn.name}: {node.lineno}")
+    return hits
+
+
+def test_sweeps_and_law_hot_paths_keep_their_sums_on_the_device():
+    """No block of a sweep (tengsim.solvers) and no law's hot path (tengsim.laws) turns a reduction into a
+    host number: the sweep's sums come over at its end, in one backend.sync."""
+    src = SOLVERS.parent
+    bad = {}
+    for path in sorted(list(SOLVERS.glob("*.py")) + list((src / "laws").glob("*.py"))):
+        if path.name in EXEMPT:
+            continue
+        found = host_conversions(path.read_text(encoding="utf-8"))
+        if found:
+            bad[str(path.relative_to(src))] = found
+    assert not bad, f"host conversions inside sweeps: {bad}"
+    assert host_conversions("def _x_block(a, acc):\n    acc[0] += float(a.sum())\n")
+    assert host_conversions("def energy_pressure(g, out, w):\n    return g.sum().item()\n")
+    assert not host_conversions("def other(a):\n    return float(a.sum())\n")

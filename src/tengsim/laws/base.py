@@ -60,11 +60,12 @@ class Law:
         phi, p, _ = self._raw(g, need_dp=False, xp=xp)
         return phi, p
 
-    def energy_pressure(self, g: np.ndarray, out: np.ndarray, work) -> float:
-        """ΣΦ(g), writing P(g) into ``out``: the solvers' hot path (``work``: two scratch arrays)."""
+    def energy_pressure(self, g: np.ndarray, out: np.ndarray, work):
+        """ΣΦ(g), writing P(g) into ``out``: the solvers' hot path (``work``: two scratch arrays).  The sum
+        is a backend scalar, left on the device (the solver brings a sweep's sums to the host at once)."""
         phi, p = self.evaluate(g)
         out[...] = p
-        return float(phi.sum())
+        return phi.sum()
 
     def pressure(self, g):
         return self.evaluate(g)[1]

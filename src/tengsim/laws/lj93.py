@@ -69,14 +69,14 @@ class LJ93(Law):
         return total(i8) / 3.0 - (4.0 / 3.0) * total(i2), p
 
     def energy_pressure(self, g, out, work):
-        """In place, no temporaries (same values as ``evaluate``)."""
+        """In place, no temporaries (same values as ``evaluate``); ΣΦ a backend scalar (no host sync)."""
         a, b = work
         np.reciprocal(g, out=a)      # g⁻¹
         np.multiply(a, a, out=b)     # g⁻²
-        s2 = float(b.sum())
+        s2 = b.sum()
         np.multiply(b, b, out=out)   # g⁻⁴
         out *= out                   # g⁻⁸
-        s8 = float(out.sum())
+        s8 = out.sum()
         out *= a                     # g⁻⁹
         b *= a                       # g⁻³
         out -= b

@@ -18,6 +18,8 @@ from functools import cached_property
 
 import numpy as np
 
+from tengsim import backend
+
 
 @dataclass(frozen=True)
 class SafeLaw:
@@ -63,14 +65,29 @@ class SafeLaw:
         t = g - gs
         return xp.where(low, phs - ps * t - 0.5 * dps * t * t, phi), xp.where(low, ps + dps * t, p)
 
-    def energy_pressure(self, g, out, work) -> float:
-        """ΣΦ(g), P(g) into ``out``: the law's own hot path when no gap is below g_safe."""
-        m = float(g.min())
+    def energy_pressure(self, g, out, work):
+        """ΣΦ(g) (a backend scalar), P(g) into ``out``: the law's own hot path when no gap is below
+        g_safe.  Looks at the gaps first (one host sync); a sweep avoids that with
+        :meth:`energy_pressure_unchecked`."""
+        m = backend.to_host(g.min())
         if m < self.g_safe or m != m:
             phi, p = self.evaluate(g)
             out[...] = p
-            return float(phi.sum())
+            return phi.sum()
         return self.law.energy_pressure(g, out, work)
+
+    def energy_pressure_unchecked(self, g, out, work):
+        """(ΣΦ, min g), both backend scalars, P into ``out``: the law's own hot path without looking at
+        the gaps (no host sync).  Right when min g >= g_safe (:meth:`covers`), which the caller checks
+        once for the whole sweep, with its other sums; else it sweeps again with :meth:`energy_pressure`
+        (rare: a trial step far into contact)."""
+        with np.errstate(divide="ignore", over="ignore", invalid="ignore"):  # g <= 0 in a rejected pass
+            return self.law.energy_pressure(g, out, work), g.min()
+
+    def covers(self, g_min: float) -> bool:
+        """Is a pass of :meth:`energy_pressure_unchecked` whose smallest gap was ``g_min`` right (no gap
+        below g_safe, no NaN)?"""
+        return g_min >= self.g_safe
 
     def pressure(self, g):
         return self.evaluate(g)[1]

@@ -138,6 +138,7 @@ class _Descent:
         self.r, self.rn, self.G, self.Gn, self.y, self.ky = ws.r, ws.rn, ws.G, ws.Gn, ws.y, ws.ky
         # a film's periodic kernel has a finite mean compliance, K(0) > 0: it says pinned_mean = False
         self.proj = bool(getattr(K, "pinned_mean", getattr(K, "periodic", False)))
+        self.unchecked = hasattr(self.law, "energy_pressure_unchecked")  # a SafeLaw (tengsim.laws.safe)
         self.search = WolfeLineSearch(self.law, ws.sweeper, self.dA, ws.gt, ws.Pt, sum_p=self.proj,
                                       lines=lines, red=red)
         self._apply, self._takes_out = K.apply, _takes_out(K.apply)
@@ -147,17 +148,18 @@ class _Descent:
         np.subtract(self.w, self.convolve(self.P), out=self.r)
         self.n_conv = 1
         if red is not None:
-            self.mean_q = red.sum([float(self.q.sum())])[0] / self.nw
+            self.mean_q = red.sum([backend.to_host(self.q.sum())])[0] / self.nw
         elif lines is None:
-            self.mean_q = float(self.q.mean())
+            self.mean_q = backend.to_host(self.q.mean())
         else:
-            self.mean_q = (float(self.q.sum()) - lines.sum(self.q)) / self.nw
+            self.mean_q = backend.to_host(self.q.sum() - lines.sum(self.q)) / self.nw
         np.subtract(self.q, self.P, out=self.G)
         if self.proj:
             self.G -= self.mean_q - self.sum_p / self.nw
         self.qw = self._dot(self.q, self.w)
         self.E = self.dA * (0.5 * self.qw + self.phis)
-        self.rmax = max(float(self.r.max()), -float(self.r.min()))
+        hi, lo = backend.sync((self.r.max(), self.r.min()))
+        self.rmax = max(float(hi), -float(lo))
         if red is not None:
             self.rmax = red.max(self.rmax)
         self.E_best = self.E
@@ -167,10 +169,10 @@ class _Descent:
     # ---- the pieces ---------------------------------------------------------------------------
     def _dot(self, a, b) -> float:
         """a·b, m-weighted (in units of the interior weight) for a weighted problem."""
-        v = float(np.vdot(a, b))
+        v = np.vdot(a, b)
         if self.red is not None:
-            return self.red.sum([v])[0]
-        return v if self.lines is None else v - self.lines.dot(a, b)
+            return self.red.sum([backend.to_host(v)])[0]
+        return backend.to_host(v if self.lines is None else v - self.lines.dot(a, b))
 
     def convolve(self, x):
         """K x into the workspace's output array (one convolution; not counted here)."""
@@ -181,17 +183,38 @@ class _Descent:
             out[:] = self._apply(x.reshape(shape)).ravel()
         return out
 
-    def _law_block(self, sl, m, sc, acc):
+    def _law_block(self, sl, m, sc, acc, unchecked):
         buf = self.sw.buf
-        acc[0] += self.law.energy_pressure(self.g[sl], self.P[sl], (buf(sc, "a", m), buf(sc, "b", m)))
+        work = (buf(sc, "a", m), buf(sc, "b", m))
+        if unchecked:
+            e, g_min = self.law.energy_pressure_unchecked(self.g[sl], self.P[sl], work)
+            acc[0] += e
+            acc[2] = np.minimum(acc[2], g_min)
+        else:
+            acc[0] += self.law.energy_pressure(self.g[sl], self.P[sl], work)
         if self.proj:
-            acc[1] += float(self.P[sl].sum())
+            acc[1] += self.P[sl].sum()
+
+    def _law_sums(self, unchecked):
+        accs = self.sw.run(self._law_block, [0.0, 0.0, np.inf], unchecked)
+        if len(accs) == 1:
+            return accs[0]
+        return [sum(a[0] for a in accs), sum(a[1] for a in accs), functools.reduce(np.minimum, (a[2] for a in accs))]
 
     def law_sweep(self):
-        """ΣΦ(g) and ΣP (periodic kernels only, else 0), with P(g) written into P."""
-        acc = self.sw.sum(self._law_block, [0.0, 0.0])
-        if self.lines is not None:
-            acc = _weigh_law(self.lines, self.law, self.g, self.P, acc, self.proj)
+        """ΣΦ(g) and ΣP (periodic kernels only, else 0), with P(g) written into P: one host sync (the
+        law's unchecked hot path, checked by the smallest gap, as in the line search)."""
+        phis, sum_p, g_min = self._law_sums(self.unchecked)
+        if self.lines is None:
+            phis, sum_p, g_min = backend.sync((phis, sum_p, g_min))
+            if self.unchecked and not self.law.covers(g_min):
+                phis, sum_p, _ = backend.sync(self._law_sums(False))
+            acc = [float(phis), float(sum_p)]
+        else:  # weighted: the deficit pixels' share needs P right first
+            if self.unchecked and not self.law.covers(backend.to_host(g_min)):
+                phis, sum_p, _ = self._law_sums(False)
+            acc = [float(v) for v in backend.sync(_weigh_law(self.lines, self.law, self.g, self.P,
+                                                             [phis, sum_p], self.proj))]
         if self.red is not None:
             acc = self.red.sum(acc)
         return acc
@@ -213,11 +236,11 @@ class _Descent:
             ds -= h
             np.matmul(c, self.mem.KB[:k2, sl], out=h)
             kds -= h
-        acc[0] += float(np.vdot(ds, self.w[sl]))
-        acc[1] += float(np.vdot(ds, kds))
-        acc[2] += float(np.vdot(ds, self.r[sl]))
+        acc[0] += np.vdot(ds, self.w[sl])
+        acc[1] += np.vdot(ds, kds)
+        acc[2] += np.vdot(ds, self.r[sl])
         if self.proj:
-            acc[3] += float(ds.sum())
+            acc[3] += ds.sum()
 
     def _direction(self):
         gamma, c = self.mem.coefficients()
@@ -227,6 +250,7 @@ class _Descent:
         if L is not None:  # the sweep wrote d and K d whole: correct its sums on the deficit pixels
             cw, cKd, cr = L.dots(self.d, self.w, self.Kd, self.r)
             acc = [acc[0] - cw, acc[1] - cKd, acc[2] - cr, acc[3] - (L.sum(self.d) if self.proj else 0.0)]
+        acc = [float(v) for v in backend.sync(acc)]  # the sweep's one host sync
         if self.red is not None:
             acc = self.red.sum(acc)
         return acc
@@ -298,11 +322,11 @@ class _Descent:
         if self.proj:
             Gns -= mu
         np.subtract(Gns, self.G[sl], out=ys)
-        acc[0] += float(np.vdot(ds, kys))
-        acc[1] += float(np.vdot(ys, kys))
-        acc[2] += float(np.vdot(ds, rns))
-        acc[3] += float(np.vdot(ys, rns))
-        acc[4] = max(acc[4], float(rns.max()), -float(rns.min()))
+        acc[0] += np.vdot(ds, kys)
+        acc[1] += np.vdot(ys, kys)
+        acc[2] += np.vdot(ds, rns)
+        acc[3] += np.vdot(ys, rns)
+        acc[4] = np.maximum(acc[4], np.maximum(rns.max(), -rns.min()))
         if k2:
             acc[5] = acc[5] + self.mem.B[:k2, sl] @ kys
 
@@ -318,10 +342,10 @@ class _Descent:
         accs = self.sw.run(self._residual_block, [0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
                            alpha, not resync, self.corr, mu, k2)
         if len(accs) == 1:
-            dky, yky, drn, yrn, self.rmax, x = accs[0]
+            dky, yky, drn, yrn, rmax, x = accs[0]
         else:
             dky, yky, drn, yrn, _, x = (sum(a[j] for a in accs) for j in range(6))
-            self.rmax = max(a[4] for a in accs)
+            rmax = functools.reduce(np.maximum, (a[4] for a in accs))
         L = self.lines
         if L is not None:  # max|r| stays a plain max; the products are weighted
             ky, rn = self.ky, self.rn
@@ -330,6 +354,9 @@ class _Descent:
             dky, yky, drn, yrn = dky - c_dky, yky - c_yky, drn - c_drn, yrn - c_yrn
             if k2:
                 x = x - L.rows(self.mem.B[:k2], ky)
+        h = backend.sync((dky, yky, drn, yrn, rmax), x if k2 else None)  # the sweep's one host sync
+        dky, yky, drn, yrn, self.rmax = (float(v) for v in h[:5])
+        x = h[5:]
         if self.red is not None:  # every rank's partial products and max|r|
             dky, yky, drn, yrn = self.red.sum([dky, yky, drn, yrn])
             self.rmax = self.red.max(self.rmax)
@@ -370,7 +397,7 @@ class _Descent:
 def _weigh_law(lines, law, g, P, acc, sum_p):
     """[ΣΦ, ΣP] of a sweep, m-weighted: less the deficit pixels' share (Φ there evaluated anew)."""
     i = lines.idx
-    phis = acc[0] - float(np.dot(lines.c, law.energy(g[i])))
+    phis = acc[0] - np.dot(lines.c, law.energy(g[i]))
     return [phis, acc[1] - lines.sum(P) if sum_p else acc[1]]
 
 
