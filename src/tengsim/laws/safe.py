@@ -29,6 +29,9 @@ class SafeLaw:
 
     law: object
 
+    def __post_init__(self):  # the law's g_safe, read on every sweep: kept here, not looked up through it
+        object.__setattr__(self, "g_safe", self.law.g_safe)
+
     def __getattr__(self, name):  # the wrapped law's g_safe, declared numbers, fields, params()
         if name == "law" or name.startswith("__"):
             raise AttributeError(name)
@@ -80,9 +83,9 @@ class SafeLaw:
         """(ΣΦ, min g), both backend scalars, P into ``out``: the law's own hot path without looking at
         the gaps (no host sync).  Right when min g >= g_safe (:meth:`covers`), which the caller checks
         once for the whole sweep, with its other sums; else it sweeps again with :meth:`energy_pressure`
-        (rare: a trial step far into contact)."""
-        with np.errstate(divide="ignore", over="ignore", invalid="ignore"):  # g <= 0 in a rejected pass
-            return self.law.energy_pressure(g, out, work), g.min()
+        (rare: a trial step far into contact).  Such a pass may meet g <= 0: the caller runs it under
+        ``np.errstate`` ignoring divide, overflow and invalid (tengsim.solvers.FastSolver does)."""
+        return self.law.energy_pressure(g, out, work), g.min()
 
     def covers(self, g_min: float) -> bool:
         """Is a pass of :meth:`energy_pressure_unchecked` whose smallest gap was ``g_min`` right (no gap

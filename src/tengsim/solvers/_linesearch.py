@@ -122,12 +122,11 @@ class WolfeLineSearch:
             dpk = dpk - np.dot(c * (Pt[i] - ray.P[i]), ray.Kd[i])
             if self.sum_p:
                 sp = sp - np.dot(c, Pt[i])
-            phis, dpk, sp = backend.sync((phis, dpk, sp))
+            phis, dpk, sp = backend.sync((phis, dpk, sp)).tolist()
         else:
-            phis, dpk, sp, g_min = backend.sync((phis, dpk, sp, g_min))
+            phis, dpk, sp, g_min = backend.sync((phis, dpk, sp, g_min)).tolist()
             if self.unchecked and not self.law.covers(g_min):
-                phis, dpk, sp, _ = backend.sync(self._sweep(a, ray, False))
-        phis, dpk, sp = float(phis), float(dpk), float(sp)
+                phis, dpk, sp, _ = backend.sync(self._sweep(a, ray, False)).tolist()
         if self.red is not None:  # every rank's share of the grid
             phis, dpk, sp = self.red.sum([phis, dpk, sp])
         e = self.dA * (0.5 * ray.qw + a * ray.dw + 0.5 * a * a * ray.dKd + phis)

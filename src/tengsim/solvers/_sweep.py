@@ -81,11 +81,14 @@ class Sweeper:
             fn(self._single[0], self.n, self._scratch[0], acc, *args)
             return [acc]
 
+        err = np.geterr()  # the caller's floating-point error handling, taken to the worker threads
+
         def group(i):
             acc = list(init)
             sc = self._scratch[i]
-            for sl, m in self.groups[i]:
-                fn(sl, m, sc, acc, *args)
+            with np.errstate(**err):
+                for sl, m in self.groups[i]:
+                    fn(sl, m, sc, acc, *args)
             return acc
 
         if len(self.groups) == 1:

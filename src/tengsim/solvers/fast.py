@@ -72,7 +72,10 @@ class FastSolver:
         if red is not None and lines is not None:
             raise TengsimError("a distributed solve cannot also be a weighted (mirror) one")
         try:
-            return self._descend(_Descent(problem, start, ws, lines), t0)
+            # the law's unchecked hot path may meet g <= 0 in a pass that is then redone checked
+            # (tengsim.laws.safe): no warnings from it (sweeps on threads take this state along)
+            with np.errstate(divide="ignore", over="ignore", invalid="ignore"):
+                return self._descend(_Descent(problem, start, ws, lines), t0)
         finally:
             self._spare.give(ws)
 
@@ -206,15 +209,14 @@ class _Descent:
         law's unchecked hot path, checked by the smallest gap, as in the line search)."""
         phis, sum_p, g_min = self._law_sums(self.unchecked)
         if self.lines is None:
-            phis, sum_p, g_min = backend.sync((phis, sum_p, g_min))
+            phis, sum_p, g_min = backend.sync((phis, sum_p, g_min)).tolist()
             if self.unchecked and not self.law.covers(g_min):
-                phis, sum_p, _ = backend.sync(self._law_sums(False))
-            acc = [float(phis), float(sum_p)]
+                phis, sum_p, _ = backend.sync(self._law_sums(False)).tolist()
+            acc = [phis, sum_p]
         else:  # weighted: the deficit pixels' share needs P right first
             if self.unchecked and not self.law.covers(backend.to_host(g_min)):
                 phis, sum_p, _ = self._law_sums(False)
-            acc = [float(v) for v in backend.sync(_weigh_law(self.lines, self.law, self.g, self.P,
-                                                             [phis, sum_p], self.proj))]
+            acc = backend.sync(_weigh_law(self.lines, self.law, self.g, self.P, [phis, sum_p], self.proj)).tolist()
         if self.red is not None:
             acc = self.red.sum(acc)
         return acc
@@ -250,7 +252,7 @@ class _Descent:
         if L is not None:  # the sweep wrote d and K d whole: correct its sums on the deficit pixels
             cw, cKd, cr = L.dots(self.d, self.w, self.Kd, self.r)
             acc = [acc[0] - cw, acc[1] - cKd, acc[2] - cr, acc[3] - (L.sum(self.d) if self.proj else 0.0)]
-        acc = [float(v) for v in backend.sync(acc)]  # the sweep's one host sync
+        acc = backend.sync(acc).tolist()  # the sweep's one host sync
         if self.red is not None:
             acc = self.red.sum(acc)
         return acc
@@ -326,7 +328,9 @@ class _Descent:
         acc[1] += np.vdot(ys, kys)
         acc[2] += np.vdot(ds, rns)
         acc[3] += np.vdot(ys, rns)
-        acc[4] = np.maximum(acc[4], np.maximum(rns.max(), -rns.min()))
+        hi, lo = rns.max(), rns.min()
+        acc[4] = hi if acc[4] is None else np.maximum(acc[4], hi)
+        acc[6] = lo if acc[6] is None else np.minimum(acc[6], lo)
         if k2:
             acc[5] = acc[5] + self.mem.B[:k2, sl] @ kys
 
@@ -339,13 +343,14 @@ class _Descent:
         self.convolve(self.P)
         self.n_conv += 1
         k2 = 2 * len(self.mem.order)
-        accs = self.sw.run(self._residual_block, [0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+        accs = self.sw.run(self._residual_block, [0.0, 0.0, 0.0, 0.0, None, 0.0, None],
                            alpha, not resync, self.corr, mu, k2)
         if len(accs) == 1:
-            dky, yky, drn, yrn, rmax, x = accs[0]
+            dky, yky, drn, yrn, hi, x, lo = accs[0]
         else:
-            dky, yky, drn, yrn, _, x = (sum(a[j] for a in accs) for j in range(6))
-            rmax = functools.reduce(np.maximum, (a[4] for a in accs))
+            dky, yky, drn, yrn, x = (sum(a[j] for a in accs) for j in (0, 1, 2, 3, 5))
+            hi = functools.reduce(np.maximum, (a[4] for a in accs))
+            lo = functools.reduce(np.minimum, (a[6] for a in accs))
         L = self.lines
         if L is not None:  # max|r| stays a plain max; the products are weighted
             ky, rn = self.ky, self.rn
@@ -354,9 +359,10 @@ class _Descent:
             dky, yky, drn, yrn = dky - c_dky, yky - c_yky, drn - c_drn, yrn - c_yrn
             if k2:
                 x = x - L.rows(self.mem.B[:k2], ky)
-        h = backend.sync((dky, yky, drn, yrn, rmax), x if k2 else None)  # the sweep's one host sync
-        dky, yky, drn, yrn, self.rmax = (float(v) for v in h[:5])
-        x = h[5:]
+        h = backend.sync((dky, yky, drn, yrn, hi, lo), x if k2 else None)  # the sweep's one host sync
+        dky, yky, drn, yrn, hi, lo = h[:6].tolist()
+        self.rmax = max(hi, -lo) if hi == hi and lo == lo else math.nan   # max|r_new|
+        x = h[6:]
         if self.red is not None:  # every rank's partial products and max|r|
             dky, yky, drn, yrn = self.red.sum([dky, yky, drn, yrn])
             self.rmax = self.red.max(self.rmax)
