@@ -8,13 +8,16 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from conftest import registered
 
 from tengsim import references as ref
 from tengsim.grid import Grid
 from tengsim.laws import LJ93, Repulsive, SafeLaw
+from tengsim.plugins import LAWS as LAWS_REGISTERED
 from tengsim.kernels import FreeKernel, PeriodicKernel, pixel_influence
 
-LAWS = [LJ93(), Repulsive(), Repulsive(scale=2.0, exponent=4.0, g_safe=0.5)]
+# every registered law with its defaults (a plugin's law is checked too), and one other parameter set
+LAWS = [LAWS_REGISTERED.get(name)() for name in LAWS_REGISTERED.names()] + [Repulsive(scale=2.0, exponent=4.0, g_safe=0.5)]
 
 
 # ---------------------------------------------------------------------------------------------
@@ -189,7 +192,7 @@ def test_energy_pressure_in_place_equals_evaluate(law):
         assert s == pytest.approx(phi.sum(), rel=1e-12)
 
 
-@pytest.mark.parametrize("boundary", ["free", "periodic"])
+@pytest.mark.parametrize("boundary", registered("boundary"))
 def test_direct_fft_path_equals_public_scipy_fft(boundary):
     """The kernels run on scipy's pocketfft binding with preallocated buffers where it exists; it
     must agree with the public scipy.fft path to round-off, with and without ``out``, and the

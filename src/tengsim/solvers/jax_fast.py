@@ -146,6 +146,7 @@ class JaxSolver:
     dtype: str = "float64"
     name: str = "jax"
     resumes_from_state: ClassVar[bool] = True  # continuation.persist may go on from its capped state
+    compiles: ClassVar[bool] = True  # compiled before its first solve on a grid (seconds, once per configuration)
 
     def __post_init__(self):
         if not self.tol > 0:
@@ -247,6 +248,9 @@ SOLVERS.register("jax", JaxSolver, summary="the fast solver compiled with JAX (G
 def gpu_solver(tol: float = 1e-6, **kw) -> JaxSolver:
     """The JAX solver on a GPU (TengsimError, one line, when JAX has none)."""
     return JaxSolver(tol=tol, **{"device": "gpu", "name": "gpu", **kw})
+
+
+gpu_solver.compiles = True  # as JaxSolver
 
 
 SOLVERS.register("gpu", gpu_solver, summary="the fast solver compiled with JAX on a GPU (pip install 'tengsim[gpu]')")
