@@ -178,10 +178,10 @@ def test_a_fast_solve_syncs_once_per_sweep(monkeypatch, block):
         assert eq.converged and it > 10
         # per iteration: the direction (again after a memory reset: at most once per first step), each
         # trial, the residual; per re-anchoring: its law sweep and q·w; α for a first direction (empty
-        # memory); the start: its law sweep, mean q, q·w, max|r|; a checked block: its own sync and at
-        # most one more for its sweep
+        # memory); the start: its law sweep, mean q, q·w, max|r|; a checked block: its own two (its
+        # smallest gap; below g_safe, SafeLaw.evaluate's test) and at most one more for its sweep
         first = 1
-        assert n <= 2 * it + t + 2 * (it // solver.resync) + 2 * first + 4 + 2 * c, (n, it, t, c)
+        assert n <= 2 * it + t + 2 * (it // solver.resync) + 2 * first + 4 + 3 * c, (n, it, t, c)
     assert w_checked == 0 and checked <= 4 * blocks   # the cold start: a few sweeps checked again
 
 

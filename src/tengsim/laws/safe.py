@@ -48,7 +48,7 @@ class SafeLaw:
         g = np.asarray(g, dtype=float)
         gs = self.g_safe
         low = g < gs
-        if not low.any():
+        if not backend.to_host(low.any()):  # a host decision (one sync): the solvers' sweeps avoid it
             phi, p, _ = self.law._raw(g, need_dp=False)
             return phi, p
         phi, p, _ = self.law._raw(np.where(low, gs, g), need_dp=False)
