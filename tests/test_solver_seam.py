@@ -150,9 +150,10 @@ def _count_syncs(monkeypatch, solve):
 @pytest.mark.parametrize("block", [None, 29], ids=["one-block", "many-blocks"])
 def test_a_fast_solve_syncs_once_per_sweep(monkeypatch, block):
     """Host syncs of fast solves (group A, LJ93, free kernel: a cold solve and the path's next, warm one):
-    one per sweep over the grid, however many blocks the sweep has: the direction's, one per
-    line-search trial, the new residual's, plus the start and the re-anchoring (every ``resync``
-    iterations).  (Before, each block of each sweep returned 3 to 6 host floats: ~15 per iteration on
+    one per sweep over the grid, however many blocks the sweep has: the direction's (with the line
+    search's first trial α = 1 swept along when the memory has pairs), one per further trial, the new
+    residual's, plus the start and the re-anchoring (every ``resync`` iterations): about 2.4 per
+    iteration on the warm solve.  (Before, each block of each sweep returned 3 to 6 host floats: ~15 per iteration on
     one block.)  A sweep whose unchecked law pass met a gap below g_safe is swept again, checked block
     by block (rare: a cold start or a trial far into contact); a warm solve has none."""
     import tengsim.solvers._sweep as S
@@ -183,6 +184,8 @@ def test_a_fast_solve_syncs_once_per_sweep(monkeypatch, block):
         first = 1
         assert n <= 2 * it + t + 2 * (it // solver.resync) + 2 * first + 4 + 3 * c, (n, it, t, c)
     assert w_checked == 0 and checked <= 4 * blocks   # the cold start: a few sweeps checked again
+    # the first trial (α = 1) rides on the direction's sweep and sync: few trials are swept on their own
+    assert w_trials <= warm.iterations // 3 and w_syncs <= 2 * warm.iterations + w_trials + 8
 
 
 HOST = {"float", "int", "bool"}                      # conversions that wait for the device

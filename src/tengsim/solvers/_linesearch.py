@@ -77,9 +77,11 @@ class WolfeLineSearch:
         self.g_trial, self.P_trial = g, P
         return gt, Pt
 
-    def _block(self, sl, m, sc, acc, a, g, P, Kd, unchecked):
-        # block by block (a sweep): the gap, the law's scratch and the pressure stay in cache; the sums
-        # stay backend scalars (no host sync inside a sweep)
+    def block(self, sl, m, sc, acc, a, g, P, Kd, unchecked, o=0):
+        """One block of a trial's sweep: g(α), P(α) into the trial buffers, [ΣΦ, Σ(P(α) − P)·K d, ΣP,
+        min g] added to ``acc[o:o + 4]`` (backend scalars: no host sync inside a sweep; min g only
+        ``unchecked``).  Block by block, the gap, the law's scratch and the pressure stay in cache; the
+        fast solver also runs it inside its direction's sweep (the first trial, α = 1)."""
         buf = self.sweeper.buf
         gb, pb, kb = self.g_trial[sl], self.P_trial[sl], Kd[sl]
         np.multiply(kb, a, out=gb)
@@ -87,20 +89,20 @@ class WolfeLineSearch:
         work = (buf(sc, "a", m), buf(sc, "b", m))
         if unchecked:
             e, g_min = self.law.energy_pressure_unchecked(gb, pb, work)
-            acc[0] += e
-            acc[3] = np.minimum(acc[3], g_min)
+            acc[o] += e
+            acc[o + 3] = np.minimum(acc[o + 3], g_min)
         else:
-            acc[0] += self.law.energy_pressure(gb, pb, work)
+            acc[o] += self.law.energy_pressure(gb, pb, work)
         dp = buf(sc, "c", m)
         np.subtract(pb, P[sl], out=dp)
-        acc[1] += np.vdot(dp, kb)
+        acc[o + 1] += np.vdot(dp, kb)
         if self.sum_p:
-            acc[2] += pb.sum()
+            acc[o + 2] += pb.sum()
 
     def _sweep(self, a, ray: Ray, unchecked: bool):
         """[ΣΦ, Σ(P(α) − P)·K d, ΣP, min g(α)] of one sweep, backend scalars (min g: +inf unless
         ``unchecked``); the sums added over the groups as Sweeper.sum adds them."""
-        accs = self.sweeper.run(self._block, [0.0, 0.0, 0.0, np.inf], a, ray.g, ray.P, ray.Kd, unchecked)
+        accs = self.sweeper.run(self.block, [0.0, 0.0, 0.0, np.inf], a, ray.g, ray.P, ray.Kd, unchecked)
         if len(accs) == 1:
             return accs[0]
         out = [sum(acc[j] for acc in accs) for j in range(3)]
@@ -127,17 +129,23 @@ class WolfeLineSearch:
             phis, dpk, sp, g_min = backend.sync((phis, dpk, sp, g_min)).tolist()
             if self.unchecked and not self.law.covers(g_min):
                 phis, dpk, sp, _ = backend.sync(self._sweep(a, ray, False)).tolist()
+        return self.finish(a, ray, phis, dpk, sp)
+
+    def finish(self, a, ray: Ray, phis, dpk, sp):
+        """(E(α), E'(α), ΣΦ, ΣP) from a trial sweep's sums on this process (host floats)."""
         if self.red is not None:  # every rank's share of the grid
             phis, dpk, sp = self.red.sum([phis, dpk, sp])
         e = self.dA * (0.5 * ray.qw + a * ray.dw + 0.5 * a * a * ray.dKd + phis)
         de = ray.slope + self.dA * (a * ray.dKd - dpk)
         return e, de, phis, sp
 
-    def search(self, alpha0: float, ray: Ray, E_ref: float = math.inf) -> Trial | None:
+    def search(self, alpha0: float, ray: Ray, E_ref: float = math.inf, first=None) -> Trial | None:
         """The accepted step from the trial α = ``alpha0`` (doubled until bracketed), or None.
 
         ``E_ref``: the caller's lowest energy so far; the approximate test is measured from
-        min(E(0), E_ref), so round-off rises of E cannot add up over many accepted steps."""
+        min(E(0), E_ref), so round-off rises of E cannot add up over many accepted steps.  ``first``:
+        :meth:`evaluate`'s answer at ``alpha0`` when the caller has swept it already (the trial
+        buffers then hold g(α0), P(α0))."""
         E0, slope0, c1, c2 = ray.E0, ray.slope, self.c1, self.c2
         eps_E = 1e-11 * max(1.0, abs(E0))
         E_lo = min(E0, E_ref)
@@ -146,7 +154,10 @@ class WolfeLineSearch:
         hi, de_hi = None, None
         best = None
         for _ in range(self.max_eval):
-            e, de, phis, sp = self.evaluate(alpha, ray)
+            if first is not None:
+                (e, de, phis, sp), first = first, None
+            else:
+                e, de, phis, sp = self.evaluate(alpha, ray)
             if not np.isfinite(e):
                 hi, de_hi = alpha, None
             else:

@@ -92,7 +92,8 @@ class FastSolver:
                 self.monitor(it, run.rmax, run.E)
             ray = run.direction()
             alpha0 = search.first_step(ray.Kd) if run.mem.empty else 1.0
-            trial = search.search(alpha0, ray, run.lowest_energy())
+            first = None if run.first is None else search.finish(alpha0, ray, *run.first)  # swept with d
+            trial = search.search(alpha0, ray, run.lowest_energy(), first)
             if trial is None:
                 return run.finish(False, it, "line search failed", t0)
             resync = (it + 1) % self.resync == 0
@@ -168,6 +169,7 @@ class _Descent:
         self.E_best = self.E
         self.sum_d = 0.0
         self.corr = None
+        self.first = None  # the first trial's sums, swept with the direction (:meth:`_direction`)
 
     # ---- the pieces ---------------------------------------------------------------------------
     def _dot(self, a, b) -> float:
@@ -228,7 +230,7 @@ class _Descent:
         return self.E_best
 
     # ---- the direction --------------------------------------------------------------------------
-    def _direction_block(self, sl, m, sc, acc, gamma, c, k2):
+    def _direction_block(self, sl, m, sc, acc, gamma, c, k2, fuse):
         ds, kds = self.d[sl], self.Kd[sl]
         np.multiply(self.G[sl], -gamma, out=ds)
         np.multiply(self.r[sl], -gamma, out=kds)
@@ -243,11 +245,30 @@ class _Descent:
         acc[2] += np.vdot(ds, self.r[sl])
         if self.proj:
             acc[3] += ds.sum()
+        if fuse:  # the line search's first trial, α = 1, on this block while it is in cache
+            self.search.block(sl, m, sc, acc, 1.0, self.g, self.P, self.Kd, True, 4)
 
     def _direction(self):
+        """[d·w, d·K d, d·r, Σd] (host floats, one sync); with a memory the line search's first trial α = 1
+        is swept along (:attr:`first`: its [ΣΦ, Σ(P(1) − P)·K d, ΣP], or None)."""
         gamma, c = self.mem.coefficients()
         k2 = 0 if c is None else c.size
-        acc = self.sw.sum(self._direction_block, [0.0, 0.0, 0.0, 0.0], gamma, c, k2)
+        # fused in the serial, unweighted solve with a SafeLaw (its check rides on this sweep's sync)
+        fuse = k2 > 0 and self.unchecked and self.lines is None and self.red is None
+        init = [0.0, 0.0, 0.0, 0.0] + ([0.0, 0.0, 0.0, np.inf] if fuse else [])
+        accs = self.sw.run(self._direction_block, init, gamma, c, k2, fuse)
+        if len(accs) == 1:
+            acc = accs[0]
+        else:
+            acc = [sum(a[j] for a in accs) for j in range(min(len(init), 7))]
+            if fuse:
+                acc.append(functools.reduce(np.minimum, (a[7] for a in accs)))
+        self.first = None
+        if fuse:
+            h = backend.sync(acc).tolist()  # the sweep's one host sync: the direction and the trial
+            if self.law.covers(h[7]):
+                self.first = h[4:7]
+            return h[:4]
         L = self.lines
         if L is not None:  # the sweep wrote d and K d whole: correct its sums on the deficit pixels
             cw, cKd, cr = L.dots(self.d, self.w, self.Kd, self.r)
