@@ -35,6 +35,10 @@ class FastSolver:
 
     The arrays of an iteration live in a workspace (tengsim.solvers._workspace), allocated once per grid and,
     on grids up to 512² points, kept by the solver for its next solve (a path's equilibria share one).
+    Host syncs: a sweep's sums stay backend scalars and come over in one ``backend.sync`` at its end: the
+    direction's (with the line search's first trial α = 1 swept along), one per further trial, the new
+    residual's; the law is evaluated through its safe extension (tengsim.laws.safe), its hot path
+    unchecked and the sweep's smallest gap checked in that same sync.
     """
 
     tol: float = 1e-6
