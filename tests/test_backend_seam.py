@@ -6,6 +6,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import registered
 
 SRC = Path(__file__).resolve().parents[1] / "src" / "tengsim"
 SEAM = SRC / "backend"
@@ -80,7 +81,7 @@ def _smooth(m, primes):
     return m == 1
 
 
-@pytest.mark.parametrize("boundary", ["free", "periodic"])
+@pytest.mark.parametrize("boundary", registered("boundary"))
 def test_kernels_pickle_without_their_buffers(boundary):
     """Dask workers pickle kernels: the convolvers (tengsim.kernels.convolve, .dct) travel without their
     per-thread buffers and convolve the same afterwards."""

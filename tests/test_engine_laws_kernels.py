@@ -8,13 +8,16 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from conftest import registered
 
 from tengsim import references as ref
 from tengsim.grid import Grid
-from tengsim.laws import LJ93, Repulsive
+from tengsim.laws import LJ93, Repulsive, SafeLaw
+from tengsim.plugins import LAWS as LAWS_REGISTERED
 from tengsim.kernels import FreeKernel, PeriodicKernel, pixel_influence
 
-LAWS = [LJ93(), Repulsive(), Repulsive(scale=2.0, exponent=4.0, g_safe=0.5)]
+# every registered law with its defaults (a plugin's law is checked too), and one other parameter set
+LAWS = [LAWS_REGISTERED.get(name)() for name in LAWS_REGISTERED.names()] + [Repulsive(scale=2.0, exponent=4.0, g_safe=0.5)]
 
 
 # ---------------------------------------------------------------------------------------------
@@ -23,7 +26,9 @@ LAWS = [LJ93(), Repulsive(), Repulsive(scale=2.0, exponent=4.0, g_safe=0.5)]
 
 @pytest.mark.parametrize("law", LAWS, ids=lambda l: type(l).__name__ + str(getattr(l, "exponent", "")))
 def test_pressure_is_minus_energy_derivative(law):
-    """P = −dΦ/dg by central differences (relative 1e-7) on both sides of g_safe."""
+    """P = −dΦ/dg by central differences (relative 1e-7) on both sides of g_safe (the law as a solve
+    evaluates it: wrapped in its safe extension)."""
+    law = SafeLaw(law)
     g = np.concatenate([np.linspace(-1.0, law.g_safe - 1e-3, 40), np.linspace(law.g_safe + 1e-3, 6.0, 200)])
     h = 1e-6
     dphi = (law.energy(g + h) - law.energy(g - h)) / (2 * h)
@@ -67,6 +72,7 @@ def test_repulsive_is_repulsive_half_of_lj93():
 @pytest.mark.parametrize("law", LAWS, ids=lambda l: type(l).__name__ + str(getattr(l, "exponent", "")))
 def test_safe_extension_continuous_and_finite(law):
     """P, Φ (and the stiffness) continuous at g_safe to O(h); finite, monotone P for g <= 0."""
+    law = SafeLaw(law)
     gs, h = law.g_safe, 1e-9
     below, above = np.array([gs - h]), np.array([gs + h])
     for f in (law.pressure, law.energy, law.stiffness):
@@ -172,9 +178,10 @@ def test_periodic_kernel_is_sum_of_images_up_to_a_constant():
     assert np.max(np.abs(diff)) < 1e-2 * np.max(np.abs(wp))
 
 
-@pytest.mark.parametrize("law", [LJ93(), Repulsive()])
+@pytest.mark.parametrize("law", [LJ93(), Repulsive(), SafeLaw(LJ93()), SafeLaw(Repulsive())], ids=repr)
 def test_energy_pressure_in_place_equals_evaluate(law):
-    """The solvers' hot path (in place, scratch buffers) gives evaluate's values, also below g_safe."""
+    """The solvers' hot path (in place, scratch buffers) gives evaluate's values, also below g_safe
+    (the law's formula, or its safe extension when wrapped)."""
     rng = np.random.default_rng(5)
     for g in (0.8 + 3 * rng.random(1000), np.linspace(-0.5, 4.0, 1001)):
         phi, p = law.evaluate(g)
@@ -185,7 +192,7 @@ def test_energy_pressure_in_place_equals_evaluate(law):
         assert s == pytest.approx(phi.sum(), rel=1e-12)
 
 
-@pytest.mark.parametrize("boundary", ["free", "periodic"])
+@pytest.mark.parametrize("boundary", registered("boundary"))
 def test_direct_fft_path_equals_public_scipy_fft(boundary):
     """The kernels run on scipy's pocketfft binding with preallocated buffers where it exists; it
     must agree with the public scipy.fft path to round-off, with and without ``out``, and the

@@ -16,6 +16,8 @@ from tengsim.laws import LJ93, Repulsive
 from tengsim.kernels import FreeKernel, pixel_influence
 from tengsim.solvers import FastSolver, Problem, State, VSRSolver
 
+from conftest import registered, solver_or_skip
+
 MU = 0.5
 DS = (0.0, 0.5, 1.0, 1.5, 2.0, 2.5)
 TOL = 1e-8       # FastSolver
@@ -31,7 +33,7 @@ def _group_a(dx=0.2):
 @lru_cache(maxsize=None)
 def sequence(solver_name):
     grid, U0, K = _group_a()
-    solver = FastSolver(TOL) if solver_name == "fast" else VSRSolver(TOL_VSR)
+    solver = solver_or_skip(solver_name, tol=TOL_VSR if solver_name == "vsr" else TOL)
     st, out = State.zero(grid.shape), []
     for D in DS:
         eq = solver.solve(Problem(U0 - D + 1.0, LJ93(), K), st)
@@ -65,9 +67,10 @@ def _dense_K(grid, coupling):
     return (coupling / np.pi) * pixel_influence(x[:, None] - x[None, :], y[:, None] - y[None, :], grid.dx, grid.dy)
 
 
-@pytest.mark.parametrize("solver_name", ["fast", "vsr"])
+@pytest.mark.parametrize("solver_name", registered("solver"))
 def test_residual_recomputed_independently(solver_name):
-    """H − (−D + U0 + K P(H)) with K the dense O(n²) matrix of pixel coefficients: max < tol."""
+    """H − (−D + U0 + K P(H)) with K the dense O(n²) matrix of pixel coefficients: max < tol, for every
+    registered solver (one that cannot run here is skipped with its reason)."""
     grid, U0, K, eqs = sequence(solver_name)
     Kd = _dense_K(grid, K.coupling)
     law = LJ93()

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from tengsim.laws import LJ93, Exponential, Law, MaugisDugdale, Repulsive
+from tengsim.laws import LJ93, Exponential, Law, MaugisDugdale, Repulsive, SafeLaw, safe
 from tengsim.plugins import LAWS
 
 REL = 1e-6
@@ -106,17 +106,29 @@ def test_declared_numbers_match_dense_evaluation(law):
 
 @pytest.mark.parametrize("law", _laws())
 def test_safe_extension_starts_at_the_declared_g_safe(law):
-    """Below g_safe, P continues linearly (C¹ at g_safe); above it, it is the law's own ``_raw``."""
+    """Wrapped (SafeLaw, as the solvers evaluate a law): below g_safe, P continues linearly (C¹ at
+    g_safe); above it, it is the law's own ``_raw``.  The law itself stays its formula everywhere."""
     gs, h = law.g_safe, 1e-7
+    wrapped = safe(law)
+    assert isinstance(wrapped, SafeLaw) and safe(wrapped) is wrapped and wrapped.law is law
     below = np.linspace(gs - 0.5, gs, 1001)
-    p = _P(law, below)
+    p = _P(wrapped, below)
     scale = max(1.0, float(np.max(np.abs(p))))
     assert np.max(np.abs(np.diff(p, 2))) <= 1e-11 * scale        # linear
-    up = (_P(law, [gs + h])[0] - _P(law, [gs])[0]) / h
-    down = (_P(law, [gs])[0] - _P(law, [gs - h])[0]) / h
+    up = (_P(wrapped, [gs + h])[0] - _P(wrapped, [gs])[0]) / h
+    down = (_P(wrapped, [gs])[0] - _P(wrapped, [gs - h])[0]) / h
     assert up == pytest.approx(down, rel=1e-4, abs=1e-6)
     above = np.linspace(gs, gs + 0.3, 301)
-    np.testing.assert_allclose(_P(law, above), law._raw(above)[1], rtol=1e-15, atol=0)
+    np.testing.assert_allclose(_P(wrapped, above), law._raw(above)[1], rtol=1e-15, atol=0)
+    pure = np.linspace(gs - 0.3, gs, 31)                         # the law alone: no extension
+    raw = _P(law, pure)
+    np.testing.assert_array_equal(raw, law._raw(pure, need_dp=False)[1])
+    if np.max(np.abs(np.diff(raw, 2))) > 1e-9 * np.max(np.abs(raw)):  # curved there (no linear wall):
+        assert not np.allclose(raw[:-1], _P(wrapped, pure[:-1]))       # the extension differs from it
+    # the wrapper is the law for everything else: its numbers, fields and parameters
+    assert wrapped.params() == law.params() and wrapped.g_safe == gs
+    for name in NUMBERS:
+        assert getattr(wrapped, name) == getattr(law, name), name
 
 
 @pytest.mark.parametrize("law", [LAWS.get(name)() for name in LAWS.names()] + OTHER_PARAMETERS,

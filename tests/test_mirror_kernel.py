@@ -3,6 +3,9 @@ import pickle
 
 import numpy as np
 import pytest
+from conftest import registered
+
+from tengsim.plugins import KERNELS
 
 from tengsim.errors import TengsimError
 from tengsim.grid import Grid, Mirror
@@ -24,7 +27,7 @@ def _field(m: Mirror, seed=0):
     return np.random.default_rng(seed).standard_normal(m.reduced_shape)
 
 
-@pytest.mark.parametrize("boundary", ["free", "periodic"])
+@pytest.mark.parametrize("boundary", registered("boundary"))
 @pytest.mark.parametrize("fp", FILMS, ids=lambda f: "halfspace" if not f else f"{f['substrate']}-{f['poisson']}")
 def test_reduced_apply_equals_full_kernel(boundary, fp):
     """reduced.apply(block) = reduce(K unfold(block)) to 1e-12 relative, and the energies agree:
@@ -50,7 +53,7 @@ def test_reduced_apply_equals_full_kernel(boundary, fp):
 
 def test_interface_attributes_and_params():
     g = Grid(9, 11, 0.2, 0.2)
-    for boundary in ("free", "periodic"):
+    for boundary in KERNELS.names():
         for fp in FILMS:
             full = make_kernel(boundary, g, 0.35, **fp)
             mk = make_mirror_kernel(boundary, g, 0.35, (0, 1), **fp)
@@ -69,7 +72,7 @@ def test_interface_attributes_and_params():
 
 def test_out_argument_and_repeated_calls():
     g = Grid(9, 9, 0.25, 0.25)
-    for boundary in ("free", "periodic"):
+    for boundary in KERNELS.names():
         mk = make_mirror_kernel(boundary, g, 1.0, (0, 1))
         pb = _field(mk.mirror)
         w1 = mk.reduced.apply(pb)
@@ -84,7 +87,7 @@ def test_out_argument_and_repeated_calls():
 
 def test_asymmetric_field_is_refused():
     g = Grid(9, 9, 0.25, 0.25)
-    for boundary in ("free", "periodic"):
+    for boundary in KERNELS.names():
         mk = make_mirror_kernel(boundary, g, 1.0, (0, 1))
         p = mk.mirror.unfold(_field(mk.mirror))
         p[0, 3] += 1e-6

@@ -14,7 +14,7 @@ from tengsim import registry
 from tengsim import plugins
 from tengsim.cli.main import main
 from tengsim.errors import TengsimError
-from tengsim.laws import LJ93, Repulsive, make_law
+from tengsim.laws import LJ93, Repulsive, SafeLaw, make_law
 from tengsim.kernels import FreeKernel, PeriodicKernel, make_kernel
 from tengsim.registry import KERNELS, LAWS, OBSERVERS, SHAPES, SOLVERS
 from tengsim.solvers import FastSolver, VSRSolver, make_solver
@@ -63,8 +63,9 @@ def test_a_new_registration_reaches_every_name_list():
 
 def test_law_params_are_its_fields_not_its_caches():
     law = LJ93()
-    law.evaluate(np.array([0.1, 1.0]))  # below g_safe: fills the cached safe-extension values
-    assert law.params() == {"g_safe": 0.6, "law": "LJ93"}
+    safe = SafeLaw(law)
+    safe.evaluate(np.array([0.1, 1.0]))  # below g_safe: fills the wrapper's cached safe-extension values
+    assert law.params() == {"g_safe": 0.6, "law": "LJ93"} and safe.params() == law.params()
     r = Repulsive(exponent=5.0)
     r.evaluate(np.array([0.1]))
     assert set(r.params()) == {"scale", "exponent", "g_safe", "law"}

@@ -11,6 +11,7 @@ import tracemalloc
 
 import numpy as np
 import pytest
+from conftest import registered
 
 from tengsim.cases.paper.contact import group_shape
 from tengsim.cases.paper.units import paper_scaling
@@ -54,7 +55,7 @@ def _group(g):
     return group_shape(g), sc.mu
 
 
-@pytest.mark.parametrize("boundary", ["free", "periodic"])
+@pytest.mark.parametrize("boundary", registered("boundary"))
 @pytest.mark.parametrize("group, dx, d_max", [("A", 0.1, 2.5), ("B", 0.25, 3.0), ("C", 0.4, 6.0)])
 def test_groups_short_path_equal_full_grid(group, dx, d_max, boundary):
     shape, mu = _group(group)
@@ -75,7 +76,7 @@ _C_PERIODIC = pytest.mark.xfail(reason="a diagonal-symmetry-breaking jump near D
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("boundary", ["free", "periodic"])
+@pytest.mark.parametrize("boundary", registered("boundary"))
 @pytest.mark.parametrize("group", ["A", "B", "C"])
 def test_groups_full_path_equal_full_grid(group, boundary, request):
     if (group, boundary) == ("C", "periodic"):

@@ -27,6 +27,7 @@ import numpy as np
 from scipy.special import ellipe, ellipk
 
 from tengsim.errors import TengsimError, positive
+from tengsim.laws.safe import safe
 
 
 def disc_integral(r, a):
@@ -105,7 +106,7 @@ class AxisymSphere:
     def __init__(self, mu: float, law, dr: float = 0.02, r_fine: float = 4.0, r_max: float = 30.0,
                  growth: float = 1.03, contact_gap: float = 1.0):
         self.mu = positive("mu", mu)
-        self.law = law
+        self.law = safe(law)  # Newton's trial gaps may fall below g_safe
         self.edges = radial_mesh(dr, r_fine, r_max, growth)
         self.C, self.r, self.area = ring_matrix(self.edges, self.mu ** 1.5)
         self.U0 = 0.5 * self.r ** 2

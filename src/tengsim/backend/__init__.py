@@ -1,8 +1,9 @@
 """The one seam for arrays and FFTs: every array the solvers allocate and every Fourier transform of
 the package goes through here (NumPy arrays, scipy's pocketfft today; a GPU backend plugs in here).
 
-- the array namespace :data:`xp` and its allocators :func:`empty`, :func:`zeros`; :func:`to_host` turns
-  a backend scalar into a host float (the one place a solve syncs);
+- the array namespace :data:`xp` and its allocators :func:`empty`, :func:`zeros`; :func:`sync` brings
+  a sweep's reductions (backend scalars, small arrays) to the host in one transfer, :func:`to_host` one
+  scalar: the only places a solve waits for the device;
 - the thread policy :func:`workers` / :func:`threads` (``TENGSIM_FFT_WORKERS`` forces a count);
 - FFT-friendly lengths :func:`fast_len`, :func:`fast_odd_len`;
 - the transforms (:mod:`tengsim.backend.fft`): the direct ``r2c``/``c2c``/``c2r``/``dct`` writing into
@@ -29,9 +30,19 @@ def zeros(shape, dtype=float):
     return xp.zeros(shape, dtype=dtype)
 
 
+def sync(scalars, tail=None):
+    """Backend scalars (then the entries of the small array ``tail``, if given) as one host float64
+    array: one transfer, stacked on the device first.  The solvers gather the scalars a sweep over the
+    grid produced and call this once per sweep, never once per scalar."""
+    a = xp.array(scalars, dtype=float)
+    if tail is not None:
+        a = xp.concatenate((a, xp.ravel(xp.asarray(tail, dtype=float))))
+    return np.asarray(a)
+
+
 def to_host(x) -> float:
-    """A backend scalar as a host float."""
-    return float(x)
+    """A backend scalar as a host float (one transfer: :func:`sync` of one value)."""
+    return float(sync((x,))[0])
 
 
 def fast_len(n: int) -> int:
@@ -53,4 +64,4 @@ def fast_odd_len(n: int) -> int:
 
 
 __all__ = ["FFTBackendWarning", "THREAD_MIN_SIZE", "empty", "fast_len", "fast_odd_len", "fft", "threads",
-           "to_host", "workers", "xp", "zeros"]
+           "sync", "to_host", "workers", "xp", "zeros"]

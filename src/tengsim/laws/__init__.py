@@ -8,5 +8,6 @@ from tengsim.laws.lj93 import LJ93
 from tengsim.laws.repulsive import Repulsive
 from tengsim.laws.maugis_dugdale import MaugisDugdale
 from tengsim.laws.exponential import Exponential
+from tengsim.laws.safe import SafeLaw, safe
 
-__all__ = ["LJ93", "LJ_PEAK_TENSION", "Exponential", "Law", "MaugisDugdale", "Repulsive", "make_law"]
+__all__ = ["LJ93", "LJ_PEAK_TENSION", "Exponential", "Law", "MaugisDugdale", "Repulsive", "SafeLaw", "make_law", "safe"]

@@ -2,9 +2,10 @@
 
 Positive P is repulsive and P = −dΦ/dg.  Units: P in W/ε, Φ in W (paper Eq. 7).
 
-Every law is made safe for any trial gap (a solver's line search may try g <= 0): below ``g_safe``
-the pressure continues linearly with the slope it has there (Φ quadratic), so P and Φ stay finite and
-C¹; physical equilibria never reach g_safe.  States are always judged by the residual of Eq. (9).
+A law is a pure formula: ``evaluate`` gives its own Φ and P at every gap.  ``g_safe`` declares how far
+down the formula is used in a solve: the solvers evaluate the law through the wrapper
+:class:`tengsim.laws.safe.SafeLaw`, which continues P linearly below g_safe (a solver's line search may
+try g <= 0); physical equilibria never reach g_safe.  States are always judged by the residual of Eq. (9).
 
 Every law also declares its own numbers (:class:`Law`, "declared numbers"): its maximum tension, the
 gaps of that peak and of zero load, its work of adhesion, its cohesive range and its steepest
@@ -33,7 +34,7 @@ class Law:
     (W/ε), ``g_peak`` (the smallest gap where P = −σ0), ``g_zero`` g0 (P(g0) = 0, the last zero below
     g_peak: the contact gap), ``work`` W = −Φ(g0) (W), ``cohesive_range`` h0 = W/σ0 (ε),
     ``max_softening`` max dP/dg over g_peak <= g <= g0 + 2 h0 (W/ε², the stiffest softening beyond the
-    peak) and ``g_safe`` (below it the safe extension).  A law without tension has ``max_tension`` =
+    peak) and ``g_safe`` (below it a solve uses the safe extension, :class:`tengsim.laws.safe.SafeLaw`).  A law without tension has ``max_tension`` =
     ``work`` = ``max_softening`` = 0 and ``g_peak`` = ``g_zero`` = ``cohesive_range`` = None.  A
     subclass overrides them with closed forms where it knows them; otherwise the base class finds them
     numerically from ``evaluate`` and ``_raw``'s dP/dg, once per law (:func:`numeric_window`,
@@ -49,42 +50,22 @@ class Law:
         the JAX solver, tengsim.solvers.jax_fast: a law whose ``_raw`` takes ``xp`` runs there too)."""
         raise NotImplementedError
 
-    @cached_property
-    def _safe(self):
-        gs = np.array([self.g_safe])
-        phi, p, dp = self._raw(gs)
-        return float(phi[0]), float(p[0]), float(dp[0])
-
     def evaluate(self, g: np.ndarray):
-        """Return (Φ, P) at gaps g (arrays of g's shape)."""
-        g = np.asarray(g, dtype=float)
-        low = g < self.g_safe
-        if not low.any():
-            phi, p, _ = self._raw(g, need_dp=False)
-            return phi, p
-        gg = np.where(low, self.g_safe, g)
-        phi, p, _ = self._raw(gg, need_dp=False)
-        phs, ps, dps = self._safe
-        t = g - self.g_safe
-        p = np.where(low, ps + dps * t, p)
-        phi = np.where(low, phs - ps * t - 0.5 * dps * t * t, phi)
+        """Return (Φ, P) at gaps g (arrays of g's shape): the law's formula, at any gap."""
+        phi, p, _ = self._raw(np.asarray(g, dtype=float), need_dp=False)
         return phi, p
 
     def evaluate_xp(self, g, xp):
-        """(Φ, P) at gaps g in the array namespace ``xp`` (jax.numpy inside a jit-compiled solver): the
-        same formulas as :meth:`evaluate`, branch-free (the safe extension by ``xp.where``)."""
-        gs = self.g_safe
-        low = g < gs
-        phi, p, _ = self._raw(xp.where(low, gs, g), need_dp=False, xp=xp)
-        phs, ps, dps = self._raw(xp.full((1,), gs, dtype=g.dtype), xp=xp)
-        t = g - gs
-        return xp.where(low, phs - ps * t - 0.5 * dps * t * t, phi), xp.where(low, ps + dps * t, p)
+        """(Φ, P) at gaps g in the array namespace ``xp`` (jax.numpy inside a jit-compiled solver)."""
+        phi, p, _ = self._raw(g, need_dp=False, xp=xp)
+        return phi, p
 
-    def energy_pressure(self, g: np.ndarray, out: np.ndarray, work) -> float:
-        """ΣΦ(g), writing P(g) into ``out``: the solvers' hot path (``work``: two scratch arrays)."""
+    def energy_pressure(self, g: np.ndarray, out: np.ndarray, work):
+        """ΣΦ(g), writing P(g) into ``out``: the solvers' hot path (``work``: two scratch arrays).  The sum
+        is a backend scalar, left on the device (the solver brings a sweep's sums to the host at once)."""
         phi, p = self.evaluate(g)
         out[...] = p
-        return float(phi.sum())
+        return phi.sum()
 
     def pressure(self, g):
         return self.evaluate(g)[1]
@@ -94,9 +75,7 @@ class Law:
 
     def stiffness(self, g):
         """−dP/dg = Φ''(g), the local interaction stiffness."""
-        g = np.asarray(g, dtype=float)
-        gg = np.maximum(g, self.g_safe)
-        return -self._raw(gg)[2]
+        return -self._raw(np.asarray(g, dtype=float))[2]
 
     # ---- declared numbers: closed forms in the built-in laws, a cached numerical search here ----------
 
@@ -162,10 +141,15 @@ class Law:
 LJ_PEAK_TENSION = 16.0 / (9.0 * 3.0**0.5)
 
 
-def _check_common(law):
-    positive("wall_stiffness", law.wall_stiffness)
+def check_g_safe(law):
+    """g_safe in (0, 1): the safe extension starts below the contact gap."""
     if not 0 < law.g_safe < 1:
         raise TengsimError(f"g_safe must lie in (0, 1), got {law.g_safe!r}")
+
+
+def _check_common(law):
+    positive("wall_stiffness", law.wall_stiffness)
+    check_g_safe(law)
 
 
 def _sqrt(x):

@@ -5,8 +5,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tengsim.errors import TengsimError
-from tengsim.laws.base import LJ_PEAK_TENSION, Law
+from tengsim.laws.base import LJ_PEAK_TENSION, Law, check_g_safe
 from tengsim.registry import LAWS
 
 
@@ -23,8 +22,7 @@ class LJ93(Law):
     g_safe: float = 0.6
 
     def __post_init__(self):
-        if not 0 < self.g_safe < 1:
-            raise TengsimError(f"g_safe must lie in (0, 1), got {self.g_safe!r}")
+        check_g_safe(self)
 
     # declared numbers (Law): closed forms
     @property
@@ -61,8 +59,8 @@ class LJ93(Law):
 
     def energy_sum_xp(self, g, xp, total):
         """(ΣΦ, P) in the array namespace ``xp``, ΣΦ summed as :meth:`energy_pressure` sums it
-        ((1/3)Σg⁻⁸ − (4/3)Σg⁻², so the JAX solver's energies round as the NumPy solver's do); None
-        below g_safe (the caller then uses :meth:`evaluate_xp`).  ``total``: the namespace's sum."""
+        ((1/3)Σg⁻⁸ − (4/3)Σg⁻², so the JAX solver's energies round as the NumPy solver's do).
+        ``total``: the namespace's sum."""
         inv = 1.0 / g
         i2 = inv * inv
         i8 = i2 * i2
@@ -71,16 +69,14 @@ class LJ93(Law):
         return total(i8) / 3.0 - (4.0 / 3.0) * total(i2), p
 
     def energy_pressure(self, g, out, work):
-        """In place, no temporaries (same values as ``evaluate``); falls back below g_safe."""
-        if float(g.min()) < self.g_safe:
-            return super().energy_pressure(g, out, work)
+        """In place, no temporaries (same values as ``evaluate``); ΣΦ a backend scalar (no host sync)."""
         a, b = work
         np.reciprocal(g, out=a)      # g⁻¹
         np.multiply(a, a, out=b)     # g⁻²
-        s2 = float(b.sum())
+        s2 = b.sum()
         np.multiply(b, b, out=out)   # g⁻⁴
         out *= out                   # g⁻⁸
-        s8 = float(out.sum())
+        s8 = out.sum()
         out *= a                     # g⁻⁹
         b *= a                       # g⁻³
         out -= b

@@ -4,7 +4,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from tengsim.errors import TengsimError, positive
-from tengsim.laws.base import Law
+from tengsim.laws.base import Law, check_g_safe
 from tengsim.registry import LAWS
 
 
@@ -28,8 +28,7 @@ class Repulsive(Law):
         positive("scale", self.scale)
         if not self.exponent > 1:
             raise TengsimError(f"exponent must be > 1, got {self.exponent!r}")
-        if not 0 < self.g_safe < 1:
-            raise TengsimError(f"g_safe must lie in (0, 1), got {self.g_safe!r}")
+        check_g_safe(self)
 
     # declared numbers (Law): no tension
     @property

@@ -26,6 +26,8 @@ import jax.numpy as jnp
 from jax import lax
 from jax.scipy.linalg import solve_triangular
 
+from tengsim.laws.safe import SafeLaw
+
 F64 = jnp.float64
 C1, C2, MAX_EVAL, FIRST_MOVE = 1e-4, 0.9, 40, 0.25  # tengsim.solvers._linesearch.WolfeLineSearch's defaults
 #: the approximate Wolfe test's energy slack, relative: the NumPy solver's in float64; float32 fields round E at ~1e-7
@@ -63,9 +65,10 @@ def build(shape, padded, periodic, pinned, law_cls, law_fields, dtype, memory, r
         return jnp.sum(a, dtype=F64)
 
     def solve(g0, q, w, spec, law_values, tol, max_iter, dA, nw):
-        law = law_twin(law_cls, law_fields, [jnp.asarray(v, dt) for v in law_values])  # no float64 promotion
+        raw = law_twin(law_cls, law_fields, [jnp.asarray(v, dt) for v in law_values])  # no float64 promotion
+        law = SafeLaw(raw)  # the safe extension below g_safe, as the NumPy solver evaluates it
 
-        fast_sum = getattr(law, "energy_sum_xp", None)
+        fast_sum = getattr(raw, "energy_sum_xp", None)
 
         def law_phis(g):
             """(ΣΦ, P(g)): the law's own sum where it has one (LJ93, summed as the NumPy solver sums it)

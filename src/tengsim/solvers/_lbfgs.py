@@ -126,5 +126,5 @@ class KMetricLBFGS:
         self.pS[slot] = alpha * d_rn
         self.pY[slot] = y_rn
         self.order.append(slot)
-        self._perm = np.array(self.order)
+        self._perm = backend.xp.asarray(self.order)
         return slot

@@ -13,10 +13,13 @@ safeguarded secant steps on E'.
 """
 from __future__ import annotations
 
+import functools
 import math
 from typing import NamedTuple
 
 import numpy as np
+
+from tengsim import backend
 
 
 class Ray(NamedTuple):
@@ -52,6 +55,8 @@ class WolfeLineSearch:
     def __init__(self, law, sweeper, dA, g_trial, P_trial, sum_p=False, c1=1e-4, c2=0.9, max_eval=40,
                  first_move=0.25, lines=None, red=None):
         self.law, self.sweeper, self.dA = law, sweeper, float(dA)
+        # a SafeLaw: its own hot path unchecked, the gaps' minimum checked once per sweep (laws.safe)
+        self.unchecked = hasattr(law, "energy_pressure_unchecked")
         self.lines = lines  # a weighted problem's deficit pixels (tengsim.solvers._weights), or None
         self.red = red      # a distributed solve's sums over all ranks (tengsim.solvers._reduce), or None
         self.g_trial, self.P_trial = g_trial, P_trial
@@ -60,7 +65,8 @@ class WolfeLineSearch:
 
     def first_step(self, Kd) -> float:
         """α for a first direction (empty memory): the gap moves by at most ``first_move`` (0.25 ε)."""
-        m = max(float(Kd.max()), -float(Kd.min()))
+        hi, lo = backend.sync((Kd.max(), Kd.min()))
+        m = max(hi, -lo)
         if self.red is not None:
             m = self.red.max(m)
         return self.first_move / m if m > self.first_move else 1.0
@@ -71,40 +77,75 @@ class WolfeLineSearch:
         self.g_trial, self.P_trial = g, P
         return gt, Pt
 
-    def _block(self, sl, m, sc, acc, a, g, P, Kd):
-        # block by block (a sweep): the gap, the law's scratch and the pressure stay in cache
+    def block(self, sl, m, sc, acc, a, g, P, Kd, unchecked, o=0):
+        """One block of a trial's sweep: g(α), P(α) into the trial buffers, [ΣΦ, Σ(P(α) − P)·K d, ΣP,
+        min g] added to ``acc[o:o + 4]`` (backend scalars: no host sync inside a sweep; min g only
+        ``unchecked``).  Block by block, the gap, the law's scratch and the pressure stay in cache; the
+        fast solver also runs it inside its direction's sweep (the first trial, α = 1)."""
         buf = self.sweeper.buf
         gb, pb, kb = self.g_trial[sl], self.P_trial[sl], Kd[sl]
         np.multiply(kb, a, out=gb)
         np.add(gb, g[sl], out=gb)
-        acc[0] += self.law.energy_pressure(gb, pb, (buf(sc, "a", m), buf(sc, "b", m)))
+        work = (buf(sc, "a", m), buf(sc, "b", m))
+        if unchecked:
+            e, g_min = self.law.energy_pressure_unchecked(gb, pb, work)
+            acc[o] += e
+            acc[o + 3] = np.minimum(acc[o + 3], g_min)
+        else:
+            acc[o] += self.law.energy_pressure(gb, pb, work)
         dp = buf(sc, "c", m)
         np.subtract(pb, P[sl], out=dp)
-        acc[1] += float(np.vdot(dp, kb))
+        acc[o + 1] += np.vdot(dp, kb)
         if self.sum_p:
-            acc[2] += float(pb.sum())
+            acc[o + 2] += pb.sum()
+
+    def _sweep(self, a, ray: Ray, unchecked: bool):
+        """[ΣΦ, Σ(P(α) − P)·K d, ΣP, min g(α)] of one sweep, backend scalars (min g: +inf unless
+        ``unchecked``); the sums added over the groups as Sweeper.sum adds them."""
+        accs = self.sweeper.run(self.block, [0.0, 0.0, 0.0, np.inf], a, ray.g, ray.P, ray.Kd, unchecked)
+        if len(accs) == 1:
+            return accs[0]
+        out = [sum(acc[j] for acc in accs) for j in range(3)]
+        return out + [functools.reduce(np.minimum, (acc[3] for acc in accs))]
 
     def evaluate(self, a, ray: Ray):
-        """(E(α), E'(α), ΣΦ, ΣP) at α = ``a``, with g(α), P(α) written into the trial buffers."""
-        phis, dpk, sp = self.sweeper.sum(self._block, [0.0, 0.0, 0.0], a, ray.g, ray.P, ray.Kd)
+        """(E(α), E'(α), ΣΦ, ΣP) at α = ``a``, with g(α), P(α) written into the trial buffers.
+
+        One host sync: the sweep's sums (and the weighted corrections) come over together, with the
+        smallest trial gap, which says whether the law's unchecked hot path was right (else a second
+        sweep, checked block by block: a trial far into contact)."""
+        phis, dpk, sp, g_min = self._sweep(a, ray, self.unchecked)
         L = self.lines
         if L is not None:  # m-weighted sums: the deficit pixels' share off (ΔA carries the interior weight)
             i, c, Pt = L.idx, L.c, self.P_trial
-            phis -= float(np.dot(c, self.law.energy(self.g_trial[i])))
-            dpk -= float(np.dot(c * (Pt[i] - ray.P[i]), ray.Kd[i]))
+            if self.unchecked and not self.law.covers(backend.to_host(g_min)):  # P(α) must be right first
+                phis, dpk, sp, g_min = self._sweep(a, ray, False)
+            phis = phis - np.dot(c, self.law.energy(self.g_trial[i]))
+            dpk = dpk - np.dot(c * (Pt[i] - ray.P[i]), ray.Kd[i])
             if self.sum_p:
-                sp -= float(np.dot(c, Pt[i]))
+                sp = sp - np.dot(c, Pt[i])
+            phis, dpk, sp = backend.sync((phis, dpk, sp)).tolist()
+        else:
+            phis, dpk, sp, g_min = backend.sync((phis, dpk, sp, g_min)).tolist()
+            if self.unchecked and not self.law.covers(g_min):
+                phis, dpk, sp, _ = backend.sync(self._sweep(a, ray, False)).tolist()
+        return self.finish(a, ray, phis, dpk, sp)
+
+    def finish(self, a, ray: Ray, phis, dpk, sp):
+        """(E(α), E'(α), ΣΦ, ΣP) from a trial sweep's sums on this process (host floats)."""
         if self.red is not None:  # every rank's share of the grid
             phis, dpk, sp = self.red.sum([phis, dpk, sp])
         e = self.dA * (0.5 * ray.qw + a * ray.dw + 0.5 * a * a * ray.dKd + phis)
         de = ray.slope + self.dA * (a * ray.dKd - dpk)
         return e, de, phis, sp
 
-    def search(self, alpha0: float, ray: Ray, E_ref: float = math.inf) -> Trial | None:
+    def search(self, alpha0: float, ray: Ray, E_ref: float = math.inf, first=None) -> Trial | None:
         """The accepted step from the trial α = ``alpha0`` (doubled until bracketed), or None.
 
         ``E_ref``: the caller's lowest energy so far; the approximate test is measured from
-        min(E(0), E_ref), so round-off rises of E cannot add up over many accepted steps."""
+        min(E(0), E_ref), so round-off rises of E cannot add up over many accepted steps.  ``first``:
+        :meth:`evaluate`'s answer at ``alpha0`` when the caller has swept it already (the trial
+        buffers then hold g(α0), P(α0))."""
         E0, slope0, c1, c2 = ray.E0, ray.slope, self.c1, self.c2
         eps_E = 1e-11 * max(1.0, abs(E0))
         E_lo = min(E0, E_ref)
@@ -113,7 +154,10 @@ class WolfeLineSearch:
         hi, de_hi = None, None
         best = None
         for _ in range(self.max_eval):
-            e, de, phis, sp = self.evaluate(alpha, ray)
+            if first is not None:
+                (e, de, phis, sp), first = first, None
+            else:
+                e, de, phis, sp = self.evaluate(alpha, ray)
             if not np.isfinite(e):
                 hi, de_hi = alpha, None
             else:

@@ -15,6 +15,8 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
+from tengsim import backend
+
 BLOCK = 1 << 15          # elements per block: 8 float64 arrays × 256 KiB fit a 2 MiB cache
 THREAD_MIN_SIZE = 512 * 512
 _POOL: ThreadPoolExecutor | None = None
@@ -70,7 +72,7 @@ class Sweeper:
     def buf(self, scratch: dict, name: str, m: int) -> np.ndarray:
         a = scratch.get(name)
         if a is None:
-            a = scratch[name] = np.empty(self.block_len)
+            a = scratch[name] = backend.empty(self.block_len)
         return a[:m]
 
     def run(self, fn, init, *args):
@@ -79,11 +81,14 @@ class Sweeper:
             fn(self._single[0], self.n, self._scratch[0], acc, *args)
             return [acc]
 
+        err = np.geterr()  # the caller's floating-point error handling, taken to the worker threads
+
         def group(i):
             acc = list(init)
             sc = self._scratch[i]
-            for sl, m in self.groups[i]:
-                fn(sl, m, sc, acc, *args)
+            with np.errstate(**err):
+                for sl, m in self.groups[i]:
+                    fn(sl, m, sc, acc, *args)
             return acc
 
         if len(self.groups) == 1:

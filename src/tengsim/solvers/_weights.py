@@ -3,7 +3,8 @@
 With multiplicities m the solvers' sums become Σ m_i a_i b_i.  On a mirror block m is the same
 interior value W (2 or 4) everywhere except on the mirror lines (1 or 2): O(√n) pixels.  So a weighted
 sum is taken as W × (the plain sum, which the solvers' sweeps already compute) minus W × Σ c_i a_i b_i
-over those few pixels only, with c = 1 − m/W: no extra pass over the grid.  The factor W goes into
+over those few pixels only, with c = 1 − m/W: no extra pass over the grid.  The corrections are backend
+scalars: the solver brings them to the host with the sweep's own sums.  The factor W goes into
 the pixel area (ΔA W), the rest of the algebra is unchanged.
 """
 from __future__ import annotations
@@ -29,20 +30,20 @@ class Weights:
         self.c = 1.0 - s[self.idx]
         self.total = float(s.sum())  # Σ m / W: the weighted pixel count, in units of W
 
-    def dot(self, a, b) -> float:
+    def dot(self, a, b):
         """Σ c a b over the deficit pixels (subtract from the plain a·b)."""
         i = self.idx
-        return float(np.dot(self.c * a[i], b[i]))
+        return np.dot(self.c * a[i], b[i])
 
     def dots(self, a, *bs) -> list:
         """[Σ c a b for b in bs]: several deficits with one vector (c a on the deficit pixels)."""
         i = self.idx
         ca = self.c * a[i]
-        return [float(np.dot(ca, b[i])) for b in bs]
+        return [np.dot(ca, b[i]) for b in bs]
 
-    def sum(self, a) -> float:
+    def sum(self, a):
         """Σ c a over the deficit pixels (subtract from the plain Σ a)."""
-        return float(np.dot(self.c, a[self.idx]))
+        return np.dot(self.c, a[self.idx])
 
     def rows(self, B, a):
         """B[:, idx] @ (c a[idx]): the deficit of the row products B @ a."""

@@ -10,7 +10,9 @@ from typing import ClassVar
 
 import numpy as np
 
+from tengsim import backend
 from tengsim.errors import TengsimError
+from tengsim.laws.safe import safe
 from tengsim.solvers._linesearch import Ray, Trial, WolfeLineSearch
 from tengsim.solvers._reduce import for_kernel
 from tengsim.solvers._weights import Weights
@@ -33,6 +35,10 @@ class FastSolver:
 
     The arrays of an iteration live in a workspace (tengsim.solvers._workspace), allocated once per grid and,
     on grids up to 512² points, kept by the solver for its next solve (a path's equilibria share one).
+    Host syncs: a sweep's sums stay backend scalars and come over in one ``backend.sync`` at its end: the
+    direction's (with the line search's first trial α = 1 swept along), one per further trial, the new
+    residual's; the law is evaluated through its safe extension (tengsim.laws.safe), its hot path
+    unchecked and the sweep's smallest gap checked in that same sync.
     """
 
     tol: float = 1e-6
@@ -70,7 +76,10 @@ class FastSolver:
         if red is not None and lines is not None:
             raise TengsimError("a distributed solve cannot also be a weighted (mirror) one")
         try:
-            return self._descend(_Descent(problem, start, ws, lines), t0)
+            # the law's unchecked hot path may meet g <= 0 in a pass that is then redone checked
+            # (tengsim.laws.safe): no warnings from it (sweeps on threads take this state along)
+            with np.errstate(divide="ignore", over="ignore", invalid="ignore"):
+                return self._descend(_Descent(problem, start, ws, lines), t0)
         finally:
             self._spare.give(ws)
 
@@ -87,7 +96,8 @@ class FastSolver:
                 self.monitor(it, run.rmax, run.E)
             ray = run.direction()
             alpha0 = search.first_step(ray.Kd) if run.mem.empty else 1.0
-            trial = search.search(alpha0, ray, run.lowest_energy())
+            first = None if run.first is None else search.finish(alpha0, ray, *run.first)  # swept with d
+            trial = search.search(alpha0, ray, run.lowest_energy(), first)
             if trial is None:
                 return run.finish(False, it, "line search failed", t0)
             resync = (it + 1) % self.resync == 0
@@ -118,25 +128,26 @@ class _Descent:
 
     def __init__(self, problem: Problem, start: State, ws, lines=None):
         K = problem.kernel
-        self.problem, self.law, self.dA = problem, problem.law, problem.dA
+        self.problem, self.law, self.dA = problem, safe(problem.law), problem.dA  # the law, safe below g_safe
         self.lines = lines
         if lines is not None:
             self.dA = problem.dA * lines.scale
         self.shape = problem.g0.shape
-        self.g0 = np.ascontiguousarray(problem.g0, dtype=float).ravel()
+        self.g0 = backend.xp.ascontiguousarray(problem.g0, dtype=float).ravel()
         self.n = self.g0.size
         self.nw = self.n if lines is None else lines.total  # the (weighted) pixel count
         self.red = red = for_kernel(K)  # None, or the sums and maxima over the ranks of a distributed solve
         if red is not None:
             self.nw = red.sum([float(self.n)])[0]
-        self.q = np.array(start.q, dtype=float).ravel()
-        self.w = np.array(start.w, dtype=float).ravel()
+        self.q = backend.xp.array(start.q, dtype=float).ravel()
+        self.w = backend.xp.array(start.w, dtype=float).ravel()
         self.sw, self.mem, self.cP = ws.sweeper, ws.memory, ws.cP
         self.g, self.P, self.d, self.Kd = ws.g, ws.P, ws.d, ws.Kd
         self.r, self.rn, self.G, self.Gn, self.y, self.ky = ws.r, ws.rn, ws.G, ws.Gn, ws.y, ws.ky
         # a film's periodic kernel has a finite mean compliance, K(0) > 0: it says pinned_mean = False
         self.proj = bool(getattr(K, "pinned_mean", getattr(K, "periodic", False)))
-        self.search = WolfeLineSearch(problem.law, ws.sweeper, self.dA, ws.gt, ws.Pt, sum_p=self.proj,
+        self.unchecked = hasattr(self.law, "energy_pressure_unchecked")  # a SafeLaw (tengsim.laws.safe)
+        self.search = WolfeLineSearch(self.law, ws.sweeper, self.dA, ws.gt, ws.Pt, sum_p=self.proj,
                                       lines=lines, red=red)
         self._apply, self._takes_out = K.apply, _takes_out(K.apply)
         # the start: g, P, ΣΦ, r (one convolution), G, E
@@ -145,30 +156,32 @@ class _Descent:
         np.subtract(self.w, self.convolve(self.P), out=self.r)
         self.n_conv = 1
         if red is not None:
-            self.mean_q = red.sum([float(self.q.sum())])[0] / self.nw
+            self.mean_q = red.sum([backend.to_host(self.q.sum())])[0] / self.nw
         elif lines is None:
-            self.mean_q = float(self.q.mean())
+            self.mean_q = backend.to_host(self.q.mean())
         else:
-            self.mean_q = (float(self.q.sum()) - lines.sum(self.q)) / self.nw
+            self.mean_q = backend.to_host(self.q.sum() - lines.sum(self.q)) / self.nw
         np.subtract(self.q, self.P, out=self.G)
         if self.proj:
             self.G -= self.mean_q - self.sum_p / self.nw
         self.qw = self._dot(self.q, self.w)
         self.E = self.dA * (0.5 * self.qw + self.phis)
-        self.rmax = max(float(self.r.max()), -float(self.r.min()))
+        hi, lo = backend.sync((self.r.max(), self.r.min()))
+        self.rmax = max(float(hi), -float(lo))
         if red is not None:
             self.rmax = red.max(self.rmax)
         self.E_best = self.E
         self.sum_d = 0.0
         self.corr = None
+        self.first = None  # the first trial's sums, swept with the direction (:meth:`_direction`)
 
     # ---- the pieces ---------------------------------------------------------------------------
     def _dot(self, a, b) -> float:
         """a·b, m-weighted (in units of the interior weight) for a weighted problem."""
-        v = float(np.vdot(a, b))
+        v = np.vdot(a, b)
         if self.red is not None:
-            return self.red.sum([v])[0]
-        return v if self.lines is None else v - self.lines.dot(a, b)
+            return self.red.sum([backend.to_host(v)])[0]
+        return backend.to_host(v if self.lines is None else v - self.lines.dot(a, b))
 
     def convolve(self, x):
         """K x into the workspace's output array (one convolution; not counted here)."""
@@ -179,17 +192,37 @@ class _Descent:
             out[:] = self._apply(x.reshape(shape)).ravel()
         return out
 
-    def _law_block(self, sl, m, sc, acc):
+    def _law_block(self, sl, m, sc, acc, unchecked):
         buf = self.sw.buf
-        acc[0] += self.law.energy_pressure(self.g[sl], self.P[sl], (buf(sc, "a", m), buf(sc, "b", m)))
+        work = (buf(sc, "a", m), buf(sc, "b", m))
+        if unchecked:
+            e, g_min = self.law.energy_pressure_unchecked(self.g[sl], self.P[sl], work)
+            acc[0] += e
+            acc[2] = np.minimum(acc[2], g_min)
+        else:
+            acc[0] += self.law.energy_pressure(self.g[sl], self.P[sl], work)
         if self.proj:
-            acc[1] += float(self.P[sl].sum())
+            acc[1] += self.P[sl].sum()
+
+    def _law_sums(self, unchecked):
+        accs = self.sw.run(self._law_block, [0.0, 0.0, np.inf], unchecked)
+        if len(accs) == 1:
+            return accs[0]
+        return [sum(a[0] for a in accs), sum(a[1] for a in accs), functools.reduce(np.minimum, (a[2] for a in accs))]
 
     def law_sweep(self):
-        """ΣΦ(g) and ΣP (periodic kernels only, else 0), with P(g) written into P."""
-        acc = self.sw.sum(self._law_block, [0.0, 0.0])
-        if self.lines is not None:
-            acc = _weigh_law(self.lines, self.law, self.g, self.P, acc, self.proj)
+        """ΣΦ(g) and ΣP (periodic kernels only, else 0), with P(g) written into P: one host sync (the
+        law's unchecked hot path, checked by the smallest gap, as in the line search)."""
+        phis, sum_p, g_min = self._law_sums(self.unchecked)
+        if self.lines is None:
+            phis, sum_p, g_min = backend.sync((phis, sum_p, g_min)).tolist()
+            if self.unchecked and not self.law.covers(g_min):
+                phis, sum_p, _ = backend.sync(self._law_sums(False)).tolist()
+            acc = [phis, sum_p]
+        else:  # weighted: the deficit pixels' share needs P right first
+            if self.unchecked and not self.law.covers(backend.to_host(g_min)):
+                phis, sum_p, _ = self._law_sums(False)
+            acc = backend.sync(_weigh_law(self.lines, self.law, self.g, self.P, [phis, sum_p], self.proj)).tolist()
         if self.red is not None:
             acc = self.red.sum(acc)
         return acc
@@ -201,7 +234,7 @@ class _Descent:
         return self.E_best
 
     # ---- the direction --------------------------------------------------------------------------
-    def _direction_block(self, sl, m, sc, acc, gamma, c, k2):
+    def _direction_block(self, sl, m, sc, acc, gamma, c, k2, fuse):
         ds, kds = self.d[sl], self.Kd[sl]
         np.multiply(self.G[sl], -gamma, out=ds)
         np.multiply(self.r[sl], -gamma, out=kds)
@@ -211,20 +244,40 @@ class _Descent:
             ds -= h
             np.matmul(c, self.mem.KB[:k2, sl], out=h)
             kds -= h
-        acc[0] += float(np.vdot(ds, self.w[sl]))
-        acc[1] += float(np.vdot(ds, kds))
-        acc[2] += float(np.vdot(ds, self.r[sl]))
+        acc[0] += np.vdot(ds, self.w[sl])
+        acc[1] += np.vdot(ds, kds)
+        acc[2] += np.vdot(ds, self.r[sl])
         if self.proj:
-            acc[3] += float(ds.sum())
+            acc[3] += ds.sum()
+        if fuse:  # the line search's first trial, α = 1, on this block while it is in cache
+            self.search.block(sl, m, sc, acc, 1.0, self.g, self.P, self.Kd, True, 4)
 
     def _direction(self):
+        """[d·w, d·K d, d·r, Σd] (host floats, one sync); with a memory the line search's first trial α = 1
+        is swept along (:attr:`first`: its [ΣΦ, Σ(P(1) − P)·K d, ΣP], or None)."""
         gamma, c = self.mem.coefficients()
         k2 = 0 if c is None else c.size
-        acc = self.sw.sum(self._direction_block, [0.0, 0.0, 0.0, 0.0], gamma, c, k2)
+        # fused in the serial, unweighted solve with a SafeLaw (its check rides on this sweep's sync)
+        fuse = k2 > 0 and self.unchecked and self.lines is None and self.red is None
+        init = [0.0, 0.0, 0.0, 0.0] + ([0.0, 0.0, 0.0, np.inf] if fuse else [])
+        accs = self.sw.run(self._direction_block, init, gamma, c, k2, fuse)
+        if len(accs) == 1:
+            acc = accs[0]
+        else:
+            acc = [sum(a[j] for a in accs) for j in range(min(len(init), 7))]
+            if fuse:
+                acc.append(functools.reduce(np.minimum, (a[7] for a in accs)))
+        self.first = None
+        if fuse:
+            h = backend.sync(acc).tolist()  # the sweep's one host sync: the direction and the trial
+            if self.law.covers(h[7]):
+                self.first = h[4:7]
+            return h[:4]
         L = self.lines
         if L is not None:  # the sweep wrote d and K d whole: correct its sums on the deficit pixels
             cw, cKd, cr = L.dots(self.d, self.w, self.Kd, self.r)
             acc = [acc[0] - cw, acc[1] - cKd, acc[2] - cr, acc[3] - (L.sum(self.d) if self.proj else 0.0)]
+        acc = backend.sync(acc).tolist()  # the sweep's one host sync
         if self.red is not None:
             acc = self.red.sum(acc)
         return acc
@@ -296,11 +349,13 @@ class _Descent:
         if self.proj:
             Gns -= mu
         np.subtract(Gns, self.G[sl], out=ys)
-        acc[0] += float(np.vdot(ds, kys))
-        acc[1] += float(np.vdot(ys, kys))
-        acc[2] += float(np.vdot(ds, rns))
-        acc[3] += float(np.vdot(ys, rns))
-        acc[4] = max(acc[4], float(rns.max()), -float(rns.min()))
+        acc[0] += np.vdot(ds, kys)
+        acc[1] += np.vdot(ys, kys)
+        acc[2] += np.vdot(ds, rns)
+        acc[3] += np.vdot(ys, rns)
+        hi, lo = rns.max(), rns.min()
+        acc[4] = hi if acc[4] is None else np.maximum(acc[4], hi)
+        acc[6] = lo if acc[6] is None else np.minimum(acc[6], lo)
         if k2:
             acc[5] = acc[5] + self.mem.B[:k2, sl] @ kys
 
@@ -313,13 +368,14 @@ class _Descent:
         self.convolve(self.P)
         self.n_conv += 1
         k2 = 2 * len(self.mem.order)
-        accs = self.sw.run(self._residual_block, [0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+        accs = self.sw.run(self._residual_block, [0.0, 0.0, 0.0, 0.0, None, 0.0, None],
                            alpha, not resync, self.corr, mu, k2)
         if len(accs) == 1:
-            dky, yky, drn, yrn, self.rmax, x = accs[0]
+            dky, yky, drn, yrn, hi, x, lo = accs[0]
         else:
-            dky, yky, drn, yrn, _, x = (sum(a[j] for a in accs) for j in range(6))
-            self.rmax = max(a[4] for a in accs)
+            dky, yky, drn, yrn, x = (sum(a[j] for a in accs) for j in (0, 1, 2, 3, 5))
+            hi = functools.reduce(np.maximum, (a[4] for a in accs))
+            lo = functools.reduce(np.minimum, (a[6] for a in accs))
         L = self.lines
         if L is not None:  # max|r| stays a plain max; the products are weighted
             ky, rn = self.ky, self.rn
@@ -328,6 +384,10 @@ class _Descent:
             dky, yky, drn, yrn = dky - c_dky, yky - c_yky, drn - c_drn, yrn - c_yrn
             if k2:
                 x = x - L.rows(self.mem.B[:k2], ky)
+        h = backend.sync((dky, yky, drn, yrn, hi, lo), x if k2 else None)  # the sweep's one host sync
+        dky, yky, drn, yrn, hi, lo = h[:6].tolist()
+        self.rmax = max(hi, -lo) if hi == hi and lo == lo else math.nan   # max|r_new|
+        x = h[6:]
         if self.red is not None:  # every rank's partial products and max|r|
             dky, yky, drn, yrn = self.red.sum([dky, yky, drn, yrn])
             self.rmax = self.red.max(self.rmax)
@@ -368,7 +428,7 @@ class _Descent:
 def _weigh_law(lines, law, g, P, acc, sum_p):
     """[ΣΦ, ΣP] of a sweep, m-weighted: less the deficit pixels' share (Φ there evaluated anew)."""
     i = lines.idx
-    phis = acc[0] - float(np.dot(lines.c, law.energy(g[i])))
+    phis = acc[0] - np.dot(lines.c, law.energy(g[i]))
     return [phis, acc[1] - lines.sum(P) if sum_p else acc[1]]
 
 

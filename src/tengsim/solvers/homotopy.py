@@ -38,6 +38,7 @@ import numpy as np
 
 from tengsim.grid import fourier_resample
 from tengsim.errors import TengsimError
+from tengsim.laws.safe import safe
 from tengsim.grid import Grid
 from tengsim.registry import SOLVERS
 from tengsim.solvers.fast import FastSolver
@@ -47,13 +48,14 @@ from tengsim.solvers._reduce import for_kernel
 
 class Softened:
     """``law`` with its range stretched by ``s`` about its contact gap g_c: Φ_s(g) = Φ(x), P_s(g) = P(x)/s,
-    x = g_c + (g − g_c)/s (a duck-typed law: what the solvers call)."""
+    x = g_c + (g − g_c)/s (a duck-typed law: what the solvers call; the law safe below its g_safe, so the
+    softened one below its own, stretched, ``g_safe``)."""
 
     def __init__(self, law, s: float):
         if not (isinstance(s, (int, float)) and s >= 1 and math.isfinite(s)):
             raise TengsimError(f"the range factor must be a finite number >= 1, got {s!r}")
         gc = getattr(law, "g_zero", None)
-        self.law, self.s, self.gc = law, float(s), float(gc) if gc is not None else 1.0
+        self.law, self.s, self.gc = safe(law), float(s), float(gc) if gc is not None else 1.0
         self.g_safe = self.gc + self.s * (float(law.g_safe) - self.gc)
 
     def _x(self, g):

@@ -41,6 +41,7 @@ from typing import ClassVar
 import numpy as np
 
 from tengsim.errors import TengsimError
+from tengsim.laws.safe import SafeLaw
 from tengsim.registry import SOLVERS
 from tengsim.solvers.types import Equilibrium, Problem, State
 
@@ -95,7 +96,10 @@ def find_device(device: str):
 
 
 def _law_form(law):
-    """(class, field names, values) of a law the loop can trace, or TengsimError."""
+    """(class, field names, values) of a law the loop can trace (a SafeLaw's own law: the loop applies
+    the safe extension itself), or TengsimError."""
+    if isinstance(law, SafeLaw):
+        law = law.law
     cls = type(law)
     raw = getattr(cls, "_raw", None)
     ok = dataclasses.is_dataclass(law) and raw is not None and hasattr(law, "evaluate_xp")
@@ -142,6 +146,7 @@ class JaxSolver:
     dtype: str = "float64"
     name: str = "jax"
     resumes_from_state: ClassVar[bool] = True  # continuation.persist may go on from its capped state
+    compiles: ClassVar[bool] = True  # compiled before its first solve on a grid (seconds, once per configuration)
 
     def __post_init__(self):
         if not self.tol > 0:
@@ -243,6 +248,9 @@ SOLVERS.register("jax", JaxSolver, summary="the fast solver compiled with JAX (G
 def gpu_solver(tol: float = 1e-6, **kw) -> JaxSolver:
     """The JAX solver on a GPU (TengsimError, one line, when JAX has none)."""
     return JaxSolver(tol=tol, **{"device": "gpu", "name": "gpu", **kw})
+
+
+gpu_solver.compiles = True  # as JaxSolver
 
 
 SOLVERS.register("gpu", gpu_solver, summary="the fast solver compiled with JAX on a GPU (pip install 'tengsim[gpu]')")

@@ -17,6 +17,7 @@ This module imports no kernel: the kernels and the solvers are independent packa
 """
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import replace
 
 import numpy as np
@@ -83,10 +84,8 @@ class MirrorSolver:
         if problem.weights is not None:
             raise TengsimError("MirrorSolver: the problem is weighted already")
         eq = self.inner.solve(Problem(g0b, problem.law, reduced, weights=m), start_b)
-        out = FoldedEquilibrium(eq.state, eq.H, eq.P, eq.residual, eq.converged, eq.iterations, eq.n_conv,
-                                eq.energy, eq.seconds, eq.message)
-        out._mirror = mirror
-        return out
+        return FoldedEquilibrium(eq.state, eq.H, eq.P, eq.residual, eq.converged, eq.iterations, eq.n_conv,
+                                 eq.energy, eq.seconds, eq.message, mirror=mirror)
 
 
 class FoldedEquilibrium(Equilibrium):
@@ -94,9 +93,20 @@ class FoldedEquilibrium(Equilibrium):
     the full grid when read.  The equilibria a path holds (secant, jump tests) then cost a block's memory;
     the one most recently read is kept unfolded (one slot per mirror, per field), so the reads of one row
     (force, contact length, status, observers, maps) unfold it once.  Built without a mirror (e.g. by
-    ``dataclasses.replace``, which passes the unfolded fields) it is a plain equilibrium."""
+    ``dataclasses.replace``, which passes the unfolded fields) it is a plain equilibrium.  A value, as
+    every Equilibrium: complete at construction (``mirror=`` included), no attribute set afterwards."""
 
     _mirror = None
+
+    def __init__(self, *fields, mirror=None, **named):
+        super().__init__(*fields, **named)
+        object.__setattr__(self, "_mirror", mirror)
+
+    def __setattr__(self, name, value):
+        raise dataclasses.FrozenInstanceError(f"cannot assign to field {name!r}")
+
+    def __delattr__(self, name):
+        raise dataclasses.FrozenInstanceError(f"cannot delete field {name!r}")
 
     def _full(self, name):
         block = self.__dict__["_" + name]

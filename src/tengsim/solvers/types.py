@@ -7,6 +7,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from tengsim import backend
+
 
 @dataclass(frozen=True)
 class Problem:
@@ -37,7 +39,7 @@ class State:
 
     @classmethod
     def zero(cls, shape) -> "State":
-        return cls(np.zeros(shape), np.zeros(shape))
+        return cls(backend.zeros(shape), backend.zeros(shape))
 
     def copy(self) -> "State":
         return State(self.q.copy(), self.w.copy())

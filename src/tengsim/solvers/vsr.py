@@ -7,7 +7,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from tengsim import backend
 from tengsim.errors import TengsimError
+from tengsim.laws.safe import safe
 from tengsim.solvers.types import Equilibrium, Problem, State, finish
 
 
@@ -37,14 +39,14 @@ class VSRSolver:
 
     def solve(self, problem: Problem, start: State) -> Equilibrium:
         t0 = time.perf_counter()
-        K, law, g0, dA = problem.kernel, problem.law, problem.g0, problem.dA
+        K, law, g0, dA = problem.kernel, safe(problem.law), problem.g0, problem.dA
         m = problem.weights
         if m is None:  # uniform: plain sums
             def energy(q, w, phi):
                 return dA * (0.5 * np.vdot(q, w) + phi.sum())
 
             def rnorm(r):
-                return float(np.linalg.norm(r))
+                return np.linalg.norm(r)
         else:  # a weighted problem (a mirror block): m-weighted sums, a plain max|r|
             m = np.asarray(m, dtype=float)
             if m.shape != np.shape(g0):
@@ -54,16 +56,15 @@ class VSRSolver:
                 return dA * (0.5 * np.vdot(m * q, w) + np.vdot(m, phi))
 
             def rnorm(r):
-                return float(np.sqrt(np.vdot(m * r, r)))
+                return np.sqrt(np.vdot(m * r, r))
         q, w = start.q.copy(), start.w.copy()
         phi, P = law.evaluate(g0 + w)
         r = w - K.apply(P)
-        E = energy(q, w, phi)
+        # E, ‖r‖ and max|r| of a state come to the host together (one backend.sync per step)
+        E, norm, rmax = backend.sync((energy(q, w, phi), rnorm(r), np.max(np.abs(r)))).tolist()
         n_conv, it, dt, cap = 1, 0, self.dt0, 1.0
         msg = ""
-        norm = rnorm(r)
         while True:
-            rmax = float(np.max(np.abs(r)))
             if rmax <= self.tol:
                 msg = "converged"
                 break
@@ -77,15 +78,14 @@ class VSRSolver:
                 w_try = K.apply(q_try)
                 n_conv += 1
             phi_t, P_t = law.evaluate(g0 + w_try)
-            E_t = energy(q_try, w_try, phi_t)
             r_t = w_try - K.apply(P_t)
             n_conv += 1
-            n_t = rnorm(r_t)
+            E_t, n_t, rmax_t = backend.sync((energy(q_try, w_try, phi_t), rnorm(r_t), np.max(np.abs(r_t)))).tolist()
             # keep a step that lowers the energy (to round-off) without blowing up the residual;
             # a rejected Δτ caps later steps, which keeps the stiffest mode stable near convergence,
             # where energy changes fall below round-off
             if E_t <= E + 1e-13 * abs(E) and n_t <= 1.5 * norm:
-                q, w, P, E, r, norm = q_try, w_try, P_t, E_t, r_t, n_t
+                q, w, P, E, r, norm, rmax = q_try, w_try, P_t, E_t, r_t, n_t, rmax_t
                 dt = min(dt * self.growth, cap)
             else:
                 cap = 0.9 * dt
