@@ -236,3 +236,8 @@ def convergence(res) -> dict:
     # relative to the finest value itself (no floor: the energy's scale is its own)
     out[HYSTERESIS] = abs(h[1] - h[0]) / abs(h[1]) if len(h) == 2 and h[1] != 0 else math.nan
     return out
+
+
+def area_name(branch: str, p: float) -> str:
+    """The refinement's observable name of A/S on ``branch`` at the pressure ``p`` (Pa)."""
+    return f"A_S_{branch[:3]}_{p:.6g}Pa".replace("+", "").replace(".", "p")

@@ -337,12 +337,8 @@ def maps_asked(res, plan) -> dict:
     return {round(D, 9): p for D, p in zip(Ds, want)} if len(Ds) == len(want) else {}
 
 
-def area_name(branch: str, p: float) -> str:
-    return f"A_S_{branch[:3]}_{p:.6g}Pa".replace("+", "").replace(".", "p")
-
-
 def _observer(plan):
-    from tengsim.design.curves import branch_curves
+    from tengsim.design.curves import area_name, branch_curves
 
     def observe(res) -> dict:
         c = branch_curves(res, plan)
@@ -354,7 +350,7 @@ def _observer(plan):
 def _watcher(plan):
     """The retraction's numbers, recorded per grid with their convergence but not judged (the pull-off force
     is judged by the refinement itself): A/S on the retraction at the asked pressures and the hysteresis."""
-    from tengsim.design.curves import branch_curves
+    from tengsim.design.curves import area_name, branch_curves
 
     def watch(res) -> dict:
         c = branch_curves(res, plan)

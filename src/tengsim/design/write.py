@@ -79,7 +79,7 @@ def _by_grid(ds, res, plan) -> None:
     hysteresis energy; and ``change_*`` attributes: each number's relative change between the last two grids
     (:func:`tengsim.design.curves.convergence`).  Nothing with one grid run outside the refinement."""
     from tengsim.design.curves import convergence
-    from tengsim.design.run import area_name
+    from tengsim.design.curves import area_name
 
     tab = res.params.get("resolution") or {}
     if not tab:
