@@ -28,8 +28,8 @@ def test_plan_physical_defaults_and_tabor():
 
 
 def test_small_design_ok_and_within_1pct_of_a_grid_sqrt2_finer(small):
-    from tengsim.config import plan_contact
-    from tengsim.contact import simulate
+    from tengsim.run.plan import plan_contact
+    from tengsim.run.simulate import simulate
     from tengsim.design.curves import branch_curves
     from tengsim.path import PathSpec
 

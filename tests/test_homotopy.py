@@ -8,7 +8,7 @@ Cold, the fast solver needs 1524–1620 iterations; the homotopy (range 2 on the
 import numpy as np
 import pytest
 
-from tengsim.contact import simulate
+from tengsim.run.simulate import simulate
 from tengsim.errors import TengsimError
 from tengsim.kernels import make_kernel
 from tengsim.laws import LJ93, MaugisDugdale

@@ -365,7 +365,7 @@ RESOLVE = ["contact", "sphere", "--radius", "5", "--cell", "4", "--tabor", "1", 
 
 
 def test_c08_a_refinement_killed_after_two_grids_keeps_them_and_resumes(tmp_path, capsys, monkeypatch):
-    from tengsim import contact
+    from tengsim.run import simulate as contact
     from tengsim.load import load_result
     from tengsim.results import checkpoint_path
 

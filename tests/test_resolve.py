@@ -1,4 +1,4 @@
-"""Automatic grid refinement (``resolve = "auto"``, tengsim.resolve; issue 22 item 1).
+"""Automatic grid refinement (``resolve = "auto"``, tengsim.run.resolve; issue 22 item 1).
 
 Fast: Richardson on synthetic sequences of known order; a cheap pyramid refinement (5 grids, about 2 s)
 reaching ``ok``; ``max_pixels`` stopping it with ``under_resolved`` and its one line; the resolution table
@@ -12,7 +12,7 @@ import math
 import numpy as np
 import pytest
 
-from tengsim import resolve
+from tengsim.run import resolve
 from tengsim.cli.main import main
 from tengsim.errors import TengsimError
 from tengsim.load import load_result
@@ -78,7 +78,7 @@ def test_cheap_refinement_reaches_ok(refined):
         r = p["richardson"][name]
         assert r["rel_error"] <= 0.01 and r["change"] <= 0.01, name
     # the curves are exactly those of a plain run on the finest grid
-    from tengsim.contact import run_contact
+    from tengsim.run.simulate import run_contact
 
     plain = run_contact({k: v for k, v in PYR_CFG.items() if k != "resolve"} | {"dx": grids[-1]})
     np.testing.assert_allclose(res.table["F"], plain.table["F"], rtol=0, atol=1e-9)
@@ -184,9 +184,9 @@ def test_bad_values_are_refused_with_one_line(tmp_path, capsys, extra, words):
 
 
 def test_one_grid_run_contact_refuses_resolve_auto():
-    from tengsim.contact import run_contact
+    from tengsim.run.simulate import run_contact
 
-    with pytest.raises(TengsimError, match="tengsim.resolve.run_contact"):
+    with pytest.raises(TengsimError, match="tengsim.run.resolve.run_contact"):
         run_contact({**PYR_CFG, "d_max": 0.0})
 
 
@@ -322,7 +322,7 @@ def test_finer_grids_keep_a_shapes_edges_where_they_fell_in_the_first_grids_pixe
     45², 65², 105², 165², 245², the edge a quarter pixel past a pixel centre on each.  A shape without edges
     (paraboloid), an edge no grid in reach can keep, and the pixel cap get the plain grid."""
     from tengsim.grid import Grid
-    from tengsim.resolve import FACTOR, PHASE_TOL, _aligned, edge_phases
+    from tengsim.run.resolve import FACTOR, PHASE_TOL, _aligned, edge_phases
     from tengsim.shapes import Cone, Cube, Hemisphere, Paraboloid, Pyramid
 
     pyr = Pyramid(N=10.0, cell=40.0)

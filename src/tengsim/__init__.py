@@ -13,8 +13,8 @@ _WHERE = {  # public name -> the module defining it, imported on first use (PEP 
     "contact_length": "tengsim.analysis",
     "force": "tengsim.analysis",
     "repulsive_area": "tengsim.analysis",
-    "simulate": "tengsim.contact",
-    "simulate_pyramid": "tengsim.contact",
+    "simulate": "tengsim.run.simulate",
+    "simulate_pyramid": "tengsim.run.simulate",
     "TengsimError": "tengsim.errors",
     "Grid": "tengsim.grid",
     "FreeKernel": "tengsim.kernels",
@@ -33,7 +33,7 @@ _WHERE = {  # public name -> the module defining it, imported on first use (PEP 
     "OBSERVERS": "tengsim.plugins",
     "SHAPES": "tengsim.plugins",
     "SOLVERS": "tengsim.plugins",
-    "resolve_contact": "tengsim.resolve",
+    "resolve_contact": "tengsim.run.resolve",
     "ContactResult": "tengsim.results",
     "Jump": "tengsim.results",
     "Array": "tengsim.shapes",
@@ -76,9 +76,9 @@ def __dir__():
 
 def run_contact(cfg: dict, progress=None, sink=None, observe=None):
     """One run of a [contact] table (the keys of ``tengsim contact``; ``resolve = "auto"``: refined until
-    converged, :func:`tengsim.resolve.run_contact`), with the study layer's full-contact length and A/S
+    converged, :func:`tengsim.run.resolve.run_contact`), with the study layer's full-contact length and A/S
     observer (``resolve_pressures``) wired in, as ``tengsim contact`` runs it.  Returns a ContactResult."""
-    from tengsim.resolve import run_contact as run
+    from tengsim.run.resolve import run_contact as run
     from tengsim.study.observe import contact_hooks
 
     return run(cfg, progress=progress, sink=sink, observe=observe, **contact_hooks(cfg))

@@ -53,7 +53,7 @@ _CF_COLUMNS = {
     "x": ("in-plane position X", "lateral"),
     "y": ("in-plane position Y", "lateral"),
 }
-# the refinement's table (tengsim.resolve) along dimension 'level': column -> (long_name, unit as above)
+# the refinement's table (tengsim.run.resolve) along dimension 'level': column -> (long_name, unit as above)
 _RESOLUTION_CF = {"dx": ("grid spacing of the level", "lateral"), "nx": ("pixels along x", "1"),
                   "ny": ("pixels along y", "1"), "seconds": ("wall time of the level's run", "s"),
                   "convolutions": ("convolutions (FFT pairs) of the level's run", "1")}
@@ -154,7 +154,7 @@ class ContactResult:
         s = self.table.get("status")
         if s is None or np.asarray(s).dtype.kind not in "US":  # older files: classify from the columns
             s = _status.classify(self.table, self.grid.dx)
-        refined = self.params.get("resolve_status")  # resolve = auto stopped by max_pixels (tengsim.resolve)
+        refined = self.params.get("resolve_status")  # resolve = auto stopped by max_pixels (tengsim.run.resolve)
         return _status.overall([*np.asarray(s).astype(str).tolist(), *([str(refined)] if refined else [])])
 
     def raise_for_status(self) -> "ContactResult":
@@ -314,7 +314,7 @@ class ContactResult:
                                   "adhesive micro-structured half-space")
 
     def _resolution_vars(self, ds, scales):
-        """(params without 'resolution', ds with it): the refinement's table (tengsim.resolve, one row per grid)
+        """(params without 'resolution', ds with it): the refinement's table (tengsim.run.resolve, one row per grid)
         as variables ``resolution_<column>`` along dimension ``level`` (coarsest first), CF attributes as the
         curves' (dx in ℓ, F in its unit, D in ε)."""
         tab = self.params.get("resolution")
@@ -392,7 +392,7 @@ def partial_path(out):
 
 def checkpoint_path(out):
     """Where a refinement (``resolve = 'auto'``) writing ``OUT`` keeps its finished grids, the finest one's
-    result and the levels so far: ``OUT.resolve.nc`` beside it (:class:`tengsim.resolve.Checkpoint`)."""
+    result and the levels so far: ``OUT.resolve.nc`` beside it (:class:`tengsim.run.resolve.Checkpoint`)."""
     from pathlib import Path
 
     return Path(str(out) + ".resolve.nc")
@@ -419,7 +419,7 @@ class RowStream:
     """Writes a contact run's rows to ``OUT.partial.csv`` as each equilibrium finishes, so a run that is
     killed (even by SIGKILL) keeps every finished equilibrium.
 
-    Pass it as ``sink`` to :func:`tengsim.contact.simulate` / ``run_contact``.  The first row writes the
+    Pass it as ``sink`` to :func:`tengsim.run.simulate.simulate` / ``run_contact``.  The first row writes the
     file, whole (atomically): the header (``# complete: false``, ``# partial_of``, ``# run_digest`` and the
     run's parameters given to :meth:`begin`, as '# key: json' lines) and the column names, so a run that
     fails before its first equilibrium leaves nothing; each row is then appended as one CSV line (the

@@ -1,4 +1,4 @@
-"""``tengsim contact``: one approach–retraction run (thin shell over tengsim.contact.run_contact)."""
+"""``tengsim contact``: one approach–retraction run (thin shell over tengsim.run.simulate.run_contact)."""
 from __future__ import annotations
 
 import argparse
@@ -16,7 +16,7 @@ def register(sub):
     """The parser: every key of every shape and law (from the [contact] schema) as an option; the help
     pages (per shape, and the index) are :mod:`tengsim.cli.keyhelp`'s."""
     from tengsim.cli.keyhelp import CLI_ONLY_HELP, HelpAction
-    from tengsim.config import common_fields, contact_table, law_keys
+    from tengsim.run.plan import common_fields, contact_table, law_keys
     from tengsim.registry import SHAPES
 
     p = sub.add_parser("contact", help=SUMMARY, add_help=False)
@@ -42,7 +42,7 @@ def register(sub):
 
 
 def run(args) -> int:
-    from tengsim.config import contact_keys, plan_contact
+    from tengsim.run.plan import contact_keys, plan_contact
 
     keys = [k for k in contact_keys() if k not in _CLI_ONLY]
     cfg = {k: getattr(args, k) for k in keys if getattr(args, k, None) not in (None, "")}
@@ -132,9 +132,9 @@ def pull_off_text(res) -> str:
 
 
 def run_contact(cfg: dict, progress=None, sink=None):
-    """:func:`tengsim.resolve.run_contact` (one grid, or refined with resolve = 'auto'), transition D judged
+    """:func:`tengsim.run.resolve.run_contact` (one grid, or refined with resolve = 'auto'), transition D judged
     with the shape's full-contact length, A/S at ``resolve_pressures`` (:func:`tengsim.study.observe.contact_hooks`)."""
-    from tengsim.resolve import run_contact as run
+    from tengsim.run.resolve import run_contact as run
     from tengsim.study.observe import contact_hooks
 
     return run(cfg, progress=progress, sink=sink, **contact_hooks(cfg))
@@ -157,7 +157,7 @@ def open_stream(out, resume: bool, quiet: bool = False):
                 raise TengsimError(f"{f} holds an interrupted run of --out {out}: add --resume to continue it, "
                                    "or delete it to start afresh")
         return RowStream(out, maps=maps)
-    if grids.is_file() and not part.is_file():  # a refinement: its finished grids are read by tengsim.resolve
+    if grids.is_file() and not part.is_file():  # a refinement: its finished grids are read by tengsim.run.resolve
         if not quiet:
             print(f"tengsim: resuming {grids}: its finished grids are kept, the refinement goes on",
                   file=sys.stderr)

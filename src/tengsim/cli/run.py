@@ -60,7 +60,7 @@ def run(args) -> int:
 
 def _contact(section, args) -> int:
     from tengsim.cli.contact import open_stream, run_contact, run_streamed, write_contact
-    from tengsim.config import plan_contact
+    from tengsim.run.plan import plan_contact
 
     plan_contact(section)  # every key checked before anything is written
     out = section.get("out")

@@ -2,7 +2,7 @@
 
 :func:`run_design` (a :class:`tengsim.design.plan.DesignPlan` → :class:`DesignResult`):
 
-1. **Grid.**  The first dx is the user's (a length) or :func:`tengsim.resolve.default_dx` (the law's
+1. **Grid.**  The first dx is the user's (a length) or :func:`tengsim.run.resolve.default_dx` (the law's
    process zone over the pixels the status asks for, and the pixel-snap limit).  Before anything runs,
    :func:`estimate` prints the grids (first, and the next two of √2 refinement), the memory of the finest
    and an estimated time: :data:`SECONDS_PER_PIXEL_ROW` × pixels × rows per grid (docs/benchmarks.md, "Design
@@ -12,7 +12,7 @@
    twice as coarse as the first: from 1.2 × the structure's height (+2 ε), extended in chunks (the last
    rows' dP/dD, extrapolated to 1.3 × the pressure still missing) until the approach reaches p_max, at most
    :data:`EXTEND_TRIES` times; else an error naming the highest pressure reached, in kPa.
-3. **Refinement.**  :func:`tengsim.resolve.resolve_contact` on dx, dx/√2, ... until the charged-area
+3. **Refinement.**  :func:`tengsim.run.resolve.resolve_contact` on dx, dx/√2, ... until the charged-area
    fraction A/S on the approach at every asked pressure, the pull-off force and the jump D values change by
    at most tol between the last two grids (and their Richardson error is within tol).  If the finest grid
    does not reach p_max (a finer grid is softer), d_max grows and the refinement runs again (once).
@@ -76,7 +76,7 @@ def _blocks(shape, grid) -> int:
 
 def start_dx(plan, cplan) -> float:
     """The first grid's dx in X units: the plan's (a length) or the default from the law's process zone."""
-    from tengsim.resolve import default_dx
+    from tengsim.run.resolve import default_dx
 
     if plan.dx is not None:
         return plan.dx / cplan.scaling.lateral
@@ -169,7 +169,7 @@ def check_budget(plan, est: Estimate, fit_pixels: int | None = None) -> None:
 
 
 def _simulate(cplan, dx, d_max, **kw):
-    from tengsim.contact import simulate
+    from tengsim.run.simulate import simulate
     from tengsim.path import PathSpec
 
     path = PathSpec(D_MIN, d_max, D_STEP, adaptive=True)
@@ -241,7 +241,7 @@ def map_depths(res, plan) -> dict:
 def maps_run(res, cplan, plan):
     """The finest grid's approach walked again up to the map depths (:func:`map_depths`), its pressure and gap
     maps kept exactly there (the same path lattice: the same states); None if no depth is known."""
-    from tengsim.contact import simulate
+    from tengsim.run.simulate import simulate
     from tengsim.path import PathSpec
 
     depths = map_depths(res, plan)
@@ -278,7 +278,7 @@ def _checkpoint(keep, plan, d_max, progress):
     import hashlib
 
     from tengsim.errors import TengsimError as _Err
-    from tengsim.resolve import Checkpoint
+    from tengsim.run.resolve import Checkpoint
 
     ck = Checkpoint(keep, hashlib.sha256(f"{plan!r}|{d_max!r}".encode()).hexdigest()[:16])
     try:
@@ -298,10 +298,10 @@ def run_design(plan, progress=None, keep=None) -> DesignResult:
     path's progress) and/or an object with ``say(text)``, which gets the lines said before and during the run
     (the Tabor number, the grids, memory and estimated time).  ``keep`` (a file path, or None): where each
     finished grid is kept (:func:`_checkpoint`), so a killed run of the same design resumes from it."""
-    from tengsim.config import plan_contact
+    from tengsim.run.plan import plan_contact
     from tengsim.design.curves import summarize
     from tengsim.design.write import to_dataset
-    from tengsim.resolve import resolve_contact
+    from tengsim.run.resolve import resolve_contact
 
     cplan = plan_contact(plan.contact_table)
     dx = start_dx(plan, cplan)

@@ -70,7 +70,7 @@ class Shape:
         """Distances from the cell centre (the apex pixel) along X to the shape's kinks: the base edge of a
         pyramid, cone, hemisphere or punch, the wall of a cube or line.  Where such an edge falls in its pixel
         sets the sign of the grid's error in what is measured there (the contact edge in full contact), so
-        automatic refinement keeps that place from grid to grid (:mod:`tengsim.resolve`).  None: ()."""
+        automatic refinement keeps that place from grid to grid (:mod:`tengsim.run.resolve`).  None: ()."""
         return ()
 
     # ---- declared input -----------------------------------------------------------------------

@@ -111,7 +111,7 @@ class Roughened:
         return getattr(self.base, "lateral_unit", "ℓ")
 
     mirror_axes = ()
-    """No mirror symmetry (tengsim.contact.choose_symmetry): a random surface has none, whatever the base's."""
+    """No mirror symmetry (tengsim.run.simulate.choose_symmetry): a random surface has none, whatever the base's."""
 
     def grid(self, dx: float) -> Grid:
         g = self.base.grid(dx)

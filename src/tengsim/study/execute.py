@@ -88,7 +88,7 @@ def compute_point(contact: dict, pid: str, plugins: str = "", expect: dict | Non
         if expect is not None and prov != expect:
             raise TengsimError(f"the worker on {info['host']} would compute this point with other code or "
                                f"input than the client's ({provenance_difference(expect, prov)}); not computed")
-        from tengsim.resolve import run_contact  # resolve = 'auto': refined until converged
+        from tengsim.run.resolve import run_contact  # resolve = 'auto': refined until converged
         from tengsim.study.observe import contact_hooks
 
         c0 = time.perf_counter()
@@ -117,8 +117,8 @@ def warm_up(plugins: str = "") -> int:
         _worker_setup(plugins)
     except TengsimError:
         pass  # the points report it, each as a failed point with the message
-    import tengsim.config  # noqa: F401
-    import tengsim.contact  # noqa: F401
+    import tengsim.run.plan  # noqa: F401
+    import tengsim.run.simulate  # noqa: F401
     import xarray  # noqa: F401
 
     return os.getpid()
@@ -151,7 +151,7 @@ def validate(study) -> tuple[dict, dict]:
     {id: message} of the invalid ones), the valid ones longest first (:func:`estimated_cost`).
     An error that every point shares is an error in the study file: raised as one TengsimError
     before anything is written."""
-    from tengsim.config import plan_contact
+    from tengsim.run.plan import plan_contact
     from tengsim.study.observe import device_values
 
     valid, invalid, first, cost = {}, {}, None, {}

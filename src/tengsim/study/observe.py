@@ -279,7 +279,7 @@ def area_name(pressure_Pa: float) -> str:
 
 def area_at(pressures, cfg: dict | None = None):
     """The observer ``res -> {area_name(P): A/S at P}`` that automatic refinement (``resolve_pressures``,
-    :func:`tengsim.resolve.run_contact`) also converges: the charged-area fraction of Eq. (12) at each
+    :func:`tengsim.run.resolve.run_contact`) also converges: the charged-area fraction of Eq. (12) at each
     nominal pressure P (Pa) on the approach (linear in F between loaded states; NaN outside the states the
     run reaches or for a run without a physical scale).  V_OC (Eq. 12) is σT/(ε_r ε0) × A/S, so its relative
     change is A/S's.  ``cfg``: the run's [contact] table (the shape's name for the patch family)."""
@@ -305,7 +305,7 @@ def area_at(pressures, cfg: dict | None = None):
 
 
 def contact_hooks(cfg: dict) -> dict:
-    """What :func:`tengsim.resolve.run_contact` needs from this layer for the [contact] table ``cfg``: the
+    """What :func:`tengsim.run.resolve.run_contact` needs from this layer for the [contact] table ``cfg``: the
     shape's full-contact length (transition_D) and the A/S observer (``resolve_pressures``)."""
     return {"full_length": lambda p: full_length({**p, "config": cfg}),
             "area_at": lambda pressures: area_at(pressures, cfg)}

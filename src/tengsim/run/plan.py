@@ -112,7 +112,7 @@ def _observer_names(v):
 
 
 RESOLVE_CHOICES = ("off", "auto")
-"""resolve: one grid (off) or automatic refinement (auto, tengsim.resolve)."""
+"""resolve: one grid (off) or automatic refinement (auto, tengsim.run.resolve)."""
 
 CONTROLS = ("approach", "load")
 """Path controls of a [contact] table: the rigid approach D (PathSpec) or the load F (LoadPathSpec)."""
@@ -262,7 +262,7 @@ def common_fields() -> list:
         *roughness_fields(),  # a roughness superimposed on the shape (tengsim.shapes.roughened)
         Field("resolve", "str", "off", choices=RESOLVE_CHOICES,
               help="auto: refine the grid (dx/√2 per level, from dx or a coarse default) until every equilibrium "
-              "is ok and the observables changed by at most resolve_tol (tengsim.resolve); off: the one grid dx"),
+              "is ok and the observables changed by at most resolve_tol (tengsim.run.resolve); off: the one grid dx"),
         Field("resolve_tol", "float", None, help="resolve = auto: relative tolerance of the observables, "
               "> 0 and < 1 (default 0.01)"),
         Field("max_pixels", "int", None, help="resolve = auto: largest grid nx·ny, >= 9 (default: what the "
@@ -571,7 +571,7 @@ def plan_contact(cfg: dict) -> ContactPlan:
 def _resolve(vals, given, dx, scaling=None) -> dict:
     """The refinement settings of a table: {} for resolve = off (resolve_tol, max_pixels, resolve_pressures
     refused there), else resolve, resolve_tol (default 0.01), max_pixels (None: the free memory's), the start dx
-    (None: a coarse default, tengsim.resolve.default_dx) and pressures (Pa; () if none: physical runs only)."""
+    (None: a coarse default, tengsim.run.resolve.default_dx) and pressures (Pa; () if none: physical runs only)."""
     if vals["resolve"] != "auto":
         bad = [k for k in ("resolve_tol", "max_pixels", "resolve_pressures") if k in given]
         if bad:

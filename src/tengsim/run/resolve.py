@@ -266,7 +266,7 @@ def resolve_contact(shape, tabor: float, path, dx: float | None = None, law=None
                     resolve_tol: float = DEFAULT_TOL, max_pixels: int | None = None, observe=None,
                     full_length: float | None = None, progress=None, checkpoint=None, start=None,
                     **simulate_kw):
-    """Run :func:`tengsim.contact.simulate` on finer and finer grids until converged (module doc).
+    """Run :func:`tengsim.run.simulate.simulate` on finer and finer grids until converged (module doc).
 
     ``dx`` the first grid's spacing (None: :func:`default_dx`), ``resolve_tol`` the relative tolerance,
     ``max_pixels`` the largest grid nx·ny (None: :func:`default_max_pixels`), ``observe(result) -> dict``
@@ -278,7 +278,7 @@ def resolve_contact(shape, tabor: float, path, dx: float | None = None, law=None
     ``checkpoint(levels, phases, result)``, if given, is called after each finished grid (to keep it: a
     killed refinement keeps every grid it finished, :class:`Checkpoint`); ``start = (levels, phases,
     result)`` continues a refinement from such a record instead of computing those grids again."""
-    from tengsim.contact import simulate
+    from tengsim.run.simulate import simulate
     from tengsim.errors import positive
     from tengsim.laws import LJ93, make_law
 
@@ -391,7 +391,7 @@ def check_max_pixels(v) -> int:
 
 
 def run_contact(cfg: dict, progress=None, sink=None, observe=None, full_length=None, area_at=None):
-    """:func:`tengsim.contact.run_contact`, refined automatically when the table says ``resolve = "auto"``.
+    """:func:`tengsim.run.simulate.run_contact`, refined automatically when the table says ``resolve = "auto"``.
 
     The refinement's grids each stream their rows to ``sink`` would mix grids in one file, so a sink is not
     given rows of a refined run (its result is written whole at the end).  ``observe(result) -> dict``: more
@@ -399,8 +399,8 @@ def run_contact(cfg: dict, progress=None, sink=None, observe=None, full_length=N
     (for transition_D; e.g. :func:`tengsim.study.observe.full_length`); ``area_at(pressures) -> observe``: the
     observer of A/S at the table's ``resolve_pressures`` (Pa; :func:`tengsim.study.observe.area_at`), needed
     when the table names them.  ``tengsim.run_contact``, ``tengsim contact`` and a study's points pass both."""
-    from tengsim import contact
-    from tengsim.config import plan_contact
+    from tengsim.run import simulate as contact
+    from tengsim.run.plan import plan_contact
 
     plan = plan_contact(cfg)
     pressures = plan.resolve.get("pressures", ())
@@ -410,7 +410,7 @@ def run_contact(cfg: dict, progress=None, sink=None, observe=None, full_length=N
                                "area_at=tengsim.study.observe.area_at)")
         extra = area_at(pressures)
         observe = extra if observe is None else (lambda res, a=observe, b=extra: {**a(res), **b(res)})
-    if plan.resolve.get("resolve", "off") != "auto":  # one grid: exactly tengsim.contact.run_contact's call
+    if plan.resolve.get("resolve", "off") != "auto":  # one grid: exactly tengsim.run.simulate.run_contact's call
         kw = {k: v for k, v in (("progress", progress), ("sink", sink)) if v is not None}
         return contact.run_contact(cfg, **kw)
     ck = Checkpoint.of(sink, cfg)

@@ -5,7 +5,7 @@ from dataclasses import is_dataclass, replace
 
 from tengsim import status
 from tengsim._version import __version__
-from tengsim.config import plan_contact
+from tengsim.run.plan import plan_contact
 from tengsim.errors import TengsimError, positive
 from tengsim.grid import Mirror
 from tengsim.shapes import Pyramid, Shape
@@ -83,7 +83,7 @@ def simulate(shape: Shape, tabor: float, dx: float, path: PathSpec, boundary: st
     not_converged / out_of_law_range / under_resolved (:mod:`tengsim.status`); with ``throw=True``
     a status other than 'ok' raises :class:`tengsim.status.ResultStatusError`, which carries the
     result.  The grid's memory is checked once, before anything is built (``check_memory_first=False``:
-    the caller has checked it, as :func:`run_contact` does through :func:`tengsim.config.plan_contact`).
+    the caller has checked it, as :func:`run_contact` does through :func:`tengsim.run.plan.plan_contact`).
 
     ``sink`` (a callable or None) receives each equilibrium as it is recorded, ``sink(row, maps)``
     (:class:`tengsim.continuation.Recorder`); if it has a ``begin(params)`` method, that is called first,
@@ -193,8 +193,8 @@ def run_contact(cfg: dict, progress=None, sink=None):
     of the same settings spell it differently, and resume only cares about what is solved)."""
     plan = plan_contact(cfg)
     if getattr(plan, "resolve", None):  # refinement is the layer above's: never run one grid silently instead
-        raise TengsimError("resolve = 'auto' runs through tengsim.resolve.run_contact (tengsim.run_contact), "
-                           "not tengsim.contact.run_contact")
+        raise TengsimError("resolve = 'auto' runs through tengsim.run.resolve.run_contact (tengsim.run_contact), "
+                           "not tengsim.run.simulate.run_contact")
     res = simulate(plan.shape, plan.tabor, plan.dx, plan.path, boundary=plan.boundary,
                    solver=plan.solver, tol=plan.tol, law=plan.law, progress=progress,
                    extra_params=plan.extra, observers=plan.observers, scaling=plan.scaling,
