@@ -7,7 +7,8 @@ import pytest
 import xarray as xr
 
 from tengsim.cli.main import main
-from tengsim.run.plan import contact_table, plan_contact
+from tengsim.run.keys import contact_table
+from tengsim.run.plan import plan_contact
 from tengsim.errors import TengsimError
 from tengsim.shapes import Cone, Cube, HeightMap, Hemisphere, Paraboloid, Pyramid
 from tengsim.grid import Grid

@@ -14,7 +14,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tengsim.run.plan import common_fields, contact_table, law_fields, law_keys, plan_contact
+from tengsim.run.keys import common_fields, contact_table, law_fields, law_keys
+from tengsim.run.plan import plan_contact
 from tengsim.errors import TengsimError
 from tengsim.plugins import LAWS, SHAPES
 from tengsim.shapes.roughened import roughness_fields

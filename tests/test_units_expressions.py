@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 from tengsim.cli.main import main
-from tengsim.run.plan import X_UNIT_KEYS, plan_contact
+from tengsim.run.keys import X_UNIT_KEYS
+from tengsim.run.plan import plan_contact
 from tengsim.run.simulate import run_contact
 from tengsim.errors import ConfigValueError, TengsimError
 from tengsim.plugins import SHAPES

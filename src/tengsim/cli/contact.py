@@ -16,7 +16,7 @@ def register(sub):
     """The parser: every key of every shape and law (from the [contact] schema) as an option; the help
     pages (per shape, and the index) are :mod:`tengsim.cli.keyhelp`'s."""
     from tengsim.cli.keyhelp import CLI_ONLY_HELP, HelpAction
-    from tengsim.run.plan import common_fields, contact_table, law_keys
+    from tengsim.run.keys import common_fields, contact_table, law_keys
     from tengsim.registry import SHAPES
 
     p = sub.add_parser("contact", help=SUMMARY, add_help=False)
@@ -42,7 +42,8 @@ def register(sub):
 
 
 def run(args) -> int:
-    from tengsim.run.plan import contact_keys, plan_contact
+    from tengsim.run.keys import contact_keys
+    from tengsim.run.plan import plan_contact
 
     keys = [k for k in contact_keys() if k not in _CLI_ONLY]
     cfg = {k: getattr(args, k) for k in keys if getattr(args, k, None) not in (None, "")}

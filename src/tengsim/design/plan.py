@@ -137,7 +137,8 @@ def _shape_params(shape: str, extra: dict) -> dict:
 def plan_design(table: dict, where: str = "") -> DesignPlan:
     """Validate a [design] table and build its :class:`DesignPlan` (no solving).  A bad value raises one
     :class:`tengsim.errors.TengsimError` line naming it in the user's units."""
-    from tengsim.run.plan import contact_table, plan_contact
+    from tengsim.run.keys import contact_table
+    from tengsim.run.plan import plan_contact
     from tengsim.plugins import SHAPES
 
     if not isinstance(table, dict):

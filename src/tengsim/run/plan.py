@@ -1,35 +1,25 @@
-"""Run descriptions: one [contact] table (CLI options or a TOML file) → the API objects of a contact run.
+"""Run descriptions: one [contact] table (CLI options or a TOML file) → the validated plan of a contact run.
 
-The table's keys come from the registries and the schema, never from a list kept here: the shape's
-dimensionless fields (its dataclass fields, plain numbers) *or* its physical fields (numbers in SI
-or unit strings such as '2um') with ``E_star``, ``W`` and ``eps`` or ``tabor``; then the grid, the
-path, and the boundary, solver, law and observers by registered name, with the chosen law's own
-parameters (its fields, :func:`law_fields`: plain numbers in units of W and ε).  A physical run builds
-the shape's :class:`tengsim.units.Scaling`; the core stays dimensionless.
+The table's keys are :mod:`tengsim.run.keys`'s.  A physical run builds the shape's
+:class:`tengsim.units.Scaling`; the core stays dimensionless.
 """
 from __future__ import annotations
 
-import dataclasses
 from dataclasses import dataclass, field
 
 from tengsim.kernels import film
 from tengsim.errors import ConfigValueError, TengsimError, finite, positive, shown
 from tengsim.laws import make_law
 from tengsim.path import PathSpec
-from tengsim.plugins import KERNELS, LAWS, OBSERVERS, SHAPES, SOLVERS
-from tengsim.schema import Field, Table, dataclass_fields, signature_fields
+from tengsim.run.keys import (ADAPTIVE_KEYS, LOAD_KEYS, common_fields, common_names, contact_keys,
+                              contact_table, law_fields, law_keys, physical_triggers, shape_class)
 from tengsim.shapes.base import dimensionless_fields, physical_fields
-from tengsim.shapes.roughened import LENGTH_KEYS as _ROUGHNESS_LENGTHS, roughen, roughness_fields
-from tengsim.units import Scaling, number_or_text, parse_quantity
+from tengsim.shapes.roughened import roughen
+from tengsim.units import Scaling, parse_quantity
 
-PHYSICAL_KEYS = ("E_star", "W", "eps")
-"""Keys that make a [contact] table a physical run (with any physical-only key of the shape)."""
 
 _SUFFIX = {"length": "_m", "pressure": "_Pa", "energy/area": "_J_m2"}
 
-X_UNIT_KEYS = {"dx": "length", "thickness": "length", "f_min": "pressure", "f_max": "pressure", "f_step": "pressure"}
-"""Keys whose bare number is *not* SI (dx, thickness in X units; loads as F of Eq. 10), with the dimension a
-unit string gives them in a physical run."""
 _QUANTITY = {"E_star": "modulus"}
 """The plausibility range (tengsim.units.PLAUSIBLE) of a key, where it is not its dimension's."""
 
@@ -42,33 +32,6 @@ def _positive_as_given(cfg, names, vals) -> None:
         raw = cfg.get(k)
         if isinstance(raw, str) and isinstance(v, (int, float)) and not isinstance(v, bool) and v <= 0:
             raise ConfigValueError(f"{k} must be > 0, got {shown(raw)}")
-
-
-def _physical_triggers(given, dim_names, phys_names) -> list:
-    """The given keys that make a [contact] table a physical run."""
-    return sorted(set(given) & (set(PHYSICAL_KEYS) | (set(phys_names) - set(dim_names))))
-
-
-def key_dims(cfg: dict) -> dict:
-    """{key: (dimension, bare number is SI)} of the quantity keys of the run a [contact] table describes.
-
-    Empty for a dimensionless run (every number plain, lengths in X units) or an unknown shape (which
-    :func:`plan_contact` reports).  In a physical run: E_star, W, eps and the shape's physical fields
-    with a dimension (a bare number is SI), and dx, thickness, f_min, f_max, f_step (a bare number is in
-    X units or F: :data:`X_UNIT_KEYS`).  Study expressions read it to give their SI value its unit."""
-    try:
-        _, cls = _shape_cls(cfg.get("shape") or "pyramid")
-    except (TengsimError, KeyError, ValueError):
-        return {}
-    dims, phys = dimensionless_fields(cls), physical_fields(cls)
-    given = {k for k, v in cfg.items() if v is not None and v != ""}
-    if not phys or not _physical_triggers(given, [f.name for f in dims], [f.name for f in phys]):
-        return {}
-    out = {f.name: (f.dim, True) for f in common_fields() if f.dim}
-    out.update({k: (d, False) for k, d in X_UNIT_KEYS.items()})
-    out.update({k: ("length", False) for k in _ROUGHNESS_LENGTHS})  # bare: ε or X units, as dx
-    out.update({f.name: (f.dim, True) for f in phys if f.dim})
-    return out
 
 
 def _bare(v) -> bool:
@@ -103,41 +66,6 @@ def _check_bare_numbers(cfg, phys) -> None:
                 check_plausible(f.name, v, _QUANTITY.get(f.name, f.dim))
 
 
-def _observer_names(v):
-    if isinstance(v, str):
-        v = [s for s in (x.strip() for x in v.split(",")) if s]
-    if not isinstance(v, (list, tuple)) or not all(isinstance(x, str) for x in v):
-        raise TengsimError(f"observers must be a list of names, got {v!r}")
-    return tuple(OBSERVERS.canonical(x) for x in v)
-
-
-RESOLVE_CHOICES = ("off", "auto")
-"""resolve: one grid (off) or automatic refinement (auto, tengsim.run.resolve)."""
-
-CONTROLS = ("approach", "load")
-"""Path controls of a [contact] table: the rigid approach D (PathSpec) or the load F (LoadPathSpec)."""
-
-_LOAD_KEYS = ("f_min", "f_max", "f_step")
-_ADAPTIVE_KEYS = ("adaptive", "adapt_tol")
-
-
-def _load_value(v, label="load"):
-    """A load key: a number (F of Eq. 10) or a string, a number or a pressure with a unit (checked later)."""
-    return number_or_text(v, label, "a pressure")
-
-
-def _maps_values(v, label="maps_at"):
-    """maps_at: a list (or comma-separated text) of numbers, or pressures with a unit (control = load)."""
-    items = v
-    if isinstance(v, str):
-        items = [t for t in v.split(",") if t.strip()]
-    elif isinstance(v, (int, float)) and not isinstance(v, bool):
-        items = [v]
-    if not isinstance(items, (list, tuple)):
-        raise TengsimError(f"{label} must be a list of numbers (or of pressures with a unit), got {v!r}")
-    return tuple(number_or_text(x, label, "a pressure") for x in items)
-
-
 def _maps_at(vals, scaling, control):
     """maps_at as numbers: D values (approach) or loads F of Eq. (10), a pressure converted (load)."""
     out = []
@@ -168,7 +96,7 @@ def _path_spec(vals, given, scaling):
     """The PathSpec (control = approach, fixed or adaptive) or LoadPathSpec (control = load) of a table."""
     control = vals["control"]
     if control == "load":
-        bad = [k for k in _ADAPTIVE_KEYS if k in given and (k != "adaptive" or vals[k])]
+        bad = [k for k in ADAPTIVE_KEYS if k in given and (k != "adaptive" or vals[k])]
         if bad:
             raise TengsimError(f"{', '.join(bad)} {'does' if len(bad) == 1 else 'do'} not apply to control = "
                                "'load' (adaptive steps are a D-path option)")
@@ -177,7 +105,7 @@ def _path_spec(vals, given, scaling):
             raise TengsimError(f"control = 'load' needs {', '.join(missing)}")
         from tengsim.loadpath import LoadPathSpec
 
-        f = {k: _load_F(k, vals[k], scaling) for k in _LOAD_KEYS if vals[k] is not None}
+        f = {k: _load_F(k, vals[k], scaling) for k in LOAD_KEYS if vals[k] is not None}
         kw = {"d_min": vals["d_min"], "d_step": vals["d_step"], "to_max": True}  # the path ends at f_max
         if "d_max" in given:  # else LoadPathSpec's wider search range
             kw["d_max"] = vals["d_max"]
@@ -186,7 +114,7 @@ def _path_spec(vals, given, scaling):
             kw.update(extend="d_max" not in given, pa_per_F=scaling.pressure(1.0), eps_m=scaling.eps)
         return LoadPathSpec(f.get("f_min", 0.0), f["f_max"], f["f_step"], refine_levels=vals["refine_levels"],
                             maps_at=_maps_at(vals, scaling, control), **kw)
-    bad = [k for k in _LOAD_KEYS if k in given]
+    bad = [k for k in LOAD_KEYS if k in given]
     if bad:
         raise TengsimError(f"{', '.join(bad)} {'does' if len(bad) == 1 else 'do'} not apply to control = "
                            "'approach' (give control = 'load')")
@@ -204,185 +132,6 @@ def _check_maps_out(maps_at, out) -> None:
     if maps_at and isinstance(out, str) and out.lower().endswith(".csv"):
         raise TengsimError(f"maps_at = {', '.join(f'{m:g}' for m in maps_at)} needs a .nc output: out = {out!r} "
                            "holds the curves only")
-
-
-def common_fields() -> list:
-    """The [contact] keys every shape has (choices and help read from the registries)."""
-    from tengsim.loadpath import LoadPathSpec
-
-    return [
-        Field("shape", "str", "pyramid", check=SHAPES.canonical,
-              help="registered shape: " + SHAPES.help()),
-        Field("tabor", help="Tabor parameter μ (coupling μ^{3/2}); dimensionless runs: default 0.5; "
-              "physical runs: no default, give tabor or eps"),
-        Field("E_star", dim="pressure", help="effective modulus E* (physical run; a bare number is Pa, 100 to 1e12)"),
-        Field("W", dim="energy/area", help="work of adhesion W (physical run; a bare number is J/m2, 1e-6 to 10)"),
-        Field("eps", dim="length",
-              help="interaction range ε (physical run; or give tabor; a bare number is m, 1e-12 to 1)"),
-        Field("dx", "any", 0.1, help="grid spacing in X units; in a physical run also a length, e.g. '20nm'"),
-        Field("d_min", default=-1.0, help="first rigid approach D of the path, in ε"),
-        Field("d_max", default=4.0, help="last rigid approach D, in ε (control = load: the search range of D, "
-              f"default {LoadPathSpec.d_max:g}; a physical run without d_max extends it until the loads are met)"),
-        Field("d_step", default=0.05, help="step in D, in ε"),
-        Field("refine_levels", "int", 4, help="step bisections before a change is called a jump"),
-        Field("maps_at", "any", (), check=_maps_values,
-              help="D values (control = load: loads F, or in a physical run nominal pressures with a unit, e.g. "
-              "'50kPa') whose pressure and gap maps "
-              "are kept, on both branches, exactly there (a value between the path's rows gets a row of its "
-              "own; one outside the path is refused); needs a .nc out"),
-        Field("control", "str", "approach", choices=CONTROLS,
-              help="path control: approach (rigid approach D, Eq. 9) or load (total force F of Eq. 10, "
-              "D an unknown)"),
-        Field("f_min", "any", None, check=_load_value,
-              help="control = load: first load, F of Eq. (10) per cell (default 0); in a physical run "
-              "also a nominal pressure with a unit, e.g. '-2kPa'"),
-        Field("f_max", "any", None, check=_load_value, help="control = load: largest load (as f_min), the "
-              "path's last (a shorter last step if f_max - f_min is no multiple of f_step)"),
-        Field("f_step", "any", None, check=_load_value, help="control = load: load step (as f_min)"),
-        Field("adaptive", "bool", False, help="control = approach: adaptive steps in D (d_step the largest)"),
-        Field("adapt_tol", "float", None, help="adaptive: force error tolerance of a step (PathSpec default 0.15)"),
-        Field("boundary", "str", "free", choices=KERNELS.names, help="elastic kernel: " + KERNELS.help()),
-        Field("thickness", "any", None,
-              help="film thickness on a rigid substrate (default: half-space), in X units; in a physical run "
-              "also a length, e.g. '400um'"),
-        Field("substrate", "str", "bonded", choices=film.SUBSTRATES,
-              help="film on its substrate: bonded (no slip) or frictionless (needs thickness)"),
-        Field("poisson", default=0.5, help="Poisson ratio ν of the film, -1 < ν <= 0.5; E* keeps its meaning, "
-              "E = E*(1 - ν²) (needs thickness)"),
-        Field("solver", "str", "fast", choices=SOLVERS.names, help="solver: " + SOLVERS.help()),
-        Field("tol", default=1e-6, help="max residual of Eq. (9) in ε"),
-        Field("symmetry", "str", "auto", choices=("auto", "off"),
-              help="auto: solve on the irreducible quarter (half) of the cell when the shape and its grid are "
-              "mirror symmetric (same answer, less time and memory); off: always the full grid"),
-        Field("law", "str", "lj93", check=LAWS.canonical, help="interaction law: " + LAWS.help()),
-        Field("observers", "any", (), check=_observer_names,
-              help="extra observers adding columns: "
-              + ("; ".join(f"{n}: {OBSERVERS.summary(n)}" for n in OBSERVERS.names() if n != "summary")
-                 or "none registered (F, Λc, areas, gaps, pressures are always there)")),
-        *roughness_fields(),  # a roughness superimposed on the shape (tengsim.shapes.roughened)
-        Field("resolve", "str", "off", choices=RESOLVE_CHOICES,
-              help="auto: refine the grid (dx/√2 per level, from dx or a coarse default) until every equilibrium "
-              "is ok and the observables changed by at most resolve_tol (tengsim.run.resolve); off: the one grid dx"),
-        Field("resolve_tol", "float", None, help="resolve = auto: relative tolerance of the observables, "
-              "> 0 and < 1 (default 0.01)"),
-        Field("max_pixels", "int", None, help="resolve = auto: largest grid nx·ny, >= 9 (default: what the "
-              "free memory holds)"),
-        Field("resolve_pressures", "floats", None, dim="pressure",
-              help="resolve = auto, physical run: nominal pressures (with a unit, e.g. '10kPa'; a bare number is "
-              "Pa) at which the charged-area fraction A/S (and so V_OC, Eq. 12) must converge too; a study "
-              "sets its [observables] pressures here"),
-        Field("out", "str", None, help="output file, .csv or .nc"),
-        Field("plot", "str", None, help="figure of F(D), Λc(D), Λc(F), .png/.pdf/.svg"),
-    ]
-
-
-def _shape_cls(name):
-    if not isinstance(name, str):
-        raise TengsimError(f"shape must be a name, got {name!r}")
-    return SHAPES.canonical(name), SHAPES.get(name)
-
-
-def law_fields(law) -> tuple:
-    """A law's [contact] keys: its dataclass fields (or constructor arguments) less the numerical guards it
-    names in ``internal_fields`` (g_safe); plain numbers in units of W and ε (help from ``field_help``).
-
-    ``law`` is a registered name or the registered class (factory); the defaults are the law's own.
-    """
-    cls = LAWS.get(law) if isinstance(law, str) else law
-    skip = tuple(getattr(cls, "internal_fields", ()) or ())
-    helps = getattr(cls, "field_help", None) or {}
-    if not dataclasses.is_dataclass(cls):
-        return signature_fields(cls, skip, helps)
-    return dataclass_fields(cls, skip, helps)
-
-
-def _default_text(f) -> str:
-    if f.required:
-        return "required"
-    return f"default {f.default:.6g}" if isinstance(f.default, float) else f"default {f.default!r}"
-
-
-def _field_help(name, f) -> str:
-    return f.help or f"parameter of law {name}, in units of W and ε"
-
-
-def law_keys() -> dict:
-    """{key: [(law name, Field), ...]}: every registered law's [contact] keys, and the laws having each.
-
-    A law key may not be a common [contact] key (a TengsimError names the clash); several laws may share
-    one (md and exp: wall_stiffness)."""
-    common = {f.name for f in common_fields()}
-    out = {}
-    for name in LAWS.names():
-        for f in law_fields(name):
-            if f.name in common:
-                raise TengsimError(f"law {name} field {f.name!r} clashes with the [contact] key of that name")
-            out.setdefault(f.name, []).append((name, f))
-    return out
-
-
-def law_key_help(entries) -> str:
-    """One help text for a law key shared by ``entries`` [(law, Field)]: its text, the laws and defaults."""
-    groups = {}
-    for name, f in entries:
-        groups.setdefault(_field_help(name, f), []).append(f"{name}: {_default_text(f)}")
-    return "; ".join(f"{h} [law {', '.join(laws)}]" for h, laws in groups.items())
-
-
-def contact_table(shape: str = "pyramid", mode: str | None = None, law: str | None = None) -> Table:
-    """The schema of a [contact] table for ``shape`` (and ``law``).
-
-    ``mode`` 'dimensionless' or 'physical' gives the table a run of that kind is parsed with; None
-    (default) every key the shape accepts in either (for docs, the sweep and the CLI).  ``law`` (a
-    registered name) adds that law's keys with its defaults; None the keys of every registered law
-    (no defaults: each law has its own).  A shape or law key named like another key is an error.
-    """
-    name, cls = _shape_cls(shape)
-    common = common_fields()
-    taken = {f.name for f in common}
-    dims, phys = dimensionless_fields(cls), physical_fields(cls)
-    for f in (*dims, *phys):
-        if f.name in taken:
-            raise TengsimError(f"shape {name} field {f.name!r} clashes with the [contact] key of that name")
-    keys = law_keys()  # every law's: a clash with a shape key is an error whichever law a run picks
-    for f in (*dims, *phys):
-        if f.name in keys:
-            raise TengsimError(f"law {keys[f.name][0][0]} field {f.name!r} clashes with the key of that name "
-                               f"of shape {name}")
-    if law is None:
-        laws = [Field(k, entries[0][1].kind, None, help=law_key_help(entries)) for k, entries in keys.items()]
-    else:
-        lname = LAWS.canonical(law)
-        laws = [dataclasses.replace(f, help=_field_help(lname, f) + f" [law {lname}]") for f in law_fields(lname)]
-    if mode == "dimensionless":
-        fields = [*common, *dims, *laws]
-    elif mode == "physical":
-        fields = [*common, *phys, *laws]
-    elif mode is None:
-        merged = {f.name: dataclasses.replace(f, default=None) if f.required else f for f in dims}
-        for f in phys:
-            d = merged.get(f.name)
-            if d == f:  # the same field in both: keep it as it is
-                continue
-            if d is None:
-                merged[f.name] = dataclasses.replace(f, default=None)
-            else:  # same name in both: a plain number, or a quantity in a physical run
-                h = d.help if d.help == f.help or not f.dim else f"{d.help} (dimensionless) / {f.help} (physical)"
-                merged[f.name] = Field(f.name, "float", None, dim=f.dim, help=h)
-        fields = [*common, *merged.values(), *laws]
-    else:
-        raise TengsimError(f"mode must be 'dimensionless', 'physical' or None, got {mode!r}")
-    return Table("contact", fields, doc=f"shape {name}")
-
-
-def contact_keys() -> tuple:
-    """Every key a [contact] table may hold for some registered shape and law (the CLI's option set)."""
-    keys = [f.name for f in common_fields()]
-    for s in SHAPES.names():
-        for k in contact_table(s).keys():
-            if k not in keys:
-                keys.append(k)
-    return tuple(keys)
 
 
 @dataclass
@@ -474,7 +223,7 @@ def plan_contact(cfg: dict) -> ContactPlan:
     """Validate a [contact] table and build its pieces (no solving)."""
     if not isinstance(cfg, dict):
         raise TengsimError(f"[contact] must be a table, got {cfg!r}")
-    name, cls = _shape_cls(cfg.get("shape") or "pyramid")
+    name, cls = shape_class(cfg.get("shape") or "pyramid")
     full = contact_table(name)
     all_law_keys = law_keys()
     unknown = [k for k in cfg if k not in full]
@@ -484,7 +233,7 @@ def plan_contact(cfg: dict) -> ContactPlan:
         every = set(contact_keys())  # once: a file of 16 000 unknown keys is checked in linear time
         others = [k for k in unknown if k in every]
         if others:
-            own = [k for k in full.keys() if k not in _common_names() and k not in all_law_keys]
+            own = [k for k in full.keys() if k not in common_names() and k not in all_law_keys]
             raise TengsimError(f"shape {name} has no key {listed(others)} (its keys: {', '.join(own)})")
         raise TengsimError(f"[contact] unknown key(s) {listed(unknown)} "
                            f"(known: {', '.join(full.keys())})")
@@ -497,7 +246,7 @@ def plan_contact(cfg: dict) -> ContactPlan:
     if wrong:
         raise TengsimError(f"law {law_name} has no key {', '.join(map(repr, wrong))} "
                            f"(its keys: {', '.join(f.name for f in lfields) or 'none'})")
-    triggers = _physical_triggers(given, dim_names, phys_names)
+    triggers = physical_triggers(given, dim_names, phys_names)
     extra, scaling, lateral = {}, None, None
     if triggers:
         if not phys:
@@ -594,7 +343,3 @@ def _resolve(vals, given, dx, scaling=None) -> dict:
             raise ConfigValueError(f"resolve_pressures must be pressures > 0, got {vals['resolve_pressures']!r}")
     return {"resolve": "auto", "resolve_tol": 0.01 if tol is None else float(tol), "max_pixels": mp, "dx": dx,
             "pressures": pressures}
-
-
-def _common_names():
-    return {f.name for f in common_fields()}

@@ -419,8 +419,8 @@ def _pressures(study) -> tuple:
 
 
 def _physical(contact: dict) -> bool:
-    """A [contact] table of a physical run (one that :func:`tengsim.run.plan.key_dims` gives units to)."""
-    from tengsim.run.plan import key_dims
+    """A [contact] table of a physical run (one that :func:`tengsim.run.keys.key_dims` gives units to)."""
+    from tengsim.run.keys import key_dims
 
     try:
         return bool(key_dims(contact))
@@ -449,7 +449,7 @@ def evaluate(contact: dict, var: dict) -> dict:
 
     if not any(isinstance(v, str) and v.startswith("=") for v in contact.values()):
         return dict(contact)
-    from tengsim.run.plan import key_dims
+    from tengsim.run.keys import key_dims
     from tengsim.units import DIMENSIONS, SI_UNIT, parse_quantity, quantity_dim, read_number
 
     zero = (0, 0, 0, 0)
