@@ -70,11 +70,11 @@ def run(args) -> int:
     from tengsim import parallel
 
     if not parallel.is_root():  # mpiexec -n N: every process solves its slab, rank 0 alone writes and reports
-        run_contact(cfg)
+        run_contact(plan)
         return 0
     line = None if args.quiet or plan.scaling is None else f"tengsim: {physical_line(plan, 'eps' in cfg)}"
     stream = open_stream(out, args.resume, args.quiet)
-    res = run_streamed(lambda bar: run_contact(cfg, progress=_Announced(bar, line), sink=stream), stream,
+    res = run_streamed(lambda bar: run_contact(plan, progress=_Announced(bar, line), sink=stream), stream,
                        args.quiet)
     if res is None:
         return 130
@@ -132,13 +132,13 @@ def pull_off_text(res) -> str:
     return f"pull-off {format_si(sc.force(F), 'N')} per cell{p} (F = {F:.4g})"
 
 
-def run_contact(cfg: dict, progress=None, sink=None):
-    """:func:`tengsim.run.resolve.run_contact` (one grid, or refined with resolve = 'auto'), transition D judged
-    with the shape's full-contact length, A/S at ``resolve_pressures`` (:func:`tengsim.study.observe.contact_hooks`)."""
+def run_contact(plan, progress=None, sink=None):
+    """:func:`tengsim.run.resolve.run_contact` of the plan (one grid, or refined with resolve = 'auto'), A/S at
+    ``resolve_pressures`` (:func:`tengsim.study.observe.contact_hooks`)."""
     from tengsim.run.resolve import run_contact as run
     from tengsim.study.observe import contact_hooks
 
-    return run(cfg, progress=progress, sink=sink, **contact_hooks(cfg))
+    return run(plan, progress=progress, sink=sink, **contact_hooks(plan.config))
 
 
 def open_stream(out, resume: bool, quiet: bool = False):

@@ -7,10 +7,13 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+import numpy as np
+
 from tengsim.kernels import film
 from tengsim.errors import ConfigValueError, TengsimError, finite, positive, shown
-from tengsim.laws import make_law
+from tengsim.laws import LJ93, make_law
 from tengsim.path import PathSpec
+from tengsim.plugins import KERNELS
 from tengsim.run.keys import (ADAPTIVE_KEYS, LOAD_KEYS, common_fields, common_names, contact_keys,
                               contact_table, law_fields, law_keys, physical_triggers, shape_class)
 from tengsim.shapes.base import dimensionless_fields, physical_fields
@@ -134,24 +137,99 @@ def _check_maps_out(maps_at, out) -> None:
                            "holds the curves only")
 
 
-@dataclass
+def coupling(tabor) -> float:
+    """The elastic coupling μ^{3/2} of Eq. (9) for the Tabor parameter μ = ``tabor`` (> 0, else a TengsimError)."""
+    return positive("tabor", tabor) ** 1.5
+
+
+def check_tol(v) -> float:
+    """resolve_tol: a number > 0 and < 1 (a ConfigValueError naming it otherwise)."""
+    if isinstance(v, bool) or not isinstance(v, (int, float)) or not 0 < float(v) < 1:
+        raise ConfigValueError(f"resolve_tol must be > 0 and < 1, got {v!r}")
+    return float(v)
+
+
+def check_max_pixels(v) -> int:
+    """max_pixels: a whole number of pixels nx·ny >= 9 (a ConfigValueError naming it otherwise)."""
+    if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or int(v) < 9:
+        raise ConfigValueError(f"max_pixels must be >= 9 (a whole number of pixels nx·ny), got {v!r}")
+    return int(v)
+
+
+DEFAULT_RESOLVE_TOL = 0.01
+"""resolve_tol when a table does not give one."""
+
+
+@dataclass(frozen=True)
+class ResolveSettings:
+    """The automatic refinement of a run (``resolve = 'auto'``, :mod:`tengsim.run.resolve`), checked when built.
+
+    ``tol`` the relative tolerance of the observables; ``max_pixels`` the largest grid nx·ny (None: what the
+    free memory holds); ``dx`` the first grid's spacing in X units (None: a coarse default); ``pressures`` the
+    nominal pressures (Pa) at which A/S must converge too (physical runs; () if none)."""
+
+    tol: float = DEFAULT_RESOLVE_TOL
+    max_pixels: int | None = None
+    dx: float | None = None
+    pressures: tuple = ()
+
+    def __post_init__(self):
+        object.__setattr__(self, "tol", check_tol(self.tol))
+        if self.max_pixels is not None:
+            object.__setattr__(self, "max_pixels", check_max_pixels(self.max_pixels))
+        if self.dx is not None:
+            object.__setattr__(self, "dx", positive("dx", self.dx))
+        object.__setattr__(self, "pressures", tuple(float(p) for p in self.pressures))
+
+
+@dataclass(frozen=True)
 class ContactPlan:
-    """Everything a contact run needs, built and validated from a config dict."""
+    """Everything a contact run needs, validated: built once from a [contact] table (:func:`plan_contact`) or
+    from API objects (:func:`tengsim.run.simulate.simulate`); nothing downstream reads a config dict.
+
+    ``tabor`` μ (> 0; :attr:`coupling` is μ^{3/2}); ``law`` an object or registered name (None: the paper's
+    LJ93); ``boundary`` a registered kernel; ``solver`` a registered name or a solver object; ``grid`` the
+    shape's grid of spacing ``dx`` unless given (then ``dx`` is the grid's); ``resolve`` the refinement
+    settings (None: one grid); ``config`` the table the plan was read from (without out and plot), kept in
+    the result's parameters."""
 
     shape: object
     tabor: float
     dx: float
     path: object  # PathSpec or tengsim.loadpath.LoadPathSpec
-    boundary: str
-    solver: str
-    tol: float
-    law: object
+    boundary: str = "free"
+    solver: object = "fast"
+    tol: float = 1e-6
+    law: object = None
     extra: dict = field(default_factory=dict)
     scaling: Scaling | None = None
     observers: tuple = ()
     kernel_params: dict = field(default_factory=dict)
-    resolve: dict = field(default_factory=dict)  # resolve = auto: {resolve, resolve_tol, max_pixels, dx (start)}
+    resolve: ResolveSettings | None = None
     symmetry: str = "auto"
+    grid: object = None
+    config: dict = field(default_factory=dict)
+
+    def __post_init__(self):
+        mu = positive("tabor", self.tabor)
+        if self.scaling is not None and abs(self.scaling.mu - mu) > 1e-9 * mu:
+            raise TengsimError(f"tabor = {mu:g} does not match the scaling's μ = {self.scaling.mu:g}")
+        law = make_law(self.law) if isinstance(self.law, str) else (self.law or LJ93())
+        grid = self.grid if self.grid is not None else self.shape.grid(self.dx)  # validates dx against the cell
+        for k, v in (("tabor", mu), ("law", law), ("boundary", KERNELS.canonical(self.boundary)), ("grid", grid),
+                     ("dx", grid.dx), ("extra", dict(self.extra or {})), ("observers", tuple(self.observers or ())),
+                     ("kernel_params", dict(self.kernel_params or {})), ("config", dict(self.config or {}))):
+            object.__setattr__(self, k, v)
+
+    @property
+    def coupling(self) -> float:
+        """μ^{3/2}, the elastic coupling of Eq. (9)."""
+        return coupling(self.tabor)
+
+
+def as_plan(plan) -> ContactPlan:
+    """``plan`` itself if it is a :class:`ContactPlan`, else the plan of the [contact] table ``plan``."""
+    return plan if isinstance(plan, ContactPlan) else plan_contact(plan)
 
 
 def _dx(raw, lateral, name="dx"):
@@ -272,7 +350,7 @@ def plan_contact(cfg: dict) -> ContactPlan:
         if vals["eps"] is not None:
             eps = positive("eps", vals["eps"])
         elif vals["tabor"] is not None:
-            eps = cls.eps_from_tabor(p, E, W, positive("tabor", vals["tabor"]))
+            eps = cls.eps_from_tabor(p, E, W, vals["tabor"])  # the shape checks μ > 0
         else:
             raise TengsimError(f"physical {name} input needs eps or tabor (tabor has no default in a physical run)")
         lateral = positive("lateral scale", cls.lateral_scale(p, eps))
@@ -294,7 +372,7 @@ def plan_contact(cfg: dict) -> ContactPlan:
                                + (f" or {', '.join(phys_names)} with E_star, W and eps or tabor (physical)"
                                   if phys_names else ""))
         vals = contact_table(name, "dimensionless", law_name).parse(cfg)
-        tabor = positive("tabor", 0.5 if vals["tabor"] is None else vals["tabor"])
+        tabor = 0.5 if vals["tabor"] is None else vals["tabor"]  # checked by ContactPlan
         shape = _build(cls, name, {f.name: vals[f.name] for f in dims if vals[f.name] is not None})
     shape, rough_extra = roughen(shape, vals, given, scaling)  # roughness = true: Roughened(shape, ...)
     extra.update(rough_extra)
@@ -314,25 +392,19 @@ def plan_contact(cfg: dict) -> ContactPlan:
     check_memory(grid.nx, grid.ny, vals["boundary"], vals["solver"], maps=2 * len(path.maps_at))
     resolve = _resolve(vals, given, dx if raw_dx not in (None, "") else None, scaling)
     return ContactPlan(shape, tabor, dx, path, vals["boundary"], vals["solver"], tol, law, extra, scaling,
-                       tuple(vals["observers"]), kernel_params, symmetry=vals["symmetry"], resolve=resolve)
+                       tuple(vals["observers"]), kernel_params, symmetry=vals["symmetry"], resolve=resolve,
+                       grid=grid, config={k: v for k, v in cfg.items() if k not in ("out", "plot")})
 
 
-def _resolve(vals, given, dx, scaling=None) -> dict:
-    """The refinement settings of a table: {} for resolve = off (resolve_tol, max_pixels, resolve_pressures
-    refused there), else resolve, resolve_tol (default 0.01), max_pixels (None: the free memory's), the start dx
-    (None: a coarse default, tengsim.run.resolve.default_dx) and pressures (Pa; () if none: physical runs only)."""
+def _resolve(vals, given, dx, scaling=None) -> ResolveSettings | None:
+    """The refinement settings of a table: None for resolve = off (resolve_tol, max_pixels, resolve_pressures
+    refused there), else its :class:`ResolveSettings` (pressures: physical runs only)."""
     if vals["resolve"] != "auto":
         bad = [k for k in ("resolve_tol", "max_pixels", "resolve_pressures") if k in given]
         if bad:
             raise ConfigValueError(f"{' and '.join(bad)} {'apply' if len(bad) > 1 else 'applies'} only with "
                                    "resolve = 'auto'")
-        return {}
-    tol = vals["resolve_tol"]
-    if tol is not None and not 0 < tol < 1:
-        raise ConfigValueError(f"resolve_tol must be > 0 and < 1, got {tol!r}")
-    mp = vals["max_pixels"]
-    if mp is not None and mp < 9:
-        raise ConfigValueError(f"max_pixels must be >= 9 (pixels nx·ny), got {mp!r}")
+        return None
     pressures = tuple(vals["resolve_pressures"] or ())
     if "resolve_pressures" in given:
         if scaling is None:
@@ -341,5 +413,5 @@ def _resolve(vals, given, dx, scaling=None) -> dict:
         bad = [p for p in pressures if not p > 0]
         if bad or not pressures:
             raise ConfigValueError(f"resolve_pressures must be pressures > 0, got {vals['resolve_pressures']!r}")
-    return {"resolve": "auto", "resolve_tol": 0.01 if tol is None else float(tol), "max_pixels": mp, "dx": dx,
-            "pressures": pressures}
+    tol = DEFAULT_RESOLVE_TOL if vals["resolve_tol"] is None else vals["resolve_tol"]
+    return ResolveSettings(tol, vals["max_pixels"], dx, pressures)

@@ -195,20 +195,20 @@ def area_fraction(res, contact_length, params: dict | None = None) -> np.ndarray
 
 
 def full_length(params: dict) -> float:
-    """Λc of full contact (2N for the pyramid, the base diameter of a cone or hemisphere; for flat-topped
-    pillars and ridges, whose top is in full contact from the first touch, the cell: the plate lies on
-    the land between them); an array: its pattern's; NaN if none."""
+    """Λc of full contact of a result's shape: its own :meth:`~tengsim.shapes.Shape.full_contact_length`
+    (the shape rebuilt from the result's parameters; an array: its pattern's); NaN if it has none or
+    cannot be rebuilt (a shape not registered here, a height map)."""
+    import dataclasses
+
+    from tengsim.registry import SHAPES
+
     params = pattern_params(params)
-    s = shape_name(params)
-    if s == "pyramid":
-        return 2 * float(params["N"])
-    if s == "hemisphere":
-        return 2 * float(params["radius"])
-    if s in ("cube", "line"):
-        return float(params["cell"])
-    if s == "cone" and math.isfinite(float(params.get("height", math.inf))):
-        return 2 * float(params["height"]) / float(params["slope"])
-    return math.nan
+    try:
+        cls = SHAPES.get(shape_name(params))
+        kw = {f.name: params[f.name] for f in dataclasses.fields(cls) if f.init and f.name in params}
+        return float(cls(**kw).full_contact_length())
+    except Exception:  # noqa: BLE001 - a shape that cannot answer has no known full-contact length
+        return math.nan
 
 
 # ---- the observables ----------------------------------------------------------------------------
@@ -306,9 +306,8 @@ def area_at(pressures, cfg: dict | None = None):
 
 def contact_hooks(cfg: dict) -> dict:
     """What :func:`tengsim.run.resolve.run_contact` needs from this layer for the [contact] table ``cfg``: the
-    shape's full-contact length (transition_D) and the A/S observer (``resolve_pressures``)."""
-    return {"full_length": lambda p: full_length({**p, "config": cfg}),
-            "area_at": lambda pressures: area_at(pressures, cfg)}
+    A/S observer (``resolve_pressures``)."""
+    return {"area_at": lambda pressures: area_at(pressures, cfg)}
 
 
 def observe(res, device: dict, settings: dict) -> dict:
