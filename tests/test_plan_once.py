@@ -98,7 +98,7 @@ def _built_in(name):
 @pytest.mark.parametrize("name", SHAPES.names())
 def test_every_registered_shape_answers_its_full_contact_length(name):
     """The shape's own answer; the study's, from a result's parameters, is the same."""
-    from tengsim.study.observe import full_length
+    from tengsim.run.area import full_length
 
     shape = _built_in(name)
     if shape is None:

@@ -242,7 +242,7 @@ PHYS = ["contact", "pyramid", "--E-star", "0.59MPa", "--W", "54mJ/m2", "--eps", 
 def test_resolve_pressures_are_judged_and_written(tmp_path, capsys):
     """resolve_pressures: A/S at each pressure is an observable of every grid (the resolution table), equal to
     the study layer's A/S of that grid's result at that pressure, and it can stop the refinement."""
-    from tengsim.study.observe import area_at, area_name
+    from tengsim.run.area import area_at, area_name
 
     out = tmp_path / "rp.nc"
     assert main([*PHYS, "--resolve", "auto", "--dx", "0.45um", "--max-pixels", "2500", "--resolve-pressures",
@@ -258,7 +258,7 @@ def test_resolve_pressures_are_judged_and_written(tmp_path, capsys):
 
 
 def test_area_observer_is_nan_outside_the_run_and_for_dimensionless():
-    from tengsim.study.observe import area_at, area_name
+    from tengsim.run.area import area_at, area_name
 
     res = resolve.run_contact({**PYR_CFG, "resolve": "off", "dx": 0.2})
     assert math.isnan(area_at([1e4])(res)[area_name(1e4)])  # no physical scale

@@ -1,4 +1,5 @@
-"""``tengsim contact``: one approach–retraction run (thin shell over tengsim.run.simulate.run_contact)."""
+"""``tengsim contact``: one approach–retraction run (a thin shell: options → one plan, :func:`tengsim.run.plan.plan_contact`
+→ :func:`tengsim.run.resolve.run_contact` → files)."""
 from __future__ import annotations
 
 import argparse
@@ -68,6 +69,7 @@ def run(args) -> int:
     if args.plot:
         check_output(args.plot, cfg.values(), what="--plot")
     from tengsim import parallel
+    from tengsim.run.resolve import run_contact
 
     if not parallel.is_root():  # mpiexec -n N: every process solves its slab, rank 0 alone writes and reports
         run_contact(plan)
@@ -130,15 +132,6 @@ def pull_off_text(res) -> str:
         return f"pull-off F = {F:.4g}"
     p = f", {format_si(sc.pressure(F), 'Pa')} nominal" if sc.cell_area else ""
     return f"pull-off {format_si(sc.force(F), 'N')} per cell{p} (F = {F:.4g})"
-
-
-def run_contact(plan, progress=None, sink=None):
-    """:func:`tengsim.run.resolve.run_contact` of the plan (one grid, or refined with resolve = 'auto'), A/S at
-    ``resolve_pressures`` (:func:`tengsim.study.observe.contact_hooks`)."""
-    from tengsim.run.resolve import run_contact as run
-    from tengsim.study.observe import contact_hooks
-
-    return run(plan, progress=progress, sink=sink, **contact_hooks(plan.config))
 
 
 def open_stream(out, resume: bool, quiet: bool = False):

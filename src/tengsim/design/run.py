@@ -217,7 +217,7 @@ def map_depths(res, plan) -> dict:
     """{D (ε): asked pressure (Pa)}: for the asked pressures nearest :data:`MAP_FRACTIONS` of p_max (above 0),
     the approach D at which ``res`` (the finest grid) reaches each on its load-controlled states, linear
     between the two states around it."""
-    from tengsim.study.observe import load_control
+    from tengsim.run.area import load_control
 
     F, D = load_control(res, "D")
     P = res.scaling.pressure(1.0) * F

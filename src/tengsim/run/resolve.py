@@ -378,15 +378,14 @@ def _why(changes: dict) -> str:
     return f"{worst} changed {changes[worst]:.2%} between the last two grids"
 
 
-def run_contact(plan, progress=None, sink=None, observe=None, area_at=None):
+def run_contact(plan, progress=None, sink=None, observe=None):
     """Run a :class:`tengsim.run.plan.ContactPlan` (or a [contact] table, planned here once): one grid
     (:func:`tengsim.run.simulate.run_contact`), or refined automatically when its ``resolve`` settings say so
     (:func:`resolve_contact`, transition_D judged with the shape's own full-contact length).
 
     The refinement's grids each stream their rows to ``sink`` would mix grids in one file, so a sink is not
     given rows of a refined run (its result is written whole at the end).  ``observe(result) -> dict``: more
-    observables to converge; ``area_at(pressures) -> observe``: the observer of A/S at the plan's
-    ``resolve.pressures`` (Pa; :func:`tengsim.study.observe.area_at`), needed when it names them."""
+    observables to converge, beside A/S at the plan's ``resolve.pressures`` (Pa; :func:`tengsim.run.area.area_at`)."""
     from tengsim.run import simulate as contact
     from tengsim.run.plan import as_plan
 
@@ -396,10 +395,9 @@ def run_contact(plan, progress=None, sink=None, observe=None, area_at=None):
         return contact.run_contact(plan, **kw)
     settings = plan.resolve
     if settings.pressures:
-        if area_at is None:
-            raise TengsimError("resolve_pressures needs the A/S observer: call tengsim.run_contact (or pass "
-                               "area_at=tengsim.study.observe.area_at)")
-        extra = area_at(settings.pressures)
+        from tengsim.run.area import area_at
+
+        extra = area_at(settings.pressures, plan.config)
         observe = extra if observe is None else (lambda res, a=observe, b=extra: {**a(res), **b(res)})
     ck = Checkpoint.of(sink, plan.config)
     full = getattr(plan.shape, "full_contact_length", None)

@@ -6,16 +6,15 @@ from dataclasses import is_dataclass, replace
 from tengsim import status
 from tengsim._version import __version__
 from tengsim.run.plan import ContactPlan, as_plan
-from tengsim.errors import TengsimError, positive
+from tengsim.errors import TengsimError
 from tengsim.grid import Mirror
 from tengsim.shapes import Pyramid, Shape
-from tengsim.laws import LJ93, Law, make_law
+from tengsim.laws import Law
 from tengsim.kernels import make_kernel
 from tengsim.kernels.distributed import SlabPeriodicKernel
-from tengsim.kernels.mirror import MirrorKernel
+from tengsim.kernels.mirror import BOUNDARIES as MIRROR_BOUNDARIES, MirrorKernel
 from tengsim.loadpath import LoadPathSpec, run_load_path
 from tengsim.path import PathSpec, run_path
-from tengsim.plugins import KERNELS
 from tengsim.resources import MAP_WORK, check_memory
 from tengsim.solvers import make_solver
 from tengsim.solvers.mirror import MirrorSolver
@@ -42,7 +41,7 @@ def choose_symmetry(shape, U0, grid, boundary: str, solver_name: str, symmetry: 
     declared = tuple(getattr(shape, "mirror_axes", ()) or ())
     if not declared:
         return (), "none (shape has no mirror)"
-    if boundary not in ("free", "periodic"):
+    if boundary not in MIRROR_BOUNDARIES:  # the kernels that have a symmetry-reduced form
         return (), f"none (boundary {boundary})"
     if solver_name not in ("fast", "vsr"):
         return (), f"none (solver {solver_name or '?'})"

@@ -89,10 +89,9 @@ def compute_point(contact: dict, pid: str, plugins: str = "", expect: dict | Non
             raise TengsimError(f"the worker on {info['host']} would compute this point with other code or "
                                f"input than the client's ({provenance_difference(expect, prov)}); not computed")
         from tengsim.run.resolve import run_contact  # resolve = 'auto': refined until converged
-        from tengsim.study.observe import contact_hooks
 
         c0 = time.perf_counter()
-        res = run_contact(dict(contact), **contact_hooks(dict(contact)))
+        res = run_contact(dict(contact))
     except Exception as exc:  # noqa: BLE001 - recorded as a failed point, the others go on
         msg = str(exc) if isinstance(exc, TengsimError) else \
             f"{type(exc).__name__}: {exc}\n{traceback.format_exc(limit=-3)}"
