@@ -189,7 +189,7 @@ class ContactPlan:
 
     ``tabor`` μ (> 0; :attr:`coupling` is μ^{3/2}); ``law`` an object or registered name (None: the paper's
     LJ93); ``boundary`` a registered kernel; ``solver`` a registered name or a solver object; ``grid`` the
-    shape's grid of spacing ``dx`` unless given (then ``dx`` is the grid's); ``resolve`` the refinement
+    shape's grid of spacing about ``dx`` unless given (then the run's is the grid's); ``resolve`` the refinement
     settings (None: one grid); ``config`` the table the plan was read from (without out and plot), kept in
     the result's parameters."""
 
@@ -217,7 +217,7 @@ class ContactPlan:
         law = make_law(self.law) if isinstance(self.law, str) else (self.law or LJ93())
         grid = self.grid if self.grid is not None else self.shape.grid(self.dx)  # validates dx against the cell
         for k, v in (("tabor", mu), ("law", law), ("boundary", KERNELS.canonical(self.boundary)), ("grid", grid),
-                     ("dx", grid.dx), ("extra", dict(self.extra or {})), ("observers", tuple(self.observers or ())),
+                     ("extra", dict(self.extra or {})), ("observers", tuple(self.observers or ())),
                      ("kernel_params", dict(self.kernel_params or {})), ("config", dict(self.config or {}))):
             object.__setattr__(self, k, v)
 
