@@ -40,6 +40,15 @@ def test_tengsim_contact_plans_once(tmp_path, counted, extra):
     assert len(counted) == 1, counted
 
 
+def test_tengsim_run_of_a_toml_contact_table_plans_once(tmp_path, counted):
+    out = tmp_path / "r.csv"
+    cfg = tmp_path / "run.toml"
+    cfg.write_text("[contact]\n" + "".join(f"{k} = {v!r}\n" for k, v in CFG.items()).replace("'", '"')
+                   + f'out = "{out}"\n')
+    assert main(["run", str(cfg), "--quiet"]) == 0
+    assert out.is_file() and len(counted) == 1, counted
+
+
 def test_the_api_helper_plans_a_table_once_and_takes_a_plan_as_is(counted):
     from tengsim.run.resolve import run_contact
 
