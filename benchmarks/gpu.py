@@ -108,7 +108,7 @@ def rough_row(n, dtype, device, cpu_max, tol, max_iter, ref_cache):
 
 def path_row(label, runs, device):
     """Whole paths through the contact API: ``runs`` = [(N, cell, mu, dx, d_max, d_step)], jax vs fast."""
-    from tengsim.contact import simulate_pyramid
+    from tengsim.run.simulate import simulate_pyramid
     from tengsim.solvers.jax_fast import JaxSolver, compile_stats
 
     out = {}

@@ -38,7 +38,7 @@ def main(argv=None):
     a = ap.parse_args(argv)
 
     from tengsim import kernels
-    from tengsim.contact import simulate_pyramid
+    from tengsim.run.simulate import simulate_pyramid
     from tengsim.shapes import Pyramid
 
     g = GROUPS[a.group]

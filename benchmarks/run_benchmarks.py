@@ -54,7 +54,7 @@ GROUPS = {
 def _symmetric_fast(args, name, g, d_max, grid, reps, wall_fast, cpu_fast, fast_ref, log):
     """tengsim fast with symmetry = 'auto' (the X+Y block): its row, ratios to the full-grid fast run, and its
     largest |ΔF| from it relative to max|F|."""
-    from tengsim.contact import simulate_pyramid
+    from tengsim.run.simulate import simulate_pyramid
     from tengsim.grid import Mirror
     from tengsim.kernels import FreeKernel
     from tengsim.kernels.mirror import MirrorKernel, ReducedKernel
@@ -176,7 +176,7 @@ def run_group(name, args, log):
     from tengsim import kernels
     from tengsim.analysis import apex_index
     from tengsim.analysis import contact_length as ts_contact_length
-    from tengsim.contact import simulate_pyramid
+    from tengsim.run.simulate import simulate_pyramid
     from tengsim.shapes import Pyramid
     from tengsim.laws import LJ93
     from tengsim.solvers import Problem, State, make_solver

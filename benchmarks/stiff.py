@@ -30,8 +30,8 @@ from pathlib import Path
 import numpy as np
 
 from tengsim import continuation
-from tengsim.config import plan_contact
-from tengsim.contact import run_contact
+from tengsim.run.plan import plan_contact
+from tengsim.run.simulate import run_contact
 from tengsim.kernels import make_kernel
 from tengsim.laws import LJ93
 from tengsim.shapes.rough import Rough

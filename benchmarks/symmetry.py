@@ -24,7 +24,7 @@ import numpy as np
 
 from tengsim.cases.paper.contact import group_shape
 from tengsim.cases.paper.units import paper_scaling
-from tengsim.contact import run_contact, simulate
+from tengsim.run.simulate import run_contact, simulate
 from tengsim.path import PathSpec
 
 

@@ -42,8 +42,8 @@ from pathlib import Path
 
 import numpy as np
 
-from tengsim.config import plan_contact
-from tengsim.contact import simulate
+from tengsim.run.plan import plan_contact
+from tengsim.run.simulate import simulate
 from tengsim.device.formulas import voc_polymer
 from tengsim.grid import Grid
 from tengsim.shapes.rough import Rough

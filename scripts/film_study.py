@@ -23,7 +23,7 @@ import numpy as np
 
 from tengsim import io
 from tengsim.kernels import film
-from tengsim.contact import simulate
+from tengsim.run.simulate import simulate
 from tengsim.device.formulas import voc_polymer
 from tengsim.shapes import Pyramid
 from tengsim.paper import area_table_from_result

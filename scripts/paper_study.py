@@ -40,7 +40,7 @@ os.environ.setdefault("TENGSIM_FFT_WORKERS", "1")
 import numpy as np  # noqa: E402
 
 from tengsim.analysis import tensile_peak_offset  # noqa: E402
-from tengsim.contact import simulate  # noqa: E402
+from tengsim.run.simulate import simulate  # noqa: E402
 from tengsim.shapes import HeightMap, Pyramid  # noqa: E402
 from tengsim.path import PathSpec  # noqa: E402
 from tengsim.cases.paper.units import paper_scaling  # noqa: E402

@@ -133,7 +133,7 @@ def test_shipped_examples_are_valid():
     """Every example config in examples/ plans without error (the README points users to them)."""
     from pathlib import Path
 
-    from tengsim.config import plan_contact
+    from tengsim.run.plan import plan_contact
     from tengsim.schema import read_config as load_toml
 
     files = sorted((Path(__file__).parent.parent / "examples").glob("*.toml"))

@@ -8,7 +8,7 @@ import pytest
 
 from tengsim.cli.keyhelp import shape_keys
 from tengsim.cli.main import main
-from tengsim.config import common_fields, law_keys
+from tengsim.run.keys import common_fields, law_keys
 from tengsim.registry import SHAPES
 
 HEAVY = ("numpy", "scipy", "xarray", "matplotlib", "dask", "SurfaceTopography")

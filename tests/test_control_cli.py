@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from tengsim.cli.main import main
-from tengsim.config import plan_contact
+from tengsim.run.plan import plan_contact
 from tengsim.loadpath import LoadPathSpec
 from tengsim.path import PathSpec
 from tengsim.cases.paper.units import paper_scaling

@@ -28,8 +28,8 @@ def test_plan_physical_defaults_and_tabor():
 
 
 def test_small_design_ok_and_within_1pct_of_a_grid_sqrt2_finer(small):
-    from tengsim.config import plan_contact
-    from tengsim.contact import simulate
+    from tengsim.run.plan import plan_contact
+    from tengsim.run.simulate import simulate
     from tengsim.design.curves import branch_curves
     from tengsim.path import PathSpec
 
@@ -174,9 +174,9 @@ def test_first_grid_is_the_default_refinements_first_fine_enough_one():
     than the process zone over START_ZONE_PIXELS, which cannot be the last (issue 29: 33² … 117² were thrown away
     for the issue's pyramid)."""
     from tengsim import status
-    from tengsim.config import plan_contact
+    from tengsim.run.plan import plan_contact
     from tengsim.design.run import START_ZONE_PIXELS, refinement_grids, start_dx
-    from tengsim.resolve import default_dx
+    from tengsim.run.resolve import default_dx
 
     from tengsim.cli.design import _read_toml
     from pathlib import Path
@@ -280,7 +280,7 @@ def test_budget_cap_lies_between_plain_grids():
     from pathlib import Path
 
     from tengsim.cli.design import _read_toml
-    from tengsim.config import plan_contact
+    from tengsim.run.plan import plan_contact
     from tengsim.design.run import D_MIN, D_STEP, ROWS_PER_STEP, SECONDS_PER_PIXEL_ROW, _blocks, budget_pixels
     from tengsim.design.run import height_eps, start_dx
 

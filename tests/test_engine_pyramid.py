@@ -10,7 +10,7 @@ from functools import lru_cache
 import numpy as np
 import pytest
 
-from tengsim.contact import simulate_pyramid
+from tengsim.run.simulate import simulate_pyramid
 
 GROUPS = {"A": (0.946, 3.78), "B": (2.37, 9.46), "C": (4.73, 18.9)}
 

@@ -20,8 +20,8 @@ from scipy.sparse.linalg import LinearOperator, cg
 from scipy.special import j0
 
 from tengsim.kernels import film
-from tengsim.config import plan_contact
-from tengsim.contact import run_contact
+from tengsim.run.plan import plan_contact
+from tengsim.run.simulate import run_contact
 from tengsim.errors import TengsimError
 from tengsim.grid import Grid
 from tengsim.kernels import FreeKernel, PeriodicKernel, make_kernel

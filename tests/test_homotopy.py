@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from conftest import registered
 
-from tengsim.contact import simulate
+from tengsim.run.simulate import simulate
 from tengsim.errors import TengsimError
 from tengsim.kernels import make_kernel
 from tengsim.laws import LJ93, MaugisDugdale

@@ -318,9 +318,9 @@ def _server(greeting: bytes | None):
 @pytest.mark.parametrize("greeting, words", [(None, "no Dask greeting within 0.5 s"),
                                              (b"HTTP/1.1 400 Bad Request\r\n\r\n", "not a Dask scheduler")])
 def test_c06_a_scheduler_that_is_not_dask_is_refused_in_its_timeout(tmp_path, capsys, monkeypatch, greeting, words):
-    from tengsim.study import execute
+    from tengsim.study import runner
 
-    monkeypatch.setattr(execute, "CONNECT_TIMEOUT_S", 0.5)
+    monkeypatch.setattr(runner, "CONNECT_TIMEOUT_S", 0.5)
     srv, port = _server(greeting)
     try:
         f = _study(tmp_path, '[axes]\n"contact.N" = [0.946]\n')
@@ -365,7 +365,7 @@ RESOLVE = ["contact", "sphere", "--radius", "5", "--cell", "4", "--tabor", "1", 
 
 
 def test_c08_a_refinement_killed_after_two_grids_keeps_them_and_resumes(tmp_path, capsys, monkeypatch):
-    from tengsim import contact
+    from tengsim.run import simulate as contact
     from tengsim.results.read import load_result
     from tengsim.results import checkpoint_path
 

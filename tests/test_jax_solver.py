@@ -21,7 +21,7 @@ import pytest
 jax = pytest.importorskip("jax")
 
 from tengsim.cli.main import main  # noqa: E402
-from tengsim.contact import simulate_pyramid  # noqa: E402
+from tengsim.run.simulate import simulate_pyramid  # noqa: E402
 from tengsim.errors import TengsimError  # noqa: E402
 from tengsim.kernels import make_kernel  # noqa: E402
 from tengsim.laws import LJ93, Exponential, MaugisDugdale, Repulsive  # noqa: E402

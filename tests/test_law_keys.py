@@ -9,7 +9,8 @@ import xarray as xr
 
 import tengsim as ts
 from tengsim.cli.main import main
-from tengsim.config import contact_table, law_fields, law_keys, plan_contact
+from tengsim.run.keys import contact_table, law_fields, law_keys
+from tengsim.run.plan import plan_contact
 from tengsim.errors import TengsimError
 from tengsim.shapes import Paraboloid
 from tengsim.laws import LJ93, Exponential, Law, MaugisDugdale

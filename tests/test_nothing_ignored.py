@@ -7,14 +7,15 @@ refused with one line where the shape variant does not use it, or is declared me
 (``metadata_fields``).  A key added later without a case here fails ``test_every_key_has_a_case``:
 give it a changed value below (and it must then change the plan) or declare it.
 
-Everything runs at plan level (:func:`tengsim.config.plan_contact`, ``shape.gap(grid)``): no solve.
+Everything runs at plan level (:func:`tengsim.run.plan.plan_contact`, ``shape.gap(grid)``): no solve.
 """
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from tengsim.config import common_fields, contact_table, law_fields, law_keys, plan_contact
+from tengsim.run.keys import common_fields, contact_table, law_fields, law_keys
+from tengsim.run.plan import plan_contact
 from tengsim.errors import TengsimError
 from tengsim.plugins import LAWS, SHAPES
 from tengsim.shapes.roughened import roughness_fields

@@ -63,7 +63,7 @@ def test_monitor_reports_inside_a_solve_at_most_every_interval(tty):
 def test_simulate_reports_inside_long_solves(monkeypatch):
     """contact.simulate hands the progress's monitor to the fast solver on large grids (threshold
     lowered here so that a small grid counts as large)."""
-    from tengsim import contact
+    from tengsim.run import simulate as contact
     from tengsim.shapes import Paraboloid
     from tengsim.path import PathSpec
 

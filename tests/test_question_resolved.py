@@ -16,7 +16,7 @@ def test_resolved_study_is_the_coarse_one_with_refinement(name, coarse):
     """Every point valid; the same 90 points as the coarse file once the refinement keys are removed;
     each point refines from the coarse grid (45², within max_pixels) with tolerance 1 %, converging A/S at
     the study's [observables] pressures too."""
-    from tengsim.config import plan_contact
+    from tengsim.run.plan import plan_contact
     from tengsim.study.validate import validate
     from tengsim.study.spec import load_study
 
@@ -52,9 +52,9 @@ def test_resolved_study_bad_refinement_key_exit_2_nothing_written(tmp_path, caps
 def test_more_grids_study_is_the_periodic_one_for_the_smooth_sided_patterns():
     """docs/design.md, "More grids": the periodic study's pyramid, cone and hemisphere points, nothing else
     changed but max_pixels, which admits the refinement 45², 65², 105², 165², 245² (each base edge a quarter
-    pixel past a pixel centre on every grid: tengsim.resolve keeps it there) and no finer grid."""
-    from tengsim.config import plan_contact
-    from tengsim.resolve import FACTOR, _aligned, edge_phases
+    pixel past a pixel centre on every grid: tengsim.run.resolve keeps it there) and no finer grid."""
+    from tengsim.run.plan import plan_contact
+    from tengsim.run.resolve import FACTOR, _aligned, edge_phases
     from tengsim.study.validate import validate
     from tengsim.study.spec import load_study
 

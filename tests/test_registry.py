@@ -46,7 +46,7 @@ def test_a_new_registration_reaches_every_name_list():
     """Registering a kernel makes it valid in simulate, the [contact] schema and its error texts."""
     KERNELS.register("periodic_copy", lambda grid, coupling: PeriodicKernel(grid, coupling))
     try:
-        from tengsim.config import plan_contact
+        from tengsim.run.plan import plan_contact
 
         assert plan_contact(dict(N=0.946, cell=3.78, boundary="periodic_copy")).boundary == "periodic_copy"
         with pytest.raises(TengsimError, match="periodic_copy"):

@@ -1,4 +1,4 @@
-"""Automatic grid refinement (``resolve = "auto"``, tengsim.resolve; issue 22 item 1).
+"""Automatic grid refinement (``resolve = "auto"``, tengsim.run.resolve; issue 22 item 1).
 
 Fast: Richardson on synthetic sequences of known order; a cheap pyramid refinement (5 grids, about 2 s)
 reaching ``ok``; ``max_pixels`` stopping it with ``under_resolved`` and its one line; the resolution table
@@ -12,7 +12,7 @@ import math
 import numpy as np
 import pytest
 
-from tengsim import resolve
+from tengsim.run import resolve
 from tengsim.cli.main import main
 from tengsim.errors import TengsimError
 from tengsim.results.read import load_result
@@ -78,7 +78,7 @@ def test_cheap_refinement_reaches_ok(refined):
         r = p["richardson"][name]
         assert r["rel_error"] <= 0.01 and r["change"] <= 0.01, name
     # the curves are exactly those of a plain run on the finest grid
-    from tengsim.contact import run_contact
+    from tengsim.run.simulate import run_contact
 
     plain = run_contact({k: v for k, v in PYR_CFG.items() if k != "resolve"} | {"dx": grids[-1]})
     np.testing.assert_allclose(res.table["F"], plain.table["F"], rtol=0, atol=1e-9)
@@ -184,9 +184,9 @@ def test_bad_values_are_refused_with_one_line(tmp_path, capsys, extra, words):
 
 
 def test_one_grid_run_contact_refuses_resolve_auto():
-    from tengsim.contact import run_contact
+    from tengsim.run.simulate import run_contact
 
-    with pytest.raises(TengsimError, match="tengsim.resolve.run_contact"):
+    with pytest.raises(TengsimError, match="tengsim.run.resolve.run_contact"):
         run_contact({**PYR_CFG, "d_max": 0.0})
 
 
@@ -242,7 +242,7 @@ PHYS = ["contact", "pyramid", "--E-star", "0.59MPa", "--W", "54mJ/m2", "--eps", 
 def test_resolve_pressures_are_judged_and_written(tmp_path, capsys):
     """resolve_pressures: A/S at each pressure is an observable of every grid (the resolution table), equal to
     the study layer's A/S of that grid's result at that pressure, and it can stop the refinement."""
-    from tengsim.study.observe import area_at, area_name
+    from tengsim.run.area import area_at, area_name
 
     out = tmp_path / "rp.nc"
     assert main([*PHYS, "--resolve", "auto", "--dx", "0.45um", "--max-pixels", "2500", "--resolve-pressures",
@@ -258,7 +258,7 @@ def test_resolve_pressures_are_judged_and_written(tmp_path, capsys):
 
 
 def test_area_observer_is_nan_outside_the_run_and_for_dimensionless():
-    from tengsim.study.observe import area_at, area_name
+    from tengsim.run.area import area_at, area_name
 
     res = resolve.run_contact({**PYR_CFG, "resolve": "off", "dx": 0.2})
     assert math.isnan(area_at([1e4])(res)[area_name(1e4)])  # no physical scale
@@ -281,10 +281,25 @@ def test_resolve_pressures_refused_with_one_line(tmp_path, capsys, extra, words)
 def test_resolve_pressures_refused_in_a_dimensionless_run(tmp_path, capsys):
     assert main([*BASE, "--resolve", "auto", "--resolve-pressures", "10kPa", "--out", str(tmp_path / "b.csv")]) == 2
     assert "applies only to a physical run" in capsys.readouterr().err
-    with pytest.raises(TengsimError, match="needs the A/S observer"):
+
+
+def test_the_api_converges_a_s_at_resolve_pressures_without_any_hook(monkeypatch):
+    """resolve.run_contact wires the A/S observer (tengsim.run.area.area_at) itself: no caller passes it."""
+    from tengsim.run.area import area_name
+
+    seen = {}
+
+    def captured(*a, observe=None, **k):
+        seen["observe"] = observe
+        raise KeyboardInterrupt  # stop before any grid is solved
+
+    monkeypatch.setattr(resolve, "resolve_contact", captured)
+    with pytest.raises(KeyboardInterrupt):
         resolve.run_contact({"shape": "pyramid", "E_star": "0.59MPa", "W": "54mJ/m2", "eps": "0.37um",
                              "pitch": "5um", "base": "2.5um", "height": "1.75um", "d_min": -1, "d_max": 2,
                              "d_step": 0.5, "resolve": "auto", "resolve_pressures": "10kPa"})
+    one_grid = resolve.run_contact({**PYR_CFG, "resolve": "off", "dx": 0.4})
+    assert set(seen["observe"](one_grid)) == {area_name(1e4)}
 
 
 def test_study_points_converge_their_observable_pressures():
@@ -322,7 +337,7 @@ def test_finer_grids_keep_a_shapes_edges_where_they_fell_in_the_first_grids_pixe
     45², 65², 105², 165², 245², the edge a quarter pixel past a pixel centre on each.  A shape without edges
     (paraboloid), an edge no grid in reach can keep, and the pixel cap get the plain grid."""
     from tengsim.grid import Grid
-    from tengsim.resolve import FACTOR, PHASE_TOL, _aligned, edge_phases
+    from tengsim.run.resolve import FACTOR, PHASE_TOL, _aligned, edge_phases
     from tengsim.shapes import Cone, Cube, Hemisphere, Paraboloid, Pyramid
 
     pyr = Pyramid(N=10.0, cell=40.0)

@@ -12,7 +12,7 @@ from tengsim.errors import TengsimError
 
 _PEAK = r"""
 import json, resource, sys
-from tengsim.contact import simulate
+from tengsim.run.simulate import simulate
 from tengsim.shapes import Pyramid
 from tengsim.path import PathSpec
 def rss():

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from tengsim.cli.main import main
-from tengsim.config import plan_contact
+from tengsim.run.plan import plan_contact
 from tengsim.errors import TengsimError
 from tengsim.grid import Grid
 from tengsim.shapes import Rough

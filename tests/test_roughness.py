@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from tengsim.cli.main import main
-from tengsim.config import plan_contact
+from tengsim.run.plan import plan_contact
 from tengsim.errors import TengsimError
 from tengsim.shapes import Paraboloid, Pyramid, Rough
 from tengsim.shapes.roughened import Roughened

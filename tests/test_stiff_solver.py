@@ -10,7 +10,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from tengsim.config import plan_contact
+from tengsim.run.plan import plan_contact
 from tengsim.continuation import PERSIST_FACTOR, Branch, persist
 from tengsim.kernels import make_kernel
 from tengsim.solvers import FastSolver, Problem, State, VSRSolver
@@ -121,7 +121,7 @@ def test_stiff_small_rough_surface_converges():
 def test_simulate_continues_capped_solves_also_on_the_mirror_block():
     """Through simulate (sphere: the mirror-reduced solve, MirrorSolver around the fast solver): with a
     cap far too small every row still converges, and F(D) equals the uncapped run's to 1e-6 relative."""
-    from tengsim.contact import simulate
+    from tengsim.run.simulate import simulate
     from tengsim.path import PathSpec
     from tengsim.shapes.axisymmetric import Paraboloid
     shape = Paraboloid(radius=1.0, cell=6.0)

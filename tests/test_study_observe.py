@@ -99,7 +99,7 @@ def test_dimensionless_run_has_no_pressure_observables():
 
 
 def test_area_fraction_per_shape_family():
-    from tengsim.study.observe import area_fraction, family
+    from tengsim.run.area import area_fraction, family
 
     L = np.array([0.0, 1.0, 2.0, 10.0])
     for shape, fam, want in [("Pyramid", "square", (L / 4) ** 2), ("Cube", "square", (L / 4) ** 2),
@@ -115,8 +115,8 @@ def test_area_fraction_per_shape_family():
 
 def test_physical_scale_of_any_shape_from_its_columns():
     """Any physical run: Pa per unit F from pressure_Pa (or F_N / cell area), metres per unit D = eps_m."""
-    from tengsim.contact import run_contact
-    from tengsim.study.observe import physical_scale
+    from tengsim.run.simulate import run_contact
+    from tengsim.run.area import physical_scale
 
     res = run_contact({"shape": "cone", "slope": 1.0, "pitch": "2um", "height": "0.4um", "E_star": "1MPa",
                        "W": "54mJ/m2", "eps": "0.1um", "dx": "0.2um", "d_min": -1.0, "d_max": 2.0,

@@ -131,7 +131,7 @@ def test_shape_axis_merges_its_own_table_and_evaluates_expressions():
             assert c["height"] == pytest.approx(a * 1e-6)
         assert c["d_max"] == pytest.approx(1.2 * a * 1e-6 / 0.37e-6 + 2)
         assert c["d_step"] == pytest.approx((c["d_max"] + 1) / 8)
-    from tengsim.config import plan_contact
+    from tengsim.run.plan import plan_contact
 
     for p in s.points:  # every point is a valid run of its own shape
         plan_contact(dict(p.contact))
@@ -164,7 +164,7 @@ def test_bad_shape_tables_are_study_errors(bad, msg):
 
 
 def test_issue_question_study_file_expands():
-    from tengsim.config import plan_contact
+    from tengsim.run.plan import plan_contact
     from tengsim.study.spec import load_study
 
     from pathlib import Path

@@ -13,8 +13,8 @@ import xarray as xr
 
 from tengsim.cli.main import main
 from tengsim import plugins
-from tengsim.config import plan_contact
-from tengsim.contact import run_contact
+from tengsim.run.plan import plan_contact
+from tengsim.run.simulate import run_contact
 from tengsim.errors import TengsimError
 from tengsim.status import SEVERITY
 from tengsim.study import parse_study, run_study
@@ -107,13 +107,13 @@ def test_bad_point_fails_with_message_others_finish(tmp_path, client):
 
 def test_failure_at_compute_is_recorded(monkeypatch):
     """An exception inside a run becomes a failed point with its message (compute_point never raises)."""
-    import tengsim.contact
+    import tengsim.run.simulate
     from tengsim.study.worker import compute_point
 
     def boom(cfg, progress=None):
         raise FloatingPointError("overflow in the solver")
 
-    monkeypatch.setattr(tengsim.contact, "run_contact", boom)
+    monkeypatch.setattr(tengsim.run.simulate, "run_contact", boom)
     r = compute_point(dict(TINY), "abc")
     assert r["status"] == "failed" and "FloatingPointError: overflow in the solver" in r["message"]
     assert r["data"] is None

@@ -16,7 +16,7 @@ from conftest import registered
 from tengsim.cases.paper.contact import group_shape
 from tengsim.cases.paper.units import paper_scaling
 from tengsim.cli.main import main
-from tengsim.contact import choose_symmetry, simulate
+from tengsim.run.simulate import choose_symmetry, simulate
 from tengsim.grid import Mirror
 from tengsim.kernels import make_kernel
 from tengsim.laws import LJ93
@@ -245,7 +245,7 @@ def test_cli_symmetry_off_and_bad_value(tmp_path, capsys):
 
 
 def test_config_symmetry_key(tmp_path, capsys):
-    from tengsim.config import plan_contact
+    from tengsim.run.plan import plan_contact
     from tengsim.errors import TengsimError
 
     assert plan_contact({"shape": "pyramid", "N": 0.946, "cell": 3.78}).symmetry == "auto"
@@ -306,7 +306,7 @@ def test_memory_check_of_a_symmetric_run_matches_its_peak_rss():
     import sys
 
     from tengsim import resources
-    from tengsim.contact import MIRROR_FULL_ARRAYS
+    from tengsim.run.simulate import MIRROR_FULL_ARRAYS
     from tengsim.resources import MAP_WORK
 
     sys.path.insert(0, os.path.dirname(__file__))

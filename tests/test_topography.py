@@ -7,7 +7,7 @@ import pytest
 
 import tengsim
 from tengsim.cli.main import main
-from tengsim.config import plan_contact
+from tengsim.run.plan import plan_contact
 from tengsim.errors import TengsimError
 from tengsim.shapes.topography import Topography, read
 

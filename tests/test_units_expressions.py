@@ -8,8 +8,9 @@ import numpy as np
 import pytest
 
 from tengsim.cli.main import main
-from tengsim.config import X_UNIT_KEYS, plan_contact
-from tengsim.contact import run_contact
+from tengsim.run.keys import X_UNIT_KEYS
+from tengsim.run.plan import plan_contact
+from tengsim.run.simulate import run_contact
 from tengsim.errors import ConfigValueError, TengsimError
 from tengsim.plugins import SHAPES
 from tengsim.shapes.base import physical_fields
@@ -50,6 +51,9 @@ def _same(a, b, path="plan"):
     if dataclasses.is_dataclass(a) and not isinstance(a, type):
         assert type(a) is type(b), path
         for f in dataclasses.fields(a):
+            if f.name == "config":  # the table as written (kept for the result's parameters): the same keys
+                assert set(a.config) == set(b.config), (path, set(a.config) ^ set(b.config))
+                continue
             _same(getattr(a, f.name), getattr(b, f.name), f"{path}.{f.name}")
     elif isinstance(a, dict):
         assert set(a) == set(b), (path, set(a) ^ set(b))

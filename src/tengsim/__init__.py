@@ -13,8 +13,8 @@ _WHERE = {  # public name -> the module defining it, imported on first use (PEP 
     "contact_length": "tengsim.analysis",
     "force": "tengsim.analysis",
     "repulsive_area": "tengsim.analysis",
-    "simulate": "tengsim.contact",
-    "simulate_pyramid": "tengsim.contact",
+    "simulate": "tengsim.run.simulate",
+    "simulate_pyramid": "tengsim.run.simulate",
     "TengsimError": "tengsim.errors",
     "Grid": "tengsim.grid",
     "FreeKernel": "tengsim.kernels",
@@ -33,7 +33,10 @@ _WHERE = {  # public name -> the module defining it, imported on first use (PEP 
     "OBSERVERS": "tengsim.plugins",
     "SHAPES": "tengsim.plugins",
     "SOLVERS": "tengsim.plugins",
-    "resolve_contact": "tengsim.resolve",
+    "resolve_contact": "tengsim.run.resolve",
+    "ContactPlan": "tengsim.run.plan",
+    "plan_contact": "tengsim.run.plan",
+    "simulate_plan": "tengsim.run.simulate",
     "ContactResult": "tengsim.results",
     "Jump": "tengsim.results",
     "Array": "tengsim.shapes",
@@ -74,17 +77,17 @@ def __dir__():
     return sorted(set(globals()) | set(_WHERE))
 
 
-def run_contact(cfg: dict, progress=None, sink=None, observe=None):
-    """One run of a [contact] table (the keys of ``tengsim contact``; ``resolve = "auto"``: refined until
-    converged, :func:`tengsim.resolve.run_contact`), with the study layer's full-contact length and A/S
-    observer (``resolve_pressures``) wired in, as ``tengsim contact`` runs it.  Returns a ContactResult."""
-    from tengsim.resolve import run_contact as run
-    from tengsim.study.observe import contact_hooks
+def run_contact(cfg, progress=None, sink=None, observe=None):
+    """One run of a [contact] table (the keys of ``tengsim contact``) or of its plan
+    (:func:`tengsim.run.plan.plan_contact`), as ``tengsim contact`` runs it: ``resolve = "auto"`` refined until
+    converged (:func:`tengsim.run.resolve.run_contact`).  Returns a ContactResult."""
+    from tengsim.run.resolve import run_contact as run
 
-    return run(cfg, progress=progress, sink=sink, observe=observe, **contact_hooks(cfg))
+    return run(cfg, progress=progress, sink=sink, observe=observe)
 
 __all__ = [
-    "KERNELS", "LAWS", "OBSERVERS", "SHAPES", "SOLVERS", "Scaling", "Summary",
+    "KERNELS", "LAWS", "OBSERVERS", "SHAPES", "SOLVERS", "Scaling", "Summary", "ContactPlan", "plan_contact",
+    "simulate_plan",
     "Array", "Exponential", "LoadPathSpec", "MaugisDugdale", "ResultStatusError", "Topography", "run_load_path",
     "Cone", "ContactResult", "Cube", "Equilibrium", "FastSolver", "FlatPunch", "FreeKernel", "Grid",
     "HeightMap", "Hemisphere", "Jump", "LJ93", "Line", "Paraboloid", "PathSpec",

@@ -343,7 +343,7 @@ _OBS_TITLES = {"pull_off_F": "pull-off F", "jump_in_D": "jump-in D", "jump_out_D
 
 
 def plot_resolution(res, path, title: str = "") -> None:
-    """Convergence of an automatically refined run (``resolve = "auto"``, tengsim.resolve): one panel per
+    """Convergence of an automatically refined run (``resolve = "auto"``, tengsim.run.resolve): one panel per
     observable against the grid spacing dx (log axis, finest right), each grid's status marked, the
     Richardson-extrapolated value as a line and its error estimate (± |error|) as a band."""
     from tengsim.errors import TengsimError

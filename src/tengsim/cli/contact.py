@@ -1,4 +1,5 @@
-"""``tengsim contact``: one approach–retraction run (thin shell over tengsim.contact.run_contact)."""
+"""``tengsim contact``: one approach–retraction run (a thin shell: options → one plan, :func:`tengsim.run.plan.plan_contact`
+→ :func:`tengsim.run.resolve.run_contact` → files)."""
 from __future__ import annotations
 
 import argparse
@@ -16,7 +17,7 @@ def register(sub):
     """The parser: every key of every shape and law (from the [contact] schema) as an option; the help
     pages (per shape, and the index) are :mod:`tengsim.cli.keyhelp`'s."""
     from tengsim.cli.keyhelp import CLI_ONLY_HELP, HelpAction
-    from tengsim.config import common_fields, contact_table, law_keys
+    from tengsim.run.keys import common_fields, contact_table, law_keys
     from tengsim.registry import SHAPES
 
     p = sub.add_parser("contact", help=SUMMARY, add_help=False)
@@ -42,7 +43,8 @@ def register(sub):
 
 
 def run(args) -> int:
-    from tengsim.config import contact_keys, plan_contact
+    from tengsim.run.keys import contact_keys
+    from tengsim.run.plan import plan_contact
 
     keys = [k for k in contact_keys() if k not in _CLI_ONLY]
     cfg = {k: getattr(args, k) for k in keys if getattr(args, k, None) not in (None, "")}
@@ -67,13 +69,14 @@ def run(args) -> int:
     if args.plot:
         check_output(args.plot, cfg.values(), what="--plot")
     from tengsim import parallel
+    from tengsim.run.resolve import run_contact
 
     if not parallel.is_root():  # mpiexec -n N: every process solves its slab, rank 0 alone writes and reports
-        run_contact(cfg)
+        run_contact(plan)
         return 0
     line = None if args.quiet or plan.scaling is None else f"tengsim: {physical_line(plan, 'eps' in cfg)}"
     stream = open_stream(out, args.resume, args.quiet)
-    res = run_streamed(lambda bar: run_contact(cfg, progress=_Announced(bar, line), sink=stream), stream,
+    res = run_streamed(lambda bar: run_contact(plan, progress=_Announced(bar, line), sink=stream), stream,
                        args.quiet)
     if res is None:
         return 130
@@ -131,15 +134,6 @@ def pull_off_text(res) -> str:
     return f"pull-off {format_si(sc.force(F), 'N')} per cell{p} (F = {F:.4g})"
 
 
-def run_contact(cfg: dict, progress=None, sink=None):
-    """:func:`tengsim.resolve.run_contact` (one grid, or refined with resolve = 'auto'), transition D judged
-    with the shape's full-contact length, A/S at ``resolve_pressures`` (:func:`tengsim.study.observe.contact_hooks`)."""
-    from tengsim.resolve import run_contact as run
-    from tengsim.study.observe import contact_hooks
-
-    return run(cfg, progress=progress, sink=sink, **contact_hooks(cfg))
-
-
 def open_stream(out, resume: bool, quiet: bool = False):
     """The :class:`tengsim.results.RowStream` writing a run's rows to ``OUT.partial.csv`` as they finish:
     a new one (refused while a partial file of an interrupted run is there, so nothing finished is
@@ -157,7 +151,7 @@ def open_stream(out, resume: bool, quiet: bool = False):
                 raise TengsimError(f"{f} holds an interrupted run of --out {out}: add --resume to continue it, "
                                    "or delete it to start afresh")
         return RowStream(out, maps=maps)
-    if grids.is_file() and not part.is_file():  # a refinement: its finished grids are read by tengsim.resolve
+    if grids.is_file() and not part.is_file():  # a refinement: its finished grids are read by tengsim.run.resolve
         if not quiet:
             print(f"tengsim: resuming {grids}: its finished grids are kept, the refinement goes on",
                   file=sys.stderr)

@@ -22,7 +22,7 @@ SUMMARY = "your own design: charged area, V_OC and pull-off against pressure, in
 def _keys() -> dict:
     """{key: help} of every option: the design's own keys, then every shape's physical [contact] keys that a
     design leaves to the user (from the registry and the schema)."""
-    from tengsim.config import contact_table
+    from tengsim.run.keys import contact_table
     from tengsim.design.plan import CONTROLLED, design_fields
     from tengsim.registry import SHAPES
 
@@ -62,7 +62,7 @@ def help_text(shape: str | None = None) -> str:
     None) and the contact options a design leaves to the user."""
     import textwrap
 
-    from tengsim.config import common_fields, contact_table, law_key_help, law_keys
+    from tengsim.run.keys import common_fields, contact_table, law_key_help, law_keys
     from tengsim.design.plan import CONTROLLED, design_fields
     from tengsim.registry import SHAPES
 

@@ -1,6 +1,6 @@
 """The help pages of ``tengsim contact``: one per shape (its keys, then the common ones) and an index.
 
-Every key and text comes from the [contact] schema (:func:`tengsim.config.contact_table`) and the
+Every key and text comes from the [contact] schema (:func:`tengsim.run.keys.contact_table`) and the
 registries; nothing here lists a key by name.  ``tengsim contact SHAPE --help`` is one page of at
 most 100 lines: the shape's keys in full, then one line per common and law key.
 """
@@ -67,7 +67,7 @@ def _one_line(key: str, text, width: int, flag: bool = True) -> str:
 
 def _keys():
     """(common fields {name: Field}, law keys {name: help text})."""
-    from tengsim.config import common_fields, law_key_help, law_keys
+    from tengsim.run.keys import common_fields, law_key_help, law_keys
 
     common = {f.name: f for f in common_fields() if f.name != "shape"}
     laws = {k: law_key_help(e) + " (a plain number, no unit)" for k, e in law_keys().items()}
@@ -76,7 +76,7 @@ def _keys():
 
 def shape_keys(shape: str) -> dict:
     """{key: Field} of the keys ``shape`` has beyond the common and law keys (schema order)."""
-    from tengsim.config import common_fields, contact_table, law_keys
+    from tengsim.run.keys import common_fields, contact_table, law_keys
 
     skip = {f.name for f in common_fields()} | set(law_keys())
     return {k: f for k, f in contact_table(shape).fields.items() if k not in skip}

@@ -60,10 +60,11 @@ def run(args) -> int:
 
 
 def _contact(section, args) -> int:
-    from tengsim.cli.contact import open_stream, run_contact, run_streamed, write_contact
-    from tengsim.config import plan_contact
+    from tengsim.cli.contact import open_stream, run_streamed, write_contact
+    from tengsim.run.plan import plan_contact
+    from tengsim.run.resolve import run_contact
 
-    plan_contact(section)  # every key checked before anything is written
+    plan = plan_contact(section)  # every key checked before anything is written; the one plan of the run
     out = section.get("out")
     if not out:
         raise TengsimError("[contact] needs out = 'FILE.csv' or 'FILE.nc'")
@@ -81,7 +82,7 @@ def _contact(section, args) -> int:
     if plot:
         check_output(plot, inputs, what="plot =")
     stream = open_stream(out, getattr(args, "resume", False), args.quiet)
-    res = run_streamed(lambda bar: run_contact(section, progress=bar, sink=stream), stream, args.quiet)
+    res = run_streamed(lambda bar: run_contact(plan, progress=bar, sink=stream), stream, args.quiet)
     if res is None:
         return 130
     res = dataclasses.replace(res, params={**res.params, "config_file": str(args.config)})

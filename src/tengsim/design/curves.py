@@ -1,14 +1,14 @@
 """From a contact result to a design's numbers: per asked pressure on each branch, and per design.
 
 **Load-controlled branches.**  A pressed device passes, on the approach, the states whose load is above every
-earlier load (:func:`tengsim.study.observe.load_control`, the zero-load state interpolated in first); on the
+earlier load (:func:`tengsim.run.area.load_control`, the zero-load state interpolated in first); on the
 retraction, the states whose load is below every earlier one.  Each asked pressure takes the value linearly
 interpolated in pressure between the two states around it on that branch; NaN outside the pressures a branch
 reaches.  At a snap (the load drops while D grows) the branch keeps the first state reached at a pressure.
 
 **Charged area A/S** (the area that makes the charge, Eq. 12): the area inside the contact boundary, from
 Greenwood's contact length Λc (the tensile-peak length along X through the apex, :mod:`tengsim.observers`) by
-the shape of the patch (:func:`tengsim.study.observe.area_fraction`): a square patch (pyramid, cube) Λc²,
+the shape of the patch (:func:`tengsim.run.area.area_fraction`): a square patch (pyramid, cube) Λc²,
 a round patch (cone, hemisphere, sphere, flat punch) the disc π/4 Λc², a ridge (line, sinusoid) the strip
 Λc × L, over the cell area.  The repulsive area (pixels with P > 0) is reported beside it.
 
@@ -45,7 +45,7 @@ def _params(res, plan) -> dict:
 
 
 def definition(res, plan) -> str:
-    from tengsim.study.observe import family
+    from tengsim.run.area import family
 
     return DEFINITIONS[family(_params(res, plan))]
 
@@ -77,7 +77,7 @@ def _at(P, y, ps):
 def states(res, plan) -> dict:
     """{'approach'|'retraction': {'P' (Pa, increasing), 'area' (A/S), 'repulsive' (fraction)}} of the
     load-controlled states (module doc)."""
-    from tengsim.study.observe import area_fraction, load_control
+    from tengsim.run.area import area_fraction, load_control
 
     sc = res.scaling
     k_p = sc.pressure(1.0)
@@ -112,7 +112,7 @@ def branch_curves(res, plan) -> dict:
 
 
 def _full_fraction(res, plan) -> float:
-    from tengsim.study.observe import area_fraction, full_length
+    from tengsim.run.area import area_fraction, full_length
 
     full = full_length(_params(res, plan))
     if not math.isfinite(full):

@@ -6,7 +6,7 @@ The table holds
 * the shape and its physical keys, ``E_star``, ``W``, ``eps`` (the interaction range: the material input;
   the Tabor number is derived per shape) and the contact options a design leaves to the user (law and its
   keys, boundary, film, solver, symmetry, roughness): the [contact] schema's own keys, checked by
-  :func:`tengsim.config.plan_contact` (nothing is retyped here);
+  :func:`tengsim.run.plan.plan_contact` (nothing is retyped here);
 * the design's own keys (:func:`design_fields`): the pressures (``p_min``, ``p_max``, ``p_step``), the device
   inputs of Eq. (12) and Eq. (17) (σ, ε_r, T, rest gap d0: the paper's values by default), the grid (``dx``
   a length, ``max_pixels``), the convergence tolerance ``tol``, the time budget and the linear-range fit.
@@ -68,7 +68,7 @@ def design_fields() -> list:
 @dataclass(frozen=True)
 class DesignPlan:
     """A validated design (SI throughout); ``contact_table`` is the [contact] table handed to
-    :func:`tengsim.config.plan_contact` (the shape's physical keys, E_star, W, eps and contact options)."""
+    :func:`tengsim.run.plan.plan_contact` (the shape's physical keys, E_star, W, eps and contact options)."""
 
     name: str
     shape: str
@@ -137,7 +137,8 @@ def _shape_params(shape: str, extra: dict) -> dict:
 def plan_design(table: dict, where: str = "") -> DesignPlan:
     """Validate a [design] table and build its :class:`DesignPlan` (no solving).  A bad value raises one
     :class:`tengsim.errors.TengsimError` line naming it in the user's units."""
-    from tengsim.config import contact_table, plan_contact
+    from tengsim.run.keys import contact_table
+    from tengsim.run.plan import plan_contact
     from tengsim.plugins import SHAPES
 
     if not isinstance(table, dict):

@@ -3,7 +3,7 @@
 :func:`run_design` (a :class:`tengsim.design.plan.DesignPlan` → :class:`DesignResult`):
 
 1. **Grid.**  The first dx is the user's (a length) or :func:`start_dx`: the finer of
-   :func:`tengsim.resolve.default_dx` (the law's process zone over the pixels the status asks for, and the
+   :func:`tengsim.run.resolve.default_dx` (the law's process zone over the pixels the status asks for, and the
    pixel-snap limit) and the process zone over :data:`START_ZONE_PIXELS`.  Before anything runs,
    :func:`estimate` prints the grids (first, and the next two of √2 refinement), the memory of the finest
    and an estimated time: :data:`SECONDS_PER_PIXEL_ROW` × pixels × rows per grid (docs/benchmarks.md, "Design
@@ -14,7 +14,7 @@
    last rows' dP/dD, extrapolated to 1.3 × the pressure still missing) until the approach reaches p_max, at
    most :data:`EXTEND_TRIES` times; else an error naming the highest pressure reached, in kPa.  A finer grid's
    walk ends a little past the D at which the grid before it reached p_max (:func:`grid_path`).
-3. **Refinement.**  :func:`tengsim.resolve.resolve_contact` on dx, dx/√2, ... until the charged-area
+3. **Refinement.**  :func:`tengsim.run.resolve.resolve_contact` on dx, dx/√2, ... until the charged-area
    fraction A/S on the approach at every asked pressure, the pull-off force and the jump D values change by
    at most tol between the last two grids (and their Richardson error is within tol).  If the finest grid
    does not reach p_max (a finer grid is softer), d_max grows and the refinement runs again (once).  The
@@ -92,9 +92,9 @@ grid pays for one or two grids finer than it needs."""
 
 
 def refinement_grids(shape, dx: float, count: int = 12) -> list:
-    """The grids :func:`tengsim.resolve.resolve_contact` walks from a first grid of spacing ``dx`` (each the
+    """The grids :func:`tengsim.run.resolve.resolve_contact` walks from a first grid of spacing ``dx`` (each the
     plain √2 step, moved to keep the shape's edges in place), at most ``count``, none over the budget limit."""
-    from tengsim.resolve import FACTOR, _aligned, edge_phases
+    from tengsim.run.resolve import FACTOR, _aligned, edge_phases
 
     out, seen, phases = [], set(), ()
     while len(out) < count:
@@ -114,16 +114,16 @@ def refinement_grids(shape, dx: float, count: int = 12) -> list:
 
 def start_dx(plan, cplan) -> float:
     """The first grid's dx in X units: the plan's (a length), or the first grid of the refinement that
-    :func:`tengsim.resolve.default_dx` would start (the cell over 9 pixels, the status's process-zone
+    :func:`tengsim.run.resolve.default_dx` would start (the cell over 9 pixels, the status's process-zone
     resolution, the pixel-snap limit: :func:`refinement_grids`) whose dx is at most the law's process zone over
     :data:`START_ZONE_PIXELS`: the same grids as from the default start, less those too coarse to be the last."""
     from tengsim import status
-    from tengsim.resolve import default_dx
+    from tengsim.run.resolve import default_dx
 
     if plan.dx is not None:
         return plan.dx / cplan.scaling.lateral
-    dx = default_dx(cplan.shape, cplan.law, cplan.tabor**1.5, cplan.boundary)
-    zone = status.process_zone_estimate(cplan.law, cplan.tabor**1.5)
+    dx = default_dx(cplan.shape, cplan.law, cplan.coupling, cplan.boundary)
+    zone = status.process_zone_estimate(cplan.law, cplan.coupling)
     if not (math.isfinite(zone) and zone > 0) or dx <= zone / START_ZONE_PIXELS:
         return dx
     for g in refinement_grids(cplan.shape, dx):
@@ -223,7 +223,7 @@ def check_budget(plan, est: Estimate, fit_pixels: int | None = None) -> None:
 
 
 def _simulate(cplan, dx, d_max, **kw):
-    from tengsim.contact import simulate
+    from tengsim.run.simulate import simulate
     from tengsim.path import PathSpec
 
     path = PathSpec(D_MIN, d_max, D_STEP, adaptive=True)
@@ -250,9 +250,9 @@ def find_d_max(plan, cplan, dx, progress=None):
     p_max = plan.pressures[-1]
     coarse = 2 * dx
     if plan.dx is None:  # the default grid's (the cell over 9 pixels at most): cheap, whatever the first grid
-        from tengsim.resolve import default_dx
+        from tengsim.run.resolve import default_dx
 
-        coarse = 2 * max(dx, default_dx(cplan.shape, cplan.law, cplan.tabor**1.5, cplan.boundary))
+        coarse = 2 * max(dx, default_dx(cplan.shape, cplan.law, cplan.coupling, cplan.boundary))
     d_max = 1.2 * height_eps(cplan, dx) + 2.0
     for _ in range(EXTEND_TRIES):
         res = _simulate(cplan, coarse, d_max)
@@ -275,7 +275,7 @@ def map_depths(res, plan) -> dict:
     """{D (ε): asked pressure (Pa)}: for the asked pressures nearest :data:`MAP_FRACTIONS` of p_max (above 0),
     the approach D at which ``res`` (the finest grid) reaches each on its load-controlled states, linear
     between the two states around it."""
-    from tengsim.study.observe import load_control
+    from tengsim.run.area import load_control
 
     F, D = load_control(res, "D")
     P = res.scaling.pressure(1.0) * F
@@ -302,7 +302,7 @@ D_MARGIN = 0.03
 
 
 def grid_path(plan, d_max):
-    """``path_for`` of the refinement (:func:`tengsim.resolve.resolve_contact`): the first grid walks to
+    """``path_for`` of the refinement (:func:`tengsim.run.resolve.resolve_contact`): the first grid walks to
     ``d_max`` (found on the coarse grid, :func:`find_d_max`); each finer grid to the D at which the grid before
     it reached p_max, plus :data:`D_MARGIN` (on the path's lattice, never beyond ``d_max``): about 10 % of the
     rows were past p_max.  Each finer grid's path also keeps the pressure and gap maps at the map depths of the
@@ -370,7 +370,7 @@ def _checkpoint(keep, plan, d_max, progress):
     import hashlib
 
     from tengsim.errors import TengsimError as _Err
-    from tengsim.resolve import Checkpoint
+    from tengsim.run.resolve import Checkpoint
 
     ck = Checkpoint(keep, hashlib.sha256(f"{plan!r}|{d_max!r}".encode()).hexdigest()[:16])
     try:
@@ -390,10 +390,10 @@ def run_design(plan, progress=None, keep=None) -> DesignResult:
     path's progress) and/or an object with ``say(text)``, which gets the lines said before and during the run
     (the Tabor number, the grids, memory and estimated time).  ``keep`` (a file path, or None): where each
     finished grid is kept (:func:`_checkpoint`), so a killed run of the same design resumes from it."""
-    from tengsim.config import plan_contact
+    from tengsim.run.plan import plan_contact
     from tengsim.design.curves import summarize
     from tengsim.design.write import to_dataset
-    from tengsim.resolve import resolve_contact
+    from tengsim.run.resolve import resolve_contact
 
     cplan = plan_contact(plan.contact_table)
     dx = start_dx(plan, cplan)

@@ -27,7 +27,7 @@ class Law:
     """Base class: subclasses give the raw law for g >= g_safe via ``_raw(g) -> (Φ, P, dP/dg)``.
 
     A law's fields (its dataclass fields, or constructor arguments) are ``[contact]`` keys of a run
-    with that law (:func:`tengsim.config.law_fields`), except the numerical guards named in
+    with that law (:func:`tengsim.run.keys.law_fields`), except the numerical guards named in
     ``internal_fields``; ``field_help`` gives a key its help text (with its unit: W and ε).
 
     Declared numbers (units W and ε; what :mod:`tengsim.status` reads): ``max_tension`` σ0 = −min P

@@ -112,7 +112,7 @@ class ContactResult:
         s = self.table.get("status")
         if s is None or np.asarray(s).dtype.kind not in "US":  # older files: classify from the columns
             s = _status.classify(self.table, self.grid.dx)
-        refined = self.params.get("resolve_status")  # resolve = auto stopped by max_pixels (tengsim.resolve)
+        refined = self.params.get("resolve_status")  # resolve = auto stopped by max_pixels (tengsim.run.resolve)
         return _status.overall([*np.asarray(s).astype(str).tolist(), *([str(refined)] if refined else [])])
 
     def raise_for_status(self) -> "ContactResult":

@@ -47,7 +47,7 @@ _CF_COLUMNS = {
     "x": ("in-plane position X", "lateral"),
     "y": ("in-plane position Y", "lateral"),
 }
-# the refinement's table (tengsim.resolve) along dimension 'level': column -> (long_name, unit as above)
+# the refinement's table (tengsim.run.resolve) along dimension 'level': column -> (long_name, unit as above)
 _RESOLUTION_CF = {"dx": ("grid spacing of the level", "lateral"), "nx": ("pixels along x", "1"),
                   "ny": ("pixels along y", "1"), "seconds": ("wall time of the level's run", "s"),
                   "convolutions": ("convolutions (FFT pairs) of the level's run", "1")}
@@ -161,7 +161,7 @@ def to_dataset(result):
                               "adhesive micro-structured half-space")
 
 def _resolution_vars(result, ds, scales):
-    """(params without 'resolution', ds with it): the refinement's table (tengsim.resolve, one row per grid)
+    """(params without 'resolution', ds with it): the refinement's table (tengsim.run.resolve, one row per grid)
     as variables ``resolution_<column>`` along dimension ``level`` (coarsest first), CF attributes as the
     curves' (dx in ℓ, F in its unit, D in ε)."""
     tab = result.params.get("resolution")

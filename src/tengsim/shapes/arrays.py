@@ -93,6 +93,10 @@ class Array:
             return ()
         return tuple(getattr(self.pattern, "mirror_axes", ()))
 
+    def full_contact_length(self) -> float:
+        """The pattern's (Λc is measured on one pattern, through the highest apex)."""
+        return float(getattr(self.pattern, "full_contact_length", lambda: float("nan"))())
+
     def __init__(self, pattern="pyramid", K=2, scatter_height=0.0, scatter_size=0.0, scatter_tilt=0.0,
                  distribution="normal", seed=0, waviness_amplitude=0.0, waviness_wavelength=1.0, **fields):
         if isinstance(pattern, str):

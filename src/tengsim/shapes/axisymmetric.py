@@ -102,6 +102,10 @@ class Hemisphere(Shape):
         r2 = np.minimum(X**2 + Y**2, self.radius**2)
         return self.k * (self.radius - np.sqrt(self.radius**2 - r2))
 
+    def full_contact_length(self) -> float:
+        """The base diameter, 2ρ."""
+        return 2 * float(self.radius)
+
     def edge_offsets(self) -> tuple:
         """The base edge (vertical tangent), the radius from the apex."""
         return (float(self.radius),)
@@ -153,6 +157,10 @@ class Cone(Shape):
     def gap(self, grid: Grid) -> np.ndarray:
         X, Y = grid.mesh()
         return np.minimum(self.slope * np.hypot(X, Y), self.height)
+
+    def full_contact_length(self) -> float:
+        """The cap's diameter, 2 height/slope (NaN for an uncapped cone)."""
+        return 2 * float(self.height) / float(self.slope) if np.isfinite(self.height) else float("nan")
 
     def edge_offsets(self) -> tuple:
         """The cap's edge, height/slope from the apex (none for an uncapped cone)."""

@@ -66,11 +66,16 @@ class Shape:
         """A square grid over the shape's cell with spacing about ``dx``."""
         return Grid.square(self.cell, dx)
 
+    def full_contact_length(self) -> float:
+        """Λc of full contact, in X units (what transition_D and the adhesive full-contact flag compare the
+        contact length with): NaN where the shape has none (the default)."""
+        return float("nan")
+
     def edge_offsets(self) -> tuple:
         """Distances from the cell centre (the apex pixel) along X to the shape's kinks: the base edge of a
         pyramid, cone, hemisphere or punch, the wall of a cube or line.  Where such an edge falls in its pixel
         sets the sign of the grid's error in what is measured there (the contact edge in full contact), so
-        automatic refinement keeps that place from grid to grid (:mod:`tengsim.resolve`).  None: ()."""
+        automatic refinement keeps that place from grid to grid (:mod:`tengsim.run.resolve`).  None: ()."""
         return ()
 
     # ---- declared input -----------------------------------------------------------------------

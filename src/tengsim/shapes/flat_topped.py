@@ -39,6 +39,11 @@ class _FlatTop(Shape):
         X, Y = grid.mesh()
         return np.where(self._on_top(X, Y), 0.0, self.height)
 
+    def full_contact_length(self) -> float:
+        """The cell: the flat top is in full contact from the first touch and the plate lies on the land
+        between the pillars (ridges)."""
+        return float(self.cell)
+
     def edge_offsets(self) -> tuple:
         """The wall, half_width from the centre."""
         return (float(self.half_width),)

@@ -36,6 +36,10 @@ class Pyramid(Shape):
                 f"pyramid base 2N = {2 * self.N:g} is wider than its cell L̄ = {self.cell:g}"
             )
 
+    def full_contact_length(self) -> float:
+        """The base, 2N."""
+        return 2 * float(self.N)
+
     def edge_offsets(self) -> tuple:
         """The base edge, N from the apex."""
         return (float(self.N),)

@@ -110,8 +110,12 @@ class Roughened:
     def lateral_unit(self) -> str:
         return getattr(self.base, "lateral_unit", "ℓ")
 
+    def full_contact_length(self) -> float:
+        """The base shape's (NaN if it has none)."""
+        return float(getattr(self.base, "full_contact_length", lambda: float("nan"))())
+
     mirror_axes = ()
-    """No mirror symmetry (tengsim.contact.choose_symmetry): a random surface has none, whatever the base's."""
+    """No mirror symmetry (tengsim.run.simulate.choose_symmetry): a random surface has none, whatever the base's."""
 
     def grid(self, dx: float) -> Grid:
         g = self.base.grid(dx)

@@ -27,7 +27,7 @@ def evaluate(contact: dict, var: dict) -> dict:
 
     if not any(isinstance(v, str) and v.startswith("=") for v in contact.values()):
         return dict(contact)
-    from tengsim.config import key_dims
+    from tengsim.run.keys import key_dims
     from tengsim.units import DIMENSIONS, SI_UNIT, parse_quantity, quantity_dim, read_number
 
     zero = (0, 0, 0, 0)

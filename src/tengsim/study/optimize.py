@@ -128,7 +128,7 @@ def optimize_study(study, out, *, workers=None, scheduler=None, client=None, res
     any status (the message says so)."""
     from scipy.optimize import differential_evolution
 
-    from tengsim.config import plan_contact
+    from tengsim.run.plan import plan_contact
     from tengsim.io import write_json
     from tengsim.results.read import load_result
     from tengsim.study.dataset import build_study

@@ -44,8 +44,8 @@ def _pressures(study) -> tuple:
 
 
 def _physical(contact: dict) -> bool:
-    """A [contact] table of a physical run (one that :func:`tengsim.config.key_dims` gives units to)."""
-    from tengsim.config import key_dims
+    """A [contact] table of a physical run (one that :func:`tengsim.run.keys.key_dims` gives units to)."""
+    from tengsim.run.keys import key_dims
 
     try:
         return bool(key_dims(contact))

@@ -30,7 +30,7 @@ def validate(study) -> tuple[dict, dict]:
     {id: message} of the invalid ones), the valid ones longest first (:func:`estimated_cost`).
     An error that every point shares is an error in the study file: raised as one TengsimError
     before anything is written."""
-    from tengsim.config import plan_contact
+    from tengsim.run.plan import plan_contact
     from tengsim.study.observe import device_values
 
     valid, invalid, first, cost = {}, {}, None, {}

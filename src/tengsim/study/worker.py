@@ -51,11 +51,10 @@ def compute_point(contact: dict, pid: str, plugins: str = "", expect: dict | Non
         if expect is not None and prov != expect:
             raise TengsimError(f"the worker on {info['host']} would compute this point with other code or "
                                f"input than the client's ({provenance_difference(expect, prov)}); not computed")
-        from tengsim.resolve import run_contact  # resolve = 'auto': refined until converged
-        from tengsim.study.observe import contact_hooks
-
+        from tengsim.run.resolve import run_contact  # resolve = 'auto': refined until converged
+        
         c0 = time.perf_counter()
-        res = run_contact(dict(contact), **contact_hooks(dict(contact)))
+        res = run_contact(dict(contact))
     except Exception as exc:  # noqa: BLE001 - recorded as a failed point, the others go on
         msg = str(exc) if isinstance(exc, TengsimError) else \
             f"{type(exc).__name__}: {exc}\n{traceback.format_exc(limit=-3)}"
@@ -80,8 +79,8 @@ def warm_up(plugins: str = "") -> int:
         _worker_setup(plugins)
     except TengsimError:
         pass  # the points report it, each as a failed point with the message
-    import tengsim.config  # noqa: F401
-    import tengsim.contact  # noqa: F401
+    import tengsim.run.plan  # noqa: F401
+    import tengsim.run.simulate  # noqa: F401
     import xarray  # noqa: F401
 
     return os.getpid()

@@ -1,7 +1,7 @@
 """The paper's contact cases: pyramid groups A, B, C (Section 3) and the A(P) tables they give.
 
 Physical scaling (Eq. 7) with E* = 0.59 MPa, W = 54 mJ/m², μ = 0.5 (so ε ≈ 0.37 µm for all groups).
-Built on the core: :func:`tengsim.contact.simulate` for the runs, :class:`tengsim.device.AreaTable` for A(P).
+Built on the core: :func:`tengsim.run.simulate.simulate` for the runs, :class:`tengsim.device.AreaTable` for A(P).
 """
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tengsim.contact import simulate
+from tengsim.run.simulate import simulate
 from tengsim.device.params import AreaTable
 from tengsim.errors import TengsimError
 from tengsim.io import jsonable

@@ -5,17 +5,16 @@ from dataclasses import is_dataclass, replace
 
 from tengsim import status
 from tengsim._version import __version__
-from tengsim.config import plan_contact
-from tengsim.errors import TengsimError, positive
+from tengsim.run.plan import ContactPlan, as_plan
+from tengsim.errors import TengsimError
 from tengsim.grid import Mirror
 from tengsim.shapes import Pyramid, Shape
-from tengsim.laws import LJ93, Law, make_law
+from tengsim.laws import Law
 from tengsim.kernels import make_kernel
 from tengsim.kernels.distributed import SlabPeriodicKernel
-from tengsim.kernels.mirror import MirrorKernel
+from tengsim.kernels.mirror import BOUNDARIES as MIRROR_BOUNDARIES, MirrorKernel
 from tengsim.loadpath import LoadPathSpec, run_load_path
 from tengsim.path import PathSpec, run_path
-from tengsim.plugins import KERNELS
 from tengsim.resources import MAP_WORK, check_memory
 from tengsim.solvers import make_solver
 from tengsim.solvers.mirror import MirrorSolver
@@ -42,7 +41,7 @@ def choose_symmetry(shape, U0, grid, boundary: str, solver_name: str, symmetry: 
     declared = tuple(getattr(shape, "mirror_axes", ()) or ())
     if not declared:
         return (), "none (shape has no mirror)"
-    if boundary not in ("free", "periodic"):
+    if boundary not in MIRROR_BOUNDARIES:  # the kernels that have a symmetry-reduced form
         return (), f"none (boundary {boundary})"
     if solver_name not in ("fast", "vsr"):
         return (), f"none (solver {solver_name or '?'})"
@@ -83,7 +82,8 @@ def simulate(shape: Shape, tabor: float, dx: float, path: PathSpec, boundary: st
     not_converged / out_of_law_range / under_resolved (:mod:`tengsim.status`); with ``throw=True``
     a status other than 'ok' raises :class:`tengsim.status.ResultStatusError`, which carries the
     result.  The grid's memory is checked once, before anything is built (``check_memory_first=False``:
-    the caller has checked it, as :func:`run_contact` does through :func:`tengsim.config.plan_contact`).
+    the caller has checked it, as :func:`run_contact` does through :func:`tengsim.run.plan.plan_contact`).
+    ``grid``: the grid to solve on (then ``dx`` is the grid's); None: the shape's grid of spacing ``dx``.
 
     ``sink`` (a callable or None) receives each equilibrium as it is recorded, ``sink(row, maps)``
     (:class:`tengsim.continuation.Recorder`); if it has a ``begin(params)`` method, that is called first,
@@ -96,13 +96,18 @@ def simulate(shape: Shape, tabor: float, dx: float, path: PathSpec, boundary: st
     (:func:`choose_symmetry`; the same answer, to round-off); 'off' the full grid.  ``params['symmetry']``
     says what was used ('x+y', 'x', 'y', 'off' or 'none (why)'), ``block_nx``, ``block_ny`` the block.
     """
-    tabor = positive("tabor", tabor)
-    if scaling is not None and abs(scaling.mu - tabor) > 1e-9 * tabor:
-        raise TengsimError(f"tabor = {tabor:g} does not match the scaling's μ = {scaling.mu:g}")
-    law = make_law(law) if isinstance(law, str) else (law or LJ93())
-    boundary = KERNELS.canonical(boundary)
-    grid = grid or shape.grid(dx)
-    solver_obj = make_solver(solver, tol=tol) if isinstance(solver, str) else solver
+    plan = ContactPlan(shape, tabor, dx, path, boundary, solver, tol, law, extra_params or {}, scaling, observers,
+                       kernel_params or {}, symmetry=symmetry, grid=grid)
+    return simulate_plan(plan, progress=progress, sink=sink, throw=throw, check_memory_first=check_memory_first)
+
+
+def simulate_plan(plan: ContactPlan, progress=None, sink=None, throw: bool = False,
+                  check_memory_first: bool = True):
+    """The run of a :class:`tengsim.run.plan.ContactPlan` on its grid (one grid: ``plan.resolve`` is not read
+    here); ``progress``, ``sink``, ``throw`` and ``check_memory_first`` as for :func:`simulate`."""
+    shape, tabor, path, grid, boundary, law = plan.shape, plan.tabor, plan.path, plan.grid, plan.boundary, plan.law
+    solver, symmetry = plan.solver, plan.symmetry
+    solver_obj = make_solver(solver, tol=plan.tol) if isinstance(solver, str) else solver
     if isinstance(solver_obj, MirrorSolver):
         solver_obj = solver_obj.inner
     U0 = shape.gap(grid)
@@ -123,12 +128,12 @@ def simulate(shape: Shape, tabor: float, dx: float, path: PathSpec, boundary: st
             and getattr(solver_obj, "monitor", 0) is None):  # long solves report as they go
         solver_obj = replace(solver_obj, monitor=progress.monitor(), monitor_every=10)
     if comm is not None:
-        kernel = SlabPeriodicKernel(grid, tabor**1.5, comm, **(kernel_params or {}))
+        kernel = SlabPeriodicKernel(grid, plan.coupling, comm, **plan.kernel_params)
         solver_obj = SlabSolver(solver_obj)
     elif mirror is None:
-        kernel = make_kernel(boundary, grid, tabor**1.5, **(kernel_params or {}))
+        kernel = make_kernel(boundary, grid, plan.coupling, **plan.kernel_params)
     else:
-        kernel = MirrorKernel(boundary, grid, tabor**1.5, mirror, **(kernel_params or {}))
+        kernel = MirrorKernel(boundary, grid, plan.coupling, mirror, **plan.kernel_params)
         solver_obj = MirrorSolver(solver_obj)
     walk = run_load_path if isinstance(path, LoadPathSpec) else run_path  # load or rigid-approach control
     params = {
@@ -153,17 +158,17 @@ def simulate(shape: Shape, tabor: float, dx: float, path: PathSpec, boundary: st
         "refine_levels": path.refine_levels,
         "jump_h": path.jump_h,
         **path.extra_params(),  # adaptive steps or load control (none for a fixed-step D path)
-        **(extra_params or {}),
+        **plan.extra,
     }
-    if scaling is not None:
-        for k, v in scaling.params().items():
+    if plan.scaling is not None:
+        for k, v in plan.scaling.params().items():
             params.setdefault(k, v)
     if sink is not None and hasattr(sink, "begin"):
         sink.begin(dict(params))
-    res = walk(U0, law, kernel, solver_obj, path, progress=progress, observers=observers, sink=sink)
+    res = walk(U0, law, kernel, solver_obj, path, progress=progress, observers=plan.observers, sink=sink)
     res = replace(res, params={**params, **res.params})  # and what the path recorded (the pixel snap number)
-    if scaling is not None:
-        res = res.with_physical(scaling)
+    if plan.scaling is not None:
+        res = res.with_physical(plan.scaling)
     res = status.attach(res, law, kernel.coupling)  # per-row 'status' column, params['status'] (tengsim.status)
     if (getattr(kernel, "film", False) and getattr(kernel, "pinned_mean", False)
             and not res.table["in_law_range"].all()):
@@ -186,17 +191,14 @@ def simulate_pyramid(N: float, cell: float, tabor: float = 0.5, dx: float = 0.05
                     symmetry=symmetry)
 
 
-def run_contact(cfg: dict, progress=None, sink=None):
-    """Plan and run a [contact] table; returns a ContactResult with the config in params.  ``sink``: as
-    for :func:`simulate` (the config is not among the parameters it is given: a CLI run and a TOML run
-    of the same settings spell it differently, and resume only cares about what is solved)."""
-    plan = plan_contact(cfg)
-    if getattr(plan, "resolve", None):  # refinement is the layer above's: never run one grid silently instead
-        raise TengsimError("resolve = 'auto' runs through tengsim.resolve.run_contact (tengsim.run_contact), "
-                           "not tengsim.contact.run_contact")
-    res = simulate(plan.shape, plan.tabor, plan.dx, plan.path, boundary=plan.boundary,
-                   solver=plan.solver, tol=plan.tol, law=plan.law, progress=progress,
-                   extra_params=plan.extra, observers=plan.observers, scaling=plan.scaling,
-                   kernel_params=plan.kernel_params, check_memory_first=False,  # plan_contact checked it
-                   sink=sink, symmetry=getattr(plan, "symmetry", "auto"))
-    return replace(res, params={**res.params, "config": {k: v for k, v in cfg.items() if k not in ("out", "plot")}})
+def run_contact(plan, progress=None, sink=None):
+    """Run a :class:`tengsim.run.plan.ContactPlan` (or a [contact] table, planned here) on one grid; returns a
+    ContactResult with the table in ``params['config']``.  ``sink``: as for :func:`simulate` (the config is not
+    among the parameters it is given: a CLI run and a TOML run of the same settings spell it differently, and
+    resume only cares about what is solved)."""
+    plan = as_plan(plan)
+    if plan.resolve is not None:  # refinement is the layer above's: never run one grid silently instead
+        raise TengsimError("resolve = 'auto' runs through tengsim.run.resolve.run_contact (tengsim.run_contact), "
+                           "not tengsim.run.simulate.run_contact")
+    res = simulate_plan(plan, progress=progress, sink=sink, check_memory_first=False)  # plan_contact checked it
+    return replace(res, params={**res.params, "config": dict(plan.config)})

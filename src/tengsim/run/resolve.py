@@ -267,7 +267,7 @@ def resolve_contact(shape, tabor: float, path, dx: float | None = None, law=None
                     resolve_tol: float = DEFAULT_TOL, max_pixels: int | None = None, observe=None,
                     full_length: float | None = None, progress=None, checkpoint=None, start=None,
                     watch=None, path_for=None, **simulate_kw):
-    """Run :func:`tengsim.contact.simulate` on finer and finer grids until converged (module doc).
+    """Run :func:`tengsim.run.simulate.simulate` on finer and finer grids until converged (module doc).
 
     ``dx`` the first grid's spacing (None: :func:`default_dx`), ``resolve_tol`` the relative tolerance,
     ``max_pixels`` the largest grid nx·ny (None: :func:`default_max_pixels`), ``observe(result) -> dict``
@@ -284,18 +284,18 @@ def resolve_contact(shape, tabor: float, path, dx: float | None = None, law=None
     judged (they do not decide when to stop: numbers a caller reports how converged they are, e.g. a design's
     hysteresis).  ``path_for(result) -> path``: the path of the next grid from the grid before it (None on the
     first grid; e.g. the D at which its maps are kept, predicted from the coarser curve); default ``path``."""
-    from tengsim.contact import simulate
+    from tengsim.run.simulate import simulate
     from tengsim.errors import positive
     from tengsim.laws import LJ93, make_law
+    from tengsim.run.plan import check_max_pixels, check_tol, coupling
 
     tol = check_tol(resolve_tol)
     law = make_law(law) if isinstance(law, str) else (law or LJ93())
-    tabor = positive("tabor", tabor)
     solver = simulate_kw.get("solver", "fast")
     if max_pixels is None:
         max_pixels = default_max_pixels(boundary, solver if isinstance(solver, str) else "fast")
     max_pixels = check_max_pixels(max_pixels)
-    dx = default_dx(shape, law, tabor**1.5, boundary) if dx is None else positive("dx", dx)
+    dx = default_dx(shape, law, coupling(tabor), boundary) if dx is None else positive("dx", dx)
     levels, names, res, seen, watched = [], [], None, set(), []
     stop, phases, done = None, (), False
     if start is not None:  # a refinement kept by its checkpoint: its grids are not computed again
@@ -324,7 +324,7 @@ def resolve_contact(shape, tabor: float, path, dx: float | None = None, law=None
         seen.add((grid.nx, grid.ny))
         t0 = time.perf_counter()
         this_path = path if path_for is None else path_for(res)
-        res = simulate(shape, tabor, dx, this_path, boundary=boundary, law=law, grid=grid, progress=progress,
+        res = simulate(shape, tabor, grid.dx, this_path, boundary=boundary, law=law, grid=grid, progress=progress,
                        **simulate_kw)
         obs = contact_observables(res, full_length)
         if observe is not None:
@@ -393,53 +393,39 @@ def _why(changes: dict) -> str:
     return f"{worst} changed {changes[worst]:.2%} between the last two grids"
 
 
-def check_tol(v) -> float:
-    if isinstance(v, bool) or not isinstance(v, (int, float)) or not 0 < float(v) < 1:
-        raise TengsimError(f"resolve_tol must be a number > 0 and < 1, got {v!r}")
-    return float(v)
-
-
-def check_max_pixels(v) -> int:
-    if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or int(v) < 9:
-        raise TengsimError(f"max_pixels must be a whole number >= 9 (pixels nx·ny), got {v!r}")
-    return int(v)
-
-
-def run_contact(cfg: dict, progress=None, sink=None, observe=None, full_length=None, area_at=None):
-    """:func:`tengsim.contact.run_contact`, refined automatically when the table says ``resolve = "auto"``.
+def run_contact(plan, progress=None, sink=None, observe=None):
+    """Run a :class:`tengsim.run.plan.ContactPlan` (or a [contact] table, planned here once): one grid
+    (:func:`tengsim.run.simulate.run_contact`), or refined automatically when its ``resolve`` settings say so
+    (:func:`resolve_contact`, transition_D judged with the shape's own full-contact length).
 
     The refinement's grids each stream their rows to ``sink`` would mix grids in one file, so a sink is not
     given rows of a refined run (its result is written whole at the end).  ``observe(result) -> dict``: more
-    observables to converge; ``full_length(params) -> float``: the shape's full-contact Λc from its parameters
-    (for transition_D; e.g. :func:`tengsim.study.observe.full_length`); ``area_at(pressures) -> observe``: the
-    observer of A/S at the table's ``resolve_pressures`` (Pa; :func:`tengsim.study.observe.area_at`), needed
-    when the table names them.  ``tengsim.run_contact``, ``tengsim contact`` and a study's points pass both."""
-    from tengsim import contact
-    from tengsim.config import plan_contact
+    observables to converge, beside A/S at the plan's ``resolve.pressures`` (Pa; :func:`tengsim.run.area.area_at`)."""
+    from tengsim.run import simulate as contact
+    from tengsim.run.plan import as_plan
 
-    plan = plan_contact(cfg)
-    pressures = plan.resolve.get("pressures", ())
-    if pressures:
-        if area_at is None:
-            raise TengsimError("resolve_pressures needs the A/S observer: call tengsim.run_contact (or pass "
-                               "area_at=tengsim.study.observe.area_at)")
-        extra = area_at(pressures)
-        observe = extra if observe is None else (lambda res, a=observe, b=extra: {**a(res), **b(res)})
-    if plan.resolve.get("resolve", "off") != "auto":  # one grid: exactly tengsim.contact.run_contact's call
+    plan = as_plan(plan)
+    if plan.resolve is None:  # one grid
         kw = {k: v for k, v in (("progress", progress), ("sink", sink)) if v is not None}
-        return contact.run_contact(cfg, **kw)
-    ck = Checkpoint.of(sink, cfg)
-    res = resolve_contact(plan.shape, plan.tabor, plan.path, dx=plan.resolve.get("dx"), law=plan.law,
-                          boundary=plan.boundary, resolve_tol=plan.resolve["resolve_tol"],
-                          max_pixels=plan.resolve.get("max_pixels"), progress=progress,
-                          full_length=None if full_length is None else full_length(plan.shape.params()),
-                          observe=observe, symmetry=getattr(plan, "symmetry", "auto"),
+        return contact.run_contact(plan, **kw)
+    settings = plan.resolve
+    if settings.pressures:
+        from tengsim.run.area import area_at
+
+        extra = area_at(settings.pressures, plan.config)
+        observe = extra if observe is None else (lambda res, a=observe, b=extra: {**a(res), **b(res)})
+    ck = Checkpoint.of(sink, plan.config)
+    full = getattr(plan.shape, "full_contact_length", None)
+    res = resolve_contact(plan.shape, plan.tabor, plan.path, dx=settings.dx, law=plan.law,
+                          boundary=plan.boundary, resolve_tol=settings.tol,
+                          max_pixels=settings.max_pixels, progress=progress,
+                          full_length=None if full is None else full(),
+                          observe=observe, symmetry=plan.symmetry,
                           solver=plan.solver, tol=plan.tol, extra_params=plan.extra, observers=plan.observers,
                           scaling=plan.scaling, kernel_params=plan.kernel_params,
                           checkpoint=None if ck is None else ck.save, start=None if ck is None else ck.load())
     params = {k: v for k, v in res.params.items() if k != Checkpoint.KEY}
-    return dataclasses.replace(res, params={**params, "config": {k: v for k, v in cfg.items()
-                                                                 if k not in ("out", "plot")}})
+    return dataclasses.replace(res, params={**params, "config": dict(plan.config)})
 
 
 class Checkpoint:

@@ -1,0 +1,208 @@
+"""The charged-area fraction A/S of a contact result (Eq. 12: V_OC = σT/(ε_r ε0) × A/S), from its contact
+length Λc and its shape: the patch family and cell of the shape, the result's scale to pressure, the approach
+states a pressed device passes, and the observer of A/S at named pressures that automatic refinement
+(``resolve_pressures``) converges.  Read by the refinement (:mod:`tengsim.run.resolve`), the study
+(:mod:`tengsim.study.observe`) and the designer (:mod:`tengsim.design`).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+# ---- units: the one place that knows how a result maps to pressure -------------------------------
+
+def physical_scale(res) -> tuple[float, float] | None:
+    """(Pa per unit F, metres per unit D) of a result, or None for a dimensionless run.
+
+    Every physical run (any shape, :class:`tengsim.units.Scaling`) carries ``pressure_Pa`` (or ``F_N``
+    with ``cell_area_m2``) and ``eps_m``: the ratio to F is one constant.  Older pyramid files without
+    those columns: the paper's scaling (Eq. 7, ℓ = ε m/n) from their parameters.
+    """
+    p = res.params
+    t = res.table
+    eps = p.get("eps_m")
+    F = np.asarray(t["F"], float)
+    ok = np.abs(F) > 1e-12 * max(1.0, float(np.max(np.abs(F)))) if len(F) else np.zeros(0, bool)
+    if eps and np.any(ok):
+        if "pressure_Pa" in t:
+            P = np.asarray(t["pressure_Pa"], float)
+            return float(np.median(P[ok] / F[ok])), float(eps)
+        if "F_N" in t and p.get("cell_area_m2"):
+            fn = np.asarray(t["F_N"], float)
+            return float(np.median(fn[ok] / F[ok])) / float(p["cell_area_m2"]), float(eps)
+    need = ("E_star_Pa", "W_J_m2", "base_m", "height_m", "pitch_m", "eps_m")
+    if shape_name(p) == "pyramid" and all(p.get(k) for k in need):
+        m, n, L, eps = p["base_m"], p["height_m"], p["pitch_m"], p["eps_m"]
+        # the pyramid's force unit 3π W ℓ²/ε with ℓ = ε m/n (Eqs. 7, 10), over the cell's area L²
+        return 3 * math.pi * m**2 * p["W_J_m2"] * eps / n**2 / L**2, float(eps)
+    return None
+
+
+FAMILIES = {
+    "square": ("pyramid", "cube"),
+    "disc": ("cone", "hemisphere", "sphere", "paraboloid", "flat_punch", "flatpunch"),
+    "line": ("line", "sinusoid", "sinusoid1d"),
+}
+"""Contact-patch family of each built-in shape for the charged-area fraction A/S (docs/design.md);
+a shape not listed (a plugin) is taken as 'square' unless its class sets ``contact_family``."""
+
+
+def shape_name(params: dict) -> str:
+    """The registered name of a result's shape (from its [contact] table, else its class name)."""
+    cfg = params.get("config")
+    if isinstance(cfg, dict) and cfg.get("shape"):
+        return str(cfg["shape"]).lower()
+    return str(params.get("shape", "")).lower()
+
+
+def is_array(params: dict) -> bool:
+    """A result of an array of patterns (:mod:`tengsim.shapes.arrays`: ``pattern``, ``K``, ``pattern_*``)."""
+    return shape_name(params) == "array" or (params.get("shape") == "Array" and "pattern_cell" in params)
+
+
+def pattern_params(params: dict) -> dict:
+    """The parameters of the one pattern a result's Λc is measured on: an array's pattern (its
+    ``pattern_*`` parameters, named as the pattern names them; Λc is measured along X through the highest
+    apex, one pattern's), the result's own otherwise."""
+    if not is_array(params):
+        return params
+    name = str(params.get("pattern") or "pyramid")
+    own = {k[len("pattern_"):]: v for k, v in params.items() if k.startswith("pattern_")}
+    return {**own, "shape": name, "config": {"shape": name}}
+
+
+def cell_side(params: dict) -> float:
+    """The side L̄ (in ℓ) of the square cell over which one contact patch is charged: an array's pattern
+    cell (its super-cell holds K × K of them), the shape's ``cell``, else √(cell area)/ℓ of a physical
+    run (``cell_area_m2``, ``lateral_m``); NaN if none of these is known."""
+    p = pattern_params(params)
+    cell = p.get("cell")
+    if cell is not None:
+        return float(cell)
+    if params.get("cell_area_m2") and params.get("lateral_m"):
+        return math.sqrt(float(params["cell_area_m2"])) / float(params["lateral_m"])
+    return math.nan
+
+
+def family(params: dict) -> str:
+    """'square', 'disc' or 'line': how Λc (Greenwood's tensile-peak length along X through the apex)
+    maps to the charged area (an array: its pattern's family)."""
+    name = shape_name(pattern_params(params))
+    for fam, names in FAMILIES.items():
+        if name in names:
+            return fam
+    try:
+        from tengsim.registry import SHAPES
+
+        return getattr(SHAPES.get(name), "contact_family", "square")
+    except Exception:  # noqa: BLE001 - an unregistered plugin's file
+        return "square"
+
+
+def area_fraction(res, contact_length, params: dict | None = None) -> np.ndarray:
+    """Charged-area fraction A/S of the cell (Eq. 12) from the contact length Λc:
+    square patches (pyramid, cube) (Λc/L̄)², discs (cone, hemisphere, sphere, flat punch) π(Λc/2)²/L̄²,
+    line gratings (line, sinusoid) Λc/L̄; clipped to [0, 1].  Λc/L̄ is the same ratio in ℓ or in metres.
+    L̄ is :func:`cell_side` (an array: the pattern's cell, so A/S is that of K × K cells alike, each as
+    the highest one; a run with the ``array_area`` observer has the sum over its cells, used instead by
+    :func:`observe`).  ``params``: the result's parameters to read (default ``res.params``)."""
+    p = res.params if params is None else params
+    cell = cell_side(p)
+    x = np.asarray(contact_length, float) / cell
+    fam = family(p)
+    if fam == "line":
+        return np.clip(x, 0.0, 1.0)
+    if fam == "disc":
+        return np.clip(math.pi / 4 * x**2, 0.0, 1.0)
+    return np.clip(x**2, 0.0, 1.0)
+
+
+def full_length(params: dict) -> float:
+    """Λc of full contact of a result's shape: its own :meth:`~tengsim.shapes.Shape.full_contact_length`
+    (the shape rebuilt from the result's parameters; an array: its pattern's); NaN if it has none or
+    cannot be rebuilt (a shape not registered here, a height map)."""
+    import dataclasses
+
+    from tengsim.registry import SHAPES
+
+    params = pattern_params(params)
+    try:
+        cls = SHAPES.get(shape_name(params))
+        kw = {f.name: params[f.name] for f in dataclasses.fields(cls) if f.init and f.name in params}
+        return float(cls(**kw).full_contact_length())
+    except Exception:  # noqa: BLE001 - a shape that cannot answer has no known full-contact length
+        return math.nan
+
+
+# ---- the observables ----------------------------------------------------------------------------
+
+def load_control(res, column: str = "contact_length"):
+    """Approach states a pressed device passes under increasing load: F above every earlier F, F > 0;
+    the zero-load state is put first, Λc (or ``column``) interpolated linearly in F between the last
+    F <= 0 and the first F > 0.  Returns (F, Λc) arrays (possibly empty)."""
+    a = res.branch("approach")
+    F, L = np.asarray(a["F"], float), np.asarray(a[column], float)
+    keep, best = [], 0.0
+    for i, f in enumerate(F):
+        if f > best:
+            keep.append(i)
+            best = f
+    if not keep:
+        return np.array([]), np.array([])
+    i0 = keep[0]
+    Fk, Lk = list(F[keep]), list(L[keep])
+    if i0 > 0 and F[i0 - 1] <= 0:
+        w = -F[i0 - 1] / (F[i0] - F[i0 - 1])
+        Fk.insert(0, 0.0)
+        Lk.insert(0, L[i0 - 1] + w * (L[i0] - L[i0 - 1]))
+    return np.array(Fk), np.array(Lk)
+
+
+def loaded_area(res, params: dict | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray, list]:
+    """(F, Λc, A/S, notes) of the approach states a pressed device passes (:func:`load_control`): A/S is
+    :func:`area_fraction` of Λc, or, for a run with the ``array_area`` observer, its
+    ``area_fraction_greenwood`` column (Σ over the array's cells).  ``params`` as in :func:`area_fraction`."""
+    p = res.params if params is None else params
+    Fk, Lk = load_control(res)
+    notes = []
+    if "area_fraction_greenwood" in res.table:  # the array_area observer: the sum over the cells
+        A = np.clip(load_control(res, "area_fraction_greenwood")[1], 0.0, 1.0)
+    else:
+        A = area_fraction(res, Lk, p)
+        if is_array(p) and len(Fk):
+            notes.append("A/S of the array from its highest cell's contact length (K × K cells alike); "
+                         "observers = ['array_area'] gives the sum over its cells")
+    return Fk, Lk, A, notes
+
+
+def area_name(pressure_Pa: float) -> str:
+    """The refinement observable of A/S at a pressure: ``A_S_at_10000Pa``."""
+    return f"A_S_at_{pressure_Pa:.6g}Pa".replace("+", "").replace(".", "p")
+
+
+def area_at(pressures, cfg: dict | None = None):
+    """The observer ``res -> {area_name(P): A/S at P}`` that automatic refinement (``resolve_pressures``,
+    :func:`tengsim.run.resolve.run_contact`) also converges: the charged-area fraction of Eq. (12) at each
+    nominal pressure P (Pa) on the approach (linear in F between loaded states; NaN outside the states the
+    run reaches or for a run without a physical scale).  V_OC (Eq. 12) is σT/(ε_r ε0) × A/S, so its relative
+    change is A/S's.  ``cfg``: the run's [contact] table (the shape's name for the patch family)."""
+    pressures = [float(p) for p in pressures]
+
+    def observe_area(res) -> dict:
+        out = {area_name(p): math.nan for p in pressures}
+        scale = physical_scale(res)
+        if scale is None:
+            return out
+        params = res.params if cfg is None else {**res.params, "config": cfg}
+        Fk, _, A, _ = loaded_area(res, params)
+        known = np.isfinite(A)
+        if np.count_nonzero(known) < 2:
+            return out
+        P, A = scale[0] * Fk[known], A[known]
+        for p in pressures:
+            if P[0] <= p <= P[-1]:
+                out[area_name(p)] = float(np.interp(p, P, A))
+        return out
+
+    return observe_area
