@@ -16,7 +16,7 @@ from tengsim.kernels.mirror import BOUNDARIES as MIRROR_BOUNDARIES, MirrorKernel
 from tengsim.loadpath import LoadPathSpec, run_load_path
 from tengsim.path import PathSpec, run_path
 from tengsim.resources import MAP_WORK, check_memory
-from tengsim.solvers import make_solver
+from tengsim.solvers import SOLVERS, make_solver
 from tengsim.solvers.mirror import MirrorSolver
 from tengsim.solvers.distributed import SlabSolver
 from tengsim import parallel
@@ -29,10 +29,11 @@ MIRROR_FULL_ARRAYS = 12
 _AXIS_NAMES = ("x", "y")
 
 
-def choose_symmetry(shape, U0, grid, boundary: str, solver_name: str, symmetry: str = "auto"):
+def choose_symmetry(shape, U0, grid, boundary: str, solver, symmetry: str = "auto"):
     """(mirror axes, label) of a run: the mirrors the shape declares (``mirror_axes``) that its gap U0 has on
     ``grid`` (odd pixel counts along them), when the kernel is the free or periodic one (half-space or
-    film) and the solver is 'fast' or 'vsr'; else () and the reason.  ``symmetry='off'``: always ()."""
+    film) and the solver (an object or a registered name) solves on a weighted block (its ``weighted_block``
+    attribute: fast, vsr); else () and the reason.  ``symmetry='off'``: always ()."""
     sym = str(symmetry).strip().lower()
     if sym not in SYMMETRY_CHOICES:
         raise TengsimError(f"symmetry = {symmetry!r} is not one of {', '.join(SYMMETRY_CHOICES)}")
@@ -43,8 +44,12 @@ def choose_symmetry(shape, U0, grid, boundary: str, solver_name: str, symmetry: 
         return (), "none (shape has no mirror)"
     if boundary not in MIRROR_BOUNDARIES:  # the kernels that have a symmetry-reduced form
         return (), f"none (boundary {boundary})"
-    if solver_name not in ("fast", "vsr"):
-        return (), f"none (solver {solver_name or '?'})"
+    if isinstance(solver, str):
+        name, solver = solver, (SOLVERS.get(solver) if solver in SOLVERS.names() else None)
+    else:
+        name = getattr(solver, "name", None)
+    if not getattr(solver, "weighted_block", False):
+        return (), f"none (solver {name or '?'})"
     axes = tuple(a for a in sorted(set(declared)) if grid.shape[a] % 2 == 1 and grid.shape[a] >= 5
                  and Mirror(grid, (a,)).is_symmetric(U0))
     if not axes:
@@ -58,7 +63,7 @@ def _check_distributed(comm, boundary, solver, grid):
     if boundary != "periodic":
         raise TengsimError(f"an MPI run ({n} processes) splits the periodic kernel across them: give boundary = "
                            f"'periodic' (got {boundary!r}), or run without mpiexec")
-    if getattr(solver, "name", "") != "fast":
+    if not getattr(solver, "splits_over_mpi", False):
         raise TengsimError(f"an MPI run ({n} processes) uses the fast solver, not {getattr(solver, 'name', solver)!r}")
     if grid.nx < n or grid.ny // 2 + 1 < n:
         raise TengsimError(f"the {grid.nx}×{grid.ny} grid is too small to split over {n} processes")
@@ -115,7 +120,7 @@ def simulate_plan(plan: ContactPlan, progress=None, sink=None, throw: bool = Fal
     if comm is not None:
         _check_distributed(comm, boundary, solver_obj, grid)
         symmetry = "off"
-    axes, sym_label = choose_symmetry(shape, U0, grid, boundary, getattr(solver_obj, "name", ""), symmetry)
+    axes, sym_label = choose_symmetry(shape, U0, grid, boundary, solver_obj, symmetry)
     if comm is not None:
         sym_label = "off (MPI run: the slabs hold the full grid)"
     mirror = Mirror(grid, axes) if axes else None

@@ -46,6 +46,8 @@ class FastSolver:
     memory: int = 10
     resync: int = 25
     name: str = "fast"
+    weighted_block: ClassVar[bool] = True  # solves on a mirror block with weighted sums (solvers.mirror)
+    splits_over_mpi: ClassVar[bool] = True  # runs on one MPI rank's slab (solvers.distributed)
     resumes_from_state: ClassVar[bool] = True  # continuation.persist may go on from its capped state
     monitor: object = None
     monitor_every: int = 100

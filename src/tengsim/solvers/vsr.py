@@ -4,6 +4,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 
@@ -32,6 +33,7 @@ class VSRSolver:
     dt0: float = 0.5
     growth: float = 1.2
     name: str = "vsr"
+    weighted_block: ClassVar[bool] = True  # solves on a mirror block with weighted sums (solvers.mirror)
 
     def __post_init__(self):
         if not self.tol > 0:
