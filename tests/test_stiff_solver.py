@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from tengsim.config import plan_contact
-from tengsim.continuation import PERSIST_FACTOR, Branch, persist
+from tengsim.continuation.walker import PERSIST_FACTOR, Branch, persist
 from tengsim.kernels import make_kernel
 from tengsim.solvers import FastSolver, Problem, State, VSRSolver
 
@@ -122,7 +122,7 @@ def test_simulate_continues_capped_solves_also_on_the_mirror_block():
     """Through simulate (sphere: the mirror-reduced solve, MirrorSolver around the fast solver): with a
     cap far too small every row still converges, and F(D) equals the uncapped run's to 1e-6 relative."""
     from tengsim.contact import simulate
-    from tengsim.path import PathSpec
+    from tengsim.continuation import PathSpec
     from tengsim.shapes.axisymmetric import Paraboloid
     shape = Paraboloid(radius=1.0, cell=6.0)
     path = PathSpec(d_min=-1.0, d_max=0.5, d_step=0.5)

@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 from tengsim.kernels import film
 from tengsim.errors import ConfigValueError, TengsimError, finite, positive, shown
 from tengsim.laws import make_law
-from tengsim.path import PathSpec
+from tengsim.continuation import PathSpec
 from tengsim.plugins import KERNELS, LAWS, OBSERVERS, SHAPES, SOLVERS
 from tengsim.schema import Field, Table, dataclass_fields, signature_fields
 from tengsim.shapes.base import dimensionless_fields, physical_fields
@@ -175,7 +175,7 @@ def _path_spec(vals, given, scaling):
         missing = [k for k in ("f_max", "f_step") if k not in given]
         if missing:
             raise TengsimError(f"control = 'load' needs {', '.join(missing)}")
-        from tengsim.loadpath import LoadPathSpec
+        from tengsim.continuation import LoadPathSpec
 
         f = {k: _load_F(k, vals[k], scaling) for k in _LOAD_KEYS if vals[k] is not None}
         kw = {"d_min": vals["d_min"], "d_step": vals["d_step"], "to_max": True}  # the path ends at f_max
@@ -208,7 +208,7 @@ def _check_maps_out(maps_at, out) -> None:
 
 def common_fields() -> list:
     """The [contact] keys every shape has (choices and help read from the registries)."""
-    from tengsim.loadpath import LoadPathSpec
+    from tengsim.continuation import LoadPathSpec
 
     return [
         Field("shape", "str", "pyramid", check=SHAPES.canonical,

@@ -170,7 +170,7 @@ def check_budget(plan, est: Estimate, fit_pixels: int | None = None) -> None:
 
 def _simulate(cplan, dx, d_max, **kw):
     from tengsim.contact import simulate
-    from tengsim.path import PathSpec
+    from tengsim.continuation import PathSpec
 
     path = PathSpec(D_MIN, d_max, D_STEP, adaptive=True)
     return simulate(cplan.shape, cplan.tabor, dx, path, boundary=cplan.boundary, solver=cplan.solver,
@@ -242,7 +242,7 @@ def maps_run(res, cplan, plan):
     """The finest grid's approach walked again up to the map depths (:func:`map_depths`), its pressure and gap
     maps kept exactly there (the same path lattice: the same states); None if no depth is known."""
     from tengsim.contact import simulate
-    from tengsim.path import PathSpec
+    from tengsim.continuation import PathSpec
 
     depths = map_depths(res, plan)
     if not depths:
@@ -316,7 +316,7 @@ def run_design(plan, progress=None, keep=None) -> DesignResult:
     _say(progress, cap_line(plan, cplan, dx, d_max, max_pixels))
     res = None
     for _ in range(2):
-        from tengsim.path import PathSpec
+        from tengsim.continuation import PathSpec
 
         path = PathSpec(D_MIN, d_max, D_STEP, adaptive=True)
         ck, found = _checkpoint(keep, plan, d_max, progress) or (None, None)

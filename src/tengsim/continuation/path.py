@@ -11,97 +11,14 @@ With ``PathSpec(adaptive=True)`` the step also adapts where the path is smooth (
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
 from tengsim.analysis import force
-from tengsim.continuation import Branch, Recorder, StateOnly, persist, secant, spent
-from tengsim.errors import TengsimError, finite, positive
+from tengsim.continuation.recorder import Recorder, spent
+from tengsim.continuation.specs import _D_TOL, PathSpec
+from tengsim.continuation.walker import Branch, StateOnly, persist, secant
+from tengsim.errors import TengsimError
 from tengsim.solvers import Problem, State
-
-
-_D_TOL = 1e-9
-"""Relative tolerance (of max(1, |D|)) within which a row's D is a requested ``maps_at`` D."""
-
-
-@dataclass(frozen=True)
-class PathSpec:
-    """Approach from ``d_min`` to ``d_max`` then retraction back, in steps of ``d_step``.
-
-    Every branch has a row at each D = d_min + k·d_step; step refinement only adds rows between.
-    ``maps_at`` lists D values whose pressure and gap maps are kept, on both branches, each exactly at
-    its D: a value off the rows the walk visits gets an extra row there (``on_grid`` False: ``on_grid``
-    keeps meaning "on the d_step lattice"), solved from the two rows around it on the branch (their
-    states interpolated; across a jump, from the state before it), without entering the continuation,
-    so every other row is the one the run has without ``maps_at``.  A value outside [d_min, the last D
-    of the lattice] is refused.
-
-    ``adaptive=True``: the step h takes the values d_step/2^k (k = 0 … ``refine_levels``) and stays on
-    the lattice D = d_min + j·d_step/2^k, so every row lies on the finest lattice and every
-    D = d_min + k·d_step is still visited (those rows keep ``on_grid`` True: they are the rows a
-    fixed-step run with the same ``d_step`` has; the others are the adaptive run's own).  After each
-    step the solved state is compared with the linear extrapolation of the two before it (the
-    secant predictor): the force error e_F = |F − F_pred| against ``adapt_tol`` × max(|F|, the most
-    tensile |F| met so far on the path), and the gap error max|H − H_pred| (ε) against
-    ``adapt_h``.  A step whose larger ratio ρ exceeds 1 keeps its (exact) end state and is refined by
-    midpoints (recursively, each half judged by the midpoint's deviation from the chord), and the
-    next step is divided by 2^⌈log₄ ρ⌉ (the error goes as h²); ρ < 1/4 lets the next step double
-    (where the lattice allows).  The same second difference, centred on the step's start, also
-    judges the step before it (look-back), which is refined the same way; each branch starts with
-    d_step (its second step's look-back judges it).  Jumps are bisected to the smallest step as in
-    the fixed scheme (a step that jumps is retried at half its length).  With refine_levels three
-    above a fixed run's and d_step eight times its d_step, the smallest steps (and so the jump
-    resolution) agree.  Measured (benchmarks/adaptive_path.py, dx 0.2): the defaults adapt_tol = 0.15,
-    adapt_h = 0.5 reproduce the fixed curve of the paper's groups A, B, C to 0.15 % of
-    max(|F|, |pull-off F|) with 2.4–2.9× fewer solves (the gap test sets the step out of contact,
-    where the force is small against the pull-off scale).
-    """
-
-    d_min: float
-    d_max: float
-    d_step: float
-    refine_levels: int = 4
-    jump_h: float = 0.3
-    predictor: bool = True
-    retract: bool = True
-    maps_at: tuple = ()
-    adaptive: bool = False
-    adapt_tol: float = 0.15
-    adapt_h: float = 0.5
-
-    def __post_init__(self):
-        finite("d_min", self.d_min)
-        finite("d_max", self.d_max)
-        positive("d_step", self.d_step)
-        if not self.d_max > self.d_min:
-            raise TengsimError(f"d_max ({self.d_max}) must be greater than d_min ({self.d_min})")
-        n = (self.d_max - self.d_min) / self.d_step
-        if n > 200000:
-            raise TengsimError(f"d_step={self.d_step} gives {n:.0f} steps; choose a larger step")
-        if int(self.refine_levels) < 0:
-            raise TengsimError(f"refine_levels must be >= 0, got {self.refine_levels!r}")
-        object.__setattr__(self, "maps_at", tuple(finite("maps_at", d) for d in self.maps_at))
-        last = float(self.targets()[-1])
-        for d in self.maps_at:
-            if not self.d_min - _D_TOL * max(1.0, abs(d)) <= d <= last + _D_TOL * max(1.0, abs(d)):
-                raise TengsimError(f"maps_at D = {d:g} is outside the path's D range [{self.d_min:g}, {last:g}]"
-                                   + (f" (the last D of the d_step lattice below d_max = {self.d_max:g})"
-                                      if last < self.d_max - 1e-9 else ""))
-        positive("adapt_tol", self.adapt_tol)
-        positive("adapt_h", self.adapt_h)
-        if self.adaptive and int(self.refine_levels) > 30:
-            raise TengsimError(f"refine_levels must be <= 30 with adaptive steps, got {self.refine_levels!r}")
-
-    def extra_params(self) -> dict:
-        """Path parameters beyond d_min, d_max, d_step, refine_levels, jump_h (none for fixed steps)."""
-        if not self.adaptive:
-            return {}
-        return {"adaptive": True, "adapt_tol": self.adapt_tol, "adapt_h": self.adapt_h}
-
-    def targets(self) -> np.ndarray:
-        k = int(np.floor((self.d_max - self.d_min) / self.d_step + 1e-9))
-        return self.d_min + self.d_step * np.arange(k + 1)
 
 
 class _Adaptive(Branch):
@@ -247,11 +164,11 @@ def run_path(U0, law, kernel, solver, spec: PathSpec, start: State | None = None
     ``progress(branch, D, done, total)`` is called after each row on the D grid.  ``observers``
     (registered names or objects, see :mod:`tengsim.observers`) add their columns to every row.
     ``sink(row, maps)`` is called with each row as it is recorded (:class:`tengsim.continuation.Recorder`).
-    A load-controlled path is :func:`tengsim.loadpath.run_load_path`.
+    A load-controlled path is :func:`tengsim.continuation.run_load_path`.
     """
     if not isinstance(spec, PathSpec):
         raise TengsimError(f"run_path walks a PathSpec (rigid approach D); got {type(spec).__name__} "
-                           "(a LoadPathSpec runs with tengsim.loadpath.run_load_path)")
+                           "(a LoadPathSpec runs with tengsim.continuation.run_load_path)")
     targets = spec.targets()
     rec = Recorder(U0, law, kernel, observers, progress, len(targets) * (2 if spec.retract else 1),
                    spec.maps_at, "D", sink=sink)
@@ -350,66 +267,6 @@ def _run_adaptive(U0, law, kernel, solver, spec, start, targets, make_on_row, wa
         back.on_row(targets[-1], eq, True, False)
         eq = back.walk(targets[-1], eq, targets[0])
     return eq
-
-
-def compare_paths(ref, other, interp: str = "pchip") -> dict:
-    """How far the curve ``other`` is from ``ref`` (two ContactResults of the same problem).
-
-    Per branch, ``other`` is cut at its jumps into continuous segments and F is interpolated on each
-    segment (``interp`` 'linear': the curve as plotted; 'pchip': monotone cubic, scipy's PCHIP, linear
-    on a 2-row segment) at every D of ``ref`` that lies
-    inside one of them; D values of ``ref`` inside a jump interval of ``other`` (between its D_before
-    and D_after) are skipped, and so are rows of ``ref`` that start a jump (the state on the far
-    side of ``ref``'s own jump, compared only if ``other`` has a segment there).  The difference is
-    relative to max(|F_ref(D)|, F_adh), F_adh = the magnitude of the most tensile F of ``ref`` (the adhesive force
-    scale), so it is a relative error where |F| is large and an error in units of the pull-off force
-    where F crosses zero.  Returns {'max_rel_dF', 'where' ((branch, D) of it), 'n_compared', 'n_skipped', 'max_rel_dF_same_D'
-    (rows at equal D, no interpolation), 'jumps_ref', 'jumps_other' (lists of (branch, D_before,
-    D_after)), 'max_jump_dD' (largest |ΔD_after| between jumps matched by branch and order; NaN if
-    the counts differ)}.
-    """
-    from scipy.interpolate import PchipInterpolator
-
-    f_adh = max(abs(float(np.min(ref.table["F"]))), 1e-12)
-    worst, worst_same, n_cmp, n_skip, where = 0.0, 0.0, 0, 0, None
-    for br in ("approach", "retraction"):
-        a, b = ref.branch(br), other.branch(br)
-        if len(a["D"]) == 0 or len(b["D"]) == 0:
-            continue
-        cuts = [0] + [i for i in np.flatnonzero(b["jump"]) if i > 0] + [len(b["D"])]
-        segs = []
-        for i0, i1 in zip(cuts[:-1], cuts[1:]):
-            D, F = b["D"][i0:i1], b["F"][i0:i1]
-            if len(D) == 0:
-                continue
-            o = np.argsort(D)
-            D, F = D[o], F[o]
-            fn = PchipInterpolator(D, F) if len(D) >= 3 and interp == "pchip" else (lambda x, D=D, F=F: np.interp(x, D, F))
-            segs.append((D[0], D[-1], fn))
-        for D, F in zip(a["D"], a["F"]):
-            seg = [s for s in segs if s[0] - 1e-12 <= D <= s[1] + 1e-12]
-            if not seg:
-                n_skip += 1
-                continue
-            scale = max(abs(F), f_adh)
-            e = min(abs(float(s[2](D)) - F) for s in seg) / scale
-            if e > worst:
-                worst, where = e, (br, float(D))
-            n_cmp += 1
-            same = np.flatnonzero(np.abs(b["D"] - D) < 1e-9)
-            if len(same):
-                worst_same = max(worst_same, float(np.min(np.abs(b["F"][same] - F))) / scale)
-
-    def jl(res):
-        return [(j.branch, j.D_before, j.D_after) for j in res.jumps]
-
-    ja, jb = jl(ref), jl(other)
-    if len(ja) == len(jb) and all(x[0] == y[0] for x, y in zip(ja, jb)):
-        dj = max((abs(x[2] - y[2]) for x, y in zip(ja, jb)), default=0.0)
-    else:
-        dj = float("nan")
-    return {"max_rel_dF": worst, "where": where, "max_rel_dF_same_D": worst_same, "n_compared": n_cmp,
-            "n_skipped": n_skip, "jumps_ref": ja, "jumps_other": jb, "max_jump_dD": dj}
 
 
 def walk_states(U0, law, kernel, solver, Ds, start: State | None = None):
