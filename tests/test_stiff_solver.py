@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from tengsim.config import plan_contact
-from tengsim.continuation.walker import PERSIST_FACTOR, Branch, persist
+from tengsim.continuation.walker import PERSIST_FACTOR, Walker, persist
 from tengsim.kernels import make_kernel
 from tengsim.solvers import FastSolver, Problem, State, VSRSolver
 
@@ -47,7 +47,7 @@ def test_stiff_bump_equilibrium_converges_and_satisfies_eq9(tmp_path):
     assert out.iterations > 3000 and "after the cap" in out.message
     assert _eq9_residual(problem, out, -1.0) <= 2e-6  # independent of the solver's own bookkeeping
     # the branch walker applies it by itself
-    br = Branch(U0, law, kernel, fast, None, None)
+    br = Walker(U0, law, kernel, fast)
     again = br.solve(-1.0, State.zero(U0.shape))
     assert again.converged and again.iterations == out.iterations
     assert np.array_equal(again.H, out.H)
@@ -60,7 +60,7 @@ def test_converged_solve_is_untouched(tmp_path):
     eq = fast.solve(problem, State.zero(U0.shape))
     assert eq.converged
     assert persist(fast, problem, eq) is eq
-    br = Branch(U0, law, kernel, fast, None, None)
+    br = Walker(U0, law, kernel, fast)
     eq2 = br.solve(-1.0, State.zero(U0.shape))
     assert np.array_equal(eq2.H, eq.H) and eq2.iterations == eq.iterations and eq2.n_conv == eq.n_conv
 

@@ -7,7 +7,8 @@ path has at that D (the same warm starts, the same branch):
 
 1. walk in D from the current state, in the direction the load moves the body (D up when the
    target is above the current F, down when below), in steps of ``d_step`` with the D path's own
-   jump bisection (:class:`tengsim.continuation.Branch`), until F crosses the target;
+   jump bisection (:class:`tengsim.continuation.walker.Walker` with
+   :class:`tengsim.continuation.steps.FixedSteps`), until F crosses the target;
 2. solve F(D) = F_target in that bracket by regula falsi (Illinois), each trial D warm-started
    from the bracket's states interpolated, until |F − F_target| <= ``f_tol``.
 
@@ -34,7 +35,8 @@ import math
 from tengsim.analysis import force
 from tengsim.continuation.recorder import Recorder, spent
 from tengsim.continuation.specs import EXTEND_LIMIT, LoadPathSpec
-from tengsim.continuation.walker import Branch
+from tengsim.continuation.steps import FixedSteps
+from tengsim.continuation.walker import Walker
 from tengsim.errors import TengsimError
 from tengsim.solvers import State
 
@@ -54,8 +56,8 @@ class _LoadBranch:
         self.spec, self.emit, self.grid = spec, emit, kernel.grid
         self.name, self.misses, self.bracket = name, [], None
         self.trail: list = []
-        self.walker = Branch(U0, law, kernel, solver, spec.d_spec(),
-                              lambda D, eq, on_grid, jump: self.trail.append((D, eq, jump)))
+        self.walker = Walker(U0, law, kernel, solver, FixedSteps(spec.refine_levels),
+                             lambda D, eq, on_grid, jump: self.trail.append((D, eq, jump)), spec.jump_h)
         self.h_min = spec.d_step / 2 ** int(spec.refine_levels)
         self.d_max = spec.d_max  # with spec.extend, raised as the approach needs (_walk)
         self.d_limit = spec.d_min + EXTEND_LIMIT * (spec.d_max - spec.d_min) if spec.extend else spec.d_max
@@ -65,7 +67,7 @@ class _LoadBranch:
 
     def set(self, D, eq):
         self.D, self.eq, self.Fc = D, eq, self.F(eq)
-        self.walker.hist = [(D, eq.state)]
+        self.walker.reset(D, eq.state)
 
     def _walk(self, s):
         """One D step in direction s from the current end of the walk; returns its new points."""
@@ -76,7 +78,7 @@ class _LoadBranch:
         if D1 < self.spec.d_min - 1e-12 or D1 > self.d_max + 1e-12:
             raise _Out()
         self.trail = []
-        self.walker.advance(D0, eq0, D1, 0, False)
+        self.walker.walk(eq0, D0, [D1], on_grid=False)
         new = [(D, eq, self.F(eq), jump) for D, eq, jump in self.trail]
         self.pts += new
         return new

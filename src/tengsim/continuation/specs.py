@@ -196,10 +196,6 @@ class LoadPathSpec:
         return {"control": "load", "f_min": self.f_min, "f_max": self.f_max, "f_step": self.f_step,
                 "f_tol": self.tol_F}
 
-    def d_spec(self) -> PathSpec:
-        return PathSpec(self.d_min, self.d_max, self.d_step, refine_levels=self.refine_levels,
-                        jump_h=self.jump_h)
-
 
 EXTEND_LIMIT = 64
 """With ``extend``, the D search of a load stops at d_min + EXTEND_LIMIT (d_max - d_min)."""

@@ -1,9 +1,23 @@
-"""The branch walker: solves each equilibrium of a branch from a predicted start (the secant predictor),
-continues a fast solve stopped at its cap (:func:`persist`), and refines a step that jumps by bisection.
+"""The branch walker: the one loop every path runs.  It solves each equilibrium of a branch from a
+predicted start (the secant predictor), continues a fast solve stopped at its cap (:func:`persist`),
+tests each step for a jump, and hands the choice of the steps to a step control it is given
+(:mod:`tengsim.continuation.steps`: fixed steps bisected at jumps, or adaptive steps).
+
+A step control is any object with ``plan(walker, eq, D_from, stops, on_grid)`` returning the walk's plan:
+
+- ``predictor`` (bool) and ``c_max`` (the secant's reach, in steps of the last one);
+- ``next()``: the D of the next step, or None at the end;
+- ``refine(Da, Db)``: the step Da → Db jumped; True if the plan takes a shorter one instead (the solved
+  state is then discarded), False to accept it as a jump;
+- ``accept(Da, eqa, Db, eqb, jump)``: the step is taken; returns ``(rows, inner)``: the rows to record
+  now, in path order, each ``(D, eq, on_grid, jump)``, and the ``(D, eq)`` the plan solved strictly
+  between Da and Db (they come before Db in the predictor's history);
+- ``finish()``: the rows still held back at the end.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, is_dataclass, replace
+from dataclasses import is_dataclass, replace
+from typing import final
 
 import numpy as np
 
@@ -13,6 +27,11 @@ from tengsim.solvers import Problem, State
 def secant(s0: State, s1: State, c: float) -> State:
     """The state c steps of (s0 → s1) beyond s1: the secant predictor of a continuation step."""
     return State(s1.q + c * (s1.q - s0.q), s1.w + c * (s1.w - s0.w))
+
+
+def jumped(eqa, eqb, dD: float, jump_h: float) -> bool:
+    """Whether the gap field changed across a step by more than ``jump_h`` (ε) beyond the rigid shift |dD|."""
+    return eqb.max_change(eqa) - abs(dD) > jump_h
 
 
 PERSIST_FACTOR = 10  # a fast solve stopped at its cap goes on for up to this many times max_iter more
@@ -43,18 +62,24 @@ def persist(solver, problem: Problem, eq):
                            f"(max|r| {eq.residual:.2e} at the cap)")
 
 
-class Branch:
-    """Walks one branch, refining steps and predicting starts."""
+@final
+class Walker:
+    """Walks one branch of a path with the step control ``steps``; ``on_row(D, eq, on_grid, jump)``
+    receives its rows in path order.  ``jump_h``: the jump criterion (:func:`jumped`).
 
-    def __init__(self, U0, law, kernel, solver, spec, on_row):
-        self.U0, self.law, self.kernel, self.solver, self.spec = U0, law, kernel, solver, spec
+    ``hist`` holds the last two accepted (D, state) of the branch (one after a jump), for the predictor;
+    ``spent`` counts the convolutions of every solve, recorded or discarded (jump checks, refining)."""
+
+    def __init__(self, U0, law, kernel, solver, steps=None, on_row=None, jump_h: float = 0.3):
+        self.law, self.kernel, self.solver, self.steps = law, kernel, solver, steps
         fold = getattr(solver, "fold_gap", None)  # a mirror solver takes g0 on its block
         self._U0s = U0 if fold is None else fold(U0, kernel)
-        self.on_row = on_row
-        self.hist: list = []  # accepted (D, state) on this branch, newest last
-        self.spent = 0  # convolutions of every solve of this branch, recorded or discarded (jump checks, refining)
+        self.on_row, self.jump_h = on_row, jump_h
+        self.hist: list = []
+        self.spent = 0
 
     def solve(self, D, start):
+        """The equilibrium at D from ``start`` (continued past the cap, :func:`persist`)."""
         problem = Problem(self._U0s - D + 1.0, self.law, self.kernel)
         eq = self.solver.solve(problem, start)
         if not eq.converged:
@@ -62,41 +87,62 @@ class Branch:
         self.spent += int(eq.n_conv)
         return eq
 
-    def _start(self, D):
-        (D1, s1) = self.hist[-1]
-        if self.spec.predictor and len(self.hist) >= 2:
+    def reset(self, D, state) -> None:
+        """Start the predictor's history afresh at (D, state)."""
+        self.hist = [(D, state)]
+
+    def push(self, D, state) -> None:
+        """Accept (D, state) as the newest of the predictor's history."""
+        self.hist = (self.hist + [(D, state)])[-2:]
+
+    def begin(self, D, eq) -> None:
+        """The branch's first row: ``eq`` at D (on the grid), the history started there."""
+        self.reset(D, eq.state)
+        self.on_row(D, eq, True, False)
+
+    def predict(self, D, c_max: float = 1.5, c_min: float = 0.0):
+        """(start, predicted): the secant start at D from the last two accepted states when D lies
+        (c_min, c_max] steps of the last step beyond the newest, else the newest state."""
+        D1, s1 = self.hist[-1]
+        if len(self.hist) >= 2:
             D0, s0 = self.hist[-2]
             if D1 != D0:
                 c = (D - D1) / (D1 - D0)
-                if 0 < c <= 1.5:
+                if c_min < c <= c_max:
                     return secant(s0, s1, c), True
         return s1, False
 
-    def _jumped(self, eqa, eqb, dD):
-        return eqb.max_change(eqa) - abs(dD) > self.spec.jump_h
+    def jumped(self, eqa, eqb, dD) -> bool:
+        return jumped(eqa, eqb, dD, self.jump_h)
 
-    def advance(self, Da, eqa, Db, level, on_grid):
-        start, predicted = self._start(Db)
+    def step(self, Da, eqa, Db, predictor: bool = True, c_max: float = 1.5):
+        """(eqb, jump): the step Da → Db from the predicted start, solved again from ``eqa`` when the
+        predicted one jumped (a predictor can overshoot onto another branch)."""
+        start, predicted = self.predict(Db, c_max) if predictor else (self.hist[-1][1], False)
         eqb = self.solve(Db, start)
-        if predicted and self._jumped(eqa, eqb, Db - Da):
+        if predicted and self.jumped(eqa, eqb, Db - Da):
             eqb = self.solve(Db, eqa.state)  # confirm without the predictor
-        if self._jumped(eqa, eqb, Db - Da):
-            if level < self.spec.refine_levels:
-                mid = 0.5 * (Da + Db)
-                eqm = self.advance(Da, eqa, mid, level + 1, False)
-                return self.advance(mid, eqm, Db, level + 1, on_grid)
-            jump = True
-        else:
-            jump = False
-        self.hist = (self.hist + [(Db, eqb.state)])[-2:]
-        if jump:
-            self.hist = self.hist[-1:]
-        self.on_row(Db, eqb, on_grid, jump)
-        return eqb
+        return eqb, self.jumped(eqa, eqb, Db - Da)
 
+    def walk(self, eq, D_from, stops, on_grid: bool = True):
+        """From the accepted ``eq`` at ``D_from`` through ``stops`` (the D the walk must visit, in path
+        order, the last its end), the steps chosen by ``self.steps``; returns the last equilibrium.
+        ``on_grid``: whether the stops are rows of the path's grid."""
+        plan = self.steps.plan(self, eq, D_from, stops, on_grid)
+        Da = D_from
+        while (Db := plan.next()) is not None:
+            eqb, jump = self.step(Da, eq, Db, plan.predictor, plan.c_max)
+            if jump and plan.refine(Da, Db):
+                continue
+            rows, inner = plan.accept(Da, eq, Db, eqb, jump)
+            for row in rows:
+                self.on_row(*row)
+            if jump:
+                self.hist = [(Db, eqb.state)]
+            else:
+                self.hist = (self.hist + [(d, e.state) for d, e in inner] + [(Db, eqb.state)])[-2:]
+            Da, eq = Db, eqb
+        for row in plan.finish():
+            self.on_row(*row)
+        return eq
 
-@dataclass
-class StateOnly:
-    """A bare state holder (``.state``) for rows kept only as states."""
-
-    state: State
