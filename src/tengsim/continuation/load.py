@@ -29,14 +29,13 @@ Approach loads below the start's F (the body stays away) are skipped.
 """
 from __future__ import annotations
 
-import dataclasses
 import math
 
 from tengsim.analysis import force
 from tengsim.continuation.recorder import Recorder, spent
 from tengsim.continuation.specs import EXTEND_LIMIT, LoadPathSpec
 from tengsim.continuation.steps import FixedSteps
-from tengsim.continuation.walker import Walker
+from tengsim.continuation.walker import Walker, revise
 from tengsim.errors import TengsimError
 from tengsim.solvers import State
 
@@ -201,7 +200,7 @@ class _LoadBranch:
         msg = (f"{self.name}: {what} {self.spec.load_text(Ft)} not met: |F - target| = {err:.3g} > f_tol = "
                f"{self.spec.tol_F:.3g} (D in [{lo:.6g}, {hi:.6g}]{', ' + how if how else ''})")
         self.misses.append(msg)
-        return dataclasses.replace(eq, converged=False, message=msg)
+        return revise(eq, converged=False, message=msg)
 
     def _left(self, s):
         """The body left the D range under this load: record the state at the end of the walk."""

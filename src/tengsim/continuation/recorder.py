@@ -65,6 +65,8 @@ class Recorder:
         """The callback ``(D, eq, on_grid, jump, map_at=None)`` that records a row of ``branch``."""
         def record(D, eq, on_grid, jump, map_at=None):
             n_maps = len(self.maps)  # for the sink: the maps this row adds
+            unfold = getattr(eq, "unfolded", None)  # a block's equilibrium: its full-grid fields once a row
+            eq = unfold() if unfold is not None else eq
             s = self.summary(eq, self.ctx)
             # a state whose gap enters the law's safe extension (g < g_safe) is outside the physical law
             in_range = bool(s["min_gap"] + 1.0 >= getattr(self.law, "g_safe", -np.inf))

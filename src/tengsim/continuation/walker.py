@@ -34,6 +34,13 @@ def jumped(eqa, eqb, dD: float, jump_h: float) -> bool:
     return eqb.max_change(eqa) - abs(dD) > jump_h
 
 
+def revise(eq, **changes):
+    """``eq`` with ``changes``: ``dataclasses.replace``, or a wrapped equilibrium's own ``replace``
+    (:class:`tengsim.solvers.mirror.FoldedEquilibrium`, which keeps the block)."""
+    own = getattr(eq, "replace", None)
+    return own(**changes) if own is not None else replace(eq, **changes)
+
+
 PERSIST_FACTOR = 10  # a fast solve stopped at its cap goes on for up to this many times max_iter more
 
 
@@ -56,7 +63,7 @@ def persist(solver, problem: Problem, eq):
     more = solver.with_inner(more) if hasattr(solver, "with_inner") else more
     eq2 = more.solve(problem, eq.state)
     what = "converged" if eq2.converged else f"not converged ({eq2.message})"
-    return replace(eq2, iterations=eq.iterations + eq2.iterations, n_conv=eq.n_conv + eq2.n_conv,
+    return revise(eq2, iterations=eq.iterations + eq2.iterations, n_conv=eq.n_conv + eq2.n_conv,
                    seconds=eq.seconds + eq2.seconds,
                    message=f"{what} after the cap: {eq.iterations} + {eq2.iterations} iterations "
                            f"(max|r| {eq.residual:.2e} at the cap)")
