@@ -6,8 +6,7 @@ import pytest
 
 from tengsim.cli.main import main
 from tengsim.config import plan_contact
-from tengsim.continuation import LoadPathSpec
-from tengsim.continuation import PathSpec
+from tengsim.continuation import LoadPathSpec, PathSpec
 from tengsim.cases.paper.units import paper_scaling
 
 GROUP_A = ["contact", "pyramid", "--N", "0.946", "--cell", "3.78", "--tabor", "0.5", "--dx", "0.3", "--quiet"]

@@ -9,8 +9,7 @@ import pytest
 import tengsim as ts
 from tengsim import references as ref
 from tengsim.kernels import FreeKernel
-from tengsim.continuation import LoadPathSpec, run_load_path
-from tengsim.continuation import PathSpec, run_path
+from tengsim.continuation import LoadPathSpec, PathSpec, run_load_path, run_path
 from tengsim.solvers import Problem, State
 from tengsim.cases.paper.units import paper_scaling
 

@@ -19,8 +19,7 @@ from tengsim.contact import choose_symmetry, simulate
 from tengsim.grid import Mirror
 from tengsim.kernels import make_kernel
 from tengsim.laws import LJ93
-from tengsim.continuation import LoadPathSpec
-from tengsim.continuation import PathSpec
+from tengsim.continuation import LoadPathSpec, PathSpec
 from tengsim.shapes import Pyramid
 from tengsim.shapes.arrays import Array
 from tengsim.shapes.flat_topped import Line

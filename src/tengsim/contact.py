@@ -13,8 +13,7 @@ from tengsim.laws import LJ93, Law, make_law
 from tengsim.kernels import make_kernel
 from tengsim.kernels.distributed import SlabPeriodicKernel
 from tengsim.kernels.mirror import MirrorKernel
-from tengsim.continuation import LoadPathSpec, run_load_path
-from tengsim.continuation import PathSpec, run_path
+from tengsim.continuation import LoadPathSpec, PathSpec, run_load_path, run_path
 from tengsim.plugins import KERNELS
 from tengsim.resources import MAP_WORK, check_memory
 from tengsim.solvers import make_solver

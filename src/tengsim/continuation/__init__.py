@@ -13,8 +13,9 @@ from tengsim.continuation.compare import compare_paths
 from tengsim.continuation.load import run_load_path
 from tengsim.continuation.path import run_path, walk_states
 from tengsim.continuation.recorder import Recorder
-from tengsim.continuation.specs import LoadPathSpec, PathSpec
-from tengsim.continuation.walker import PERSIST_FACTOR, persist, secant
+from tengsim.continuation.specs import BRANCHES, LoadPathSpec, PathSpec
+from tengsim.continuation.steps import AdaptiveSteps, FixedSteps
+from tengsim.continuation.walker import PERSIST_FACTOR, Walker, persist, secant
 
-__all__ = ["LoadPathSpec", "PERSIST_FACTOR", "PathSpec", "Recorder", "compare_paths", "persist",
-           "run_load_path", "run_path", "secant", "walk_states"]
+__all__ = ["AdaptiveSteps", "BRANCHES", "FixedSteps", "LoadPathSpec", "PERSIST_FACTOR", "PathSpec", "Recorder",
+           "Walker", "compare_paths", "persist", "run_load_path", "run_path", "secant", "walk_states"]

@@ -3,6 +3,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from tengsim.continuation.specs import BRANCHES
+
 
 def compare_paths(ref, other, interp: str = "pchip") -> dict:
     """How far the curve ``other`` is from ``ref`` (two ContactResults of the same problem).
@@ -24,7 +26,7 @@ def compare_paths(ref, other, interp: str = "pchip") -> dict:
 
     f_adh = max(abs(float(np.min(ref.table["F"]))), 1e-12)
     worst, worst_same, n_cmp, n_skip, where = 0.0, 0.0, 0, 0, None
-    for br in ("approach", "retraction"):
+    for br in BRANCHES:
         a, b = ref.branch(br), other.branch(br)
         if len(a["D"]) == 0 or len(b["D"]) == 0:
             continue

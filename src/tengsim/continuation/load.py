@@ -33,7 +33,7 @@ import math
 
 from tengsim.analysis import force
 from tengsim.continuation.recorder import Recorder, spent
-from tengsim.continuation.specs import EXTEND_LIMIT, LoadPathSpec
+from tengsim.continuation.specs import BRANCHES, EXTEND_LIMIT, LoadPathSpec
 from tengsim.continuation.steps import FixedSteps
 from tengsim.continuation.walker import Walker, revise
 from tengsim.errors import TengsimError
@@ -66,7 +66,7 @@ class _LoadBranch:
 
     def set(self, D, eq):
         self.D, self.eq, self.Fc = D, eq, self.F(eq)
-        self.walker.reset(D, eq.state)
+        self.walker.reset(D, eq)
 
     def _walk(self, s):
         """One D step in direction s from the current end of the walk; returns its new points."""
@@ -77,7 +77,7 @@ class _LoadBranch:
         if D1 < self.spec.d_min - 1e-12 or D1 > self.d_max + 1e-12:
             raise _Out()
         self.trail = []
-        self.walker.walk(eq0, D0, [D1], on_grid=False)
+        self.walker.walk([D1], on_grid=False, start=(D0, eq0))
         new = [(D, eq, self.F(eq), jump) for D, eq, jump in self.trail]
         self.pts += new
         return new
@@ -237,7 +237,7 @@ def run_load_path(U0, law, kernel, solver, spec: LoadPathSpec, start: State | No
     def map_at(Ft):  # the maps_at entry of the load Ft, if any
         return next((m for m in spec.maps_at if abs(m - Ft) <= 1e-9 * spec.f_step), None)
 
-    up = _LoadBranch(U0, law, kernel, solver, spec, rec.on_row("approach"), "approach")
+    up = _LoadBranch(U0, law, kernel, solver, spec, rec.on_row(BRANCHES[0]), BRANCHES[0])
     eq0 = up.walker.solve(spec.d_min, state)
     up.set(spec.d_min, eq0)
     up.emit(spec.d_min, eq0, False, False)  # at rest, out of contact
@@ -248,7 +248,7 @@ def run_load_path(U0, law, kernel, solver, spec: LoadPathSpec, start: State | No
             raise TengsimError(_not_reached(spec, up, Ft))
     branches = [up]
     if spec.retract:
-        down = _LoadBranch(U0, law, kernel, solver, spec, rec.on_row("retraction"), "retraction")
+        down = _LoadBranch(U0, law, kernel, solver, spec, rec.on_row(BRANCHES[1]), BRANCHES[1])
         branches.append(down)
         down.set(up.D, up.eq)
         met = bool(abs(up.Fc - targets[-1]) <= spec.tol_F)  # (a miss there is flagged on the approach's row)

@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 
 from tengsim.continuation.recorder import Recorder, spent
-from tengsim.continuation.specs import _D_TOL, PathSpec
+from tengsim.continuation.specs import _D_TOL, BRANCHES, PathSpec
 from tengsim.continuation.steps import AdaptiveSteps, FixedSteps
 from tengsim.continuation.walker import Walker
 from tengsim.errors import TengsimError
@@ -51,14 +51,15 @@ def run_path(U0, law, kernel, solver, spec: PathSpec, start: State | None = None
         return walkers[-1]
 
     steps = AdaptiveSteps.of(spec) if spec.adaptive else FixedSteps(spec.refine_levels, spec.predictor)
-    eq = None
-    for branch, Ds in (("approach", targets), ("retraction", targets[::-1]))[:2 if spec.retract else 1]:
+    eq = None  # handed from branch to branch: the walker holds the current equilibrium, not this frame
+    for branch, Ds in tuple(zip(BRANCHES, (targets, targets[::-1])))[:2 if spec.retract else 1]:
         walker = Walker(U0, law, kernel, solver, steps, rows(branch), spec.jump_h)
         walkers.append(walker)
-        if eq is None:
-            eq = walker.solve(Ds[0], start if start is not None else State.zero(kernel.grid.shape))
-        walker.begin(Ds[0], eq)
-        eq = walker.walk(eq, Ds[0], Ds[1:])
+        walker.begin(Ds[0], eq if eq is not None else
+                     walker.solve(Ds[0], start if start is not None else State.zero(kernel.grid.shape)))
+        eq = None
+        walker.walk(Ds[1:])
+        eq = walker.take()
     return spent(rec.result(eq.state if keep_states else None), walkers)
 
 

@@ -10,6 +10,9 @@ import numpy as np
 from tengsim.errors import TengsimError, finite, positive
 
 
+BRANCHES = ("approach", "retraction")
+"""The branches of a path, in path order: the load (D or F) going up, then back down."""
+
 _D_TOL = 1e-9
 """Relative tolerance (of max(1, |D|)) within which a row's D is a requested ``maps_at`` D."""
 

@@ -74,7 +74,8 @@ class Walker:
     """Walks one branch of a path with the step control ``steps``; ``on_row(D, eq, on_grid, jump)``
     receives its rows in path order.  ``jump_h``: the jump criterion (:func:`jumped`).
 
-    ``hist`` holds the last two accepted (D, state) of the branch (one after a jump), for the predictor;
+    ``hist`` holds the last two accepted (D, state) of the branch (one after a jump), for the predictor,
+    ``eq`` the last accepted equilibrium (a caller hands it over, so that no frame keeps an older one alive);
     ``spent`` counts the convolutions of every solve, recorded or discarded (jump checks, refining)."""
 
     def __init__(self, U0, law, kernel, solver, steps=None, on_row=None, jump_h: float = 0.3):
@@ -83,6 +84,7 @@ class Walker:
         self._U0s = U0 if fold is None else fold(U0, kernel)
         self.on_row, self.jump_h = on_row, jump_h
         self.hist: list = []
+        self.eq = None  # the current (last accepted) equilibrium; the walker holds it, not its caller
         self.spent = 0
 
     def solve(self, D, start):
@@ -94,9 +96,14 @@ class Walker:
         self.spent += int(eq.n_conv)
         return eq
 
-    def reset(self, D, state) -> None:
-        """Start the predictor's history afresh at (D, state)."""
-        self.hist = [(D, state)]
+    def reset(self, D, eq) -> None:
+        """Start afresh at the accepted ``eq`` at D: the predictor's history and the current equilibrium."""
+        self.hist, self.eq = [(D, eq.state)], eq
+
+    def take(self):
+        """The current equilibrium, handed over: the walker keeps no reference to it."""
+        eq, self.eq = self.eq, None
+        return eq
 
     def push(self, D, state) -> None:
         """Accept (D, state) as the newest of the predictor's history."""
@@ -104,7 +111,7 @@ class Walker:
 
     def begin(self, D, eq) -> None:
         """The branch's first row: ``eq`` at D (on the grid), the history started there."""
-        self.reset(D, eq.state)
+        self.reset(D, eq)
         self.on_row(D, eq, True, False)
 
     def predict(self, D, c_max: float = 1.5, c_min: float = 0.0):
@@ -127,19 +134,24 @@ class Walker:
         predicted one jumped (a predictor can overshoot onto another branch)."""
         start, predicted = self.predict(Db, c_max) if predictor else (self.hist[-1][1], False)
         eqb = self.solve(Db, start)
+        del start  # the solver copied it
         if predicted and self.jumped(eqa, eqb, Db - Da):
+            eqb = None  # discarded: freed before the solve again
             eqb = self.solve(Db, eqa.state)  # confirm without the predictor
         return eqb, self.jumped(eqa, eqb, Db - Da)
 
-    def walk(self, eq, D_from, stops, on_grid: bool = True):
-        """From the accepted ``eq`` at ``D_from`` through ``stops`` (the D the walk must visit, in path
-        order, the last its end), the steps chosen by ``self.steps``; returns the last equilibrium.
+    def walk(self, stops, on_grid: bool = True, start=None):
+        """From the current equilibrium (or ``start`` = (D, eq), the history kept as it is) through
+        ``stops`` (the D the walk must visit, in path order, the last its end), the steps chosen by
+        ``self.steps``; returns the last equilibrium, also the walker's current one.
         ``on_grid``: whether the stops are rows of the path's grid."""
+        D_from, eq = start if start is not None else (self.hist[-1][0], self.eq)
         plan = self.steps.plan(self, eq, D_from, stops, on_grid)
         Da = D_from
         while (Db := plan.next()) is not None:
             eqb, jump = self.step(Da, eq, Db, plan.predictor, plan.c_max)
             if jump and plan.refine(Da, Db):
+                eqb = None  # discarded: freed before the shorter step's solve
                 continue
             rows, inner = plan.accept(Da, eq, Db, eqb, jump)
             for row in rows:
@@ -149,6 +161,7 @@ class Walker:
             else:
                 self.hist = (self.hist + [(d, e.state) for d, e in inner] + [(Db, eqb.state)])[-2:]
             Da, eq = Db, eqb
+            self.eq = eq
         for row in plan.finish():
             self.on_row(*row)
         return eq

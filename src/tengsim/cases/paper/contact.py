@@ -14,8 +14,7 @@ from tengsim.device.params import AreaTable
 from tengsim.errors import TengsimError
 from tengsim.io import jsonable
 from tengsim.shapes import Pyramid
-from tengsim.continuation import LoadPathSpec
-from tengsim.continuation import PathSpec
+from tengsim.continuation import LoadPathSpec, PathSpec
 from tengsim.cases.paper.units import PAPER_GROUPS, paper_scaling
 
 # The paper's reported partial-to-full contact transitions (Fig. 4a), for comparison only.
