@@ -15,7 +15,7 @@ paper's −1 … 14 rounded up to a multiple of the largest step, so both runs v
 
 Counted: *solves* (every call of the solver, rejected adaptive steps and the fixed scheme's
 predictor-confirm solves included), *rows* (equilibria in the result), convolutions (sum of n_conv
-over every solve) and wall time.  F is compared by :func:`tengsim.path.compare_paths`: the adaptive
+over every solve) and wall time.  F is compared by :func:`tengsim.continuation.compare_paths`: the adaptive
 curve is cut at its jumps, interpolated on each continuous piece (PCHIP; linear reported too) at every D of the fixed
 curve, fixed D inside an adaptive jump interval are skipped; the error is |ΔF| / max(|F|, |pull-off
 F|).  Jump positions are the D_after of each recorded jump (branch, order).
@@ -51,7 +51,7 @@ class Counting:
 def run_group(group, dx, fixed_step, factor, tol, adapt_h, refine):
     import tengsim as ts
     from tengsim.kernels import FreeKernel
-    from tengsim.path import PathSpec, compare_paths, run_path
+    from tengsim.continuation import PathSpec, compare_paths, run_path
     from tengsim.cases.paper.units import paper_scaling
 
     sc = paper_scaling(group)
@@ -125,7 +125,7 @@ def table(rows, args) -> str:
         "included); *rows* the equilibria in the result; *conv* the convolutions of all solves. "
         "*max rel ΔF*: the adaptive curve, cut at its jumps and interpolated by PCHIP (scipy's monotone "
         "cubic) on each piece (*linear*: the same, linearly, the curve as plotted), at every D of the fixed curve, |ΔF| / max(|F_fixed|, |pull-off F|) "
-        "(`tengsim.path.compare_paths`); fixed D inside an adaptive jump interval are skipped. "
+        "(`tengsim.continuation.compare_paths`); fixed D inside an adaptive jump interval are skipped. "
         "At the D both runs share (every 0.8) the states agree to the solver tolerance (max rel ΔF "
         "there: " + ", ".join(f"{r['group']} {r['max_rel_dF_same_D']:.1e}" for r in rows) + "). "
         "*max jump ΔD*: largest |ΔD_after| between jumps matched by branch and order (NaN if the "

@@ -8,7 +8,7 @@ pixels per cell (default 40: dx = L̄/40 = 0.095, at least as fine as the paper'
 and a 640² grid = 2^7·5, FFT-friendly, where dx = 0.1 itself gives 39 px/cell and 624² = 2^4·3·13).
 
 The path: D-controlled approach only (no retraction) with the package's path machinery
-(``tengsim.path.run_path``: warm starts, secant predictor, jump bisection), LJ93, fast solver
+(``tengsim.continuation.run_path``: warm starts, secant predictor, jump bisection), LJ93, fast solver
 (tol 1e-6), from D = −1 to ``--d-max`` (default 23.5 ε, where the nominal pressure has passed 150 kPa),
 fixed step ``--d-step`` (default 0.1 ε ≈ 0.7 kPa on the film) or, with ``--adaptive``, the adaptive
 continuation (``PathSpec(adaptive=True)``, step ``--d-step`` with ``--refine`` halvings).
@@ -62,7 +62,7 @@ class CountingSolver:
 def run(K=16, px=40, scatter=0.02, seed=0, d_step=0.1, d_max=23.5, adaptive=False, refine=3, film=True):
     from tengsim.kernels import make_kernel
     from tengsim.observers import ArrayArea
-    from tengsim.path import PathSpec, run_path
+    from tengsim.continuation import PathSpec, run_path
     from tengsim.solvers import make_solver
 
     sc = paper_scaling("A")

@@ -53,7 +53,7 @@ def _eq_row(case, D, eq, grid):
 def md_sphere():
     from tengsim.kernels import FreeKernel
     from tengsim.laws import MaugisDugdale
-    from tengsim.path import walk_states
+    from tengsim.continuation import walk_states
     from tengsim.shapes import Paraboloid
     from tengsim.solvers import FastSolver
     mu = 1.0

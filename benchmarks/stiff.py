@@ -29,7 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
-from tengsim import continuation
+from tengsim.continuation import walker as continuation
 from tengsim.run.plan import plan_contact
 from tengsim.run.simulate import run_contact
 from tengsim.kernels import make_kernel

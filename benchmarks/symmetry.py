@@ -25,7 +25,7 @@ import numpy as np
 from tengsim.cases.paper.contact import group_shape
 from tengsim.cases.paper.units import paper_scaling
 from tengsim.run.simulate import run_contact, simulate
-from tengsim.path import PathSpec
+from tengsim.continuation import PathSpec
 
 
 def _runner(group, dx, d_max, d_step, boundary, tol):

@@ -27,7 +27,7 @@ from tengsim.run.simulate import simulate
 from tengsim.device.formulas import voc_polymer
 from tengsim.shapes import Pyramid
 from tengsim.paper import area_table_from_result
-from tengsim.path import PathSpec
+from tengsim.continuation import PathSpec
 from tengsim.cases.paper.units import paper_scaling
 
 SIGMA, EPS_R, T_POLY = 5.84e-6, 2.40, 400e-6  # Section 4 (Fig. 5): σ, ε_r, polymer thickness for Eq. (12)

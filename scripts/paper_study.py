@@ -42,7 +42,7 @@ import numpy as np  # noqa: E402
 from tengsim.analysis import tensile_peak_offset  # noqa: E402
 from tengsim.run.simulate import simulate  # noqa: E402
 from tengsim.shapes import HeightMap, Pyramid  # noqa: E402
-from tengsim.path import PathSpec  # noqa: E402
+from tengsim.continuation import PathSpec  # noqa: E402
 from tengsim.cases.paper.units import paper_scaling  # noqa: E402
 
 PAPER = {"A": 1.75, "B": 5.20, "C": 10.95}

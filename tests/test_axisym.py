@@ -19,7 +19,7 @@ from tengsim.axisym import AxisymSphere, disc_integral, walk
 from tengsim.shapes import Paraboloid
 from tengsim.laws import LJ93
 from tengsim.kernels import FreeKernel
-from tengsim.path import PathSpec, run_path
+from tengsim.continuation import PathSpec, run_path
 from tengsim.solvers import FastSolver
 
 

@@ -124,7 +124,7 @@ def test_a_negative_pressure_with_its_unit_is_a_value(tmp_path, capsys):
 
 def test_d_max_help_states_the_load_control_default():
     from tengsim.run.keys import common_fields
-    from tengsim.loadpath import LoadPathSpec
+    from tengsim.continuation import LoadPathSpec
 
     f = {x.name: x for x in common_fields()}["d_max"]
     assert f.default == 4.0 and f"default {LoadPathSpec.d_max:g}" in f.help

@@ -6,8 +6,7 @@ import pytest
 
 from tengsim.cli.main import main
 from tengsim.run.plan import plan_contact
-from tengsim.loadpath import LoadPathSpec
-from tengsim.path import PathSpec
+from tengsim.continuation import LoadPathSpec, PathSpec
 from tengsim.cases.paper.units import paper_scaling
 
 GROUP_A = ["contact", "pyramid", "--N", "0.946", "--cell", "3.78", "--tabor", "0.5", "--dx", "0.3", "--quiet"]
@@ -159,7 +158,7 @@ def test_cli_maps_at_refused_one_line_nothing_written(tmp_path, capsys, bad, wor
 def test_cli_load_not_met_warns_with_where(tmp_path, capsys, monkeypatch):
     """A load whose outer solve stops short of f_tol (regula falsi capped at one step here): exit 0, the
     rows not_converged, and the warnings say which loads and where."""
-    from tengsim import loadpath
+    from tengsim.continuation import load as loadpath
 
     monkeypatch.setattr(loadpath._LoadBranch, "max_root_steps", 1)
     out = tmp_path / "l.csv"

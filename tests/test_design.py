@@ -31,7 +31,7 @@ def test_small_design_ok_and_within_1pct_of_a_grid_sqrt2_finer(small):
     from tengsim.run.plan import plan_contact
     from tengsim.run.simulate import simulate
     from tengsim.design.curves import branch_curves
-    from tengsim.path import PathSpec
+    from tengsim.continuation import PathSpec
 
     assert small.status == "ok"
     res = small.finest

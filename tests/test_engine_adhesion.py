@@ -23,7 +23,7 @@ from tengsim import references as ref
 from tengsim.shapes import Paraboloid
 from tengsim.laws import LJ93
 from tengsim.kernels import FreeKernel
-from tengsim.path import PathSpec, run_path
+from tengsim.continuation import PathSpec, run_path
 from tengsim.solvers import FastSolver
 
 AXISYM_TOL = 3e-3  # the 2-D engine at dx 0.1–0.2 against the rings (dr 0.04, mesh-converged to 1e-4, 1e-3 at μ = 3)

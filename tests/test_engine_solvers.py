@@ -165,7 +165,7 @@ def test_vsr_reaches_tighter_tol():
 def test_vsr_and_fast_agree_on_whole_path():
     """Approach and retraction of group A (μ = 0.5, dx = 0.2): both solvers, same D grid and
     step control, give the same F(D) and Λc(D) on both branches (to 1e-5 and one-hundredth of dx)."""
-    from tengsim.path import PathSpec, run_path
+    from tengsim.continuation import PathSpec, run_path
 
     grid, U0, K = _group_a(0.2)
     spec = PathSpec(-1.0, 2.5, 0.25)

@@ -14,7 +14,7 @@ from tengsim.errors import TengsimError
 from tengsim.kernels import make_kernel
 from tengsim.laws import LJ93, MaugisDugdale
 from tengsim.plugins import LAWS
-from tengsim.path import PathSpec
+from tengsim.continuation import PathSpec
 from tengsim.shapes.rough import Rough
 from tengsim.solvers import FastSolver, Problem, State, make_solver
 from tengsim.solvers.homotopy import HomotopySolver, Softened, homotopy_solve, plan_stages

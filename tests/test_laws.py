@@ -181,7 +181,7 @@ def md_branch(mu, dx, cell, Ds, k=1e4, tol=1e-7, pre=(), smoothing=0.2):
     from tengsim.analysis import apex_index, edge_radius
     from tengsim.shapes import Paraboloid
     from tengsim.kernels import FreeKernel
-    from tengsim.path import walk_states
+    from tengsim.continuation import walk_states
     from tengsim.solvers import FastSolver
     shape = Paraboloid(1.0, cell)
     grid = shape.grid(dx)
@@ -329,12 +329,12 @@ def test_md_sphere_dmt_end_mu01():
 
 
 def test_walk_states_matches_run_path():
-    """tengsim.path.walk_states (the walks above) gives run_path's approach rows (LJ93 sphere, μ = 0.5,
+    """tengsim.continuation.walk_states (the walks above) gives run_path's approach rows (LJ93 sphere, μ = 0.5,
     dx 0.25, cell 4, D −0.6 … 0.4 in 0.2 steps) to the solver tolerance (F within 1e-5); it also walks down."""
     from tengsim.analysis import force
     from tengsim.shapes import Paraboloid
     from tengsim.kernels import FreeKernel
-    from tengsim.path import PathSpec, run_path, walk_states
+    from tengsim.continuation import PathSpec, run_path, walk_states
     from tengsim.solvers import FastSolver
     shape = Paraboloid(1.0, 4.0)
     grid = shape.grid(0.25)

@@ -9,8 +9,7 @@ import pytest
 import tengsim as ts
 from tengsim import references as ref
 from tengsim.kernels import FreeKernel
-from tengsim.loadpath import LoadPathSpec, run_load_path
-from tengsim.path import PathSpec, run_path
+from tengsim.continuation import LoadPathSpec, PathSpec, run_load_path, run_path
 from tengsim.solvers import Problem, State
 from tengsim.cases.paper.units import paper_scaling
 
@@ -169,7 +168,7 @@ def test_paper_area_table_load_controlled_matches_d_picked():
 @lru_cache(maxsize=None)
 def group_a_load(maps_at=(), steps=None):
     """Group A at dx 0.4 under load −0.5 … 0.5 in steps of 0.25 (``steps``: the regula-falsi cap)."""
-    from tengsim import loadpath
+    from tengsim.continuation import load as loadpath
 
     sc = paper_scaling("A")
     shape = ts.Pyramid(sc.N, sc.cell)

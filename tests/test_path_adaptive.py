@@ -2,7 +2,7 @@
 
 Criteria (benchmarks/adaptive_path.py measures them on groups A, B, C at dx 0.2): F within 0.5 %
 (|ΔF| / max(|F|, |pull-off F|), the adaptive curve interpolated by PCHIP at the fixed curve's D,
-``tengsim.path.compare_paths``), jump D within the smallest step, at least 2× fewer solver calls
+``tengsim.continuation.compare_paths``), jump D within the smallest step, at least 2× fewer solver calls
 (defaults adapt_tol 0.15, adapt_h 0.5: 119 / 53 = 2.25× here, 2.46× at dx 0.2; checked at 2×).
 """
 from __future__ import annotations
@@ -14,7 +14,7 @@ import pytest
 
 import tengsim as ts
 from tengsim.kernels import FreeKernel
-from tengsim.path import PathSpec, compare_paths, run_path
+from tengsim.continuation import PathSpec, compare_paths, run_path
 from tengsim.cases.paper.units import paper_scaling
 
 

@@ -65,7 +65,7 @@ def test_simulate_reports_inside_long_solves(monkeypatch):
     lowered here so that a small grid counts as large)."""
     from tengsim.run import simulate as contact
     from tengsim.shapes import Paraboloid
-    from tengsim.path import PathSpec
+    from tengsim.continuation import PathSpec
 
     monkeypatch.setattr(contact, "MONITOR_MIN_POINTS", 0)
     s = io.StringIO()

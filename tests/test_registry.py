@@ -138,15 +138,15 @@ def test_observer_errors_are_named():
 
 
 def test_paper_study_uses_an_observer_not_a_monkeypatch():
-    """scripts/paper_study.py used to replace tengsim.path.summarize on import."""
-    import tengsim.path
+    """scripts/paper_study.py used to replace tengsim.continuation.path.summarize on import."""
+    import tengsim.continuation.path
 
-    before = dict(vars(tengsim.path))
+    before = dict(vars(tengsim.continuation.path))
     path = Path(__file__).parent.parent / "scripts" / "paper_study.py"
     spec = importlib.util.spec_from_file_location("_paper_study_under_test", path)
     mod = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(mod)
-    assert {k: v for k, v in vars(tengsim.path).items() if before.get(k) is not v} == {}
+    assert {k: v for k, v in vars(tengsim.continuation.path).items() if before.get(k) is not v} == {}
     case = dict(name="t_A", study="t", group="A", mu=0.5, boundary="free", d_min=-1.0, d_max=0.0,
                 d_step=0.5, tol=1e-5, dx=0.3, variant="")
     _, rows, info = mod.run_case(case)

@@ -14,7 +14,7 @@ _PEAK = r"""
 import json, resource, sys
 from tengsim.run.simulate import simulate
 from tengsim.shapes import Pyramid
-from tengsim.path import PathSpec
+from tengsim.continuation import PathSpec
 def rss():
     # peak RSS of this process image: VmHWM (getrusage's ru_maxrss also counts the parent's RSS at
     # fork time, since Linux keeps it across exec)

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from tengsim.run.plan import plan_contact
-from tengsim.continuation import PERSIST_FACTOR, Branch, persist
+from tengsim.continuation.walker import PERSIST_FACTOR, Walker, persist
 from tengsim.kernels import make_kernel
 from tengsim.solvers import FastSolver, Problem, State, VSRSolver
 
@@ -47,7 +47,7 @@ def test_stiff_bump_equilibrium_converges_and_satisfies_eq9(tmp_path):
     assert out.iterations > 3000 and "after the cap" in out.message
     assert _eq9_residual(problem, out, -1.0) <= 2e-6  # independent of the solver's own bookkeeping
     # the branch walker applies it by itself
-    br = Branch(U0, law, kernel, fast, None, None)
+    br = Walker(U0, law, kernel, fast)
     again = br.solve(-1.0, State.zero(U0.shape))
     assert again.converged and again.iterations == out.iterations
     assert np.array_equal(again.H, out.H)
@@ -60,7 +60,7 @@ def test_converged_solve_is_untouched(tmp_path):
     eq = fast.solve(problem, State.zero(U0.shape))
     assert eq.converged
     assert persist(fast, problem, eq) is eq
-    br = Branch(U0, law, kernel, fast, None, None)
+    br = Walker(U0, law, kernel, fast)
     eq2 = br.solve(-1.0, State.zero(U0.shape))
     assert np.array_equal(eq2.H, eq.H) and eq2.iterations == eq.iterations and eq2.n_conv == eq.n_conv
 
@@ -122,7 +122,7 @@ def test_simulate_continues_capped_solves_also_on_the_mirror_block():
     """Through simulate (sphere: the mirror-reduced solve, MirrorSolver around the fast solver): with a
     cap far too small every row still converges, and F(D) equals the uncapped run's to 1e-6 relative."""
     from tengsim.run.simulate import simulate
-    from tengsim.path import PathSpec
+    from tengsim.continuation import PathSpec
     from tengsim.shapes.axisymmetric import Paraboloid
     shape = Paraboloid(radius=1.0, cell=6.0)
     path = PathSpec(d_min=-1.0, d_max=0.5, d_step=0.5)

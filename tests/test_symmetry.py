@@ -20,8 +20,7 @@ from tengsim.run.simulate import choose_symmetry, simulate
 from tengsim.grid import Mirror
 from tengsim.kernels import make_kernel
 from tengsim.laws import LJ93
-from tengsim.loadpath import LoadPathSpec
-from tengsim.path import PathSpec
+from tengsim.continuation import LoadPathSpec, PathSpec
 from tengsim.shapes import Pyramid
 from tengsim.shapes.arrays import Array
 from tengsim.shapes.flat_topped import Line
@@ -263,7 +262,7 @@ def test_config_symmetry_key(tmp_path, capsys):
 def test_whole_run_memory_under_30_percent():
     """Group B at dx 0.1 (99², block 50²), the path D −1 → 4 → −1 in 0.25: the tracemalloc peak of the whole
     symmetric run is <= 30 % of the full grid's (measured 0.292).  What keeps it there: the equilibria the
-    path holds keep H and P on the block (FoldedEquilibrium, unfolded when read, the last one kept), g0 and
+    path holds keep H and P on the block (FoldedEquilibrium, unfolded when read), g0 and
     the zero start are made on the block, the jump test compares blocks."""
     shape, mu = _group("B")
     run = lambda sym: simulate(shape, mu, 0.1, PathSpec(-1.0, 4.0, 0.25), symmetry=sym)  # noqa: E731
@@ -273,11 +272,11 @@ def test_whole_run_memory_under_30_percent():
 
 
 def test_folded_equilibrium_reads_like_the_full_one():
-    """H and P read unfolded (read-only, the same array on a second read), max_change on the blocks equals
-    the full grids', dataclasses.replace gives a plain equilibrium holding the unfolded fields."""
-    import dataclasses
-
+    """A wrapper, not a subclass: H and P read unfolded (read-only, equal on a second read), the rest of the
+    record is the block's, max_change on the blocks equals the full grids', ``unfolded()`` is the plain
+    equilibrium on the full grid, ``replace`` changes the block's record and keeps it folded."""
     from tengsim.kernels.mirror import MirrorKernel
+    from tengsim.solvers import Equilibrium
     from tengsim.solvers.mirror import FoldedEquilibrium
 
     shape, mu = _group("A")
@@ -287,12 +286,19 @@ def test_folded_equilibrium_reads_like_the_full_one():
     U0 = shape.gap(grid)
     e1 = s.solve(Problem(U0 + 1.0, LJ93(), K), State.zero(grid.shape))
     e2 = s.solve(Problem(U0 + 0.5, LJ93(), K), e1.state)
-    assert isinstance(e1, FoldedEquilibrium) and e1.H.shape == grid.shape and not e1.H.flags.writeable
-    assert e2.H is e2.H and np.array_equal(e1.H, np.asarray(e1.H))
+    assert isinstance(e1, FoldedEquilibrium) and not isinstance(e1, Equilibrium)
+    assert e1.H.shape == grid.shape and not e1.H.flags.writeable and not e1.P.flags.writeable
+    assert np.array_equal(e2.H, e2.H) and e1.block.H.shape == tuple(K.mirror.reduced_shape)
+    assert (e2.state, e2.iterations, e2.n_conv, e2.energy, e2.message) == (
+        e2.block.state, e2.block.iterations, e2.block.n_conv, e2.block.energy, e2.block.message)
     full = float(np.max(np.abs(np.asarray(e2.H) - np.asarray(e1.H))))
     assert e2.max_change(e1) == full
-    r = dataclasses.replace(e2, message="x")
-    assert type(r) is FoldedEquilibrium and r._mirror is None and r.H is e2.H  # the unfolded fields, passed on
+    plain = e2.unfolded()
+    assert type(plain) is Equilibrium and np.array_equal(plain.H, e2.H) and np.array_equal(plain.P, e2.P)
+    assert plain.max_change(e1) == full and e1.max_change(plain) == full  # folded against plain: full grids
+    r = e2.replace(message="x")
+    assert type(r) is FoldedEquilibrium and r.message == "x" and r.block.H is e2.block.H
+    assert np.array_equal(r.H, e2.H)
 
 
 @pytest.mark.slow

@@ -6,7 +6,7 @@ import pytest
 
 from tengsim.analysis import tensile_peak_offset
 from tengsim.errors import TengsimError
-from tengsim.path import PathSpec
+from tengsim.continuation import PathSpec
 from tengsim.cases.paper.units import PaperScaling, paper_scaling
 from tengsim.units import parse_quantity
 

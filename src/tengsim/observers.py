@@ -4,7 +4,7 @@ The continuation path calls every observer once per recorded equilibrium with th
 ``eq`` (``eq.P``, ``eq.H`` in the units of Eq. 7) and a :class:`Context` (grid, apex index, initial
 gap U0, law, kernel).  The built-in :class:`Summary` gives the columns every run has (Eq. 10's F, the
 contact length, ...); more observers are passed to :func:`tengsim.simulate` or
-:func:`tengsim.path.run_path` as ``observers=`` (registered names or objects) and their columns are
+:func:`tengsim.continuation.run_path` as ``observers=`` (registered names or objects) and their columns are
 appended to the table, CSV and NetCDF.  A user registers one with::
 
     @OBSERVERS.register("mine")

@@ -9,7 +9,7 @@
    and an estimated time: :data:`SECONDS_PER_PIXEL_ROW` × pixels × rows per grid (docs/benchmarks.md, "Design
    time constant"); an estimate above the plan's budget is refused (a :class:`tengsim.errors.TengsimError`
    naming max_pixels and tol) before anything is solved or written.
-2. **Path.**  An adaptive D walk (:class:`tengsim.path.PathSpec`) from D = -1 ε to a d_max found on a grid
+2. **Path.**  An adaptive D walk (:class:`tengsim.continuation.path.PathSpec`) from D = -1 ε to a d_max found on a grid
    twice as coarse as the default first grid: from 1.2 × the structure's height (+2 ε), extended in chunks (the
    last rows' dP/dD, extrapolated to 1.3 × the pressure still missing) until the approach reaches p_max, at
    most :data:`EXTEND_TRIES` times; else an error naming the highest pressure reached, in kPa.  A finer grid's
@@ -224,7 +224,7 @@ def check_budget(plan, est: Estimate, fit_pixels: int | None = None) -> None:
 
 def _simulate(cplan, dx, d_max, **kw):
     from tengsim.run.simulate import simulate
-    from tengsim.path import PathSpec
+    from tengsim.continuation import PathSpec
 
     path = PathSpec(D_MIN, d_max, D_STEP, adaptive=True)
     return simulate(cplan.shape, cplan.tabor, dx, path, boundary=cplan.boundary, solver=cplan.solver,
@@ -309,7 +309,7 @@ def grid_path(plan, d_max):
     grid before it (:func:`map_depths` of its curve), so the finest grid's maps are recorded during its own walk
     (an extra row at each such D, solved from the rows around it: the walk's other rows are unchanged);
     ``plan.maps`` false: no maps."""
-    from tengsim.path import PathSpec
+    from tengsim.continuation import PathSpec
 
     def on_lattice(D):
         return D_MIN + math.ceil((D - D_MIN) / D_STEP - 1e-9) * D_STEP
@@ -408,7 +408,7 @@ def run_design(plan, progress=None, keep=None) -> DesignResult:
     _say(progress, cap_line(plan, cplan, dx, d_max, max_pixels))
     res = None
     for _ in range(2):
-        from tengsim.path import PathSpec
+        from tengsim.continuation import PathSpec
 
         path = PathSpec(D_MIN, d_max, D_STEP, adaptive=True)
         ck, found = _checkpoint(keep, plan, d_max, progress) or (None, None)

@@ -92,7 +92,7 @@ def _maps_values(v, label="maps_at"):
 
 def common_fields() -> list:
     """The [contact] keys every shape has (choices and help read from the registries)."""
-    from tengsim.loadpath import LoadPathSpec
+    from tengsim.continuation import LoadPathSpec
 
     return [
         Field("shape", "str", "pyramid", check=SHAPES.canonical,

@@ -12,7 +12,7 @@ import numpy as np
 from tengsim.kernels import film
 from tengsim.errors import ConfigValueError, TengsimError, finite, positive, shown
 from tengsim.laws import LJ93, make_law
-from tengsim.path import PathSpec
+from tengsim.continuation import PathSpec
 from tengsim.plugins import KERNELS
 from tengsim.run.keys import (ADAPTIVE_KEYS, LOAD_KEYS, common_fields, common_names, contact_keys,
                               contact_table, law_fields, law_keys, physical_triggers, shape_class)
@@ -106,7 +106,7 @@ def _path_spec(vals, given, scaling):
         missing = [k for k in ("f_max", "f_step") if k not in given]
         if missing:
             raise TengsimError(f"control = 'load' needs {', '.join(missing)}")
-        from tengsim.loadpath import LoadPathSpec
+        from tengsim.continuation import LoadPathSpec
 
         f = {k: _load_F(k, vals[k], scaling) for k in LOAD_KEYS if vals[k] is not None}
         kw = {"d_min": vals["d_min"], "d_step": vals["d_step"], "to_max": True}  # the path ends at f_max
@@ -196,7 +196,7 @@ class ContactPlan:
     shape: object
     tabor: float
     dx: float
-    path: object  # PathSpec or tengsim.loadpath.LoadPathSpec
+    path: object  # PathSpec or tengsim.continuation.load.LoadPathSpec
     boundary: str = "free"
     solver: object = "fast"
     tol: float = 1e-6

@@ -13,8 +13,8 @@ from tengsim.laws import Law
 from tengsim.kernels import make_kernel
 from tengsim.kernels.distributed import SlabPeriodicKernel
 from tengsim.kernels.mirror import BOUNDARIES as MIRROR_BOUNDARIES, MirrorKernel
-from tengsim.loadpath import LoadPathSpec, run_load_path
-from tengsim.path import PathSpec, run_path
+from tengsim.continuation import LoadPathSpec, run_load_path
+from tengsim.continuation import PathSpec, run_path
 from tengsim.resources import MAP_WORK, check_memory
 from tengsim.solvers import SOLVERS, make_solver
 from tengsim.solvers.mirror import MirrorSolver

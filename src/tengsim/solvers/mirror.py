@@ -4,9 +4,9 @@ A :class:`MirrorSolver` wraps a solver ('fast', 'vsr').  Given a :class:`~tengsi
 kernel carries a mirror (duck-typed: ``kernel.mirror`` a :class:`tengsim.grid.Mirror`, ``kernel.reduced``
 the kernel acting on the block; tengsim.kernels.mirror builds one) and ``g0`` on the full grid, it
 solves the weighted problem on the block (g0 reduced, weights = the block pixels' multiplicities) and
-returns an :class:`~tengsim.solvers.Equilibrium` whose ``state`` lives on the block (the path's secant
-predictions and starts then cost a block's memory) and whose ``H`` and ``P`` are unfolded to the full
-grid, so that everything reading a solution (path, recorder, observers, status, maps) sees the full grid.
+returns a :class:`FoldedEquilibrium`, the block's equilibrium wrapped: its ``state`` lives on the block (the
+path's secant predictions and starts then cost a block's memory) and its ``H`` and ``P`` are unfolded to
+the full grid when read, so that everything reading a solution (path, recorder, observers, status, maps) sees the full grid.
 A start on the full grid (the path's ``State.zero``) is reduced first.
 
 For a symmetric g0 the block's iterates are the full grid's (the full solver keeps a symmetric iterate
@@ -17,8 +17,7 @@ This module imports no kernel: the kernels and the solvers are independent packa
 """
 from __future__ import annotations
 
-import dataclasses
-from dataclasses import replace
+from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
@@ -84,53 +83,48 @@ class MirrorSolver:
         if problem.weights is not None:
             raise TengsimError("MirrorSolver: the problem is weighted already")
         eq = self.inner.solve(Problem(g0b, problem.law, reduced, weights=m), start_b)
-        return FoldedEquilibrium(eq.state, eq.H, eq.P, eq.residual, eq.converged, eq.iterations, eq.n_conv,
-                                 eq.energy, eq.seconds, eq.message, mirror=mirror)
+        return FoldedEquilibrium(eq, mirror)
 
 
-class FoldedEquilibrium(Equilibrium):
-    """An :class:`~tengsim.solvers.Equilibrium` that keeps H and P on the block and gives them unfolded to
-    the full grid when read.  The equilibria a path holds (secant, jump tests) then cost a block's memory;
-    the one most recently read is kept unfolded (one slot per mirror, per field), so the reads of one row
-    (force, contact length, status, observers, maps) unfold it once.  Built without a mirror (e.g. by
-    ``dataclasses.replace``, which passes the unfolded fields) it is a plain equilibrium.  A value, as
-    every Equilibrium: complete at construction (``mirror=`` included), no attribute set afterwards."""
+@dataclass(frozen=True)
+class FoldedEquilibrium:
+    """The equilibrium of a mirror-symmetric problem: the block's :class:`~tengsim.solvers.Equilibrium`
+    (``block``) wrapped with the ``mirror`` that unfolds it, read as the full grid's.  ``H`` and ``P`` are
+    unfolded when read (a new read-only array each read), every other field is the block's.  The
+    equilibria a path holds (secant, jump tests) then cost a block's memory, and no full-grid field
+    outlives its reader; a reader of many fields takes :meth:`unfolded` once."""
 
-    _mirror = None
+    block: Equilibrium
+    mirror: object
 
-    def __init__(self, *fields, mirror=None, **named):
-        super().__init__(*fields, **named)
-        object.__setattr__(self, "_mirror", mirror)
-
-    def __setattr__(self, name, value):
-        raise dataclasses.FrozenInstanceError(f"cannot assign to field {name!r}")
-
-    def __delattr__(self, name):
-        raise dataclasses.FrozenInstanceError(f"cannot delete field {name!r}")
-
-    def _full(self, name):
-        block = self.__dict__["_" + name]
-        m = self._mirror
-        if m is None:
-            return block
-        slot = m.__dict__.setdefault("_unfolded", {})
-        hit = slot.get(name)
-        if hit is not None and hit[0] is block:
-            return hit[1]
-        full = m.unfold(block)
-        full.flags.writeable = False  # shared by every read: a reader that wants to write copies
-        slot[name] = (block, full)
+    def _full(self, block):
+        full = self.mirror.unfold(block)
+        full.flags.writeable = False  # as a plain equilibrium's: a reader that wants to write copies
         return full
+
+    H = property(lambda self: self._full(self.block.H))
+    P = property(lambda self: self._full(self.block.P))
+
+    def unfolded(self) -> Equilibrium:
+        """The plain equilibrium on the full grid (H and P unfolded once)."""
+        return replace(self.block, H=self.H, P=self.P)
+
+    def replace(self, **changes) -> "FoldedEquilibrium":
+        """``dataclasses.replace`` on the block (its H and P stay the block's)."""
+        return FoldedEquilibrium(replace(self.block, **changes), self.mirror)
 
     def max_change(self, other) -> float:
         """max |H − other.H|: on the blocks when both are folded by the same mirror (the unfolded fields
         only repeat the block's values)."""
-        if self._mirror is not None and getattr(other, "_mirror", None) is self._mirror:
-            return float(np.max(np.abs(self.__dict__["_H"] - other.__dict__["_H"])))
-        return super().max_change(other)
+        if isinstance(other, FoldedEquilibrium) and other.mirror is self.mirror:
+            return float(np.max(np.abs(self.block.H - other.block.H)))
+        return float(np.max(np.abs(self.H - other.H)))
 
-    H = property(lambda self: self._full("H"), lambda self, v: self.__dict__.__setitem__("_H", v))
-    P = property(lambda self: self._full("P"), lambda self, v: self.__dict__.__setitem__("_P", v))
+
+for _f in fields(Equilibrium):  # the rest of the record reads through to the block's
+    if _f.name not in ("H", "P"):
+        setattr(FoldedEquilibrium, _f.name, property(lambda self, _n=_f.name: getattr(self.block, _n)))
+del _f
 
 
 def _reduce_state(start: State, mirror, full, block) -> State:

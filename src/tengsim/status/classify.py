@@ -138,7 +138,7 @@ def problems(result) -> list[tuple[str, str]]:
         where = f"at {k} of {n} equilibria ({_where(t, m)})"
         if kind == NOT_CONVERGED:
             text = f"residual of Eq. (9) above tol = {p.get('tol', '?')}"
-            if p.get("load_not_met"):  # load control: the outer solve on D missed a load (tengsim.loadpath)
+            if p.get("load_not_met"):  # load control: the outer solve on D missed a load (tengsim.continuation.load)
                 text += f" or load not met to f_tol = {p.get('f_tol', '?')}"
             text += f" {where}"
             if _snaps(snap) and p.get("solver", "fast") == "fast":  # stiff at the pixel: the homotopy's case

@@ -14,8 +14,7 @@ from tengsim.device.params import AreaTable
 from tengsim.errors import TengsimError
 from tengsim.io import jsonable
 from tengsim.shapes import Pyramid
-from tengsim.loadpath import LoadPathSpec
-from tengsim.path import PathSpec
+from tengsim.continuation import LoadPathSpec, PathSpec
 from tengsim.cases.paper.units import PAPER_GROUPS, paper_scaling
 
 # The paper's reported partial-to-full contact transitions (Fig. 4a), for comparison only.
@@ -87,7 +86,7 @@ def area_table_from_result(res, group: str) -> AreaTable:
 
 def run_group_load(group: str, f_max: float, settings: RunSettings = RunSettings(), n_loads: int | None = None,
                    f_min: float = 0.0, progress=None):
-    """Load-controlled approach of one pyramid group (:class:`tengsim.loadpath.LoadPathSpec`): loads
+    """Load-controlled approach of one pyramid group (:class:`tengsim.continuation.LoadPathSpec`): loads
     ``f_min`` … ``f_max`` (F of Eq. 10 per cell) in equal steps, ``n_loads`` (default settings.n_loads)
     or more so that a step is at most settings.p_step_Pa (at most 400 steps), D searched from
     settings.d_min in steps of settings.d_step (to two steps beyond settings.d_max), no retraction."""

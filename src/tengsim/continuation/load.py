@@ -7,7 +7,8 @@ path has at that D (the same warm starts, the same branch):
 
 1. walk in D from the current state, in the direction the load moves the body (D up when the
    target is above the current F, down when below), in steps of ``d_step`` with the D path's own
-   jump bisection (:class:`tengsim.continuation.Branch`), until F crosses the target;
+   jump bisection (:class:`tengsim.continuation.walker.Walker` with
+   :class:`tengsim.continuation.steps.FixedSteps`), until F crosses the target;
 2. solve F(D) = F_target in that bracket by regula falsi (Illinois), each trial D warm-started
    from the bracket's states interpolated, until |F − F_target| <= ``f_tol``.
 
@@ -28,129 +29,15 @@ Approach loads below the start's F (the body stays away) are skipped.
 """
 from __future__ import annotations
 
-import dataclasses
 import math
-from dataclasses import dataclass
-
-import numpy as np
 
 from tengsim.analysis import force
-from tengsim.errors import TengsimError, finite, positive
-from tengsim.continuation import Branch, Recorder, spent
-from tengsim.path import PathSpec
+from tengsim.continuation.recorder import Recorder, spent
+from tengsim.continuation.specs import BRANCHES, EXTEND_LIMIT, LoadPathSpec
+from tengsim.continuation.steps import FixedSteps
+from tengsim.continuation.walker import Walker, revise
+from tengsim.errors import TengsimError
 from tengsim.solvers import State
-
-
-@dataclass(frozen=True)
-class LoadPathSpec:
-    """Load from ``f_min`` up to ``f_max`` then back, in steps of ``f_step`` (F of Eq. 10).
-
-    The approach starts at rest at D = ``d_min``; D is searched within [``d_min``, ``d_max``] by a
-    walk of step ``d_step`` (jumps bisected ``refine_levels`` times, gap criterion ``jump_h`` as
-    in :class:`tengsim.path.PathSpec`).  ``f_tol``: accepted |F − target| (default 1e-4 f_step).
-    Rows at the targets have ``on_grid`` True; fold, landing and separation rows have it False.
-    ``maps_at`` lists loads whose maps are kept: a load off the f_step lattice becomes an extra target
-    on both branches (its row has ``on_grid`` False), so its map is of the state at that load; a load
-    outside [f_min, the last load of the lattice] is refused.  A load with no state on a branch (on the
-    approach below the load at rest, on the retraction past the pull-off) has no map there.
-    A target whose regula falsi ends (``max_root_steps`` steps, or a D bracket narrower than 1e-12)
-    with |F − target| > ``f_tol`` is recorded with ``converged`` False (status not_converged), and the
-    result's ``params['load_not_met']`` names each such load, its branch and D bracket.
-    """
-
-    f_min: float
-    f_max: float
-    f_step: float
-    d_min: float = -1.0
-    d_max: float = 20.0
-    d_step: float = 0.05
-    refine_levels: int = 4
-    jump_h: float = 0.3
-    f_tol: float | None = None
-    retract: bool = True
-    maps_at: tuple = ()
-    extend: bool = False
-    pa_per_F: float | None = None
-    eps_m: float | None = None
-    to_max: bool = False
-    """``to_max``: f_max is a load of the path even where f_max - f_min is no multiple of f_step (the last
-    step is then shorter), so the path ends at the load asked for.  ``extend``: the approach's search in D goes on past ``d_max`` (the span d_max - d_min doubled at each
-    reach, up to :data:`EXTEND_LIMIT` times the first span) until the load is met, so no d_max is to be
-    guessed.  ``pa_per_F`` (Pa per unit of F) and ``eps_m`` (m per ε): a physical run's units, in which
-    its errors name the loads and D."""
-
-    def __post_init__(self):
-        finite("f_min", self.f_min)
-        finite("f_max", self.f_max)
-        positive("f_step", self.f_step)
-        finite("d_min", self.d_min)
-        finite("d_max", self.d_max)
-        positive("d_step", self.d_step)
-        if not self.f_max > self.f_min:
-            raise TengsimError(f"f_max ({self.f_max}) must be greater than f_min ({self.f_min})")
-        if not self.d_max > self.d_min:
-            raise TengsimError(f"d_max ({self.d_max}) must be greater than d_min ({self.d_min})")
-        if (self.f_max - self.f_min) / self.f_step > 100000:
-            raise TengsimError(f"f_step={self.f_step} gives too many load steps; choose a larger step")
-        if int(self.refine_levels) < 0:
-            raise TengsimError(f"refine_levels must be >= 0, got {self.refine_levels!r}")
-        if self.f_tol is not None:
-            positive("f_tol", self.f_tol)
-        object.__setattr__(self, "maps_at", tuple(finite("maps_at", f) for f in self.maps_at))
-        last = float(self.targets()[-1])
-        tol = 1e-9 * self.f_step
-        for f in self.maps_at:
-            if not self.f_min - tol <= f <= last + tol:
-                raise TengsimError(f"maps_at load F = {f:g} is outside the path's load range [{self.f_min:g}, "
-                                   f"{last:g}]" + (f" (the last load of the f_step lattice below f_max = "
-                                                   f"{self.f_max:g})" if last < self.f_max - tol else ""))
-
-    @property
-    def tol_F(self) -> float:
-        return self.f_tol if self.f_tol is not None else 1e-4 * self.f_step
-
-    def targets(self) -> np.ndarray:
-        k = int(np.floor((self.f_max - self.f_min) / self.f_step + 1e-9))
-        t = self.f_min + self.f_step * np.arange(k + 1)
-        if self.to_max and t[-1] < self.f_max - 1e-9 * self.f_step:
-            t = np.append(t, self.f_max)
-        return t
-
-    def path_targets(self) -> list:
-        """The loads the path visits, in increasing order: [(F, on the f_step lattice)], the lattice and the
-        ``maps_at`` loads off it."""
-        lattice = [(float(f), True) for f in self.targets()]
-        tol = 1e-9 * self.f_step
-        extra = [(f, False) for f in sorted(set(self.maps_at)) if all(abs(f - g) > tol for g, _ in lattice)]
-        return sorted(lattice + extra)
-
-    def load_text(self, F: float) -> str:
-        """A load as the user gave it: 'p kPa (F = f)' in a physical run, 'F = f' otherwise."""
-        if self.pa_per_F is None:
-            return f"F = {F:.6g}"
-        from tengsim.units import format_si
-
-        return f"{format_si(F * self.pa_per_F, 'Pa', 4)} (F = {F:.6g})"
-
-    def d_text(self, D: float) -> str:
-        """D in ε, with its length in a physical run."""
-        if self.eps_m is None:
-            return f"{D:.6g}"
-        from tengsim.units import format_si
-
-        return f"{D:.6g} ε ({format_si(D * self.eps_m, 'm', 4)})"
-
-    def extra_params(self) -> dict:
-        return {"control": "load", "f_min": self.f_min, "f_max": self.f_max, "f_step": self.f_step,
-                "f_tol": self.tol_F}
-
-    def d_spec(self) -> PathSpec:
-        return PathSpec(self.d_min, self.d_max, self.d_step, refine_levels=self.refine_levels,
-                        jump_h=self.jump_h)
-
-
-EXTEND_LIMIT = 64
-"""With ``extend``, the D search of a load stops at d_min + EXTEND_LIMIT (d_max - d_min)."""
 
 
 class _Out(Exception):
@@ -168,8 +55,8 @@ class _LoadBranch:
         self.spec, self.emit, self.grid = spec, emit, kernel.grid
         self.name, self.misses, self.bracket = name, [], None
         self.trail: list = []
-        self.walker = Branch(U0, law, kernel, solver, spec.d_spec(),
-                              lambda D, eq, on_grid, jump: self.trail.append((D, eq, jump)))
+        self.walker = Walker(U0, law, kernel, solver, FixedSteps(spec.refine_levels),
+                             lambda D, eq, on_grid, jump: self.trail.append((D, eq, jump)), spec.jump_h)
         self.h_min = spec.d_step / 2 ** int(spec.refine_levels)
         self.d_max = spec.d_max  # with spec.extend, raised as the approach needs (_walk)
         self.d_limit = spec.d_min + EXTEND_LIMIT * (spec.d_max - spec.d_min) if spec.extend else spec.d_max
@@ -179,7 +66,7 @@ class _LoadBranch:
 
     def set(self, D, eq):
         self.D, self.eq, self.Fc = D, eq, self.F(eq)
-        self.walker.hist = [(D, eq.state)]
+        self.walker.reset(D, eq)
 
     def _walk(self, s):
         """One D step in direction s from the current end of the walk; returns its new points."""
@@ -190,7 +77,7 @@ class _LoadBranch:
         if D1 < self.spec.d_min - 1e-12 or D1 > self.d_max + 1e-12:
             raise _Out()
         self.trail = []
-        self.walker.advance(D0, eq0, D1, 0, False)
+        self.walker.walk([D1], on_grid=False, start=(D0, eq0))
         new = [(D, eq, self.F(eq), jump) for D, eq, jump in self.trail]
         self.pts += new
         return new
@@ -313,7 +200,7 @@ class _LoadBranch:
         msg = (f"{self.name}: {what} {self.spec.load_text(Ft)} not met: |F - target| = {err:.3g} > f_tol = "
                f"{self.spec.tol_F:.3g} (D in [{lo:.6g}, {hi:.6g}]{', ' + how if how else ''})")
         self.misses.append(msg)
-        return dataclasses.replace(eq, converged=False, message=msg)
+        return revise(eq, converged=False, message=msg)
 
     def _left(self, s):
         """The body left the D range under this load: record the state at the end of the walk."""
@@ -337,7 +224,7 @@ def _not_reached(spec: LoadPathSpec, branch: _LoadBranch, Ft: float) -> str:
 def run_load_path(U0, law, kernel, solver, spec: LoadPathSpec, start: State | None = None,
                   progress=None, keep_states: bool = False, observers=(), sink=None):
     """Solve the load-controlled approach–retraction path; returns a ContactResult (same columns as
-    :func:`tengsim.path.run_path`: D is an output, F the control).  ``progress(branch, F, done, total)``;
+    :func:`tengsim.continuation.run_path`: D is an output, F the control).  ``progress(branch, F, done, total)``;
     ``sink(row, maps)`` as for run_path."""
 
     targets = spec.targets()
@@ -350,7 +237,7 @@ def run_load_path(U0, law, kernel, solver, spec: LoadPathSpec, start: State | No
     def map_at(Ft):  # the maps_at entry of the load Ft, if any
         return next((m for m in spec.maps_at if abs(m - Ft) <= 1e-9 * spec.f_step), None)
 
-    up = _LoadBranch(U0, law, kernel, solver, spec, rec.on_row("approach"), "approach")
+    up = _LoadBranch(U0, law, kernel, solver, spec, rec.on_row(BRANCHES[0]), BRANCHES[0])
     eq0 = up.walker.solve(spec.d_min, state)
     up.set(spec.d_min, eq0)
     up.emit(spec.d_min, eq0, False, False)  # at rest, out of contact
@@ -361,7 +248,7 @@ def run_load_path(U0, law, kernel, solver, spec: LoadPathSpec, start: State | No
             raise TengsimError(_not_reached(spec, up, Ft))
     branches = [up]
     if spec.retract:
-        down = _LoadBranch(U0, law, kernel, solver, spec, rec.on_row("retraction"), "retraction")
+        down = _LoadBranch(U0, law, kernel, solver, spec, rec.on_row(BRANCHES[1]), BRANCHES[1])
         branches.append(down)
         down.set(up.D, up.eq)
         met = bool(abs(up.Fc - targets[-1]) <= spec.tol_F)  # (a miss there is flagged on the approach's row)

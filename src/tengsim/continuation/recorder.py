@@ -1,11 +1,10 @@
-"""Continuation machinery shared by every path (D-controlled :mod:`tengsim.path`, load-controlled
-:mod:`tengsim.loadpath`): the secant predictor, the branch walker with jump bisection, and the
-recorder that turns each equilibrium into a row of the result table.
+"""The recorder: turns each equilibrium of a path into a row of the result table (the built-in summary,
+the status inputs, the observers' columns), keeps the maps asked for, reports progress, and builds the
+:class:`tengsim.results.ContactResult`.
 """
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, is_dataclass, replace
 
 import numpy as np
 
@@ -13,41 +12,7 @@ from tengsim import observers as obs
 from tengsim.analysis import apex_index
 from tengsim.errors import TengsimError
 from tengsim.results import CURVE_COLUMNS, PHYSICAL_COLUMNS, ContactResult
-from tengsim.solvers import Problem, State
 from tengsim.status import EdgeScan, pixel_snap_number, row_status
-
-
-def secant(s0: State, s1: State, c: float) -> State:
-    """The state c steps of (s0 → s1) beyond s1: the secant predictor of a continuation step."""
-    return State(s1.q + c * (s1.q - s0.q), s1.w + c * (s1.w - s0.w))
-
-
-PERSIST_FACTOR = 10  # a fast solve stopped at its cap goes on for up to this many times max_iter more
-
-
-def persist(solver, problem: Problem, eq):
-    """The automatic fallback of a fast solve that stopped at its iteration cap (issue 23): go on from
-    where it stopped, with ``PERSIST_FACTOR`` × max_iter more iterations.
-
-    Where the law is stiffer than a pixel (pixel snap number ≫ 1) the fast solver's work is a long
-    sequence of single pixels snapping in, then a slow settling of the stiff contact; both make progress
-    every iteration, only more slowly than the cap allows (measured, docs/benchmarks.md "Stiff laws").
-    Runs only on a solve that did not converge, so every equilibrium that converges within the cap is
-    unchanged bit for bit.  Any other solver, or a solve that failed otherwise (line search, non-finite),
-    is returned as it is; a continued solve that still fails says so in its message, with both counts."""
-    inner = getattr(solver, "inner", solver)
-    if (PERSIST_FACTOR < 1 or not getattr(inner, "resumes_from_state", False) or not is_dataclass(inner)
-            or not np.isfinite(eq.residual)
-            or not str(eq.message).startswith("not converged")):
-        return eq
-    more = replace(inner, max_iter=PERSIST_FACTOR * int(inner.max_iter))
-    more = solver.with_inner(more) if hasattr(solver, "with_inner") else more
-    eq2 = more.solve(problem, eq.state)
-    what = "converged" if eq2.converged else f"not converged ({eq2.message})"
-    return replace(eq2, iterations=eq.iterations + eq2.iterations, n_conv=eq.n_conv + eq2.n_conv,
-                   seconds=eq.seconds + eq2.seconds,
-                   message=f"{what} after the cap: {eq.iterations} + {eq2.iterations} iterations "
-                           f"(max|r| {eq.residual:.2e} at the cap)")
 
 
 def spent(res, walkers):
@@ -57,65 +22,6 @@ def spent(res, walkers):
     return replace(res, params={**res.params, "n_conv_spent": int(sum(w.spent for w in walkers))})
 
 
-class Branch:
-    """Walks one branch, refining steps and predicting starts."""
-
-    def __init__(self, U0, law, kernel, solver, spec, on_row):
-        self.U0, self.law, self.kernel, self.solver, self.spec = U0, law, kernel, solver, spec
-        fold = getattr(solver, "fold_gap", None)  # a mirror solver takes g0 on its block
-        self._U0s = U0 if fold is None else fold(U0, kernel)
-        self.on_row = on_row
-        self.hist: list = []  # accepted (D, state) on this branch, newest last
-        self.spent = 0  # convolutions of every solve of this branch, recorded or discarded (jump checks, refining)
-
-    def solve(self, D, start):
-        problem = Problem(self._U0s - D + 1.0, self.law, self.kernel)
-        eq = self.solver.solve(problem, start)
-        if not eq.converged:
-            eq = persist(self.solver, problem, eq)
-        self.spent += int(eq.n_conv)
-        return eq
-
-    def _start(self, D):
-        (D1, s1) = self.hist[-1]
-        if self.spec.predictor and len(self.hist) >= 2:
-            D0, s0 = self.hist[-2]
-            if D1 != D0:
-                c = (D - D1) / (D1 - D0)
-                if 0 < c <= 1.5:
-                    return secant(s0, s1, c), True
-        return s1, False
-
-    def _jumped(self, eqa, eqb, dD):
-        return eqb.max_change(eqa) - abs(dD) > self.spec.jump_h
-
-    def advance(self, Da, eqa, Db, level, on_grid):
-        start, predicted = self._start(Db)
-        eqb = self.solve(Db, start)
-        if predicted and self._jumped(eqa, eqb, Db - Da):
-            eqb = self.solve(Db, eqa.state)  # confirm without the predictor
-        if self._jumped(eqa, eqb, Db - Da):
-            if level < self.spec.refine_levels:
-                mid = 0.5 * (Da + Db)
-                eqm = self.advance(Da, eqa, mid, level + 1, False)
-                return self.advance(mid, eqm, Db, level + 1, on_grid)
-            jump = True
-        else:
-            jump = False
-        self.hist = (self.hist + [(Db, eqb.state)])[-2:]
-        if jump:
-            self.hist = self.hist[-1:]
-        self.on_row(Db, eqb, on_grid, jump)
-        return eqb
-
-
-@dataclass
-class StateOnly:
-    """A bare state holder (``.state``) for rows kept only as states."""
-
-    state: State
-
-
 class Recorder:
     """Collects what one path produces: a row per equilibrium (the built-in summary, the status inputs
     and the observers' columns), the maps asked for, and progress.  Shared by every kind of path.
@@ -123,7 +29,7 @@ class Recorder:
     ``control`` names the path's control variable ('D' or 'F'); maps are kept at the rows whose
     control value is within ``map_tol`` of an entry of ``maps_at`` (rows on the path's grid), and at a
     row the path marks as the one for an entry (``map_at``: an extra row a path adds at that value, see
-    :func:`tengsim.path.run_path`); one map per entry and branch, the first such row.
+    :func:`tengsim.continuation.run_path`); one map per entry and branch, the first such row.
 
     ``sink`` (a plain callable or None) is called as ``sink(row, maps)`` once each equilibrium is
     recorded, in path order: ``row`` the row's dict (the table's columns), ``maps`` the list of the maps
@@ -158,6 +64,8 @@ class Recorder:
         """The callback ``(D, eq, on_grid, jump, map_at=None)`` that records a row of ``branch``."""
         def record(D, eq, on_grid, jump, map_at=None):
             n_maps = len(self.maps)  # for the sink: the maps this row adds
+            unfold = getattr(eq, "unfolded", None)  # a block's equilibrium: its full-grid fields once a row
+            eq = unfold() if unfold is not None else eq
             s = self.summary(eq, self.ctx)
             # a state whose gap enters the law's safe extension (g < g_safe) is outside the physical law
             in_range = bool(s["min_gap"] + 1.0 >= getattr(self.law, "g_safe", -np.inf))

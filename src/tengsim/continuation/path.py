@@ -1,0 +1,124 @@
+"""Continuation in the rigid approach D: approach (D up) then retraction (D down), paper Section 2.
+
+Each equilibrium is warm-started from the previous one on its branch (with a secant predictor), so
+the path follows the stable branch and shows jump-in, jump-out and hysteresis as the paper's VSR
+does.  Step control: when the gap field changes by more than ``jump_h`` (in ε, beyond the rigid
+shift |ΔD|) across a step, the step is bisected, up to ``refine_levels`` times; a change that
+survives the finest step is recorded as a jump.
+
+With ``PathSpec(adaptive=True)`` the step also adapts where the path is smooth
+(:class:`tengsim.continuation.steps.AdaptiveSteps`): ``d_step`` is then the largest step and
+d_step/2^refine_levels the smallest.  Both branches are walked by the one
+:class:`tengsim.continuation.walker.Walker`, given the step control.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from tengsim.continuation.recorder import Recorder, spent
+from tengsim.continuation.specs import _D_TOL, BRANCHES, PathSpec
+from tengsim.continuation.steps import AdaptiveSteps, FixedSteps
+from tengsim.continuation.walker import Walker
+from tengsim.errors import TengsimError
+from tengsim.solvers import State
+
+
+def run_path(U0, law, kernel, solver, spec: PathSpec, start: State | None = None,
+             progress=None, keep_states: bool = False, observers=(), sink=None):
+    """Solve the approach–retraction path; returns a :class:`tengsim.results.ContactResult`.
+
+    ``progress(branch, D, done, total)`` is called after each row on the D grid.  ``observers``
+    (registered names or objects, see :mod:`tengsim.observers`) add their columns to every row.
+    ``sink(row, maps)`` is called with each row as it is recorded (:class:`tengsim.continuation.Recorder`).
+    A load-controlled path is :func:`tengsim.continuation.run_load_path`.
+    """
+    if not isinstance(spec, PathSpec):
+        raise TengsimError(f"run_path walks a PathSpec (rigid approach D); got {type(spec).__name__} "
+                           "(a LoadPathSpec runs with tengsim.continuation.run_load_path)")
+    targets = spec.targets()
+    rec = Recorder(U0, law, kernel, observers, progress, len(targets) * (2 if spec.retract else 1),
+                   spec.maps_at, "D", sink=sink)
+    U0 = rec.U0
+    # the zero start is made in the first solve's call: not held for the whole walk (a full-grid pair beside
+    # a mirror block's states)
+
+    walkers = []  # whatever solved: the branches and the map rows (their convolutions, for n_conv_spent)
+
+    def rows(branch):  # the Recorder's callback, with the extra rows at the maps_at D between the walk's rows
+        if not spec.maps_at:
+            return rec.on_row(branch)
+        walkers.append(_MapRows(rec.on_row(branch), spec.maps_at, U0, law, kernel, solver, spec.jump_h))
+        return walkers[-1]
+
+    steps = AdaptiveSteps.of(spec) if spec.adaptive else FixedSteps(spec.refine_levels, spec.predictor)
+    eq = None  # handed from branch to branch: the walker holds the current equilibrium, not this frame
+    for branch, Ds in tuple(zip(BRANCHES, (targets, targets[::-1])))[:2 if spec.retract else 1]:
+        walker = Walker(U0, law, kernel, solver, steps, rows(branch), spec.jump_h)
+        walkers.append(walker)
+        walker.begin(Ds[0], eq if eq is not None else
+                     walker.solve(Ds[0], start if start is not None else State.zero(kernel.grid.shape)))
+        eq = None
+        walker.walk(Ds[1:])
+        eq = walker.take()
+    return spent(rec.result(eq.state if keep_states else None), walkers)
+
+
+class _MapRows:
+    """Passes a branch's rows to the Recorder's callback ``record``, in path order, adding a row at each
+    requested D (``maps_at``) the walk steps over: when a row arrives whose step from the row before
+    passes such a D, the state there is solved first (from the two rows' states interpolated; from the
+    state before when the step is a jump) and recorded as an extra row (``on_grid`` False, its map kept:
+    ``map_at``).  The walk's own continuation never sees these states.  A row at a requested D (to
+    :data:`_D_TOL`) is the one that D's map is kept at."""
+
+    def __init__(self, record, maps_at, U0, law, kernel, solver, jump_h):
+        self.record, self.walker = record, Walker(U0, law, kernel, solver, jump_h=jump_h)
+        self.wanted, self.last = sorted(set(maps_at)), None
+
+    @property
+    def spent(self) -> int:
+        """Convolutions of the extra rows' solves."""
+        return self.walker.spent
+
+    def _hit(self, D):
+        return next((m for m in self.wanted if abs(D - m) <= _D_TOL * max(1.0, abs(m))), None)
+
+    def __call__(self, D, eq, on_grid, jump):
+        if self.last is not None:
+            Da, eqa = self.last
+            lo, hi = min(Da, D), max(Da, D)
+            passed = [m for m in self.wanted if lo < m < hi and self._hit(D) != m and self._hit(Da) != m]
+            for m in sorted(passed, reverse=bool(D < Da)):  # in path order
+                t = (m - Da) / (D - Da)
+                start = eqa.state if jump else State(eqa.state.q + t * (eq.state.q - eqa.state.q),
+                                                      eqa.state.w + t * (eq.state.w - eqa.state.w))
+                eqm = self.walker.solve(m, start)
+                jm = bool(jump) and self.walker.jumped(eqa, eqm, m - Da)
+                self.record(m, eqm, False, jm, m)
+                self.wanted.remove(m)
+                if jump:  # the jump lies on one side of the extra row: flag the row after it
+                    jump = self.walker.jumped(eqm, eq, D - m)
+                Da, eqa = m, eqm
+        m = self._hit(D)
+        self.record(D, eq, on_grid, jump, m)
+        if m is not None:
+            self.wanted.remove(m)
+        self.last = (D, eq)
+
+
+def walk_states(U0, law, kernel, solver, Ds, start: State | None = None):
+    """Equilibria of Eq. (9) at the displacements ``Ds``, in the order given (up or down), each solved
+    from the secant extrapolation of the two before (the first from ``start``, default zero).
+
+    One branch only: no jump detection or step refinement (use :func:`run_path` for that); meant for
+    short, finely stepped walks along a branch from a state already on it.  Yields (D, Equilibrium).
+    """
+    walker = Walker(U0, law, kernel, solver)
+    state = start if start is not None else State.zero(kernel.grid.shape)
+    for D in Ds:
+        D = float(D)
+        if walker.hist:  # the secant of the last two, at any distance, either way
+            state, _ = walker.predict(D, c_max=np.inf, c_min=-np.inf)
+        eq = walker.solve(D, state)
+        walker.push(D, eq.state)
+        yield D, eq
