@@ -387,7 +387,7 @@ def test_line_search_accepts_a_wolfe_point_and_leaves_it_in_its_buffers():
     approximate) Wolfe conditions of its docstring, E(α) equals the energy recomputed from scratch
     at q + α d, and the trial buffers hold g + α K d and P(g + α K d)."""
     from tengsim.solvers._workspace import Workspace
-    from tengsim.solvers.fast import _Descent
+    from tengsim.solvers._descent import _Descent
 
     grid, U0, K = _group_a(dx=0.2)
     law = LJ93()

@@ -29,6 +29,7 @@ Approach loads below the start's F (the body stays away) are skipped.
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 
 from tengsim.analysis import force

@@ -5,6 +5,7 @@ the status inputs, the observers' columns), keeps the maps asked for, reports pr
 from __future__ import annotations
 
 import time
+from dataclasses import replace
 
 import numpy as np
 

@@ -370,7 +370,7 @@ def _checkpoint(keep, plan, d_max, progress):
     import hashlib
 
     from tengsim.errors import TengsimError as _Err
-    from tengsim.run.resolve import Checkpoint
+    from tengsim.run.checkpoint import Checkpoint
 
     ck = Checkpoint(keep, hashlib.sha256(f"{plan!r}|{d_max!r}".encode()).hexdigest()[:16])
     try:

@@ -30,8 +30,8 @@ the finest value is e = (f3 − f2)/((h2/h3)^p − 1) and the extrapolated value
 Edges kept in place: a shape with kinks (``Shape.edge_offsets``: the base edge of a pyramid, cone, hemisphere or
 punch, the wall of a cube or line) has the grid error of what is measured at them (the contact edge in full
 contact, so A/S) set by where each edge falls in its pixel, and refinement by √2 moves that place from grid to
-grid: the values then oscillate (a pyramid's A/S in full contact, 45² … 225²: 0.2531, 0.2520, 0.2534, 0.2523,
-0.2503 about its footprint 0.25), Richardson sees differences of opposite sign and cannot certify them.  So each
+grid: the values then oscillate about their limit (docs/validation.md, "Automatic refinement"), Richardson
+sees differences of opposite sign and cannot certify them.  So each
 finer grid is the first FFT-friendly odd one from the plain next grid up to :data:`PHASE_SPAN` × its pixels whose
 edges fall within :data:`PHASE_TOL` of a pixel of their place on the first grid (the plain next grid if none
 does; ``params['resolve_edge_phases']`` records the places): grids similar with respect to the geometry, as a
@@ -42,12 +42,8 @@ it equals the finest grid's error, so criteria (b) and (c) ask the same; with r 
 error of tol/3 and a grid up to 4× larger than needed.  A level costs about twice the one before, so the
 whole sequence about twice the finest grid.
 
-Nested start: not used (measured, docs/validation.md "Automatic refinement").  Each grid walks the whole
-path from the zero state.  Offering the coarse grid's equilibrium at the same D and branch, prolonged to the
-finer grid (one convolution), as a second start at every step beside the secant predictor saved 2.5–6.6 %
-on the finest grids of two sphere cases at best, and cost up to 15 % where the path is cheap: the secant predictor's
-error is below the coarse grid's discretization error, and on the sphere the grids differ where the work
-is, at the pixel-snapping contact edge (the experiment is commit 422dd44 on branch ``nested``).
+Nested start: not used; each grid walks the whole path from the zero state (why: docs/validation.md,
+"Automatic refinement").
 """
 from __future__ import annotations
 
@@ -60,6 +56,7 @@ import numpy as np
 from tengsim import backend
 from tengsim.errors import TengsimError
 from tengsim.grid import Grid
+from tengsim.run.checkpoint import Checkpoint
 
 FACTOR = math.sqrt(2.0)
 """Refinement factor in dx between two grids (twice the pixels)."""
@@ -426,61 +423,3 @@ def run_contact(plan, progress=None, sink=None, observe=None):
                           checkpoint=None if ck is None else ck.save, start=None if ck is None else ck.load())
     params = {k: v for k, v in res.params.items() if k != Checkpoint.KEY}
     return dataclasses.replace(res, params={**params, "config": dict(plan.config)})
-
-
-class Checkpoint:
-    """The finished grids of a refinement writing ``out`` (``resolve = 'auto'`` with a row stream), kept in
-    :func:`checkpoint_path`: after each grid, the finest grid's result (NetCDF, written atomically) with the
-    levels so far and the table's digest in its parameters; read back by ``--resume`` (the grids are not
-    computed again); removed with the partial file once the result is saved
-    (:meth:`tengsim.results.RowStream.finish`)."""
-
-    KEY = "resolve_checkpoint"
-
-    def __init__(self, path, digest: str):
-        self.path, self.digest = path, digest
-
-    @classmethod
-    def of(cls, sink, cfg: dict):
-        """The checkpoint of the run streaming to ``sink`` (a RowStream: its ``out``), None without one."""
-        import hashlib
-
-        from tengsim import io
-
-        out = getattr(sink, "out", None)
-        if out is None:
-            return None
-        cfg = {k: v for k, v in cfg.items() if k not in ("out", "plot")}
-        digest = hashlib.sha256(io.dumps(dict(sorted(cfg.items()))).encode()).hexdigest()[:16]
-        from tengsim.results import checkpoint_path
-
-        return cls(checkpoint_path(out), digest)
-
-    def save(self, levels, phases, res) -> None:
-        from tengsim import io
-
-        kept = {self.KEY: io.dumps({"digest": self.digest, "levels": levels, "phases": list(phases)})}
-        dataclasses.replace(res, params={**res.params, **kept}).save(self.path)
-
-    def load(self):
-        """(levels, phases, result) kept by an interrupted run of this table, or None if there is none."""
-        import json
-
-        from tengsim.results.read import load_result
-
-        if not self.path.is_file():
-            return None
-        try:
-            _, res = load_result(self.path)
-            rec = json.loads(res.params[self.KEY])
-            res = dataclasses.replace(res, params={k: v for k, v in res.params.items() if k != self.KEY})
-        except (TengsimError, KeyError, TypeError, ValueError) as exc:
-            raise TengsimError(f"--resume: {self.path} is not a refinement checkpoint ({exc}); delete it to "
-                               "start afresh") from None
-        if rec.get("digest") != self.digest:
-            raise TengsimError(f"--resume: {self.path} was written by another run (its [contact] table "
-                               "differs); delete it to start afresh")
-        levels = rec["levels"]
-        for lv in levels:  # strict JSON wrote NaN as null
-            lv["obs"] = {k: (math.nan if v is None else v) for k, v in lv["obs"].items()}
-        return levels, rec["phases"], res

@@ -1,0 +1,65 @@
+"""The finished grids of an automatic refinement kept on disk, so a killed run resumes where it stopped."""
+from __future__ import annotations
+
+import dataclasses
+import math
+
+from tengsim.errors import TengsimError
+
+
+class Checkpoint:
+    """The finished grids of a refinement writing ``out`` (``resolve = 'auto'`` with a row stream), kept in
+    :func:`checkpoint_path`: after each grid, the finest grid's result (NetCDF, written atomically) with the
+    levels so far and the table's digest in its parameters; read back by ``--resume`` (the grids are not
+    computed again); removed with the partial file once the result is saved
+    (:meth:`tengsim.results.RowStream.finish`)."""
+
+    KEY = "resolve_checkpoint"
+
+    def __init__(self, path, digest: str):
+        self.path, self.digest = path, digest
+
+    @classmethod
+    def of(cls, sink, cfg: dict):
+        """The checkpoint of the run streaming to ``sink`` (a RowStream: its ``out``), None without one."""
+        import hashlib
+
+        from tengsim import io
+
+        out = getattr(sink, "out", None)
+        if out is None:
+            return None
+        cfg = {k: v for k, v in cfg.items() if k not in ("out", "plot")}
+        digest = hashlib.sha256(io.dumps(dict(sorted(cfg.items()))).encode()).hexdigest()[:16]
+        from tengsim.results import checkpoint_path
+
+        return cls(checkpoint_path(out), digest)
+
+    def save(self, levels, phases, res) -> None:
+        from tengsim import io
+
+        kept = {self.KEY: io.dumps({"digest": self.digest, "levels": levels, "phases": list(phases)})}
+        dataclasses.replace(res, params={**res.params, **kept}).save(self.path)
+
+    def load(self):
+        """(levels, phases, result) kept by an interrupted run of this table, or None if there is none."""
+        import json
+
+        from tengsim.results.read import load_result
+
+        if not self.path.is_file():
+            return None
+        try:
+            _, res = load_result(self.path)
+            rec = json.loads(res.params[self.KEY])
+            res = dataclasses.replace(res, params={k: v for k, v in res.params.items() if k != self.KEY})
+        except (TengsimError, KeyError, TypeError, ValueError) as exc:
+            raise TengsimError(f"--resume: {self.path} is not a refinement checkpoint ({exc}); delete it to "
+                               "start afresh") from None
+        if rec.get("digest") != self.digest:
+            raise TengsimError(f"--resume: {self.path} was written by another run (its [contact] table "
+                               "differs); delete it to start afresh")
+        levels = rec["levels"]
+        for lv in levels:  # strict JSON wrote NaN as null
+            lv["obs"] = {k: (math.nan if v is None else v) for k, v in lv["obs"].items()}
+        return levels, rec["phases"], res
