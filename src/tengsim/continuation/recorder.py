@@ -73,13 +73,6 @@ class Recorder:
             more = {}
             for o in self.extra:
                 more.update(self._observe(o, eq, self.ctx))
-            pz = self.edges(eq.H)
-            self.rows.append(dict(branch=branch, D=D, on_grid=on_grid, jump=jump, converged=eq.converged,
-                                  in_law_range=in_range, process_zone=pz,
-                                  status=row_status(bool(eq.converged), in_range, pz, self.grid.dx, self.snap,
-                                                    self.edges.face),
-                                  residual=eq.residual, iterations=eq.iterations, n_conv=eq.n_conv,
-                                  seconds=eq.seconds, energy=eq.energy, **s, **more))
             value = D if self.control == "D" else s["F"]
             for m in self.maps_at:
                 tol = self.map_tol * (max(1.0, abs(m)) if self.control == "D" else 1.0) + 1e-9
@@ -87,6 +80,17 @@ class Recorder:
                 if hit and (branch, m) not in self._map_keys:
                     self._map_keys.add((branch, m))
                     self.maps.append(dict(branch=branch, D=D, P=eq.P.copy(), H=eq.H.copy()))
+            H, rec = eq.H, dict(converged=eq.converged, residual=eq.residual, iterations=eq.iterations,
+                                n_conv=eq.n_conv, seconds=eq.seconds, energy=eq.energy)
+            del eq  # the edge scan needs H only: a block's unfolded P is freed before it
+            pz = self.edges(H)
+            del H
+            self.rows.append(dict(branch=branch, D=D, on_grid=on_grid, jump=jump, converged=rec["converged"],
+                                  in_law_range=in_range, process_zone=pz,
+                                  status=row_status(bool(rec["converged"]), in_range, pz, self.grid.dx, self.snap,
+                                                    self.edges.face),
+                                  residual=rec["residual"], iterations=rec["iterations"], n_conv=rec["n_conv"],
+                                  seconds=rec["seconds"], energy=rec["energy"], **s, **more))
             if on_grid:
                 self.done += 1
                 if self.progress:

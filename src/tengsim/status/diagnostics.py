@@ -214,6 +214,38 @@ def _wall_steps(U0: np.ndarray, w: CohesiveWindow, axis: int) -> np.ndarray:
     return big & ((d > WALL_RATIO * before) | (d > WALL_RATIO * after))
 
 
+class _Cosine:
+    """|cos| of the angle between a scan (axis 1 of ``G``) and the gap's gradient, at given pixels only: the
+    gradient as :func:`numpy.gradient` makes it (central differences inside, one-sided at the border; a
+    reversed view flips only the sign), so no gradient field of the whole box is made.  ``fixed``: the
+    value everywhere (a box one pixel wide)."""
+
+    def __init__(self, G, d_along: float, d_across: float, fixed: float | None = None):
+        self.G, self.d, self.e, self.fixed = G, d_along, d_across, fixed
+
+    @staticmethod
+    def _diff(G, r, c, axis, h):
+        n = G.shape[axis]
+        k = c if axis == 1 else r
+        lo, hi = np.maximum(k - 1, 0), np.minimum(k + 1, n - 1)
+        a = G[r, hi] if axis == 1 else G[hi, c]
+        b = G[r, lo] if axis == 1 else G[lo, c]
+        inner = (k > 0) & (k < n - 1)
+        return np.where(inner, (a - b) / (2.0 * h), (a - b) / h)
+
+    def at(self, r, c):
+        if self.fixed is not None:
+            return np.full(np.shape(r), self.fixed)
+        along = self._diff(self.G, r, c, 1, self.d)
+        across = self._diff(self.G, r, c, 0, self.e)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return np.nan_to_num(np.abs(along) / np.hypot(along, across))
+
+
+_ROWS = 16
+"""Rows of the gap made at a time where only a mask of it is kept."""
+
+
 def _scan(G, walls, labels, cos, w, wall_pix):
     """Openings along axis 1 of G (m × n) in the + direction: (labels of the contact spot each opening
     leaves, normal widths in pixels).  See :class:`EdgeScan`."""
@@ -231,17 +263,18 @@ def _scan(G, walls, labels, cos, w, wall_pix):
     P, nxt, e = P[keep], nxt[keep], E[np.minimum(k[keep], len(E) - 1)]
     keep = (P // (n - 1) == e // (n - 1)) & (e < nxt)
     P, e = P[keep], e[keep]
-    af, bf = a.ravel(), b.ravel()
-    pos_p = P % (n - 1) + (w.g_peak - af[P]) / (bf[P] - af[P])
-    pos_e = e % (n - 1) + (w.g_end - af[e]) / (bf[e] - af[e])
-    inner = P + P // (n - 1)  # the pixel i (flat in G) the opening leaves, and i+1 beyond it
-    at_wall = walls.ravel()[e]
-    c = cos.ravel()[inner + 1]
+    # indexed by (row, column), never raveled: G is a transposed or reversed view, and a ravel would copy it
+    rp, cp = np.divmod(P, n - 1)  # the pixel the opening leaves is (rp, cp), the one beyond it (rp, cp + 1)
+    re_, ce = np.divmod(e, n - 1)
+    pos_p = cp + (w.g_peak - a[rp, cp]) / (b[rp, cp] - a[rp, cp])
+    pos_e = ce + (w.g_end - a[re_, ce]) / (b[re_, ce] - a[re_, ce])
+    at_wall = walls[re_, ce]
+    c = cos.at(rp, cp + 1)
     width = np.where(at_wall, wall_pix, (pos_e - pos_p) * c)
     # a wall opening is judged once the face pixel at the wall is past the peak (its zone has formed);
     # a gradual opening where the scan runs within 45° of the edge normal (the other scan sees the rest)
     judged = np.where(at_wall, e > P, c >= np.sqrt(0.5))
-    return labels.ravel()[inner][judged], width[judged]
+    return labels[rp, cp][judged], width[judged]
 
 
 def face_uncertainty(U0: np.ndarray, walls) -> float:
@@ -296,31 +329,29 @@ class EdgeScan:
         w = self.w
         if w is None:
             return float("nan")
-        g = np.asarray(H, dtype=float) + 1.0
-        near = g < w.g_end
+        H = np.asarray(H, dtype=float)
+        near = np.empty(H.shape, dtype=bool)
+        for k in range(0, H.shape[0], _ROWS):  # g = H + 1 a band of rows at a time: no full-grid float temporary
+            np.less(H[k:k + _ROWS] + 1.0, w.g_end, out=near[k:k + _ROWS])
         rows, cols = np.flatnonzero(near.any(axis=1)), np.flatnonzero(near.any(axis=0))
+        del near
         if not len(rows):
             return float("nan")
         # the work is element-wise on the box around the edges (2 pixels' margin: central differences)
-        i0, i1 = max(rows[0] - 2, 0), min(rows[-1] + 3, g.shape[0])
-        j0, j1 = max(cols[0] - 2, 0), min(cols[-1] + 3, g.shape[1])
-        g = g[i0:i1, j0:j1]
+        i0, i1 = max(rows[0] - 2, 0), min(rows[-1] + 3, H.shape[0])
+        j0, j1 = max(cols[0] - 2, 0), min(cols[-1] + 3, H.shape[1])
+        g = H[i0:i1, j0:j1] + 1.0
         wx, wy = self.walls[0][i0:i1 - 1, j0:j1], self.walls[1][i0:i1, j0:j1 - 1]
         inside = g < w.g_peak
         if not inside.any() or inside.all():
             return float("nan")
         labels, _ = ndimage.label(inside)
-        gx, gy = np.gradient(g, self.dx, self.dy) if min(g.shape) > 1 else (np.ones_like(g), np.zeros_like(g))
-        norm = np.hypot(gx, gy)
-        with np.errstate(invalid="ignore", divide="ignore"):  # the cosines in place: fewer full-size temporaries
-            cx = np.divide(np.abs(gx, out=gx), norm, out=gx)
-            cy = np.divide(np.abs(gy, out=gy), norm, out=gy)
-        del norm
-        cx, cy = np.nan_to_num(cx, copy=False), np.nan_to_num(cy, copy=False)
+        flat = min(g.shape) <= 1  # no gradient across a single row or column: cosines 1 along axis 0, 0 along 1
         labs, widths = [], []
-        for G, W, L, C, d in ((g.T, wx.T, labels.T, cx.T, self.dx), (g, wy, labels, cy, self.dy)):
+        for G, W, L, d, e in ((g.T, wx.T, labels.T, self.dx, self.dy), (g, wy, labels, self.dy, self.dx)):
             for s in (slice(None), slice(None, None, -1)):
-                lab, wid = _scan(G[:, s], W[:, s], L[:, s], C[:, s], w, self.wall_zone / d)
+                cos = _Cosine(G[:, s], d, e, 1.0 if (flat and G is not g) else 0.0 if flat else None)
+                lab, wid = _scan(G[:, s], W[:, s], L[:, s], cos, w, self.wall_zone / d)
                 labs.append(lab)
                 widths.append(wid * d)
         lab, wid = np.concatenate(labs), np.concatenate(widths)
