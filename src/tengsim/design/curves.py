@@ -235,6 +235,8 @@ def convergence(res) -> dict:
         out[label] = float(rich.get(key, {}).get("change", math.nan))
     out[RETRACTION_AREA] = largest(watched, "A_S_ret")
     h = [float(x) for x in (res.params.get("resolution") or {}).get("hysteresis_W", [])][-2:]
-    # relative to the finest value itself (no floor: the energy's scale is its own)
-    out[HYSTERESIS] = abs(h[1] - h[0]) / abs(h[1]) if len(h) == 2 and h[1] != 0 else math.nan
+    # relative to the finest value itself (no floor: the energy's scale is its own); 0 on both grids (within
+    # each grid's uncertainty, tengsim.results.hysteresis) is no change
+    out[HYSTERESIS] = (abs(h[1] - h[0]) / abs(h[1]) if h[1] != 0 else 0.0 if h[0] == 0 else math.nan) \
+        if len(h) == 2 else math.nan
     return out
