@@ -100,7 +100,8 @@ class _Branch:
         jump's interval."""
         allx = self.rows()
         order = np.argsort(allx, kind="stable")
-        out = np.interp(x, allx[order], np.concatenate([s[1] for s in self.segments])[order])  # linear everywhere, across the jumps' intervals too
+        # linear everywhere first, across the jumps' intervals too (the trapezoid across a jump)
+        out = np.interp(x, allx[order], np.concatenate([s[1] for s in self.segments])[order])
         if cubic:
             for (sx, _), p in zip(self.segments, self._pchip):
                 if p is None:
