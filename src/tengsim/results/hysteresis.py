@@ -14,15 +14,18 @@ conservative law dissipates nothing) it gives a number of either sign that is qu
    interval the straight line between the two rows (the trapezoid across the jump, as before);
 4. integrates the difference approach − retraction on those points.
 
-The uncertainty is the change of that number when each branch is filled in linearly instead (the trapezoid rule:
-the old rule's disagreement with the higher-order one), plus the change from the trapezoid to Simpson's rule of
-the difference itself on the points, over the D runs between jumps (the error both branches share), plus, for
-each jump, half of |ΔF| × ΔD over the interval in which it happened (where in it the state jumped is not known), plus the solver's share: each row's F is
-known to about |dF/dD| × its residual (the ``residual`` column, a gap error in the units of D, times the
-branch's stiffness), integrated over D for both branches (two branches at the same D differ by about that:
-one converged from below, the other from above).  A loop energy whose magnitude is within that
-bound is not distinguishable from zero and is reported as 0 (never as a negative energy); a larger one keeps its
-value, sign included.
+The uncertainty (``bound``) is the sum of
+- the change of that number when each branch is filled in linearly instead (the trapezoid rule: the old rule's
+  disagreement with the higher-order one), plus the change from the trapezoid to Simpson's rule of the
+  difference itself, over the D runs between jumps (the error both branches share): ``quadrature``;
+- the solver's share: each row's F is known to about |dF/dD| × its residual (the ``residual`` column, a gap
+  error in the units of D, times the branch's stiffness), integrated over D for both branches (two branches at
+  the same D differ by about that: one converged from below, the other from above): ``solver``;
+- for each jump, half of |ΔF| × ΔD over the interval in which it happened (where in it the state jumped is not
+  known): ``jumps``.
+
+A loop energy whose magnitude is within that bound is not distinguishable from zero and is reported as 0 (never
+as a negative energy); a larger one keeps its value, sign included.
 """
 from __future__ import annotations
 
