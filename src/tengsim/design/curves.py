@@ -171,6 +171,7 @@ def summarize(res, plan) -> tuple[dict, dict, list]:
                          f"{pressure_text(plan.pressures[-1])}")
     slope, lin = _linear(plan.pressures, app["voc_eq12"], plan.fit_max)
     diff = ret["area"] - app["area"]
+    loop = res.loop_energy  # 0 where within its uncertainty, never a negative energy of quadrature error
     summary = {
         "status": res.status,
         "tabor": sc.mu,
@@ -180,7 +181,8 @@ def summarize(res, plan) -> tuple[dict, dict, list]:
         "full_contact_Pa": full_P,
         "sensitivity_V_per_Pa": slope,
         "linear_range_Pa": lin,
-        "hysteresis_J_m2": sc.work(res.hysteresis) / sc.cell_area,
+        "hysteresis_J_m2": sc.work(loop.value) / sc.cell_area,
+        "hysteresis_bound_J_m2": sc.work(loop.bound) / sc.cell_area,
         "area_hysteresis": float(np.nanmax(np.abs(diff))) if np.any(np.isfinite(diff)) else math.nan,
         "area_at_p_max": float(app["area"][-1]),
         "voc_eq12_at_p_max_V": float(app["voc_eq12"][-1]),
@@ -233,8 +235,10 @@ def convergence(res) -> dict:
         out[label] = float(rich.get(key, {}).get("change", math.nan))
     out[RETRACTION_AREA] = largest(watched, "A_S_ret")
     h = [float(x) for x in (res.params.get("resolution") or {}).get("hysteresis_W", [])][-2:]
-    # relative to the finest value itself (no floor: the energy's scale is its own)
-    out[HYSTERESIS] = abs(h[1] - h[0]) / abs(h[1]) if len(h) == 2 and h[1] != 0 else math.nan
+    # relative to the finest value itself (no floor: the energy's scale is its own); 0 on both grids (within
+    # each grid's uncertainty, tengsim.results.hysteresis) is no change
+    out[HYSTERESIS] = (abs(h[1] - h[0]) / abs(h[1]) if h[1] != 0 else 0.0 if h[0] == 0 else math.nan) \
+        if len(h) == 2 else math.nan
     return out
 
 

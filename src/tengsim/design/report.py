@@ -13,7 +13,10 @@ ROWS = (
     ("sensitivity_V_per_Pa", "sensitivity dV_OC/dP (Eq. 12, least-squares line over [p_min, fit_max])", "V/kPa"),
     ("linear_range_Pa", "linear range (V_OC within 10 % of that line, or of its rise over the fit range, up to)",
      "kPa"),
-    ("hysteresis_J_m2", "hysteresis: energy lost per cycle per unit nominal area (∮F dD)", "J/m²"),
+    ("hysteresis_J_m2", "hysteresis: energy lost per cycle per unit nominal area (∮F dD over the D range both "
+                        "branches cover; 0 where within its uncertainty below)", "J/m²"),
+    ("hysteresis_bound_J_m2", "hysteresis uncertainty (± : quadrature rule change, solver residual, jump location)",
+     "J/m²"),
     ("area_hysteresis", "hysteresis: largest |A/S retraction − A/S approach| at an asked pressure", ""),
     ("area_at_p_max", "charged area A/S at p_max (approach)", ""),
     ("voc_eq12_at_p_max_V", "V_OC at p_max, Eq. 12 (polymer)", "V"),

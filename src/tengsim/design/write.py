@@ -33,6 +33,7 @@ _CURVE = {"charged_area_fraction": "area", "repulsive_area_fraction": "repulsive
           "voc_eq17": "voc_eq17", "dvoc_dp": "dvoc_dp"}
 SUMMARY_UNITS = {"jump_in_Pa": "Pa", "pull_off_N": "N per cell", "pull_off_Pa": "Pa", "full_contact_Pa": "Pa",
                  "sensitivity_V_per_Pa": "V/Pa", "linear_range_Pa": "Pa", "hysteresis_J_m2": "J/m2",
+                 "hysteresis_bound_J_m2": "J/m2",
                  "area_hysteresis": "1", "area_at_p_max": "1", "voc_eq12_at_p_max_V": "V",
                  "voc_eq17_at_p_max_V": "V", "tabor": "1", "seconds": "s"}
 
@@ -121,6 +122,10 @@ def csv_columns(ds) -> dict:
     return {k: np.asarray(v) for k, v in rows.items()}
 
 
+def _finite(v):
+    return float(v) if v is not None and math.isfinite(float(v)) else None
+
+
 def write_design(result, out_dir, figures: bool = True) -> list:
     """Write design.nc, design.csv, the figures and report.md of ``result`` into ``out_dir``; returns the paths."""
     from tengsim.io import csv_text, write_dataset, write_text
@@ -130,7 +135,9 @@ def write_design(result, out_dir, figures: bool = True) -> list:
     ds = result.dataset
     write_dataset(ds, out / "design.nc")
     header = {"design": result.plan.name, "status": result.status, "grids": result.summary["grids"],
-              "tolerance": result.plan.tol, "charged_area_definition": result.summary["charged_area_definition"]}
+              "tolerance": result.plan.tol, "charged_area_definition": result.summary["charged_area_definition"],
+              # the loop energy (J/m2) and its uncertainty: 0 where within it (tengsim.results.hysteresis)
+              **{k: _finite(result.summary.get(k)) for k in ("hysteresis_J_m2", "hysteresis_bound_J_m2")}}
     write_text(out / "design.csv", csv_text(csv_columns(ds), header, missing=""))
     paths = [out / "design.nc", out / "design.csv"]
     figs = []

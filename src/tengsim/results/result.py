@@ -10,11 +10,11 @@ import dataclasses
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.integrate import trapezoid
 
 from tengsim import status as _status
 from tengsim.grid import Grid
 from tengsim.results import write
+from tengsim.results.hysteresis import LoopEnergy, loop_energy
 from tengsim.results.columns import CURVE_COLUMNS
 
 
@@ -142,15 +142,18 @@ class ContactResult:
         return float(np.min(r["F"]))
 
     @property
+    def loop_energy(self) -> LoopEnergy:
+        """∮ F dD, approach minus retraction, over the D range both branches cover, with its quadrature
+        uncertainty (:func:`tengsim.results.hysteresis.loop_energy`)."""
+        t = self.table
+        return loop_energy(t["D"], t["F"], t["branch"], t.get("jump"), t.get("residual"))
+
+    @property
     def hysteresis(self) -> float:
         """∮ F dD, approach minus retraction: the energy lost per cycle (for the paper's scaling the work
-        per cell is 3π m² W ε²/n² times this value)."""
-        a, r = self.branch("approach"), self.branch("retraction")
-        if len(r["D"]) < 2:
-            return 0.0
-        ia = np.argsort(a["D"])
-        ir = np.argsort(r["D"])
-        return float(trapezoid(a["F"][ia], a["D"][ia]) - trapezoid(r["F"][ir], r["D"][ir]))
+        per cell is 3π m² W ε²/n² times this value); 0 where it is within its quadrature uncertainty
+        (:attr:`loop_energy`'s bound), never a negative energy that is only quadrature error."""
+        return self.loop_energy.value
 
     def transition_D(self, full_length: float, fraction: float = 0.95) -> float:
         """First approach D at which Λc reaches ``fraction`` × ``full_length`` (linear interpolation):
