@@ -81,7 +81,8 @@ def test_the_fast_solver_allocates_from_the_backend(monkeypatch):
 
 def test_wrapping_solvers_return_new_values():
     """The mirror and slab solvers build the equilibrium they return complete (issue 28, item 5):
-    a FoldedEquilibrium takes its mirror at construction and refuses any later assignment; the
+    a FoldedEquilibrium wraps the block's equilibrium with its mirror at construction and refuses any later
+    assignment; the
     slab solver's gathered equilibrium is a new value, the inner solver's left as it was."""
     import dataclasses
 
@@ -90,11 +91,12 @@ def test_wrapping_solvers_return_new_values():
     from tengsim.solvers.types import Equilibrium, State
 
     z = np.zeros((2, 2))
-    eq = FoldedEquilibrium(State(z, z), z, z, 0.0, True, 1, 2, 0.0, 0.0, "ok", mirror=None)
-    for name in ("_mirror", "H", "residual"):
+    block = Equilibrium(State(z, z), z, z, 0.0, True, 1, 2, 0.0, 0.0, "ok")
+    eq = FoldedEquilibrium(block, mirror=None)
+    for name in ("mirror", "block", "H", "residual"):
         with pytest.raises(dataclasses.FrozenInstanceError):
             setattr(eq, name, 1)
-    assert eq._mirror is None and eq.H is z
+    assert eq.mirror is None and eq.block is block
 
     inner_eq = Equilibrium(State(z[:1], z[:1]), z[:1], z[:1], 0.5, True, 3, 4, -1.0, 0.1, "converged")
 

@@ -39,15 +39,6 @@ def physical_scale(res) -> tuple[float, float] | None:
     return None
 
 
-FAMILIES = {
-    "square": ("pyramid", "cube"),
-    "disc": ("cone", "hemisphere", "sphere", "paraboloid", "flat_punch", "flatpunch"),
-    "line": ("line", "sinusoid", "sinusoid1d"),
-}
-"""Contact-patch family of each built-in shape for the charged-area fraction A/S (docs/design.md);
-a shape not listed (a plugin) is taken as 'square' unless its class sets ``contact_family``."""
-
-
 def shape_name(params: dict) -> str:
     """The registered name of a result's shape (from its [contact] table, else its class name)."""
     cfg = params.get("config")
@@ -87,16 +78,19 @@ def cell_side(params: dict) -> float:
 
 def family(params: dict) -> str:
     """'square', 'disc' or 'line': how Λc (Greenwood's tensile-peak length along X through the apex)
-    maps to the charged area (an array: its pattern's family)."""
-    name = shape_name(pattern_params(params))
-    for fam, names in FAMILIES.items():
-        if name in names:
-            return fam
-    try:
-        from tengsim.registry import SHAPES
+    maps to the charged area (an array: its pattern's family).  The shape answers: its class's
+    ``contact_family``, the class found in the registry by name or by class name (a result's ``shape``
+    parameter); a shape not registered (a plugin's, not loaded) is 'square'."""
+    from tengsim.plugins import SHAPES  # the built-in shapes registered
 
-        return getattr(SHAPES.get(name), "contact_family", "square")
-    except Exception:  # noqa: BLE001 - an unregistered plugin's file
+    name = shape_name(pattern_params(params))
+    for key in SHAPES.names():
+        cls = SHAPES.get(key)
+        if name in (key, getattr(cls, "__name__", "").lower()):
+            return getattr(cls, "contact_family", "square")
+    try:
+        return getattr(SHAPES.get(name), "contact_family", "square")  # an alias
+    except Exception:  # noqa: BLE001 - not registered
         return "square"
 
 

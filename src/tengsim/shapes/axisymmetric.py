@@ -21,6 +21,8 @@ class Paraboloid(Shape):
     pitch/ℓ, and the coupling μ^{3/2} with Tabor's μ = (R W²/(E*² ε³))^{1/3}.
     """
 
+    contact_family = "disc"
+
     radius: float = 1.0
     cell: float = 10.0
 
@@ -64,6 +66,8 @@ class Hemisphere(Shape):
     ``k`` = ℓ/ε is the ratio of the lateral to the vertical unit (k = 1: both ε).  Physical input
     (radius R, pitch): ℓ = sqrt(R ε), ρ = R/ℓ, k = ℓ/ε, cell = pitch/ℓ, so U0 = h0/ε exactly.
     """
+
+    contact_family = "disc"
 
     radius: float = 3.0
     cell: float = 10.0
@@ -119,6 +123,8 @@ class Cone(Shape):
     cell pitch/ℓ and the cap height/ε.
     """
 
+    contact_family = "disc"
+
     slope: float = 1.0
     cell: float = 10.0
     height: float = np.inf
@@ -173,6 +179,8 @@ class FlatPunch(Shape):
 
     Physical input (radius, step, pitch): ℓ = ε, every length divided by ε.
     """
+
+    contact_family = "disc"
 
     radius: float = 1.0
     cell: float = 6.0

@@ -53,6 +53,9 @@ class Shape:
     #: mirror symmetries of the gap about the cell centre (0: X ↦ −X, 1: Y ↦ −Y) that a solve may use
     #: (issue 22: the irreducible block); none declared, none used.  A run checks them on its grid.
     mirror_axes = ()
+    #: how the contact length Λc maps to the charged area A/S (tengsim.run.area.family): 'square' (a square
+    #: patch of side Λc), 'disc' (a disc of diameter Λc) or 'line' (a strip of width Λc)
+    contact_family = "square"
 
     def gap(self, grid: Grid) -> np.ndarray:  # pragma: no cover - abstract
         raise NotImplementedError

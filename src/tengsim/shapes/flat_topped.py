@@ -75,6 +75,8 @@ class Line(_FlatTop):
     Physical input (half_width, height, pitch): ℓ = ε, every length divided by ε.
     """
 
+    contact_family = "line"
+
     physical_fields = _flat_top_fields("ridge")
     field_help = {"half_width": "half the ridge width a", "height": "ridge height in ε", "cell": "cell side"}
 

@@ -20,6 +20,8 @@ class Sinusoid1D(Shape):
     Physical input (wavelength, amplitude): ℓ = ε, every length divided by ε.
     """
 
+    contact_family = "line"
+
     wavelength: float = 10.0
     amplitude: float = 1.0
 
