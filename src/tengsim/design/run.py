@@ -160,8 +160,7 @@ def estimate(plan, cplan, dx: float, d_max: float) -> Estimate:
 
     grids, secs = [], 0.0
     rows = ROWS_PER_STEP * (d_max - D_MIN) / D_STEP
-    for k in range(LEVELS_ESTIMATED):
-        g = cplan.shape.grid(dx / math.sqrt(2.0) ** k)
+    for g in refinement_grids(cplan.shape, dx, LEVELS_ESTIMATED):  # the grids the refinement will walk
         if plan.max_pixels is not None and g.nx * g.ny > plan.max_pixels and grids:
             break
         grids.append((g.nx, g.ny, g.dx * cplan.scaling.lateral))
