@@ -140,3 +140,20 @@ def test_contact_plan_is_the_type_simulate_runs():
     a = simulate_plan(p)
     b = simulate(p.shape, p.tabor, p.dx, p.path)
     assert list(a.table["F"]) == list(b.table["F"]) and isinstance(p, ContactPlan)
+
+
+def test_shapes_answer_their_contact_family():
+    """The charged area's family comes from the shape class (no list of names in run.area): the built-in
+    shapes as docs/design.md tabulates them, by registered name and by class name (a result's 'shape'
+    parameter), and an unregistered name falls back to the square patch."""
+    from tengsim.plugins import SHAPES
+    from tengsim.run.area import family
+
+    expect = {"pyramid": "square", "cube": "square", "cone": "disc", "hemisphere": "disc", "sphere": "disc",
+              "flat_punch": "disc", "line": "line", "sinusoid": "line"}
+    for name, fam in expect.items():
+        assert family({"shape": name}) == fam, name
+        assert family({"shape": SHAPES.get(name).__name__}) == fam, name
+    assert family({"shape": "no-such-shape"}) == "square"
+    for name in SHAPES.names():
+        assert family({"shape": name}) in ("square", "disc", "line")
