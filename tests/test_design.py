@@ -324,3 +324,14 @@ def test_budget_cap_lies_between_plain_grids():
     assert nxt.nx * nxt.ny > cap  # the cap lies before the next plain grid, which the budget does not pay for
     secs = sum(SECONDS_PER_PIXEL_ROW * _blocks(cp.shape, g) * rows for g in below)
     assert secs <= plan.budget_s  # the plain grids up to the cap fit the budget
+
+
+def test_report_table_cells_hold_no_pipe():
+    """Every label of the report's tables is one Markdown cell: no '|' inside a label would split its row."""
+    from tengsim.design import report
+
+    for entry in vars(report).values():
+        if isinstance(entry, (list, tuple)):
+            for row in entry:
+                if isinstance(row, tuple) and len(row) >= 2 and isinstance(row[1], str):
+                    assert "|" not in row[1], row

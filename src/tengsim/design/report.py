@@ -17,7 +17,8 @@ ROWS = (
                         "branches cover; 0 where within its uncertainty below)", "J/m²"),
     ("hysteresis_bound_J_m2", "hysteresis uncertainty (± : quadrature rule change, solver residual, jump location)",
      "J/m²"),
-    ("area_hysteresis", "hysteresis: largest |A/S retraction − A/S approach| at an asked pressure", ""),
+    ("area_hysteresis", "hysteresis: largest difference between A/S on the retraction and on the approach at an "
+                        "asked pressure (absolute)", ""),
     ("area_at_p_max", "charged area A/S at p_max (approach)", ""),
     ("voc_eq12_at_p_max_V", "V_OC at p_max, Eq. 12 (polymer)", "V"),
     ("voc_eq17_at_p_max_V", "V_OC at p_max, Eq. 17 (rest gap)", "V"),
