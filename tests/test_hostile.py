@@ -518,3 +518,25 @@ def test_c05_a_huge_popsize_is_refused_before_any_point(tmp_path, capsys):
                          "popsize = 1000000000\n")
     line = refused(capsys, ["optimize", str(f), "--out", str(tmp_path / "o"), "--workers", "1"], where=tmp_path)
     assert "popsize" in line and "at most 100000" in line and not (tmp_path / "o").exists()
+
+
+def test_c12_a_child_forked_during_a_sweep_does_not_keep_the_folder(tmp_path):
+    """A process forked while the study folder is locked (a worker a Dask nanny restarts by fork during the
+    sweep) does not hold the folder once the sweep has ended: the next sweep on it takes the lock."""
+    import time
+
+    from tengsim.study.layout import StudyDir
+
+    sd = StudyDir(tmp_path / "out")
+    with sd.lock():
+        pid = os.fork()
+        if pid == 0:  # the child lives on past the sweep
+            time.sleep(3.0)
+            os._exit(0)
+        time.sleep(0.3)
+    try:
+        with sd.lock():
+            pass
+    finally:
+        os.kill(pid, 9)
+        os.waitpid(pid, 0)

@@ -17,7 +17,8 @@ conservative law dissipates nothing) it gives a number of either sign that is qu
 The uncertainty (``bound``) is the sum of
 - the change of that number when each branch is filled in linearly instead (the trapezoid rule: the old rule's
   disagreement with the higher-order one), plus the change from the trapezoid to Simpson's rule of the
-  difference itself, over the D runs between jumps (the error both branches share): ``quadrature``;
+  difference itself, over the D runs between jumps (the error both branches share), and the sums' rounding:
+  ``quadrature``;
 - the solver's share: each row's F is known to about |dF/dD| × its residual (the ``residual`` column, a gap
   error in the units of D, times the branch's stiffness), integrated over D for both branches (two branches at
   the same D differ by about that: one converged from below, the other from above): ``solver``;
@@ -133,8 +134,11 @@ def _rule_change(g, x, gaps) -> float:
         inside |= (x[:-1] >= g0) & (x[1:] <= g1)
     err, start = 0.0, 0
     for k in [*np.flatnonzero(inside), len(x) - 1]:
-        if k - start >= 2:  # at least three points
-            xs, gs = x[start:k + 1], g[start:k + 1]
+        n = k + 1 - start
+        if n >= 3:  # at least three points; an odd count (Simpson's rule proper: SciPy's handling of an even
+            # count changed between releases), the run's last interval left to the trapezoid alone
+            end = start + (n if n % 2 else n - 1)
+            xs, gs = x[start:end], g[start:end]
             err += abs(float(trapezoid(gs, xs)) - float(simpson(gs, x=xs)))
         start = k + 1
     return err
@@ -161,6 +165,8 @@ def loop_energy(D, F, branch, jump=None, residual=None) -> LoopEnergy:
     quad = abs(est - float(trapezoid(a.at(x, False) - r.at(x, False), x))) + _rule_change(g, x, a.gaps() + r.gaps())
     solver = float(trapezoid(a.solver_error(x) + r.solver_error(x), x))
     jumps = float(a.jump_error(lo, hi) + r.jump_error(lo, hi))
+    roundoff = 64 * np.finfo(float).eps * float(trapezoid(np.abs(a.at(x, True)) + np.abs(r.at(x, True)), x))
+    quad += roundoff  # the sums' own rounding: a loop of two identical branches is 0, not ±1e-17
     bound = quad + solver + jumps
     value = est if abs(est) > bound else 0.0
     return LoopEnergy(value, est, bound, quad, solver, jumps, (float(lo), float(hi)))

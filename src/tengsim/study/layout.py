@@ -25,6 +25,24 @@ import os
 from dataclasses import dataclass
 from pathlib import Path
 
+_HELD: set = set()
+"""The study-folder lock descriptors this process holds (:meth:`StudyDir.lock`)."""
+
+
+def _drop_held_in_child() -> None:
+    """In a child forked while a lock is held (a worker a Dask nanny restarts by fork), close its copies of
+    the lock descriptors: the flock belongs to the open file, so a child that kept a copy would hold the
+    folder after the sweep ended.  Closing a copy (never unlocking it) leaves the parent's lock as it is."""
+    for fd in list(_HELD):
+        try:
+            os.close(fd)
+        except OSError:
+            pass
+    _HELD.clear()
+
+
+os.register_at_fork(after_in_child=_drop_held_in_child)
+
 
 @dataclass
 class StudyDir:
@@ -74,8 +92,10 @@ class StudyDir:
                                    "wait for it to finish, or use another --out") from None
             os.ftruncate(fd, 0)
             os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
+            _HELD.add(fd)
             yield path
         finally:
+            _HELD.discard(fd)
             os.close(fd)  # closing releases the lock
 
     @property
