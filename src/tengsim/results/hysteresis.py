@@ -15,6 +15,7 @@ conservative law dissipates nothing) it gives a number of either sign that is qu
 4. integrates the difference approach − retraction on those points.
 
 The uncertainty (``bound``) is the sum of
+
 - the change of that number when each branch is filled in linearly instead (the trapezoid rule: the old rule's
   disagreement with the higher-order one), plus the change from the trapezoid to Simpson's rule of the
   difference itself, over the D runs between jumps (the error both branches share), and the sums' rounding:
