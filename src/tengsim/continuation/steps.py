@@ -41,6 +41,9 @@ class _FixedPlan:
     def next(self):
         return self.todo[-1][0] if self.todo else None
 
+    def can_refine(self) -> bool:
+        return self.todo[-1][1] < self.L
+
     def refine(self, Da, Db):
         _, level, on_grid = self.todo[-1]
         if level >= self.L:
@@ -115,6 +118,9 @@ class _AdaptivePlan:
             k += 1
         self.k, self.nj = k, j + self.sgn * 2 ** (L - k)
         return self.ctl.d_min + self.nj * self.h_min
+
+    def can_refine(self) -> bool:
+        return self.k < self.ctl.L
 
     def refine(self, Da, Db):
         if self.k >= self.ctl.L:

@@ -9,6 +9,11 @@ A step control is any object with ``plan(walker, eq, D_from, stops, on_grid)`` r
 - ``next()``: the D of the next step, or None at the end;
 - ``refine(Da, Db)``: the step Da → Db jumped; True if the plan takes a shorter one instead (the solved
   state is then discarded), False to accept it as a jump;
+- ``can_refine()`` (optional): whether ``refine`` would take a shorter step now.  A step whose predicted
+  start jumped is then shortened at once, without the second solve from the step's start that confirms
+  the jump (that solve would be discarded with the step; near a fold it is the walk's costliest, ~3× a
+  row's iterations).  Without it, or when False, every jump is confirmed before it is refined or
+  recorded, so a recorded jump is always one the unpredicted start makes too;
 - ``accept(Da, eqa, Db, eqb, jump)``: the step is taken; returns ``(rows, inner)``: the rows to record
   now, in path order, each ``(D, eq, on_grid, jump)``, and the ``(D, eq)`` the plan solved strictly
   between Da and Db (they come before Db in the predictor's history);
@@ -129,13 +134,16 @@ class Walker:
     def jumped(self, eqa, eqb, dD) -> bool:
         return jumped(eqa, eqb, dD, self.jump_h)
 
-    def step(self, Da, eqa, Db, predictor: bool = True, c_max: float = 1.5):
+    def step(self, Da, eqa, Db, predictor: bool = True, c_max: float = 1.5, shorten: bool = False):
         """(eqb, jump): the step Da → Db from the predicted start, solved again from ``eqa`` when the
-        predicted one jumped (a predictor can overshoot onto another branch)."""
+        predicted one jumped (a predictor can overshoot onto another branch), unless ``shorten``: the
+        caller then takes a shorter step instead, and the predicted jump is returned unconfirmed."""
         start, predicted = self.predict(Db, c_max) if predictor else (self.hist[-1][1], False)
         eqb = self.solve(Db, start)
         del start  # the solver copied it
         if predicted and self.jumped(eqa, eqb, Db - Da):
+            if shorten:
+                return eqb, True
             eqb = None  # discarded: freed before the solve again
             eqb = self.solve(Db, eqa.state)  # confirm without the predictor
         return eqb, self.jumped(eqa, eqb, Db - Da)
@@ -148,8 +156,10 @@ class Walker:
         D_from, eq = start if start is not None else (self.hist[-1][0], self.eq)
         plan = self.steps.plan(self, eq, D_from, stops, on_grid)
         Da = D_from
+        can_refine = getattr(plan, "can_refine", None)
         while (Db := plan.next()) is not None:
-            eqb, jump = self.step(Da, eq, Db, plan.predictor, plan.c_max)
+            eqb, jump = self.step(Da, eq, Db, plan.predictor, plan.c_max,
+                                  shorten=can_refine is not None and can_refine())
             if jump and plan.refine(Da, Db):
                 eqb = None  # discarded: freed before the shorter step's solve
                 continue
