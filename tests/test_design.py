@@ -58,6 +58,7 @@ def test_dataset_contract_and_physics(small):
               "eps_r", "thickness_m", "status", "grids", "tolerance", "charged_area_definition"):
         assert k in ds.attrs, k
     assert ds.attrs["Conventions"] == "CF-1.10" and ds.attrs["shape"] == "pyramid"
+    assert ds.attrs["solver_tolerance_eps"] == pytest.approx(0.01 * ds.attrs["tolerance"])  # and stated
     A = ds["charged_area_fraction"].values
     eps0 = 8.8541878128e-12
     # Eq. 12 and Eq. 17 from A/S with the paper's σ, ε_r, T and rest gap
@@ -335,3 +336,29 @@ def test_report_table_cells_hold_no_pipe():
             for row in entry:
                 if isinstance(row, tuple) and len(row) >= 2 and isinstance(row[1], str):
                     assert "|" not in row[1], row
+
+
+def test_the_designs_solver_tolerance_moves_its_numbers_far_less_than_tol():
+    """A design solves each equilibrium to max|r| <= 0.01 × tol (design.run.SOLVER_TOL_PER_TOL), not a contact
+    run's 1e-6: on the small pyramid's first grid, A/S on both branches at every asked pressure, the pull-off
+    force and the hysteresis move by less than tol/20 against the 1e-6 solve (measured 2e-4 for A/S)."""
+    import dataclasses
+
+    from tengsim.design import run as R
+    from tengsim.design.curves import branch_curves
+    from tengsim.run.plan import plan_contact
+
+    plan = plan_design(SMALL)
+    assert R.solver_tol(plan) == pytest.approx(1e-4)
+    out = []
+    for tol in (R.solver_tol(plan), 1e-6):
+        cplan = dataclasses.replace(plan_contact(plan.contact_table), tol=tol)
+        dx = R.start_dx(plan, cplan)
+        res = R._simulate(cplan, dx, R.find_d_max(plan, cplan, dx)[0])
+        assert res.params["tol"] == tol and res.status == "ok"
+        c = branch_curves(res, plan)
+        out.append((np.concatenate([c["approach"]["area"], c["retraction"]["area"]]), res.pull_off_force,
+                    res.hysteresis))
+    (a, f, h), (a0, f0, h0) = out
+    assert np.max(np.abs(a - a0) / np.maximum(np.abs(a0), 0.01)) < plan.tol / 20
+    assert abs(f - f0) < plan.tol / 20 * abs(f0) and abs(h - h0) <= plan.tol / 20 * abs(h0) + 1e-12

@@ -59,7 +59,8 @@ def to_dataset(res, plan, summary: dict):
         "design_name": plan.name, "E_star_Pa": plan.E_star, "W_J_m2": plan.W, "eps_m": plan.eps,
         "tabor": float(summary["tabor"]), "sigma_C_m2": plan.sigma, "eps_r": plan.eps_r, "thickness_m": plan.T,
         "gap_m": plan.gap, "status": str(summary["status"]), "grids": str(summary["grids"]),
-        "tolerance": float(plan.tol), "charged_area_definition": str(summary["charged_area_definition"]),
+        "tolerance": float(plan.tol), "solver_tolerance_eps": float(res.params.get("tol", math.nan)),
+        "charged_area_definition": str(summary["charged_area_definition"]),
         "contact_config": json.dumps({k: v for k, v in plan.contact_table.items()}, sort_keys=True, default=str),
     }
     for k, v in summary.items():
