@@ -84,6 +84,8 @@ class FastSolver:
     def _descend(self, run: "_Descent", t0: float) -> Equilibrium:
         search = run.search
         for it in range(self.max_iter + 1):
+            # the residual of the last step comes over with the next direction's sweep (one sync)
+            got = run.direction(self.tol) if it < self.max_iter else run.settle()
             if not math.isfinite(run.rmax):
                 return run.finish(False, it, "non-finite residual", t0)
             if run.rmax <= self.tol:
@@ -92,8 +94,7 @@ class FastSolver:
                 break
             if self.monitor is not None and it % self.monitor_every == 0:
                 self.monitor(it, run.rmax, run.E)
-            ray = run.direction()
-            alpha0 = search.first_step(ray.Kd) if run.mem.empty else 1.0
+            ray, alpha0 = got
             first = None if run.first is None else search.finish(alpha0, ray, *run.first)  # swept with d
             trial = search.search(alpha0, ray, run.lowest_energy(), first)
             if trial is None:
@@ -101,5 +102,5 @@ class FastSolver:
             resync = (it + 1) % self.resync == 0
             run.accept(trial, ray, resync)                     # E at the new point (re-anchor w = K q)
             pair = run.new_residual(trial.alpha, resync)       # one convolution: r, G, y, K y
-            run.remember(trial.alpha, ray, pair, resync)       # the L-BFGS memory
+            run.remember(trial.alpha, ray, pair, resync)       # the L-BFGS memory (the pair unconfirmed)
         return run.finish(False, self.max_iter, f"not converged in {self.max_iter} iterations", t0)
