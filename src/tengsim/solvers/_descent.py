@@ -3,7 +3,6 @@ L-BFGS memory, and the fused sweeps that update them."""
 from __future__ import annotations
 
 import functools
-import inspect
 import math
 from typing import NamedTuple
 
@@ -11,6 +10,7 @@ import numpy as np
 
 from tengsim import backend
 from tengsim.laws.safe import safe
+from tengsim.solvers._kernelcall import takes_out
 from tengsim.solvers._linesearch import Ray, Trial, WolfeLineSearch, _energy_at
 from tengsim.solvers._reduce import for_kernel
 from tengsim.solvers.types import Equilibrium, Problem, State, finish
@@ -50,6 +50,10 @@ class _Descent:
 
     A weighted problem (``lines``, tengsim.solvers._weights): the sweeps' plain sums are corrected on
     the few pixels whose weight differs from the interior one, and ΔA carries the interior weight.
+
+    The new residual's numbers are due (:class:`_Due`) until the next direction's sweep brings them
+    over with its own (:meth:`_direction`): max|r| is known one sweep late, and the L-BFGS pair is
+    stored unconfirmed and confirmed or taken back then (:meth:`_settle`).
     """
 
     def __init__(self, problem: Problem, start: State, ws, lines=None):
@@ -75,7 +79,7 @@ class _Descent:
         self.unchecked = hasattr(self.law, "energy_pressure_unchecked")  # a SafeLaw (tengsim.laws.safe)
         self.search = WolfeLineSearch(self.law, ws.sweeper, self.dA, ws.gt, ws.Pt, sum_p=self.proj,
                                       lines=lines, red=red)
-        self._apply, self._takes_out = K.apply, _takes_out(K.apply)
+        self._apply, self._takes_out = K.apply, takes_out(K.apply)
         # the start: g, P, ΣΦ, r (one convolution), G, E
         np.add(self.g0, self.w, out=self.g)
         self.phis, self.sum_p = self.law_sweep()
@@ -415,25 +419,6 @@ def _weigh_law(lines, law, g, P, acc, sum_p):
     i = lines.idx
     phis = acc[0] - np.dot(lines.c, _energy_at(law, g[i]))
     return [phis, acc[1] - lines.sum(P) if sum_p else acc[1]]
-
-
-def _takes_out(fn) -> bool:
-    """Does ``fn`` accept an ``out=`` keyword (the package's kernels do)?  Asked once per function:
-    ``inspect.signature`` costs ~20 µs, a tenth of a warm equilibrium on group A's grid."""
-    func = getattr(fn, "__func__", fn)  # a bound method's function: the same answer for every instance
-    try:
-        return _signature_takes_out(func)
-    except TypeError:  # an unhashable callable: not cached
-        return _signature_takes_out.__wrapped__(func)
-
-
-@functools.lru_cache(maxsize=64)
-def _signature_takes_out(fn) -> bool:
-    try:
-        params = inspect.signature(fn).parameters.values()
-    except (TypeError, ValueError):
-        return False
-    return any(p.name == "out" or p.kind is p.VAR_KEYWORD for p in params)
 
 
 def _axpy(x, y, a, tmp):

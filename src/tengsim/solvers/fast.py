@@ -31,10 +31,18 @@ class FastSolver:
 
     The arrays of an iteration live in a workspace (tengsim.solvers._workspace), allocated once per grid and,
     on grids up to 512² points, kept by the solver for its next solve (a path's equilibria share one).
-    Host syncs: a sweep's sums stay backend scalars and come over in one ``backend.sync`` at its end: the
-    direction's (with the line search's first trial α = 1 swept along), one per further trial, the new
-    residual's; the law is evaluated through its safe extension (tengsim.laws.safe), its hot path
-    unchecked and the sweep's smallest gap checked in that same sync.
+    Host syncs: at most one per iteration, plus one per line-search trial swept on its own.  A sweep's
+    sums stay backend scalars and come over in one ``backend.sync`` at its end; the new residual's
+    sweep has none of its own: its numbers (max|r|, the new L-BFGS pair's curvature test) ride on the
+    next direction's sync, with the direction's sums and the line search's first trial α = 1 swept
+    along (or max|K d| for a first step).  So the convergence test sees a residual one sweep late (a
+    converged solve sweeps one direction in vain), and the memory stores each pair unconfirmed, on
+    backend arrays, and takes it back exactly in the rare case its test fails (then the direction is
+    swept again).  A re-anchoring step adds one (its law sweep's sums with q·w); the start two; a
+    weighted (mirror) solve syncs as the plain one, a distributed one syncs each residual (its sums
+    must be added over the ranks before the memory's update).  The law is evaluated through its safe
+    extension (tengsim.laws.safe), its hot path unchecked and the sweep's smallest gap checked in
+    that same sync.
     """
 
     tol: float = 1e-6
