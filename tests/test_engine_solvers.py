@@ -394,10 +394,10 @@ def test_line_search_accepts_a_wolfe_point_and_leaves_it_in_its_buffers():
     start = FastSolver(1e-8).solve(Problem(U0 - 1.0 + 1.0, law, K), State.zero(grid.shape)).state
     prob = Problem(U0 - 1.3 + 1.0, law, K)  # the next D: a real warm step
     run = _Descent(prob, start, Workspace(grid.nx * grid.ny, 10, grid.area))
-    ray = run.direction()
+    ray, alpha0 = run.direction(0.0)  # tol 0: the start's residual does not end the solve
     ls = run.search
-    assert ray.slope < 0
-    trial = ls.search(ls.first_step(ray.Kd), ray, run.lowest_energy())
+    assert ray.slope < 0 and alpha0 == ls.first_step(float(ray.Kd.max()), float(ray.Kd.min()))
+    trial = ls.search(alpha0, ray, run.lowest_energy())
     assert trial is not None and trial.alpha > 0
     g_new = ray.g + trial.alpha * ray.Kd
     assert np.allclose(ls.g_trial, g_new, rtol=0, atol=1e-14)

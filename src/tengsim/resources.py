@@ -8,7 +8,8 @@
 * periodic kernel: the multiplier and one complex buffer on the half spectrum nx·(ny/2 + 1), ~6 more
   while building it;
 * fast solver: 12 work arrays, the convolution output, copies of g0, q and w (16 n), and the L-BFGS
-  memory: s, y and their images K s, K y, 4·memory rows of n;
+  memory: s, y and their images K s, K y, 4·(memory + 1) rows of n (the 4 spare rows keep an evicted
+  pair until its successor is confirmed);
 * VSR solver: ~14 n (state, trial state, pressures, energies, residuals);
 * the path: U0 and g0, and up to three equilibria alive (q, w, H, P each): 14 n; every saved map
   2 n, and 2 n more while the result is written.
@@ -71,7 +72,7 @@ def estimate_bytes(nx: int, ny: int, boundary: str = "free", solver: str = "fast
         P = px * py
         build = KERNEL_BUILD_FREE * P
         kept = 2.0 * P + 2.0 * nx * py
-    work = VSR_WORK if solver == "vsr" else FAST_WORK + 4 * int(memory)
+    work = VSR_WORK if solver == "vsr" else FAST_WORK + 4 * (int(memory) + 1)
     solve = kept + work * n + PATH_WORK * n + MAP_WORK * int(maps) * n
     return int(_F64 * max(build, solve))
 

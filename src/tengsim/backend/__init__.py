@@ -1,7 +1,8 @@
 """The one seam for arrays and FFTs: every array the solvers allocate and every Fourier transform of
 the package goes through here (NumPy arrays, scipy's pocketfft today; a GPU backend plugs in here).
 
-- the array namespace :data:`xp` and its allocators :func:`empty`, :func:`zeros`; :func:`sync` brings
+- the array namespace :data:`xp` and its allocators :func:`empty`, :func:`zeros`; the small solve
+  :func:`solve_upper` (the L-BFGS memory's triangular systems, on backend arrays); :func:`sync` brings
   a sweep's reductions (backend scalars, small arrays) to the host in one transfer, :func:`to_host` one
   scalar: the only places a solve waits for the device;
 - the thread policy :func:`workers` / :func:`threads` (``TENGSIM_FFT_WORKERS`` forces a count);
@@ -13,6 +14,7 @@ the package goes through here (NumPy arrays, scipy's pocketfft today; a GPU back
 from __future__ import annotations
 
 import numpy as np
+from scipy.linalg.lapack import dtrtrs
 
 from tengsim.backend import fft
 from tengsim.backend.fft import THREAD_MIN_SIZE, FFTBackendWarning, threads, workers
@@ -45,6 +47,13 @@ def to_host(x) -> float:
     return float(sync((x,))[0])
 
 
+def solve_upper(a, b, trans=False):
+    """x with U x = b (``trans``: Uᵀ x = b), U the upper triangle of the small square backend array ``a``
+    (its lower triangle is not read): LAPACK's trtrs for NumPy (scipy's solve_triangular costs ~10× more
+    on these tiny systems).  A zero pivot is not checked: x is then meaningless (LAPACK leaves b)."""
+    return dtrtrs(a, b, lower=0, trans=int(bool(trans)))[0]
+
+
 def fast_len(n: int) -> int:
     """Smallest size >= n whose prime factors are 2, 3, 5 (and 7, 11, as scipy allows)."""
     return fft.next_fast_len(int(n))
@@ -64,4 +73,4 @@ def fast_odd_len(n: int) -> int:
 
 
 __all__ = ["FFTBackendWarning", "THREAD_MIN_SIZE", "empty", "fast_len", "fast_odd_len", "fft", "threads",
-           "sync", "to_host", "workers", "xp", "zeros"]
+           "solve_upper", "sync", "to_host", "workers", "xp", "zeros"]

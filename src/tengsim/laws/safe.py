@@ -98,6 +98,16 @@ class SafeLaw:
     def energy(self, g):
         return self.evaluate(g)[0]
 
+    def energy_at(self, g):
+        """Φ at gaps g, the values of :meth:`energy` without its host decision (no sync: the extension
+        applied by ``where`` on every gap; for a few gaps, e.g. a weighted sweep's deficit pixels)."""
+        gs = self.g_safe
+        low = g < gs
+        phi, _, _ = self.law._raw(np.where(low, gs, g), need_dp=False)
+        phs, ps, dps = self._at_safe
+        t = g - gs
+        return np.where(low, phs - ps * t - 0.5 * dps * t * t, phi)
+
     def stiffness(self, g):
         """−dP/dg: the law's, and below g_safe its value at g_safe (P is linear there)."""
         return self.law.stiffness(np.maximum(np.asarray(g, dtype=float), self.g_safe))

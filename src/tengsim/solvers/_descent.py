@@ -3,16 +3,34 @@ L-BFGS memory, and the fused sweeps that update them."""
 from __future__ import annotations
 
 import functools
-import inspect
 import math
+from typing import NamedTuple
 
 import numpy as np
 
 from tengsim import backend
 from tengsim.laws.safe import safe
-from tengsim.solvers._linesearch import Ray, Trial, WolfeLineSearch
+from tengsim.solvers._kernelcall import takes_out
+from tengsim.solvers._linesearch import Ray, Trial, WolfeLineSearch, _energy_at
 from tengsim.solvers._reduce import for_kernel
 from tengsim.solvers.types import Equilibrium, Problem, State, finish
+
+
+class _Due(NamedTuple):
+    """A residual whose numbers have not come to the host yet (they ride on the next sweep's sync):
+    max r and min r, and the new pair's d·K y and y·K y (None at the start: no pair) with the step α,
+    ΔA α² |d·K d| and whether the step re-anchored (the curvature test, :meth:`_Descent._settle`)."""
+
+    hi: object
+    lo: object
+    dky: object = None
+    yky: object = None
+    alpha: float = 0.0
+    sks: float = 0.0
+    resync: bool = False
+
+    def values(self) -> list:
+        return [self.hi, self.lo] if self.dky is None else [self.hi, self.lo, self.dky, self.yky]
 
 
 class _Descent:
@@ -32,6 +50,10 @@ class _Descent:
 
     A weighted problem (``lines``, tengsim.solvers._weights): the sweeps' plain sums are corrected on
     the few pixels whose weight differs from the interior one, and ΔA carries the interior weight.
+
+    The new residual's numbers are due (:class:`_Due`) until the next direction's sweep brings them
+    over with its own (:meth:`_direction`): max|r| is known one sweep late, and the L-BFGS pair is
+    stored unconfirmed and confirmed or taken back then (:meth:`_settle`).
     """
 
     def __init__(self, problem: Problem, start: State, ws, lines=None):
@@ -57,39 +79,42 @@ class _Descent:
         self.unchecked = hasattr(self.law, "energy_pressure_unchecked")  # a SafeLaw (tengsim.laws.safe)
         self.search = WolfeLineSearch(self.law, ws.sweeper, self.dA, ws.gt, ws.Pt, sum_p=self.proj,
                                       lines=lines, red=red)
-        self._apply, self._takes_out = K.apply, _takes_out(K.apply)
+        self._apply, self._takes_out = K.apply, takes_out(K.apply)
         # the start: g, P, ΣΦ, r (one convolution), G, E
         np.add(self.g0, self.w, out=self.g)
         self.phis, self.sum_p = self.law_sweep()
         np.subtract(self.w, self.convolve(self.P), out=self.r)
         self.n_conv = 1
         if red is not None:
-            self.mean_q = red.sum([backend.to_host(self.q.sum())])[0] / self.nw
+            sq = self.q.sum()
         elif lines is None:
-            self.mean_q = backend.to_host(self.q.mean())
+            sq = self.q.mean()
         else:
-            self.mean_q = backend.to_host(self.q.sum() - lines.sum(self.q)) / self.nw
+            sq = self.q.sum() - lines.sum(self.q)
+        sq, qw = backend.sync((sq, self._dot_dev(self.q, self.w))).tolist()  # one sync: mean q and q·w
+        if red is not None:
+            self.mean_q, self.qw = red.sum([sq])[0] / self.nw, red.sum([qw])[0]
+        else:
+            self.mean_q, self.qw = (sq if lines is None else sq / self.nw), qw
         np.subtract(self.q, self.P, out=self.G)
         if self.proj:
             self.G -= self.mean_q - self.sum_p / self.nw
-        self.qw = self._dot(self.q, self.w)
         self.E = self.dA * (0.5 * self.qw + self.phis)
-        hi, lo = backend.sync((self.r.max(), self.r.min()))
-        self.rmax = max(float(hi), -float(lo))
-        if red is not None:
-            self.rmax = red.max(self.rmax)
+        self.rmax = math.inf
+        self._due = _Due(self.r.max(), self.r.min())  # max|r|: with the first direction's sums
+        if red is not None:  # a distributed solve reduces max|r| over the ranks at once
+            self._settle(backend.sync(self._due.values()).tolist())
         self.E_best = self.E
         self.sum_d = 0.0
         self.corr = None
         self.first = None  # the first trial's sums, swept with the direction (:meth:`_direction`)
 
     # ---- the pieces ---------------------------------------------------------------------------
-    def _dot(self, a, b) -> float:
-        """a·b, m-weighted (in units of the interior weight) for a weighted problem."""
+    def _dot_dev(self, a, b):
+        """a·b, m-weighted (in units of the interior weight) for a weighted problem: a backend scalar
+        (this process's share in a distributed solve)."""
         v = np.vdot(a, b)
-        if self.red is not None:
-            return self.red.sum([backend.to_host(v)])[0]
-        return backend.to_host(v if self.lines is None else v - self.lines.dot(a, b))
+        return v if self.lines is None else v - self.lines.dot(a, b)
 
     def convolve(self, x):
         """K x into the workspace's output array (one convolution; not counted here)."""
@@ -118,22 +143,25 @@ class _Descent:
             return accs[0]
         return [sum(a[0] for a in accs), sum(a[1] for a in accs), functools.reduce(np.minimum, (a[2] for a in accs))]
 
-    def law_sweep(self):
-        """ΣΦ(g) and ΣP (periodic kernels only, else 0), with P(g) written into P: one host sync (the
-        law's unchecked hot path, checked by the smallest gap, as in the line search)."""
+    def law_sweep(self, extra=()):
+        """[ΣΦ(g), ΣP] (ΣP for periodic kernels only, else 0) with P(g) written into P, then the backend
+        scalars ``extra`` as host floats: one host sync (the law's unchecked hot path, checked by the
+        smallest gap, as in the line search; a weighted problem's share of the deficit pixels taken
+        with it).  Distributed: ΣΦ and ΣP summed over the ranks (``extra`` as this process has it)."""
         phis, sum_p, g_min = self._law_sums(self.unchecked)
-        if self.lines is None:
-            phis, sum_p, g_min = backend.sync((phis, sum_p, g_min)).tolist()
-            if self.unchecked and not self.law.covers(g_min):
-                phis, sum_p, _ = backend.sync(self._law_sums(False)).tolist()
-            acc = [phis, sum_p]
-        else:  # weighted: the deficit pixels' share needs P right first
-            if self.unchecked and not self.law.covers(backend.to_host(g_min)):
-                phis, sum_p, _ = self._law_sums(False)
-            acc = backend.sync(_weigh_law(self.lines, self.law, self.g, self.P, [phis, sum_p], self.proj)).tolist()
+        L, extra = self.lines, list(extra)
+        if L is not None:  # weighted: the deficit pixels' share, from the unchecked P first
+            phis, sum_p = _weigh_law(L, self.law, self.g, self.P, [phis, sum_p], self.proj)
+        h = backend.sync([phis, sum_p, g_min] + extra).tolist()
+        if self.unchecked and not self.law.covers(h[2]):  # P was not right everywhere: checked anew
+            phis, sum_p, _ = self._law_sums(False)
+            if L is not None:
+                phis, sum_p = _weigh_law(L, self.law, self.g, self.P, [phis, sum_p], self.proj)
+            h[:2] = backend.sync((phis, sum_p)).tolist()
+        acc = h[:2]
         if self.red is not None:
             acc = self.red.sum(acc)
-        return acc
+        return acc + h[3:]
 
     def lowest_energy(self) -> float:
         """The lowest E so far: E may rise by round-off in an accepted step (approximate Wolfe);
@@ -161,12 +189,16 @@ class _Descent:
             self.search.block(sl, m, sc, acc, 1.0, self.g, self.P, self.Kd, True, 4)
 
     def _direction(self):
-        """[d·w, d·K d, d·r, Σd] (host floats, one sync); with a memory the line search's first trial α = 1
-        is swept along (:attr:`first`: its [ΣΦ, Σ(P(1) − P)·K d, ΣP], or None)."""
+        """One sweep and its one host sync: ([d·w, d·K d, d·r, Σd], α0, taken_back).
+
+        Along come: with a memory, the line search's first trial α = 1 (:attr:`first`: its [ΣΦ,
+        Σ(P(1) − P)·K d, ΣP], or None); without, max K d and min K d for α0 (else α0 = 1); and the due
+        residual's numbers (:meth:`_settle`: ``taken_back`` says the memory lost the pair this direction
+        was computed with, which is then void)."""
         gamma, c = self.mem.coefficients()
         k2 = 0 if c is None else c.size
-        # fused in the serial, unweighted solve with a SafeLaw (its check rides on this sweep's sync)
-        fuse = k2 > 0 and self.unchecked and self.lines is None and self.red is None
+        # the first trial fused with a SafeLaw (its check rides on this sweep's sync), not distributed
+        fuse = k2 > 0 and self.unchecked and self.red is None
         init = [0.0, 0.0, 0.0, 0.0] + ([0.0, 0.0, 0.0, np.inf] if fuse else [])
         accs = self.sw.run(self._direction_block, init, gamma, c, k2, fuse)
         if len(accs) == 1:
@@ -175,33 +207,79 @@ class _Descent:
             acc = [sum(a[j] for a in accs) for j in range(min(len(init), 7))]
             if fuse:
                 acc.append(functools.reduce(np.minimum, (a[7] for a in accs)))
-        self.first = None
-        if fuse:
-            h = backend.sync(acc).tolist()  # the sweep's one host sync: the direction and the trial
-            if self.law.covers(h[7]):
-                self.first = h[4:7]
-            return h[:4]
         L = self.lines
         if L is not None:  # the sweep wrote d and K d whole: correct its sums on the deficit pixels
             cw, cKd, cr = L.dots(self.d, self.w, self.Kd, self.r)
-            acc = [acc[0] - cw, acc[1] - cKd, acc[2] - cr, acc[3] - (L.sum(self.d) if self.proj else 0.0)]
-        acc = backend.sync(acc).tolist()  # the sweep's one host sync
+            acc[:4] = [acc[0] - cw, acc[1] - cKd, acc[2] - cr, acc[3] - (L.sum(self.d) if self.proj else 0.0)]
+            if fuse:  # the trial's too, from its unchecked P(1) (void unless its smallest gap is covered)
+                acc[4:7] = self.search.weigh(*acc[4:7], self.P, self.Kd)
+        if not k2:
+            acc += [self.Kd.max(), self.Kd.min()]
+        due = [] if self._due is None else self._due.values()
+        h = backend.sync(acc + due).tolist()  # the sweep's one host sync
+        taken_back = self._settle(h[len(acc):]) if due else False
+        self.first = None
+        if fuse and self.law.covers(h[7]):
+            self.first = h[4:7]
+        alpha0 = 1.0 if k2 else self.search.first_step(h[4], h[5])
+        sums = h[:4]
         if self.red is not None:
-            acc = self.red.sum(acc)
-        return acc
+            sums = self.red.sum(sums)
+        return sums, alpha0, taken_back
 
-    def direction(self) -> Ray:
-        """d = −H G and K d = −K H G (one sweep), and E along d.
+    def _settle(self, h) -> bool:
+        """The due residual's numbers ``h`` (host floats, :meth:`_Due.values`): max|r| and, for a new pair,
+        its curvature test: the memory holds the pair unconfirmed (:meth:`remember`) and keeps it, or
+        takes it back (and, on a re-anchored step, its products with G anew).  Returns True when taken back."""
+        due, self._due = self._due, None
+        hi, lo = h[0], h[1]
+        self.rmax = max(hi, -lo) if hi == hi and lo == lo else math.nan   # max|r_new|
+        if self.red is not None:
+            self.rmax = self.red.max(self.rmax)
+        if due.dky is None:
+            return False
+        dA, alpha = self.dA, due.alpha
+        sy = dA * alpha * h[2]
+        yy = dA * h[3]
+        if sy > 1e-14 * max(due.sks, 1e-300) and yy > 0:
+            self.mem.confirm()
+            return False
+        self.mem.rollback()
+        if due.resync:
+            self.mem.refresh(self.r)
+        return True
+
+    def ended(self, tol: float) -> bool:
+        """Is the current residual non-finite or max|r| <= ``tol``?"""
+        return not math.isfinite(self.rmax) or self.rmax <= tol
+
+    def settle(self) -> None:
+        """Bring the due residual's numbers over on their own (the solve ends without another sweep)."""
+        if self._due is not None:
+            self._settle(backend.sync(self._due.values()).tolist())
+
+    def direction(self, tol: float):
+        """(Ray, α0): d = −H G and K d = −K H G (one sweep), E along d, and the line search's first α;
+        or None when the residual that came over with the sweep ends the solve (:meth:`ended`: the
+        sweep is then void; it wrote only d, K d and the trial buffers).
 
         The slope E'(0) = ΔA (d·w − P·K d) is taken as ΔA d·r (equal, since r = w − K P and K is
         symmetric): near convergence d·w and P·K d nearly cancel, and their difference is noise.
+        A pair that failed the curvature test is taken back and d computed anew without it.
         Not a descent direction (d·r >= 0): the memory is dropped, d = −G."""
-        dw, dKd, dr, sum_d = self._direction()
+        if self._due is None and self.ended(tol):
+            return None
+        sums, alpha0, taken_back = self._direction()
+        if self.ended(tol):
+            return None
+        if taken_back:
+            sums, alpha0, _ = self._direction()
+        dw, dKd, dr, sum_d = sums
         if not dr < 0:
             self.mem.reset()
-            dw, dKd, dr, sum_d = self._direction()
+            (dw, dKd, dr, sum_d), alpha0, _ = self._direction()
         self.sum_d = sum_d
-        return Ray(self.g, self.P, self.Kd, self.qw, dw, dKd, self.E, self.dA * dr)
+        return Ray(self.g, self.P, self.Kd, self.qw, dw, dKd, self.E, self.dA * dr), alpha0
 
     # ---- the step -------------------------------------------------------------------------------
     def accept(self, trial: Trial, ray: Ray, resync: bool) -> None:
@@ -234,11 +312,11 @@ class _Descent:
         _axpy(self.Kd, corr, -alpha, Pt)
         w[:] = w_exact
         np.add(self.g0, w, out=self.g)
-        self.phis, self.sum_p = self.law_sweep()
-        self.qw = self._dot(q, w)
+        self.phis, self.sum_p, qw = self.law_sweep([self._dot_dev(q, w)])  # q·w in the law sweep's sync
+        self.qw = qw if self.red is None else self.red.sum([qw])[0]
         return corr
 
-    def _residual_block(self, sl, m, sc, acc, alpha, step, corr, mu, k2):
+    def _residual_block(self, sl, m, sc, acc, alpha, step, corr, mu, k2, slot, held):
         # q ← q + α d, w ← w + α K d; r_new = w − K P; K y = Δr; G_new = q − P; y = ΔG
         ds = self.d[sl]
         if step:
@@ -264,20 +342,34 @@ class _Descent:
         hi, lo = rns.max(), rns.min()
         acc[4] = hi if acc[4] is None else np.maximum(acc[4], hi)
         acc[6] = lo if acc[6] is None else np.minimum(acc[6], lo)
+        B, KB = self.mem.B, self.mem.KB
         if k2:
-            acc[5] = acc[5] + self.mem.B[:k2, sl] @ kys
+            acc[5] = acc[5] + B[:k2, sl] @ kys
+        # the new pair's rows s = α d, y, K s, K y (unconfirmed); a full memory's oldest pair aside first
+        if held is not None:
+            sp = self.mem.spare
+            B[2 * sp:2 * sp + 2, sl] = B[2 * held:2 * held + 2, sl]
+            KB[2 * sp:2 * sp + 2, sl] = KB[2 * held:2 * held + 2, sl]
+        np.multiply(ds, alpha, out=B[2 * slot, sl])
+        B[2 * slot + 1, sl] = ys
+        np.multiply(self.Kd[sl], alpha, out=KB[2 * slot, sl])
+        KB[2 * slot + 1, sl] = kys
 
     def new_residual(self, alpha: float, resync: bool):
         """K P at the new point (one convolution) and, in one sweep, the step of q and w (unless
-        re-anchored), the new residual and gradient, the pair y = ΔG, K y = Δr and their products.
+        re-anchored), the new residual and gradient, the pair y = ΔG, K y = Δr, their products, and the
+        pair's rows in the memory (:meth:`KMetricLBFGS.next_slot <tengsim.solvers._lbfgs.KMetricLBFGS.next_slot>`).
 
-        Returns (d·K y, y·K y, d·r_new, y·r_new, B K y): what the memory update needs; sets max|r|."""
+        Returns (d·K y, y·K y, d·r_new, y·r_new, max r_new, min r_new, B K y): backend values, no host
+        sync (a distributed solve's: synced and summed over the ranks)."""
         mu = self.mean_q - self.sum_p / self.nw if self.proj else 0.0
         self.convolve(self.P)
         self.n_conv += 1
-        k2 = 2 * len(self.mem.order)
+        mem = self.mem
+        k2 = 2 * len(mem.order)
+        slot, held = mem.next_slot()
         accs = self.sw.run(self._residual_block, [0.0, 0.0, 0.0, 0.0, None, 0.0, None],
-                           alpha, not resync, self.corr, mu, k2)
+                           alpha, not resync, self.corr, mu, k2, slot, held)
         if len(accs) == 1:
             dky, yky, drn, yrn, hi, x, lo = accs[0]
         else:
@@ -290,42 +382,31 @@ class _Descent:
             c_dky, c_drn = L.dots(self.d, ky, rn)
             c_yky, c_yrn = L.dots(self.y, ky, rn)
             dky, yky, drn, yrn = dky - c_dky, yky - c_yky, drn - c_drn, yrn - c_yrn
-            if k2:
-                x = x - L.rows(self.mem.B[:k2], ky)
-        h = backend.sync((dky, yky, drn, yrn, hi, lo), x if k2 else None)  # the sweep's one host sync
-        dky, yky, drn, yrn, hi, lo = h[:6].tolist()
-        self.rmax = max(hi, -lo) if hi == hi and lo == lo else math.nan   # max|r_new|
-        x = h[6:]
-        if self.red is not None:  # every rank's partial products and max|r|
-            dky, yky, drn, yrn = self.red.sum([dky, yky, drn, yrn])
-            self.rmax = self.red.max(self.rmax)
-            if k2:
-                x = self.red.sum(np.asarray(x, dtype=float))
-        return dky, yky, drn, yrn, (x if k2 else None)
-
-    def _store_block(self, sl, m, sc, acc, alpha, slot):
-        B, KB = self.mem.B, self.mem.KB
-        np.multiply(self.d[sl], alpha, out=B[2 * slot, sl])
-        B[2 * slot + 1, sl] = self.y[sl]
-        np.multiply(self.Kd[sl], alpha, out=KB[2 * slot, sl])
-        KB[2 * slot + 1, sl] = self.ky[sl]
+            if k2:  # the rows as they were: the held pair's from the spare rows
+                moved = None if held is None else (2 * held, mem.B[2 * mem.spare:2 * mem.spare + 2])
+                x = x - L.rows(mem.B[:k2], ky, moved)
+        if self.red is None:
+            return dky, yky, drn, yrn, hi, lo, (x if k2 else None)
+        h = backend.sync((dky, yky, drn, yrn, hi, lo), x if k2 else None)  # every rank's partial values
+        dky, yky, drn, yrn = self.red.sum(h[:4].tolist())
+        x = self.red.sum(np.asarray(h[6:], dtype=float)) if k2 else None
+        return dky, yky, drn, yrn, float(h[4]), float(h[5]), x
 
     def remember(self, alpha: float, ray: Ray, pair, resync: bool) -> None:
-        """Update the L-BFGS memory with the pair (s = α d, y) if ⟨s, y⟩ > 0 (curvature), then make
-        the new residual and gradient current (on a re-anchored step, the memory's products anew)."""
-        dky, yky, drn, yrn, x = pair
+        """Update the L-BFGS memory with the pair (s = α d, y), unconfirmed, and make the new residual
+        and gradient current (on a re-anchored step, the memory's products anew).  The residual is
+        due (:class:`_Due`): max|r| and the curvature test ⟨s, y⟩ > 0 come over with the next sweep's
+        sync (a distributed solve's are here already: settled at once)."""
+        dky, yky, drn, yrn, hi, lo, x = pair
         dA = self.dA
-        sy = dA * alpha * dky
-        yy = dA * yky
-        sks = dA * alpha * alpha * abs(ray.dKd)
-        store = sy > 1e-14 * max(sks, 1e-300) and yy > 0
-        slot = self.mem.update(alpha, None if x is None else dA * x, sy, yy, dA * drn, dA * yrn, store)
-        if slot is not None:
-            self.sw.run(self._store_block, (), alpha, slot)
+        self.mem.update(alpha, None if x is None else dA * x, dA * alpha * dky, dA * yky, dA * drn, dA * yrn)
         self.r, self.rn = self.rn, self.r
         self.G, self.Gn = self.Gn, self.G
         if resync:
             self.mem.refresh(self.r)
+        self._due = _Due(hi, lo, dky, yky, alpha, dA * alpha * alpha * abs(ray.dKd), resync)
+        if self.red is not None:
+            self._settle([hi, lo, dky, yky])
 
     def finish(self, ok: bool, it: int, msg: str, t0: float) -> Equilibrium:
         st = State(self.q.reshape(self.shape), self.w.reshape(self.shape))
@@ -336,27 +417,8 @@ class _Descent:
 def _weigh_law(lines, law, g, P, acc, sum_p):
     """[ΣΦ, ΣP] of a sweep, m-weighted: less the deficit pixels' share (Φ there evaluated anew)."""
     i = lines.idx
-    phis = acc[0] - np.dot(lines.c, law.energy(g[i]))
+    phis = acc[0] - np.dot(lines.c, _energy_at(law, g[i]))
     return [phis, acc[1] - lines.sum(P) if sum_p else acc[1]]
-
-
-def _takes_out(fn) -> bool:
-    """Does ``fn`` accept an ``out=`` keyword (the package's kernels do)?  Asked once per function:
-    ``inspect.signature`` costs ~20 µs, a tenth of a warm equilibrium on group A's grid."""
-    func = getattr(fn, "__func__", fn)  # a bound method's function: the same answer for every instance
-    try:
-        return _signature_takes_out(func)
-    except TypeError:  # an unhashable callable: not cached
-        return _signature_takes_out.__wrapped__(func)
-
-
-@functools.lru_cache(maxsize=64)
-def _signature_takes_out(fn) -> bool:
-    try:
-        params = inspect.signature(fn).parameters.values()
-    except (TypeError, ValueError):
-        return False
-    return any(p.name == "out" or p.kind is p.VAR_KEYWORD for p in params)
 
 
 def _axpy(x, y, a, tmp):

@@ -20,23 +20,30 @@ work (tengsim.solvers._sweep):
   recurrence (G changes by y each step, so they change by <s_i, y>, <y_i, y>, which the new
   pair's column of [<s_i, y_j>] needs anyway) and recomputed exactly on ``refresh``;
 * the new pair's row <s, y_j> follows from the direction's coefficients and the small matrices.
+
+Everything here runs on backend arrays, the small matrices included: the fast solver updates the
+memory before the host has seen the new pair's products, so a pair is stored speculatively
+(:meth:`KMetricLBFGS.update`) and the solver confirms it (:meth:`~KMetricLBFGS.confirm`) or takes it back
+exactly (:meth:`~KMetricLBFGS.rollback`) once the curvature test's numbers have come over.  The rows of
+the pair a full memory evicts are kept in two spare rows until then.
 """
 from __future__ import annotations
 
 import numpy as np
-from scipy.linalg.lapack import dtrtrs
 
 from tengsim import backend
 
 
 class KMetricLBFGS:
-    """Ring of m pairs (s, y) and images (K s, K y); slot j lives in rows 2j, 2j + 1."""
+    """Ring of m pairs (s, y) and images (K s, K y); slot j lives in rows 2j, 2j + 1, and rows 2m, 2m + 1
+    (slot m, :attr:`spare`) hold an evicted pair's rows until its successor is confirmed."""
 
     def __init__(self, memory: int, n: int, dA: float):
         self.m, self.dA = int(memory), float(dA)
         m = self.m
-        self.B = backend.empty((2 * m, n))     # s_j, y_j
-        self.KB = backend.empty((2 * m, n))    # K s_j, K y_j
+        self.spare = m
+        self.B = backend.empty((2 * m + 2, n))     # s_j, y_j
+        self.KB = backend.empty((2 * m + 2, n))    # K s_j, K y_j
         self.SY = backend.zeros((m, m))  # SY[i, j] = <s_i, y_j>, by slot
         self.YY = backend.zeros((m, m))  # YY[i, j] = <y_i, y_j>
         self.pS = backend.zeros(m)       # <s_i, G> for the current gradient G
@@ -44,6 +51,7 @@ class KMetricLBFGS:
         self.order: list[int] = []  # slots, oldest first; the active slots are always 0 .. k-1
         self._last = (1.0, backend.zeros(0), backend.zeros(0))
         self._perm = backend.zeros(0, int)   # active slots in age order (oldest first), as an index array
+        self._undo = None  # how to take back the last, unconfirmed pair (:meth:`rollback`)
         self.lines = None  # a weighted problem's deficit pixels (tengsim.solvers._weights): m-weighted products
         self.red = None    # a distributed solve's sums over all ranks (tengsim.solvers._reduce)
 
@@ -55,6 +63,7 @@ class KMetricLBFGS:
         self.order = []
         self._perm = backend.zeros(0, int)
         self._last = (1.0, backend.zeros(0), backend.zeros(0))
+        self._undo = None
 
     def refresh(self, r) -> None:
         """Recompute <s_i, G>, <y_i, G> exactly from r = K G (one pass over the rows)."""
@@ -70,22 +79,23 @@ class KMetricLBFGS:
 
     def coefficients(self):
         """(γ, c) of  H G = γ G + Σ_rows c_i B_i  (and K H G = γ r + Σ c_i KB_i) over rows B[:2k];
-        c is None while the memory is empty (H = identity)."""
+        c is None while the memory is empty (H = identity).  Backend values: nothing comes to the host."""
         k = len(self.order)
         if not k:
             self._last = (1.0, backend.zeros(0), backend.zeros(0))
             return 1.0, None
+        xp = backend.xp
         act = self._perm
         new = act[-1]
         yy = self.YY[new, new]
-        gamma = self.SY[new, new] / yy if yy > 0 else 1.0
+        # γ = <s, y>/<y, y> of the newest pair (1 if <y, y> <= 0: only an unconfirmed pair, taken back)
+        gamma = xp.where(yy > 0, self.SY[new, new] / xp.where(yy > 0, yy, 1.0), 1.0)
         SYa = self.SY[act[:, None], act]
-        # R = upper triangle of SYa, positive diagonal (<s_i, y_i> > 0 for every stored pair);
-        # LAPACK's trtrs reads only the upper triangle (no triu copy needed), and directly:
-        # scipy's solve_triangular costs ~10× more on these tiny systems
-        u = dtrtrs(SYa, self.pS[act], lower=0)[0]
-        top = dtrtrs(SYa, np.diag(SYa) * u + gamma * (self.YY[act[:, None], act] @ u) - gamma * self.pY[act],
-                     lower=0, trans=1)[0]
+        # R = upper triangle of SYa, positive diagonal (<s_i, y_i> > 0 for every stored pair); the
+        # triangular solve reads only the upper triangle (no triu copy needed)
+        u = backend.solve_upper(SYa, self.pS[act])
+        top = backend.solve_upper(SYa, xp.diag(SYa) * u + gamma * (self.YY[act[:, None], act] @ u)
+                                  - gamma * self.pY[act], trans=True)
         cS = backend.empty(k)
         cY = backend.empty(k)
         cS[act] = top
@@ -95,27 +105,41 @@ class KMetricLBFGS:
         self._last = (gamma, cS, cY)
         return gamma, c
 
-    def update(self, alpha, x, sy, yy, d_rn, y_rn, store: bool):
-        """After the step s = α d, G ← G + y.  ``x`` = ΔA·B[:2k] @ K y (the rows' products with the
-        new y), ``d_rn`` = ΔA d·r_new, ``y_rn`` = ΔA y·r_new.
+    def next_slot(self):
+        """(slot, held): the slot the next pair goes to, and the slot whose rows must first be copied to
+        the spare rows (the oldest pair, evicted from a full memory), else None."""
+        k = len(self.order)
+        if k < self.m:
+            return k, None
+        return self.order[0], self.order[0]
 
-        Keeps <s_i, G>, <y_i, G> current and, if ``store`` (sy = <s, y> > 0, yy = <y, y>), makes room
-        for the pair (s, y), evicting the oldest when full; returns the slot whose rows
-        B[2 slot] = s, B[2 slot + 1] = y, KB[...] = K s, K y the caller must then fill, else None.
+    def update(self, alpha, x, sy, yy, d_rn, y_rn) -> int:
+        """After the step s = α d, G ← G + y.  ``x`` = ΔA·B[:2k] @ K y (the rows' products with the
+        new y), ``d_rn`` = ΔA d·r_new, ``y_rn`` = ΔA y·r_new, ``sy`` = <s, y>, ``yy`` = <y, y>: backend
+        values (host floats do as well).
+
+        Keeps <s_i, G>, <y_i, G> current and stores the pair (s, y) in :meth:`next_slot`'s slot
+        (evicting the oldest when full), whose rows B[2 slot] = s, B[2 slot + 1] = y, KB[...] = K s, K y
+        the caller fills (and, for a held slot, copies to the spare rows first).  The pair is
+        unconfirmed: the caller then calls :meth:`confirm` if the curvature test passes (sy > 0, yy > 0),
+        else :meth:`rollback`, which leaves the memory as if the pair had never been stored.
+        Returns the slot.
         """
         k, m = len(self.order), self.m
         if k:
             xs, xy = x[0::2], x[1::2]          # <s_i, y>, <y_i, y>
-            if store:
-                gamma, cS, cY = self._last
-                # <d, y_j> from d = −(γ G + Σ cS_i s_i + Σ cY_i y_i), with G the old gradient
-                dy = -(gamma * self.pY[:k] + cS @ self.SY[:k, :k] + cY @ self.YY[:k, :k]) if cS.size \
-                    else -self.pY[:k]
+            gamma, cS, cY = self._last
+            # <d, y_j> from d = −(γ G + Σ cS_i s_i + Σ cY_i y_i), with G the old gradient
+            dy = -(gamma * self.pY[:k] + cS @ self.SY[:k, :k] + cY @ self.YY[:k, :k]) if cS.size \
+                else -self.pY[:k]
             self.pS[:k] += xs
             self.pY[:k] += xy
-        if not store:
-            return None
-        slot = k if k < m else self.order.pop(0)
+        slot, held = self.next_slot()
+        # a full memory overwrites the evicted slot's entries: keep them (small arrays) to take the pair back
+        saved = None if held is None else (self.SY.copy(), self.YY.copy(), self.pS.copy(), self.pY.copy())
+        self._undo = (list(self.order), self._perm, saved, held)
+        if held is not None:
+            self.order.pop(0)
         if k:  # the evicted slot's own entries are overwritten by the diagonal just below
             self.SY[:k, slot] = xs
             self.SY[slot, :k] = alpha * dy
@@ -128,3 +152,21 @@ class KMetricLBFGS:
         self.order.append(slot)
         self._perm = backend.xp.asarray(self.order)
         return slot
+
+    def confirm(self) -> None:
+        """The last pair passed the curvature test: it stays, the evicted pair's rows are free."""
+        self._undo = None
+
+    def rollback(self) -> None:
+        """Take back the last, unconfirmed pair: the memory as :meth:`update` would have left it without
+        storing (the products with the old pairs kept current), the evicted pair's rows back in place."""
+        order, perm, saved, held = self._undo
+        self._undo = None
+        self.order, self._perm = order, perm
+        if saved is not None:
+            for a, b in zip((self.SY, self.YY, self.pS, self.pY), saved):
+                a[...] = b
+        if held is not None:
+            sp = self.spare
+            self.B[2 * held:2 * held + 2] = self.B[2 * sp:2 * sp + 2]
+            self.KB[2 * held:2 * held + 2] = self.KB[2 * sp:2 * sp + 2]

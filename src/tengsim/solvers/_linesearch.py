@@ -63,9 +63,9 @@ class WolfeLineSearch:
         self.sum_p = bool(sum_p)
         self.c1, self.c2, self.max_eval, self.first_move = c1, c2, int(max_eval), first_move
 
-    def first_step(self, Kd) -> float:
-        """α for a first direction (empty memory): the gap moves by at most ``first_move`` (0.25 ε)."""
-        hi, lo = backend.sync((Kd.max(), Kd.min()))
+    def first_step(self, hi, lo) -> float:
+        """α for a first direction (empty memory) from max K d and min K d (host floats): the gap moves by
+        at most ``first_move`` (0.25 ε)."""
         m = max(hi, -lo)
         if self.red is not None:
             m = self.red.max(m)
@@ -115,21 +115,27 @@ class WolfeLineSearch:
         smallest trial gap, which says whether the law's unchecked hot path was right (else a second
         sweep, checked block by block: a trial far into contact)."""
         phis, dpk, sp, g_min = self._sweep(a, ray, self.unchecked)
-        L = self.lines
-        if L is not None:  # m-weighted sums: the deficit pixels' share off (ΔA carries the interior weight)
-            i, c, Pt = L.idx, L.c, self.P_trial
-            if self.unchecked and not self.law.covers(backend.to_host(g_min)):  # P(α) must be right first
-                phis, dpk, sp, g_min = self._sweep(a, ray, False)
-            phis = phis - np.dot(c, self.law.energy(self.g_trial[i]))
-            dpk = dpk - np.dot(c * (Pt[i] - ray.P[i]), ray.Kd[i])
-            if self.sum_p:
-                sp = sp - np.dot(c, Pt[i])
-            phis, dpk, sp = backend.sync((phis, dpk, sp)).tolist()
+        if self.lines is not None:  # the deficit pixels' share off, taken with the unchecked P(α) first
+            phis, dpk, sp, g_min = backend.sync(self.weigh(phis, dpk, sp, ray.P, ray.Kd) + [g_min]).tolist()
+            if self.unchecked and not self.law.covers(g_min):  # P(α) was not right there: checked anew
+                phis, dpk, sp, _ = self._sweep(a, ray, False)
+                phis, dpk, sp = backend.sync(self.weigh(phis, dpk, sp, ray.P, ray.Kd)).tolist()
         else:
             phis, dpk, sp, g_min = backend.sync((phis, dpk, sp, g_min)).tolist()
             if self.unchecked and not self.law.covers(g_min):
                 phis, dpk, sp, _ = backend.sync(self._sweep(a, ray, False)).tolist()
         return self.finish(a, ray, phis, dpk, sp)
+
+    def weigh(self, phis, dpk, sp, P, Kd) -> list:
+        """A trial sweep's [ΣΦ, Σ(P(α) − P)·K d, ΣP] m-weighted (ΔA carries the interior weight): the
+        deficit pixels' share off, from the trial buffers g(α), P(α) (backend values)."""
+        L = self.lines
+        i, c, Pt = L.idx, L.c, self.P_trial
+        phis = phis - np.dot(c, _energy_at(self.law, self.g_trial[i]))
+        dpk = dpk - np.dot(c * (Pt[i] - P[i]), Kd[i])
+        if self.sum_p:
+            sp = sp - np.dot(c, Pt[i])
+        return [phis, dpk, sp]
 
     def finish(self, a, ray: Ray, phis, dpk, sp):
         """(E(α), E'(α), ΣΦ, ΣP) from a trial sweep's sums on this process (host floats)."""
@@ -184,3 +190,9 @@ class WolfeLineSearch:
             e, _, phis, sp = self.evaluate(best[1], ray)  # the buffers must hold the accepted point
             return Trial(best[1], e, phis, sp)
         return None
+
+
+def _energy_at(law, g):
+    """Φ(g) on a few pixels: a SafeLaw's without a host sync (tengsim.laws.safe), else the law's own."""
+    fn = getattr(law, "energy_at", None)
+    return law.energy(g) if fn is None else fn(g)

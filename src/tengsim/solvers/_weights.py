@@ -45,7 +45,12 @@ class Weights:
         """Σ c a over the deficit pixels (subtract from the plain Σ a)."""
         return np.dot(self.c, a[self.idx])
 
-    def rows(self, B, a):
-        """B[:, idx] @ (c a[idx]): the deficit of the row products B @ a."""
+    def rows(self, B, a, moved=None):
+        """B[:, idx] @ (c a[idx]): the deficit of the row products B @ a.  ``moved`` = (j, R): rows
+        j, j + 1, ... of B are read from the rows of R instead (rows kept aside while B's are overwritten)."""
         i = self.idx
-        return B[:, i] @ (self.c * a[i])
+        Bi = B[:, i]
+        if moved is not None:
+            j, R = moved
+            Bi[j:j + len(R)] = R[:, i]
+        return Bi @ (self.c * a[i])

@@ -15,7 +15,7 @@ from tengsim.solvers._lbfgs import KMetricLBFGS
 from tengsim.solvers._sweep import Sweeper
 
 #: grids up to this many points keep their workspace between solves (the allocation matters only
-#: there; a large grid's workspace, ~(13 + 4 m) arrays, is given back with its solve)
+#: there; a large grid's workspace, ~(13 + 4 (m + 1)) arrays, is given back with its solve)
 KEEP_MAX_SIZE = 512 * 512
 
 _ARRAYS = ("g", "gt", "P", "Pt", "d", "Kd", "r", "rn", "G", "Gn", "y", "ky", "cP")

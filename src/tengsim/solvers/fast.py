@@ -31,10 +31,18 @@ class FastSolver:
 
     The arrays of an iteration live in a workspace (tengsim.solvers._workspace), allocated once per grid and,
     on grids up to 512² points, kept by the solver for its next solve (a path's equilibria share one).
-    Host syncs: a sweep's sums stay backend scalars and come over in one ``backend.sync`` at its end: the
-    direction's (with the line search's first trial α = 1 swept along), one per further trial, the new
-    residual's; the law is evaluated through its safe extension (tengsim.laws.safe), its hot path
-    unchecked and the sweep's smallest gap checked in that same sync.
+    Host syncs: at most one per iteration, plus one per line-search trial swept on its own.  A sweep's
+    sums stay backend scalars and come over in one ``backend.sync`` at its end; the new residual's
+    sweep has none of its own: its numbers (max|r|, the new L-BFGS pair's curvature test) ride on the
+    next direction's sync, with the direction's sums and the line search's first trial α = 1 swept
+    along (or max|K d| for a first step).  So the convergence test sees a residual one sweep late (a
+    converged solve sweeps one direction in vain), and the memory stores each pair unconfirmed, on
+    backend arrays, and takes it back exactly in the rare case its test fails (then the direction is
+    swept again).  A re-anchoring step adds one (its law sweep's sums with q·w); the start two; a
+    weighted (mirror) solve syncs as the plain one, a distributed one syncs each residual (its sums
+    must be added over the ranks before the memory's update).  The law is evaluated through its safe
+    extension (tengsim.laws.safe), its hot path unchecked and the sweep's smallest gap checked in
+    that same sync.
     """
 
     tol: float = 1e-6
@@ -84,6 +92,8 @@ class FastSolver:
     def _descend(self, run: "_Descent", t0: float) -> Equilibrium:
         search = run.search
         for it in range(self.max_iter + 1):
+            # the residual of the last step comes over with the next direction's sweep (one sync)
+            got = run.direction(self.tol) if it < self.max_iter else run.settle()
             if not math.isfinite(run.rmax):
                 return run.finish(False, it, "non-finite residual", t0)
             if run.rmax <= self.tol:
@@ -92,8 +102,7 @@ class FastSolver:
                 break
             if self.monitor is not None and it % self.monitor_every == 0:
                 self.monitor(it, run.rmax, run.E)
-            ray = run.direction()
-            alpha0 = search.first_step(ray.Kd) if run.mem.empty else 1.0
+            ray, alpha0 = got
             first = None if run.first is None else search.finish(alpha0, ray, *run.first)  # swept with d
             trial = search.search(alpha0, ray, run.lowest_energy(), first)
             if trial is None:
@@ -101,5 +110,5 @@ class FastSolver:
             resync = (it + 1) % self.resync == 0
             run.accept(trial, ray, resync)                     # E at the new point (re-anchor w = K q)
             pair = run.new_residual(trial.alpha, resync)       # one convolution: r, G, y, K y
-            run.remember(trial.alpha, ray, pair, resync)       # the L-BFGS memory
+            run.remember(trial.alpha, ray, pair, resync)       # the L-BFGS memory (the pair unconfirmed)
         return run.finish(False, self.max_iter, f"not converged in {self.max_iter} iterations", t0)
