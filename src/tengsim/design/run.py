@@ -398,12 +398,13 @@ def run_design(plan, progress=None, keep=None) -> DesignResult:
     path's progress) and/or an object with ``say(text)``, which gets the lines said before and during the run
     (the Tabor number, the grids, memory and estimated time).  ``keep`` (a file path, or None): where each
     finished grid is kept (:func:`_checkpoint`), so a killed run of the same design resumes from it."""
-    from tengsim.run.plan import ResolveSettings, plan_contact
+    from tengsim.run.plan import ResolveSettings, as_plan
     from tengsim.design.curves import summarize
     from tengsim.design.write import to_dataset
     from tengsim.run.resolve import resolve_plan
 
-    cplan = dataclasses.replace(plan_contact(plan.contact_table), tol=solver_tol(plan))
+    cplan = dataclasses.replace(as_plan(plan.contact_table if plan.contact is None else plan.contact),
+                                tol=solver_tol(plan))  # the plan plan_design built (planned once)
     dx = start_dx(plan, cplan)
     est = estimate(plan, cplan, dx, 1.2 * height_eps(cplan, dx) + 2.0)
     _say(progress, f"{plan.name}: Tabor number {cplan.tabor:.3g} (from eps = {plan.eps * 1e9:.3g} nm), "
