@@ -69,7 +69,7 @@ def design_fields() -> list:
 class DesignPlan:
     """A validated design (SI throughout); ``contact_table`` is the [contact] table handed to
     :func:`tengsim.run.plan.plan_contact` (the shape's physical keys, E_star, W, eps and contact options) and
-    ``contact`` the :class:`tengsim.run.plan.ContactPlan` it gave (what :func:`tengsim.design.run.run_design`
+    ``contact_plan`` the :class:`tengsim.run.plan.ContactPlan` it gave (what :func:`tengsim.design.run.run_design`
     runs: a design is planned once)."""
 
     name: str
@@ -92,7 +92,7 @@ class DesignPlan:
     tabor: float
     maps: bool = True
     extra: dict = field(default_factory=dict)
-    contact: object = field(default=None, compare=False, repr=False)
+    contact_plan: object = field(default=None, compare=False, repr=False)
 
     def shape_params_json(self) -> str:
         return json.dumps(self.shape_params, sort_keys=True)
@@ -202,7 +202,7 @@ def plan_design(table: dict, where: str = "") -> DesignPlan:
     return DesignPlan(name=name, shape=shape, contact_table=cfg, shape_params=sp, pressures=pressures,
                       sigma=own["sigma"], eps_r=own["eps_r"], T=own["T"], gap=own["gap"], tol=tol, dx=own["dx"],
                       max_pixels=own["max_pixels"], budget_s=own["budget"], fit_max=fit_max, E_star=sc.E_star,
-                      W=sc.W, eps=sc.eps, tabor=sc.mu, maps=bool(own["maps"]), contact=plan)
+                      W=sc.W, eps=sc.eps, tabor=sc.mu, maps=bool(own["maps"]), contact_plan=plan)
 
 
 def _pressures(own: dict, where: str) -> tuple:

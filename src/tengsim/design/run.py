@@ -403,7 +403,7 @@ def run_design(plan, progress=None, keep=None) -> DesignResult:
     from tengsim.design.write import to_dataset
     from tengsim.run.resolve import resolve_plan
 
-    cplan = dataclasses.replace(as_plan(plan.contact_table if plan.contact is None else plan.contact),
+    cplan = dataclasses.replace(as_plan(plan.contact_table if plan.contact_plan is None else plan.contact_plan),
                                 tol=solver_tol(plan))  # the plan plan_design built (planned once)
     dx = start_dx(plan, cplan)
     est = estimate(plan, cplan, dx, 1.2 * height_eps(cplan, dx) + 2.0)
