@@ -1,5 +1,6 @@
 """Plan once (issue 28 item 1): a [contact] table becomes one frozen, validated ContactPlan, read once per run;
-everything downstream takes that plan; each check lives in one place; the shape answers its full-contact length."""
+everything downstream takes that plan (the refinement driver resolve_plan too, each grid a simulate_plan of it);
+each check lives in one place; the shape answers its full-contact length."""
 import dataclasses
 import math
 
@@ -157,3 +158,59 @@ def test_shapes_answer_their_contact_family():
     assert family({"shape": "no-such-shape"}) == "square"
     for name in SHAPES.names():
         assert family({"shape": name}) in ("square", "disc", "line")
+
+
+@pytest.fixture
+def spied(monkeypatch):
+    """The plans the refinement driver (resolve_plan) and the one-grid run (simulate_plan) are given; both
+    still run (every caller reaches them through their modules)."""
+    from tengsim.run import resolve, simulate
+
+    seen = {"resolve": [], "grids": []}
+    real_resolve, real_grid = resolve.resolve_plan, simulate.simulate_plan
+
+    def resolving(plan, **kw):
+        seen["resolve"].append(plan)
+        return real_resolve(plan, **kw)
+
+    def one_grid(plan, **kw):
+        seen["grids"].append(plan)
+        return real_grid(plan, **kw)
+
+    monkeypatch.setattr(resolve, "resolve_plan", resolving)
+    monkeypatch.setattr(simulate, "simulate_plan", one_grid)
+    return seen
+
+
+def _refined_by_the_plan(seen, res, tol):
+    """Refinements of a ContactPlan whose settings are the run's, each of their grids a simulate_plan."""
+    assert seen["resolve"] and all(isinstance(p, ContactPlan) for p in seen["resolve"])
+    assert all(isinstance(p.resolve, ResolveSettings) and p.resolve.tol == tol for p in seen["resolve"])
+    assert all(isinstance(p, ContactPlan) for p in seen["grids"])
+    ran = [p.grid.dx for p in seen["grids"]]
+    grids = res.params["resolve_grids"]
+    assert len(grids) >= 2  # the refinement's grids are the last simulate_plan runs, in order
+    assert ran[-len(grids):] == pytest.approx(grids, rel=1e-12)
+
+
+def test_a_resolve_auto_run_plans_once_and_refines_that_plan(tmp_path, counted, spied):
+    from tengsim.results.read import load_result
+
+    out = tmp_path / "r.csv"
+    assert main([*PYR, "--resolve", "auto", "--resolve-tol", "0.2", "--max-pixels", str(9 * 9),
+                 "--out", str(out)]) == 0
+    assert len(counted) == 1, counted
+    _refined_by_the_plan(spied, load_result(out)[1], 0.2)
+    assert len(spied["resolve"]) == 1
+    assert all(p.shape is spied["resolve"][0].shape for p in spied["grids"])  # the one plan's pieces, not rebuilt
+
+
+def test_a_design_plans_once_and_refines_that_plan(counted, spied):
+    from tengsim.design import plan_design, run_design
+
+    small = {"shape": "pyramid", "pitch": "1um", "base": "0.5um", "height": "0.2um", "E_star": "5MPa",
+             "W": "20mJ/m2", "eps": "50nm", "p_max": "20kPa", "p_step": "10kPa", "tol": 0.05, "maps": False}
+    res = run_design(plan_design(small))  # a refinement per D range tried (the last reaches p_max)
+    assert len(counted) == 1, counted
+    _refined_by_the_plan(spied, res.finest, 0.05)
+    assert spied["resolve"][-1].path.d_max == res.finest.params["d_max"]

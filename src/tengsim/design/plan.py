@@ -68,7 +68,9 @@ def design_fields() -> list:
 @dataclass(frozen=True)
 class DesignPlan:
     """A validated design (SI throughout); ``contact_table`` is the [contact] table handed to
-    :func:`tengsim.run.plan.plan_contact` (the shape's physical keys, E_star, W, eps and contact options)."""
+    :func:`tengsim.run.plan.plan_contact` (the shape's physical keys, E_star, W, eps and contact options) and
+    ``contact_plan`` the :class:`tengsim.run.plan.ContactPlan` it gave (what :func:`tengsim.design.run.run_design`
+    runs: a design is planned once)."""
 
     name: str
     shape: str
@@ -90,6 +92,7 @@ class DesignPlan:
     tabor: float
     maps: bool = True
     extra: dict = field(default_factory=dict)
+    contact_plan: object = field(default=None, compare=False, repr=False)
 
     def shape_params_json(self) -> str:
         return json.dumps(self.shape_params, sort_keys=True)
@@ -199,7 +202,7 @@ def plan_design(table: dict, where: str = "") -> DesignPlan:
     return DesignPlan(name=name, shape=shape, contact_table=cfg, shape_params=sp, pressures=pressures,
                       sigma=own["sigma"], eps_r=own["eps_r"], T=own["T"], gap=own["gap"], tol=tol, dx=own["dx"],
                       max_pixels=own["max_pixels"], budget_s=own["budget"], fit_max=fit_max, E_star=sc.E_star,
-                      W=sc.W, eps=sc.eps, tabor=sc.mu, maps=bool(own["maps"]))
+                      W=sc.W, eps=sc.eps, tabor=sc.mu, maps=bool(own["maps"]), contact_plan=plan)
 
 
 def _pressures(own: dict, where: str) -> tuple:

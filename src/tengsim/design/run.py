@@ -398,12 +398,13 @@ def run_design(plan, progress=None, keep=None) -> DesignResult:
     path's progress) and/or an object with ``say(text)``, which gets the lines said before and during the run
     (the Tabor number, the grids, memory and estimated time).  ``keep`` (a file path, or None): where each
     finished grid is kept (:func:`_checkpoint`), so a killed run of the same design resumes from it."""
-    from tengsim.run.plan import plan_contact
+    from tengsim.run.plan import ResolveSettings, as_plan
     from tengsim.design.curves import summarize
     from tengsim.design.write import to_dataset
-    from tengsim.run.resolve import resolve_contact
+    from tengsim.run.resolve import resolve_plan
 
-    cplan = dataclasses.replace(plan_contact(plan.contact_table), tol=solver_tol(plan))
+    cplan = dataclasses.replace(as_plan(plan.contact_table if plan.contact_plan is None else plan.contact_plan),
+                                tol=solver_tol(plan))  # the plan plan_design built (planned once)
     dx = start_dx(plan, cplan)
     est = estimate(plan, cplan, dx, 1.2 * height_eps(cplan, dx) + 2.0)
     _say(progress, f"{plan.name}: Tabor number {cplan.tabor:.3g} (from eps = {plan.eps * 1e9:.3g} nm), "
@@ -420,13 +421,10 @@ def run_design(plan, progress=None, keep=None) -> DesignResult:
 
         path = PathSpec(D_MIN, d_max, D_STEP, adaptive=True)
         ck, found = _checkpoint(keep, plan, d_max, progress) or (None, None)
-        res = resolve_contact(cplan.shape, cplan.tabor, path, dx=dx, law=cplan.law, boundary=cplan.boundary,
-                              resolve_tol=plan.tol, max_pixels=max_pixels, observe=_observer(plan),
-                              watch=_watcher(plan), path_for=grid_path(plan, d_max),
-                              progress=progress if callable(progress) else None, symmetry=cplan.symmetry,
-                              solver=cplan.solver, tol=cplan.tol,
-                              extra_params=cplan.extra, scaling=cplan.scaling, kernel_params=cplan.kernel_params,
-                              checkpoint=None if ck is None else ck.save, start=found)
+        res = resolve_plan(dataclasses.replace(cplan, path=path, resolve=ResolveSettings(plan.tol, max_pixels, dx)),
+                           observe=_observer(plan), watch=_watcher(plan), path_for=grid_path(plan, d_max),
+                           progress=progress if callable(progress) else None,
+                           checkpoint=None if ck is None else ck.save, start=found)
         if res.scaling is None:  # every grid taken back from the checkpoint file, which keeps the columns only
             res = dataclasses.replace(res, scaling=cplan.scaling)
         ok, D_hit, top, slope = _reach(res, plan.pressures[-1])
