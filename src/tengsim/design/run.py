@@ -36,7 +36,7 @@ import numpy as np
 
 from tengsim.errors import TengsimError
 
-SECONDS_PER_PIXEL_ROW = 7.6e-6
+SECONDS_PER_PIXEL_ROW = 6.4e-6
 """Wall seconds per (pixel of the solved block) × (path row), one core: measured on the 2-core build machine
 (docs/benchmarks.md, 'Design time constant'); used for the printed estimate only."""
 D_MIN = -1.0
