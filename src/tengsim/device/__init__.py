@@ -15,7 +15,8 @@ from tengsim.device.formulas import (CMEOCycle, cmeo_cycle, eq20_force, electros
                                      fom_structural, isc_apart, qsc_apart, voc_apart,
                                      voc_from_contact_length, voc_polymer, voltage)
 from tengsim.device.analysis import (FigureOfMerit, ResistanceSweep, StaticVoltageCurve, VQCycle, figure_of_merit,
-                                     resistance_sweep, staircase_summary, steady_charge, voc_from_area, vq_cycle)
+                                     resistance_sweep, staircase_summary, steady_charge, steady_start, voc_from_area,
+                                     vq_cycle)
 
 _MOVED = {"fig7_params", "fig7_summary", "fig7_waveform", "fig8_params", "fig8_summary", "fig8_waveform",
           "run_fig7", "run_fig8"}

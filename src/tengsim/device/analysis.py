@@ -12,7 +12,7 @@ from tengsim.device import formulas as fm
 from tengsim.device.dynamics import simulate
 from tengsim.device.params import DeviceParams, SolverOptions
 from tengsim.device.result import DeviceResult
-from tengsim.errors import positive, require
+from tengsim.errors import TengsimError, positive, require
 
 
 # --- Section 4: static voltage-pressure curve (Eq. 12) ---
@@ -92,20 +92,54 @@ class ResistanceSweep:
                                  "optimum_at_edge": int(self.optimum_at_edge)})
 
 
-def steady_charge(params: DeviceParams, waveform, options: SolverOptions | None = None) -> float:
-    """Q at the start of a periodic steady cycle (C), by one secant step on the one-cycle map Q0 -> Q(T).
+STEADY_RTOL = 1e-9
+""":func:`steady_charge` stops when one cycle from its Q0 returns to Q0 within this × the charge scale σS."""
+STEADY_STEPS = 8
 
-    The map is affine in Q0 when the plate starts each cycle at rest and F_e is small (both hold for
-    the paper's devices); at large R the contact RC time is many periods, so plain time-stepping
-    would need hundreds of cycles to settle.
+
+def steady_start(params: DeviceParams, waveform, options: SolverOptions | None = None) -> tuple[float, float]:
+    """(Q0 in C, A/S held) at the start of a periodic steady cycle: the fixed point of the one-cycle map
+    Q0 -> Q(T), by secant steps (at large R the contact RC time is many periods, so plain time-stepping would
+    need hundreds of cycles).
+
+    The charged area a cycle starts with is the one a first cycle from the run's own start leaves (with
+    ``area_memory = 'max'`` the largest the pressure reached: every later cycle starts with it).  With it the
+    map is affine in Q0 when the plate starts each cycle at rest and F_e is small (both hold for the paper's
+    devices), so the first step from Q0 = 0 and Q0 = the rest charge (where that is 0, the charge one cycle
+    from 0 leaves) lands on it; each step is checked by the next cycle and the secant goes on, up to
+    :data:`STEADY_STEPS` steps, until |Q(T) − Q0| <= :data:`STEADY_RTOL` σS.  Raises a
+    :class:`tengsim.errors.TengsimError` where no steady cycle is found.
     """
     per = waveform.period
     dt = per / 20
+    first = simulate(params, waveform, per, dt_out=dt, options=options)
+    area0 = float(first.area[-1] / params.area_m2)
+
+    def gap(q0):  # Q(T) − Q0 of one cycle from Q0
+        return simulate(params, waveform, per, dt_out=dt, options=options, q0_C=q0, area0=area0).Q[-1] - q0
+
+    tol = STEADY_RTOL * abs(params.charge_scale)
+    x0, f0 = 0.0, gap(0.0)
+    if abs(f0) <= tol:
+        return 0.0, area0
     q_rest = params.charge_scale * params.area.initial_fraction / (params.gamma3 + 1.0)
-    q_a = simulate(params, waveform, per, dt_out=dt, options=options, q0_C=0.0).Q[-1]
-    q_b = simulate(params, waveform, per, dt_out=dt, options=options, q0_C=q_rest).Q[-1]
-    beta = (q_b - q_a) / q_rest if q_rest else 0.0
-    return float(q_a / (1.0 - beta)) if abs(1.0 - beta) > 1e-12 else float(q_a)
+    x1 = q_rest if q_rest else f0
+    f1 = gap(x1)
+    for _ in range(STEADY_STEPS):
+        if abs(f1) <= tol or f1 == f0:
+            break
+        x0, f0, x1 = x1, f1, x1 - f1 * (x1 - x0) / (f1 - f0)
+        f1 = gap(x1)
+    if abs(f1) <= tol:
+        return float(x1), area0
+    raise TengsimError(f"no periodic steady cycle found at R = {params.load_ohm:.3g} ohm (one cycle still moves "
+                       f"the charge by {abs(f1):.3g} C after {STEADY_STEPS} secant steps): run it without the "
+                       "steady start and with more cycles")
+
+
+def steady_charge(params: DeviceParams, waveform, options: SolverOptions | None = None) -> float:
+    """Q at the start of a periodic steady cycle (C): :func:`steady_start`'s charge."""
+    return steady_start(params, waveform, options)[0]
 
 
 def resistance_sweep(params: DeviceParams, waveform, loads_ohm, *, cycles: int = 3, skip_cycles: int = 1,
@@ -126,8 +160,8 @@ def resistance_sweep(params: DeviceParams, waveform, loads_ohm, *, cycles: int =
     rows = []
     for i, r in enumerate(loads):
         pr = params.replace(load_ohm=float(r))
-        q0 = steady_charge(pr, waveform, options) if steady else None
-        res = simulate(pr, waveform, int(cycles) * per, dt_out=dt_out, options=options, q0_C=q0)
+        q0, area0 = steady_start(pr, waveform, options) if steady else (None, None)
+        res = simulate(pr, waveform, int(cycles) * per, dt_out=dt_out, options=options, q0_C=q0, area0=area0)
         s = res.summary(skip_cycles)
         rows.append(tuple(math.nan if s[k] is None else s[k]
                           for k in ("energy_per_cycle_J", "average_power_W", "peak_voltage_V", "peak_current_A",
@@ -210,5 +244,5 @@ def staircase_summary(result: DeviceResult) -> dict:
             "area_fraction_steps": [float(result.params.area(p)) for p in steps]}
 
 
-__all__ = ["StaticVoltageCurve", "voc_from_area", "ResistanceSweep", "resistance_sweep", "steady_charge", "VQCycle",
-           "vq_cycle", "FigureOfMerit", "figure_of_merit", "staircase_summary"]
+__all__ = ["StaticVoltageCurve", "voc_from_area", "ResistanceSweep", "resistance_sweep", "steady_charge",
+           "steady_start", "VQCycle", "vq_cycle", "FigureOfMerit", "figure_of_merit", "staircase_summary"]

@@ -101,11 +101,13 @@ def _area_fraction(core: _Core, tb):
 
 def simulate(params: DeviceParams, waveform, t_end: float, *, dt_out: float | None = None,
              options: SolverOptions | None = None, progress: bool = False,
-             q0_C: float | None = None) -> DeviceResult:
+             q0_C: float | None = None, area0: float | None = None) -> DeviceResult:
     """Integrate Eqs. (13)-(22) from rest (y = 0) over [0, t_end] s; returns a :class:`DeviceResult`.
 
     Output rows: a uniform grid of step ``dt_out`` (default 2e-5 s) plus the instant just before
-    each impact, so that impact peaks are not missed. ``q0_C`` overrides ``params.initial_charge``.
+    each impact, so that impact peaks are not missed. ``q0_C`` overrides ``params.initial_charge``;
+    ``area0`` the charged-area fraction A/S held at the start (default ``params.area.initial_fraction``:
+    with ``area_memory = 'max'`` a run that goes on from another's end starts from the area it reached).
     """
     require(isinstance(params, DeviceParams), f"params must be DeviceParams, got {type(params).__name__}")
     t_end = positive("t_end", t_end)
@@ -120,7 +122,8 @@ def simulate(params: DeviceParams, waveform, t_end: float, *, dt_out: float | No
     bps = np.asarray(waveform.breakpoints(0.0, t_end), dtype=float) / tau
     edges = np.concatenate([[0.0], bps[(bps > 0) & (bps < tb_end)], [tb_end]])
 
-    g1 = params.area.initial_fraction
+    g1 = params.area.initial_fraction if area0 is None else finite("area0", area0)
+    require(0.0 <= g1 <= 1.0, f"area0 must be a fraction A/S in [0, 1], got {g1!r}")
     s = np.zeros(_NSTATE)
     if params.initial_charge == "rest" or params.load_mode == "short":
         s[2] = g1 / (core.g3 + 1.0)  # Q_SC at the rest gap: V = 0
@@ -205,12 +208,15 @@ def simulate(params: DeviceParams, waveform, t_end: float, *, dt_out: float | No
                             events=core.impact, rtol=opts.rtol, atol=opts.atol, max_step=opts.max_step / tau)
             require(sol.status >= 0, f"integrator failed at t = {a * tau:.6g} s: {sol.message}")
             nfev += sol.nfev
-            keep = sol.t < b - eps_t
-            emit(sol.t[keep], sol.y.T[keep], False, g1, e_impact)
+            # an event before the first output time leaves sol.t and sol.y as empty lists (scipy)
+            ts = np.asarray(sol.t, dtype=float)
+            ys = np.asarray(sol.y, dtype=float).reshape(len(s), ts.size)
+            keep = ts < b - eps_t
+            emit(ts[keep], ys.T[keep], False, g1, e_impact)
             if sol.status == 1 and sol.t_events[0].size:
                 te = float(sol.t_events[0][0])
                 se = sol.y_events[0][0].copy()
-                if not np.any(keep) or te > sol.t[keep][-1] + eps_t:
+                if not np.any(keep) or te > ts[keep][-1] + eps_t:
                     emit(te, se, False, g1, e_impact)  # pre-impact row keeps the peak
                 e_impact += 0.5 * max(se[1], 0.0) ** 2
                 impacts.append(te * tau)
@@ -219,7 +225,7 @@ def simulate(params: DeviceParams, waveform, t_end: float, *, dt_out: float | No
                 contact = True
                 a = te
             else:
-                s = sol.y[:, -1].copy()
+                s = ys[:, -1].copy()
                 a = b
             if progress and time.perf_counter() - last_report > 1.0:
                 last_report = time.perf_counter()
