@@ -209,3 +209,16 @@ def test_device_runs_with_an_output_step_that_ends_a_flight_before_its_first_row
     out = tmp_path / "r.csv"
     assert main(["device", "fig7", "--dt", "10ms", "--cycles", "4", "--out", str(out), "--quiet"]) == 0
     assert out.exists()
+
+
+def test_the_paper_fig7_sweep_over_its_whole_range_finds_every_steady_cycle():
+    """The Fig. 7 device's default sweep (1 kΩ–10 GΩ, 15 loads): every load's steady start is found (at 3.16 GΩ
+    the secant meets the integrator's own error, 2.4e-17 C, above 1e-9 σS) and the numbers are docs/device.md's."""
+    from tengsim.cases.paper import fig7_params, fig7_waveform
+    from tengsim.device import resistance_sweep
+
+    sw = resistance_sweep(fig7_params(), fig7_waveform(), np.logspace(3, 10, 15))
+    assert np.all(np.isfinite(sw.average_power_W)) and not sw.optimum_at_edge
+    assert 3e6 <= sw.optimum_ohm <= 1e7
+    assert sw.energy_per_cycle_J.max() == pytest.approx(86e-9, rel=0.01)
+    assert sw.energy_per_cycle_J[6] == pytest.approx(44.8e-9, rel=0.01) and sw.load_ohm[6] == pytest.approx(1e6)
