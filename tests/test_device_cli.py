@@ -100,3 +100,14 @@ def test_plots(tmp_path):
     plot_resistance_sweep(sw, tmp_path / "sw.png")
     for name in ("f7.png", "vq.pdf", "f8.png", "sw.png"):
         assert (tmp_path / name).stat().st_size > 1000
+
+
+def test_a_bad_time_is_named_as_the_user_wrote_it(tmp_path, capsys):
+    """`--dt -1ms`: one line naming '-1ms' (the check sees -0.001 s), exit 2, nothing written."""
+    from tengsim.cli.main import main as cli
+
+    out = tmp_path / "r.csv"
+    assert cli(["device", "fig7", "--dt", "-1ms", "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "'-1ms'" in err[0] and "--dt must be > 0" in err[0]
+    assert not out.exists() and not list(tmp_path.iterdir())

@@ -102,7 +102,12 @@ class Field:
         else:  # pragma: no cover - a schema bug
             raise TypeError(f"unknown field kind {k!r}")
         if self.check is not None:
-            v = self.check(v, label) if _arity(self.check) == 2 else self.check(v)
+            try:
+                v = self.check(v, label) if _arity(self.check) == 2 else self.check(v)
+            except TengsimError as e:  # the check sees the number in SI: name the value as the user wrote it
+                if self.dim is None or not isinstance(value, str) or shown(value) in str(e):
+                    raise
+                raise type(e)(f"{e} (given as {shown(value)})") from None
         return v
 
     def _number(self, value, label):
