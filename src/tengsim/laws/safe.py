@@ -21,6 +21,18 @@ import numpy as np
 from tengsim import backend
 
 
+def extended(raw, g, gs, at_safe, xp):
+    """The safe extension's formula, once: (Φ, P) at gaps g of a law whose ``raw(g)`` gives its (Φ, P, …)
+    in the array namespace ``xp``; the law's own at g >= gs, below it P continued linearly with the
+    slope it has at gs and Φ its integral (quadratic).  ``at_safe``: (Φ, P, dP/dg) at gs (host floats,
+    or arrays of ``xp`` when gs is traced).  Branch-free (``xp.where``)."""
+    low = g < gs
+    phi, p = raw(xp.where(low, gs, g))[:2]
+    phs, ps, dps = at_safe
+    t = g - gs
+    return xp.where(low, phs - ps * t - 0.5 * dps * t * t, phi), xp.where(low, ps + dps * t, p)
+
+
 @dataclass(frozen=True)
 class SafeLaw:
     """``law`` at gaps >= its ``g_safe``, continued linearly in P below.
@@ -43,30 +55,23 @@ class SafeLaw:
         phi, p, dp = self.law._raw(np.array([self.g_safe]))
         return float(phi[0]), float(p[0]), float(dp[0])
 
+    def _raw_np(self, g):
+        return self.law._raw(g, need_dp=False)
+
     def evaluate(self, g):
         """(Φ, P) at gaps g: the law's above g_safe, the linear continuation below."""
         g = np.asarray(g, dtype=float)
-        gs = self.g_safe
-        low = g < gs
-        if not backend.to_host(low.any()):  # a host decision (one sync): the solvers' sweeps avoid it
+        if not backend.to_host((g < self.g_safe).any()):  # a host decision (one sync): the sweeps avoid it
             phi, p, _ = self.law._raw(g, need_dp=False)
             return phi, p
-        phi, p, _ = self.law._raw(np.where(low, gs, g), need_dp=False)
-        phs, ps, dps = self._at_safe
-        t = g - gs
-        p = np.where(low, ps + dps * t, p)
-        phi = np.where(low, phs - ps * t - 0.5 * dps * t * t, phi)
-        return phi, p
+        return extended(self._raw_np, g, self.g_safe, self._at_safe, np)
 
     def evaluate_xp(self, g, xp):
         """:meth:`evaluate` in the array namespace ``xp`` (jax.numpy inside the compiled solver),
         branch-free (the extension by ``xp.where``; g_safe may be a traced scalar)."""
         gs, raw = self.g_safe, self.law._raw
-        low = g < gs
-        phi, p, _ = raw(xp.where(low, gs, g), need_dp=False, xp=xp)
-        phs, ps, dps = raw(xp.full((1,), gs, dtype=g.dtype), xp=xp)
-        t = g - gs
-        return xp.where(low, phs - ps * t - 0.5 * dps * t * t, phi), xp.where(low, ps + dps * t, p)
+        return extended(lambda x: raw(x, need_dp=False, xp=xp), g, gs,
+                        raw(xp.full((1,), gs, dtype=g.dtype), xp=xp), xp)
 
     def energy_pressure(self, g, out, work):
         """ΣΦ(g) (a backend scalar), P(g) into ``out``: the law's own hot path when no gap is below
@@ -101,12 +106,7 @@ class SafeLaw:
     def energy_at(self, g):
         """Φ at gaps g, the values of :meth:`energy` without its host decision (no sync: the extension
         applied by ``where`` on every gap; for a few gaps, e.g. a weighted sweep's deficit pixels)."""
-        gs = self.g_safe
-        low = g < gs
-        phi, _, _ = self.law._raw(np.where(low, gs, g), need_dp=False)
-        phs, ps, dps = self._at_safe
-        t = g - gs
-        return np.where(low, phs - ps * t - 0.5 * dps * t * t, phi)
+        return extended(self._raw_np, g, self.g_safe, self._at_safe, np)[0]
 
     def stiffness(self, g):
         """−dP/dg: the law's, and below g_safe its value at g_safe (P is linear there)."""
