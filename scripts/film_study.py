@@ -1,4 +1,4 @@
-"""Finite-thickness film vs half-space for the paper's pyramid arrays (issue 15, "Finite-thickness film").
+"""Finite-thickness film vs half-space for the paper's pyramid arrays (docs/validation.md, "Finite-thickness film").
 
 Two studies, written as Markdown (with their parameters) to --out, and every curve as CSV beside it:
 
@@ -11,7 +11,7 @@ Two studies, written as Markdown (with their parameters) to --out, and every cur
    same run on the half-space, and the pressure–approach slope once the array is flat, against the
    film's uniaxial-strain stiffness M/t (M = E(1 − ν)/((1 + ν)(1 − 2ν)), E = E*(1 − ν²)).
 
-    python scripts/film_study.py --out docs/data/film_study.md
+    python scripts/film_study.py --out film_study/film_study.md
 """
 from __future__ import annotations
 
@@ -26,7 +26,7 @@ from tengsim.kernels import film
 from tengsim.run.simulate import simulate
 from tengsim.device.formulas import voc_polymer
 from tengsim.shapes import Pyramid
-from tengsim.paper import area_table_from_result
+from tengsim.cases.paper.contact import area_table_from_result
 from tengsim.continuation import PathSpec
 from tengsim.cases.paper.units import paper_scaling
 
@@ -167,7 +167,7 @@ def study_law(group, dx, d_step, thickness_m, poisson, p_target, out_dir):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--out", default="docs/data/film_study.md")
+    ap.add_argument("--out", default="film_study/film_study.md")
     ap.add_argument("--group", default="A")
     ap.add_argument("--ratios", default="0.25,0.5,0.75,1,2,5,10,200")
     ap.add_argument("--dx", type=float, default=0.2)

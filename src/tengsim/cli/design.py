@@ -2,7 +2,7 @@ r"""``tengsim design``: a designer's question in one command (thin shell over :m
 
 Examples::
 
-    tengsim design pyramid --pitch 10um --base 5um --height 3.5um --E-star 1MPa --W 50mJ/m2 --eps 100nm \
+    tengsim design pyramid --pitch 10um --base 5um --height 3.5um --E-star 1MPa --W 50mJ/m2 --eps 200nm \
         --p-max 100kPa --p-step 5kPa --out d1/
     tengsim design d1.toml --out d1/                  # the same keys in a TOML file ([design] or top level)
     tengsim design a.toml b.toml --out cmp/           # each in cmp/NAME/, plus cmp/compare.csv and compare.png

@@ -44,10 +44,8 @@ class PathSpec:
     d_step (its second step's look-back judges it).  Jumps are bisected to the smallest step as in
     the fixed scheme (a step that jumps is retried at half its length).  With refine_levels three
     above a fixed run's and d_step eight times its d_step, the smallest steps (and so the jump
-    resolution) agree.  Measured (benchmarks/adaptive_path.py, dx 0.2): the defaults adapt_tol = 0.15,
-    adapt_h = 0.5 reproduce the fixed curve of the paper's groups A, B, C to 0.15 % of
-    max(|F|, |pull-off F|) with 2.4–2.9× fewer solves (the gap test sets the step out of contact,
-    where the force is small against the pull-off scale).
+    resolution) agree.  How closely the defaults (adapt_tol = 0.15, adapt_h = 0.5) reproduce the fixed
+    curve, and with how many fewer solves: docs/validation.md, "Continuation".
     """
 
     d_min: float

@@ -50,7 +50,7 @@ PERSIST_FACTOR = 10  # a fast solve stopped at its cap goes on for up to this ma
 
 
 def persist(solver, problem: Problem, eq):
-    """The automatic fallback of a fast solve that stopped at its iteration cap (issue 23): go on from
+    """The automatic fallback of a fast solve that stopped at its iteration cap: go on from
     where it stopped, with ``PERSIST_FACTOR`` × max_iter more iterations.
 
     Where the law is stiffer than a pixel (pixel snap number ≫ 1) the fast solver's work is a long

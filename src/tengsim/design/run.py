@@ -23,8 +23,7 @@
 4. **Maps.**  Each grid after the first keeps the pressure and gap maps at the D where the grid before it
    reached the asked pressures nearest 10 %, 50 % and 100 % of p_max (:func:`grid_path`): the finest grid's
    maps come from its own walk, at the coarser grid's prediction of those D (the figure titles say the
-   pressure each map is at and the one asked).  ``maps = false``: none.  (The finest grid's approach walked a
-   second time for them was about a quarter of the run.)
+   pressure each map is at and the one asked).  ``maps = false``: none.
 """
 from __future__ import annotations
 
@@ -48,8 +47,7 @@ LEVELS_ESTIMATED = 3
 EXTEND_TRIES = 6
 SOLVER_TOL_PER_TOL = 0.01
 """Each equilibrium of a design is solved to max|r| <= this × the design's tol (ε; 1e-4 at the default 1 %): the
-solver's share of a reported number is then far below tol (docs/validation.md, "A design's solver tolerance").  A
-contact run's own default (1e-6) is tighter than a design's numbers need, and cost a design a third more time."""
+solver's share of a reported number is then far below tol (docs/validation.md, "A design's solver tolerance")."""
 
 
 @dataclass(frozen=True)
@@ -88,11 +86,9 @@ def _blocks(shape, grid) -> int:
 START_ZONE_PIXELS = 12.0
 """Pixels across the law's a-priori process zone ℓ_D on a design's first grid (by default).  The grid status asks
 for :data:`tengsim.status.RESOLUTION` (1.2); a design's numbers (A/S at the smallest contact of the curve, the
-pull-off) ask for far more: the issue's pyramid and cone (ℓ_D = 595 nm) converged at 35 pixels per ℓ_D (585²),
-the test suite's small pyramid (ℓ_D = 470 nm, 1 µm pitch) at 77, and the refinement judges from the last three
-grids only (its observed order; the change from the last two), so the grids coarser than ℓ_D/12 (33² … 165² of
-the issue's designs, 5 of their 8 grids) were walked and thrown away.  A design that would converge on a coarser
-grid pays for one or two grids finer than it needs."""
+pull-off) ask for far more, and the refinement judges from the last three grids only, so coarser first grids are
+walked and thrown away (the measurements behind the 12: docs/benchmarks.md, "A design's walk").  A design that
+would converge on a coarser grid pays for one or two grids finer than it needs."""
 
 
 def refinement_grids(shape, dx: float, count: int = 12) -> list:

@@ -1,4 +1,4 @@
-"""Convolutions of mirror-symmetric fields on their irreducible block (issue 22): the DCT-I and the
+"""Convolutions of mirror-symmetric fields on their irreducible block: the DCT-I and the
 "even" transform per mirrored axis, :class:`MirrorConvolver` and the kernel's spectrum
 :func:`mirror_spectrum`.  The transforms are the seam's (:mod:`tengsim.backend.fft`).
 """
@@ -15,7 +15,7 @@ from tengsim.backend import workers as _workers
 from tengsim.kernels.convolve import _IntoConvolver, _use_direct
 
 
-# --- mirror-symmetric fields: convolutions on the irreducible block (issue 22) ---------------------
+# --- mirror-symmetric fields: convolutions on the irreducible block ----------------------------------
 # A field even about the centre pixel of an axis is held as its block x_0 … x_c (x_0 on the mirror
 # line).  Per axis, one of four transforms (``modes``):
 #   "dct1": free (zero-padded) axis, mirrored.  The even extension of the block, zero-padded to
@@ -239,8 +239,8 @@ class MirrorConvolver(_IntoConvolver):
     def _even(self, src, k, dst, t, spec=None):
         """dst ← the even transform along k of src (the DFT of the unfolded lines, real), times ``spec``
         if given; line chunk by line chunk, so src may be dst.  Two lines a, b share one complex FFT:
-        both even and real, FFT(a + ib) = A + iB with A, B real (measured 0.55–0.8 of the time of two
-        real FFTs: pocketfft's r2c gains little over c2c, least along the first axis)."""
+        both even and real, FFT(a + ib) = A + iB with A, B real (cheaper than two real FFTs:
+        pocketfft's r2c gains little over c2c)."""
         Z, _ = self._buffers()
         o, m = 1 - k, src.shape[k]
         n, ch = 2 * m - 1, self._lines

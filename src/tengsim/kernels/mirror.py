@@ -1,4 +1,4 @@
-"""Symmetry-reduced kernels (issue 22): the free or periodic kernel acting on the irreducible block of
+"""Symmetry-reduced kernels: the free or periodic kernel acting on the irreducible block of
 a mirror-symmetric field, without ever building the full grid's kernel.
 
 A field even about the centre pixel of an odd grid along one or both axes (:class:`tengsim.grid.Mirror`)

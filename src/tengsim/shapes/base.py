@@ -51,7 +51,7 @@ class Shape:
     lateral_unit: str = "ℓ"
     si_map: dict = {}
     #: mirror symmetries of the gap about the cell centre (0: X ↦ −X, 1: Y ↦ −Y) that a solve may use
-    #: (issue 22: the irreducible block); none declared, none used.  A run checks them on its grid.
+    #: (the irreducible block); none declared, none used.  A run checks them on its grid.
     mirror_axes = ()
     #: how the contact length Λc maps to the charged area A/S (tengsim.run.area.family): 'square' (a square
     #: patch of side Λc), 'disc' (a disc of diameter Λc) or 'line' (a strip of width Λc)

@@ -1,4 +1,4 @@
-"""Roughness on any shape (issue 23, item 1): a shape's gap with the ``rough`` shape's self-affine surface
+"""Roughness on any shape: a shape's gap with the ``rough`` shape's self-affine surface
 superimposed — the micro-pattern carrying nano-scale roughness.
 
 ``Roughened(base, hurst, rms_height | rms_slope, short_cutoff, long_cutoff, seed)`` is a composition, not a

@@ -14,8 +14,8 @@ the rows; the solver reads the rows itself, block by block together with its oth
 work (tengsim.solvers._sweep):
 
 * the 2m stored rows are read twice for H v and K H v and once for the update, and nothing else
-  touches them (float32 rows halve the bytes, but measured on rough surfaces they cost up to
-  20–30 % more iterations, from cancellation in the compact form, and no time overall);
+  touches them (float32 rows would halve the bytes, but cancellation in the compact form costs more
+  iterations than that saves);
 * the inner products with the current gradient G, <s_i, G> and <y_i, G>, are carried along by
   recurrence (G changes by y each step, so they change by <s_i, y>, <y_i, y>, which the new
   pair's column of [<s_i, y_j>] needs anyway) and recomputed exactly on ``refresh``;

@@ -1,5 +1,5 @@
 """Cold equilibria of laws stiff at the pixel scale: continuation in the law's range, on nested grids
-(issue 23, item 3; measured in docs/benchmarks.md, "Stiff laws": the range homotopy).
+(measured in docs/benchmarks.md, "Stiff laws": the range homotopy).
 
 Where the pixel snap number (steepest softening of the law × pixel compliance) is above 1, the fast solver
 from the undeformed state spends its iterations on a long sequence of junctions snapping into contact

@@ -3,7 +3,7 @@
 :class:`JaxSolver` runs the algorithm of :class:`tengsim.solvers.FastSolver` (traced in
 tengsim.solvers._jax_loop) as one ``lax.while_loop``: no Python between iterations, every array on the
 device, the convolution ``jnp.fft`` inside the compiled program.  It therefore sits beside the
-package's FFT seam (tengsim._fft, which serves NumPy arrays to scipy's pocketfft on the host) rather
+package's FFT seam (tengsim.backend.fft, which serves NumPy arrays to scipy's pocketfft on the host) rather
 than in it: a JAX array inside a traced loop cannot go through a host FFT, and the kernels' spectra are
 all the loop takes from them.  Any kernel that multiplies in Fourier space runs: the free cell (zero
 padded), the periodic one and both with a film; the mirror-block kernel (a DCT-I, which JAX lacks) is
@@ -12,14 +12,11 @@ refused ("mirror kernel is CPU only"), and so is a slab-distributed (MPI) kernel
 
 Registered solvers: ``jax`` (JAX's default device: the GPU when JAX has one, else the CPU) and
 ``gpu`` (a GPU or a one-line error), both float64; ``JaxSolver(dtype="float32")`` from the API.
-Results equal the NumPy solver's: in float64 step for step to round-off (a cold solve: the same
-iterations, H to ~1e-14), and where round-off grows (a long path, an adhesive rough surface: L-BFGS on
-a non-convex energy amplifies a last-bit difference ~×10 per few iterations) the same equilibria to
-the tolerance (tests/test_jax_solver.py).  float32 fields (scalars still accumulated in float64, the
-rows' products and the law in float32): the tolerance is raised to ``F32_TOL`` (2e-5) at least; the
-paper's LJ93 law converges there with F to ~1e-7 relative of float64 (measured, 65² rough), but a
-stiff wall (md, exp: k = 1000 W/ε²) stalls at max|r| ~ 2e-3 (k times float32's rounding of g), F to
-~1e-3: float32 is for soft laws and for memory (298 against 596 bytes per point, memory 10).
+Results equal the NumPy solver's: in float64 step for step to round-off, and where round-off grows
+(a long path, an adhesive rough surface) the same equilibria to the tolerance (tests/test_jax_solver.py).
+float32 fields (scalars still accumulated in float64, the rows' products and the law in float32): the
+tolerance is raised to ``F32_TOL`` (2e-5) at least; float32 is for soft laws and for memory (how close
+each precision comes, and the bytes per point: docs/benchmarks.md, "GPU").
 
 Compilation: one per static configuration (grid shape, kernel kind, law class, dtype, memory, resync,
 device), cached in this module and shared by every solver object and every equilibrium of a path; D

@@ -1,4 +1,4 @@
-"""Solve a mirror-symmetric problem on its irreducible block (issue 22: symmetry-reduced kernels).
+"""Solve a mirror-symmetric problem on its irreducible block (symmetry-reduced kernels).
 
 A :class:`MirrorSolver` wraps a solver ('fast', 'vsr').  Given a :class:`~tengsim.solvers.Problem` whose
 kernel carries a mirror (duck-typed: ``kernel.mirror`` a :class:`tengsim.grid.Mirror`, ``kernel.reduced``

@@ -33,10 +33,8 @@ peak faster than one pixel is stiff — s = max_g dP/dg × c_pix (the law's decl
 with c_pix the gap change of a pixel under unit pressure on that pixel alone (one convolution of the
 run's kernel) — has no stable state in that band of gaps when s > 1: pixels snap in and out one at a
 time and the contact edge is pinned to the lattice, whatever the process zone; below 1 the lattice
-still traps the edge, by less.  Every judged row of a run with s > SNAP_LIMIT is under-resolved.
-Measured (MD sphere, μ = 1, smoothing 0.2, cell 5): s = 0.79 / 0.58 / 0.41 at dx 0.091 / 0.067 / 0.048,
-pull-off +1.7 / +0.9 % against the finest; (μ = 3, smoothing 0.6: s = 0.67 / 0.52, +0.72 / +0.21 % over
-Maugis).  s grows about as μ^{3/2} dx.
+still traps the edge, by less.  Every judged row of a run with s > SNAP_LIMIT is under-resolved
+(calibration: docs/statuses.md).  s grows about as μ^{3/2} dx.
 
 A-priori estimate (stated with every run, ``params['process_zone_estimate']``): at a crack-like
 contact edge (JKR limit) the Dugdale zone is ℓ_D = (π/4) E* W/σ0², i.e. π/(4 κ σ0²) in units of the

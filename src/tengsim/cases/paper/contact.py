@@ -122,7 +122,7 @@ def area_table_from_load_result(res, group: str) -> AreaTable:
 
 def area_table_load_controlled(group: str, settings: RunSettings = RunSettings(), f_max: float | None = None,
                                n_loads: int | None = None, progress=None, d_result=None) -> AreaTable:
-    """A(P) under load control (issue 15): the load-controlled approach from F = 0 to ``f_max`` (default:
+    """A(P) under load control: the load-controlled approach from F = 0 to ``f_max`` (default:
     the largest F the D-controlled approach ``d_result`` reached, run here if not given)."""
     if f_max is None:
         d_result = d_result if d_result is not None else run_group(group, settings)

@@ -61,7 +61,7 @@ def reproduce(out_dir, quick: bool = False, progress_factory=None, log=None,
         plot_fig3(results, stage / "fig3.pdf", FIG3_D)
         plot_fig4(results, stage / "fig4.png", PAPER_TRANSITION_D)
         plot_fig4(results, stage / "fig4.pdf", PAPER_TRANSITION_D)
-        # Fig. 5: V_OC(pressure) by Eq. (12) from the load-controlled A(P) of each group (issue 15): a
+        # Fig. 5: V_OC(pressure) by Eq. (12) from the load-controlled A(P) of each group: a
         # LoadPathSpec approach from F = 0 to the largest F the D path reached; the table picked from the
         # D path is kept beside it for comparison (fig5.csv, summary 'area_table_vs_D_picked')
         curves, cols = {}, {}
