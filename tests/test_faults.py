@@ -3,7 +3,7 @@
 Hypothesis draws the bad values (non-positive, NaN, infinite, text, a unit on a dimensionless key, a choice
 not offered) and the key they go to; each is sent through the real command line in process (no solve is
 reached: validation refuses before any work).  The table of faults tried, and what happened, is in
-docs/validation.md ("Faults and bad input").
+docs/statuses.md ("Faults and bad input").
 """
 import math
 

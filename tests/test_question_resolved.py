@@ -1,4 +1,4 @@
-"""examples/design/question*_resolved.toml (docs/design.md, "The design question on converged grids"):
+"""examples/design/question*_resolved.toml (docs/design.md, "The design question"):
 the coarse design studies with resolve = "auto"; the same points otherwise, and bad refinement keys refused."""
 from pathlib import Path
 
@@ -50,7 +50,7 @@ def test_resolved_study_bad_refinement_key_exit_2_nothing_written(tmp_path, caps
 
 
 def test_more_grids_study_is_the_periodic_one_for_the_smooth_sided_patterns():
-    """docs/design.md, "More grids": the periodic study's pyramid, cone and hemisphere points, nothing else
+    """docs/validation.md, "Automatic refinement" (edges kept in place): the periodic study's pyramid, cone and hemisphere points, nothing else
     changed but max_pixels, which admits the refinement 45², 65², 105², 165², 245² (each base edge a quarter
     pixel past a pixel centre on every grid: tengsim.run.resolve keeps it there) and no finer grid."""
     from tengsim.run.plan import plan_contact

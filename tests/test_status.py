@@ -346,7 +346,7 @@ def test_snapping_run_is_under_resolved_with_its_own_line(tmp_path):
 
 
 # ---- issue 22 item 2: every contact edge, walls, and the thresholds calibrated on grid convergence --------
-# (benchmarks/status_calibration.py, docs/validation.md "Calibration against grid convergence")
+# (benchmarks/status_calibration.py, docs/statuses.md "Calibration against grid convergence")
 
 def _radial(dx, centres, n=81):
     """A gap with conical openings around several contact spots: g = 1 + s (r − a) outside each, the

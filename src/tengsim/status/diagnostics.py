@@ -24,7 +24,7 @@ sphere; ℓ_D below).  The face itself is sampled at pixel centres, so each wall
 half a pixel: a face n pixels wide is known to 2/n of its area (``face_uncertainty``, a-priori); above
 FACE_LIMIT = 1 % every judged row is under-resolved.
 
-Calibration against grid convergence (benchmarks/status_calibration.py, docs/validation.md): coarse →
+Calibration against grid convergence (benchmarks/status_calibration.py, docs/statuses.md): coarse →
 fine runs of every registered shape and law; runs whose pull-off or jump D move by more than 1 % from the
 finest grid must not be ``ok``, runs within 1 % must not be flagged.
 
