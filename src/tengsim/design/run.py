@@ -225,6 +225,63 @@ def check_budget(plan, est: Estimate, fit_pixels: int | None = None) -> None:
                        "--budget")
 
 
+def preflight(plan) -> None:
+    """Every bound of a design checked from its sizes alone, before any array is allocated or anything is
+    written: the first grid fits the cell (in the user's units), is within ``max_pixels`` and the memory, and
+    its shortest path (D to 2 ε: no structure at all) fits the budget.  The full estimate, with the structure's
+    height, follows in :func:`run_design`; this one needs no gap array (a --dx of 0.02 nm was killed for its
+    memory before any check)."""
+    from tengsim.design.units import length_text, time_text
+    from tengsim.errors import GeometryError
+    from tengsim.resources import check_memory
+    from tengsim.run.plan import as_plan
+
+    from tengsim.solvers import make_solver
+
+    cplan = as_plan(plan.contact_table if plan.contact_plan is None else plan.contact_plan)
+    make_solver(cplan.solver, tol=solver_tol(plan))  # a solver this machine lacks (gpu): refused now, one line
+    lateral = cplan.scaling.lateral
+    try:
+        dx = start_dx(plan, cplan)
+        g = cplan.shape.grid(dx)
+    except GeometryError as exc:
+        raise exc.in_metres(lateral) from None
+    first = f"the first grid {g.nx}×{g.ny} (dx {length_text(g.dx * lateral)})"
+    if plan.max_pixels is not None and g.nx * g.ny > plan.max_pixels:
+        raise TengsimError(f"{plan.name[:80]}: {first} has {g.nx * g.ny} pixels, over max_pixels = "
+                           f"{plan.max_pixels}: give a larger --max-pixels or a coarser --dx")
+    check_memory(g.nx, g.ny, cplan.boundary, cplan.solver)
+    secs = SECONDS_PER_PIXEL_ROW * _blocks(cplan.shape, g) * ROWS_PER_STEP * (2.0 - D_MIN) / D_STEP
+    if secs > plan.budget_s:
+        raise TengsimError(f"{plan.name[:80]}: {first} alone is estimated at {time_text(secs)}, over the budget "
+                           f"of {time_text(plan.budget_s)}: give a coarser --dx, a coarser --tol (now "
+                           f"{plan.tol:g}) or a larger --budget")
+
+
+class BudgetSpent(TengsimError):
+    """A design stopped at its time budget (what finished is kept; the message says how to go on)."""
+
+
+def _deadline(progress, plan, keep, started):
+    """``progress`` (called per path row) that also stops the run, cleanly, once ``plan.budget_s`` seconds
+    have passed since ``started``: the finished grids stay in ``keep`` and the message says how to go on."""
+    import time
+
+    def call(*a, **k):
+        if time.monotonic() - started > plan.budget_s:
+            from tengsim.design.units import time_text
+
+            where = (f"the finished grids are kept in {keep}: run the same command with a larger --budget to go "
+                     "on from them") if keep is not None and keep.exists() else \
+                "no grid had finished: give a larger --budget, a coarser --dx or a coarser --tol"
+            raise BudgetSpent(f"{plan.name[:80]}: stopped at the budget of {time_text(plan.budget_s)}; {where}")
+        if callable(progress):
+            return progress(*a, **k)
+        return None
+
+    return call
+
+
 def solver_tol(plan) -> float:
     """The solver's tolerance of a design (:data:`SOLVER_TOL_PER_TOL`)."""
     return SOLVER_TOL_PER_TOL * plan.tol
@@ -403,6 +460,10 @@ def run_design(plan, progress=None, keep=None) -> DesignResult:
     from tengsim.design.write import to_dataset
     from tengsim.run.resolve import resolve_plan
 
+    import time
+
+    started = time.monotonic()
+    preflight(plan)
     cplan = dataclasses.replace(as_plan(plan.contact_table if plan.contact_plan is None else plan.contact_plan),
                                 tol=solver_tol(plan))  # the plan plan_design built (planned once)
     dx = start_dx(plan, cplan)
@@ -423,7 +484,7 @@ def run_design(plan, progress=None, keep=None) -> DesignResult:
         ck, found = _checkpoint(keep, plan, d_max, progress) or (None, None)
         res = resolve_plan(dataclasses.replace(cplan, path=path, resolve=ResolveSettings(plan.tol, max_pixels, dx)),
                            observe=_observer(plan), watch=_watcher(plan), path_for=grid_path(plan, d_max),
-                           progress=progress if callable(progress) else None,
+                           progress=_deadline(progress, plan, keep, started),
                            checkpoint=None if ck is None else ck.save, start=found)
         if res.scaling is None:  # every grid taken back from the checkpoint file, which keeps the columns only
             res = dataclasses.replace(res, scaling=cplan.scaling)

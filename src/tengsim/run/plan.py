@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from tengsim.kernels import film
-from tengsim.errors import ConfigValueError, TengsimError, finite, positive, shown
+from tengsim.errors import ConfigValueError, GeometryError, TengsimError, finite, positive, shown
 from tengsim.laws import LJ93, make_law
 from tengsim.continuation import PathSpec
 from tengsim.plugins import KERNELS
@@ -354,7 +354,10 @@ def plan_contact(cfg: dict) -> ContactPlan:
         else:
             raise TengsimError(f"physical {name} input needs eps or tabor (tabor has no default in a physical run)")
         lateral = positive("lateral scale", cls.lateral_scale(p, eps))
-        shape = cls.from_si(p, eps)
+        try:
+            shape = cls.from_si(p, eps)
+        except GeometryError as exc:  # said in metres, as the sizes were given
+            raise exc.in_metres(lateral) from None
         scaling = Scaling(E, W, eps, lateral, _cell_area_m2(cls, p, shape, lateral))
         tabor = scaling.mu
         if vals["tabor"] is not None and abs(tabor - vals["tabor"]) > 1e-8 * vals["tabor"]:
@@ -386,7 +389,10 @@ def plan_contact(cfg: dict) -> ContactPlan:
     _check_maps_out(path.maps_at, cfg.get("out"))
     tol = positive("tol", vals["tol"])
     law = _build_law(law_name, {f.name: vals[f.name] for f in lfields if f.name in given})
-    grid = shape.grid(dx)  # validates dx against the cell
+    try:
+        grid = shape.grid(dx)  # validates dx against the cell
+    except GeometryError as exc:
+        raise (exc.in_metres(lateral) if lateral is not None else exc) from None
     from tengsim.resources import check_memory
 
     check_memory(grid.nx, grid.ny, vals["boundary"], vals["solver"], maps=2 * len(path.maps_at))
