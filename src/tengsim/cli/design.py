@@ -76,7 +76,7 @@ def help_text(shape: str | None = None) -> str:
     common = {f.name: f for f in common_fields()}
     laws = law_keys()
     out += ["", "the material (required: E_star, W, eps):"]
-    out += [line(k, common[k].help) for k in ("E_star", "W", "eps")]
+    out += [line(k, common[k].help.replace("; or give tabor", "")) for k in ("E_star", "W", "eps")]  # no tabor
     if shape is None:
         out += ["", f"the shape: one of {', '.join(SHAPES.names())}; its keys: tengsim design SHAPE --help"]
     else:
@@ -121,6 +121,7 @@ def _read_toml(path: str) -> dict:
 
 def _tables(args) -> list:
     """[(label, table)] of the designs the command line names."""
+    from tengsim.errors import shown
     from tengsim.registry import SHAPES
 
     opts = {k: getattr(args, k) for k in _keys() if getattr(args, k, None) not in (None, "")}
@@ -128,13 +129,13 @@ def _tables(args) -> list:
     first = args.inputs[0]
     if not first.lower().endswith(".toml"):
         if first.lower() not in names:
-            raise TengsimError(f"unknown shape {first!r} (shapes: {', '.join(SHAPES.names())}; or give TOML files)")
+            raise TengsimError(f"unknown shape {shown(first)} (shapes: {', '.join(SHAPES.names())}; or give TOML files)")
         if len(args.inputs) > 1:
-            raise TengsimError(f"give one shape with its options, or TOML files: got {' '.join(args.inputs)}")
+            raise TengsimError(f"give one shape with its options, or TOML files: got {shown(' '.join(args.inputs), 200)}")
         return [("", {"shape": first, **opts})]
     bad = [x for x in args.inputs if not x.lower().endswith(".toml")]
     if bad:
-        raise TengsimError(f"{bad[0]}: several inputs must all be TOML files")
+        raise TengsimError(f"{shown(bad[0])}: several inputs must all be TOML files")
     return [(f"{x}: ", {**_read_toml(x), **opts}) for x in args.inputs]
 
 

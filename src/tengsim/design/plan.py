@@ -20,7 +20,7 @@ import json
 import math
 from dataclasses import dataclass, field
 
-from tengsim.errors import ConfigValueError, TengsimError, shown
+from tengsim.errors import ConfigValueError, TengsimError, listed, shown
 
 PAPER_DEVICE = {"sigma": 5.84e-6, "eps_r": 2.40, "T": 400e-6, "gap": 0.1e-3}
 """The paper's device (Section 5, Fig. 8): σ = 5.84 µC/m², ε_r = 2.40, T = 400 µm, rest gap d0 = 0.1 mm."""
@@ -166,7 +166,7 @@ def plan_design(table: dict, where: str = "") -> DesignPlan:
     if shape in (None, ""):
         raise ConfigValueError(f"{where}give the shape (one of {', '.join(SHAPES.names())})")
     if not isinstance(shape, str) or shape.strip().lower() not in [s.lower() for s in SHAPES.names()]:
-        raise ConfigValueError(f"{where}unknown shape {shape!r} (shapes: {', '.join(SHAPES.names())})")
+        raise ConfigValueError(f"{where}unknown shape {shown(shape)} (shapes: {', '.join(SHAPES.names())})")
     shape = SHAPES.canonical(shape)
     own_names = {f.name for f in design_fields()}
     contact_keys = set(contact_table(shape, "physical").keys())
@@ -175,16 +175,16 @@ def plan_design(table: dict, where: str = "") -> DesignPlan:
         raise ConfigValueError(f"{where}a design takes eps (the interaction range, a length such as '50nm'), "
                                "not tabor: the Tabor number is derived for each shape and printed")
     if refused:
-        raise ConfigValueError(f"{where}{', '.join(refused)}: set by the design itself (the path extends until "
+        raise ConfigValueError(f"{where}{listed(refused)}: set by the design itself (the path extends until "
                                "p_max is reached; the grid is refined to tol)")
     unknown = sorted(k for k in table if k not in own_names and k not in contact_keys)
     if unknown:
-        raise ConfigValueError(f"{where}shape {shape} has no key {', '.join(map(repr, unknown))} (design keys: "
+        raise ConfigValueError(f"{where}shape {shape} has no key {listed(unknown)} (design keys: "
                                f"{', '.join(sorted(own_names))}; [contact] keys of {shape}: "
                                f"{', '.join(k for k in sorted(contact_keys) if k not in CONTROLLED)})")
     if table.get("eps") in (None, ""):
         raise ConfigValueError(f"{where}eps is missing: give the interaction range ε of the law, a length such as "
-                               "'50nm' (docs/design.md, 'Choosing ε')")
+                               "'50nm' (docs/own_design.md, 'Choosing ε')")
     own = _own(table)
     cfg = {k: v for k, v in table.items() if k in contact_keys and k not in own_names and v not in (None, "")}
     cfg["shape"] = shape

@@ -395,6 +395,8 @@ def plan_contact(cfg: dict) -> ContactPlan:
         raise (exc.in_metres(lateral) if lateral is not None else exc) from None
     from tengsim.resources import check_memory
 
+    if kernel_params.get("thickness") is not None:  # a film thinner than its pixel allows: refused now
+        film.check_film_pixels(kernel_params["thickness"], max(grid.dx, grid.dy), lateral)
     check_memory(grid.nx, grid.ny, vals["boundary"], vals["solver"], maps=2 * len(path.maps_at))
     resolve = _resolve(vals, given, dx if raw_dx not in (None, "") else None, scaling)
     return ContactPlan(shape, tabor, dx, path, vals["boundary"], vals["solver"], tol, law, extra, scaling,
