@@ -106,7 +106,12 @@ def test_comparison_folder_names_stay_inside_out_and_off_reserved_names():
 
     from tengsim.cli.design import RESERVED, _folders
 
-    names = ["..", ".", "compare.csv", "compare.png", "../../etc", "", "a" * 300, ".hidden", "a/b", "a"]
+    from tengsim.errors import TengsimError
+
+    for reserved in ("compare.csv", "Compare.PNG"):
+        with pytest.raises(TengsimError, match="comparison's own file"):
+            _folders([SimpleNamespace(name="a"), SimpleNamespace(name=reserved)])
+    names = ["..", ".", "compare.csv_", "compare", "../../etc", "", "a" * 300, ".hidden", "a/b", "a"]
     got = _folders([SimpleNamespace(name=n) for n in names])
     assert len(set(got)) == len(got)
     out = Path("/tmp/out").resolve()

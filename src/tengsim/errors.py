@@ -22,12 +22,11 @@ class GeometryError(TengsimError):
         self.template, self.lengths = template, lengths
         super().__init__(template.format(**{k: f"{v:g}" for k, v in lengths.items()}))
 
-    def in_metres(self, lateral: float) -> "GeometryError":
-        """The same error with every length times ``lateral`` (m), written with its SI prefix ('24 µm')."""
-        from tengsim.units import format_si
-
+    def in_metres(self, lateral: float, fmt) -> "GeometryError":
+        """The same error with every length times ``lateral`` (m), written by ``fmt(metres)`` (the physical
+        layer passes :func:`tengsim.units.format_si` with 'm': '24 µm')."""
         err = GeometryError(self.template, **self.lengths)
-        err.args = (self.template.format(**{k: format_si(v * lateral, "m") for k, v in self.lengths.items()}),)
+        err.args = (self.template.format(**{k: fmt(v * lateral) for k, v in self.lengths.items()}),)
         return err
 
 

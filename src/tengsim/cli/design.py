@@ -158,11 +158,15 @@ DESIGN_FILES = ("design.nc", "design.csv", "design.png", "maps.png", "report.md"
 def _folders(plans) -> list:
     """The folder (relative to --out) of each design: '' for one design; for several, a safe name made from
     each design's name (:func:`tengsim.io.safe_name`: never '..', '.', a hidden or reserved name), chosen
-    before anything runs."""
+    before anything runs; a design named as the comparison's own files (compare.csv) is refused."""
     from tengsim.io import safe_name
 
     if len(plans) == 1:
         return [""]
+    for p in plans:
+        if p.name.strip().lower() in RESERVED:
+            raise TengsimError(f"design name {p.name!r} is the name of the comparison's own file in --out: "
+                               "choose another name")
     taken: set = set()
     return [safe_name(p.name, taken, RESERVED) for p in plans]
 

@@ -234,8 +234,7 @@ def preflight(plan) -> None:
     from tengsim.design.units import length_text, time_text
     from tengsim.errors import GeometryError
     from tengsim.resources import check_memory
-    from tengsim.run.plan import as_plan
-
+    from tengsim.run.plan import _metres, as_plan
     from tengsim.solvers import make_solver
 
     cplan = as_plan(plan.contact_table if plan.contact_plan is None else plan.contact_plan)
@@ -245,7 +244,7 @@ def preflight(plan) -> None:
         dx = start_dx(plan, cplan)
         g = cplan.shape.grid(dx)
     except GeometryError as exc:
-        raise exc.in_metres(lateral) from None
+        raise exc.in_metres(lateral, _metres) from None
     first = f"the first grid {g.nx}×{g.ny} (dx {length_text(g.dx * lateral)})"
     if plan.max_pixels is not None and g.nx * g.ny > plan.max_pixels:
         raise TengsimError(f"{plan.name[:80]}: {first} has {g.nx * g.ny} pixels, over max_pixels = "

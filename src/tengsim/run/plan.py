@@ -297,6 +297,13 @@ def _cell_area_m2(cls, p, shape, lateral) -> float:
     return getattr(shape, "cell_area", shape.cell**2) * lateral**2
 
 
+def _metres(v: float) -> str:
+    """A length in metres as the user reads it ('24 µm'): for :meth:`GeometryError.in_metres`."""
+    from tengsim.units import format_si
+
+    return format_si(v, "m")
+
+
 def plan_contact(cfg: dict) -> ContactPlan:
     """Validate a [contact] table and build its pieces (no solving)."""
     if not isinstance(cfg, dict):
@@ -357,7 +364,7 @@ def plan_contact(cfg: dict) -> ContactPlan:
         try:
             shape = cls.from_si(p, eps)
         except GeometryError as exc:  # said in metres, as the sizes were given
-            raise exc.in_metres(lateral) from None
+            raise exc.in_metres(lateral, _metres) from None
         scaling = Scaling(E, W, eps, lateral, _cell_area_m2(cls, p, shape, lateral))
         tabor = scaling.mu
         if vals["tabor"] is not None and abs(tabor - vals["tabor"]) > 1e-8 * vals["tabor"]:
@@ -392,7 +399,7 @@ def plan_contact(cfg: dict) -> ContactPlan:
     try:
         grid = shape.grid(dx)  # validates dx against the cell
     except GeometryError as exc:
-        raise (exc.in_metres(lateral) if lateral is not None else exc) from None
+        raise (exc.in_metres(lateral, _metres) if lateral is not None else exc) from None
     from tengsim.resources import check_memory
 
     if kernel_params.get("thickness") is not None:  # a film thinner than its pixel allows: refused now

@@ -5,7 +5,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tengsim.errors import GeometryError, TengsimError, positive
+from tengsim.errors import GeometryError, positive
 from tengsim.grid import Grid
 from tengsim.registry import SHAPES
 from tengsim.shapes.base import Shape, _length
