@@ -279,6 +279,7 @@ def test_a_design_checkpoint_belongs_to_the_input_files_content(here):
              "W": "20mJ/m2", "eps": "50nm", "p_max": "20kPa", "tol": 0.05}
     a = identity(plan_design(table))
     assert identity(plan_design(table)) == a  # the same input: the same grids
+    assert identity(plan_design({**table, "budget": 1200})) == a  # a larger budget goes on from them
     np.savetxt(here / "h.txt", h * 1.5)
     assert identity(plan_design(table)) != a  # the same name, another surface: not the same grids
 

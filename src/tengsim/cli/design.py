@@ -129,9 +129,11 @@ def _tables(args) -> list:
     first = args.inputs[0]
     if not first.lower().endswith(".toml"):
         if first.lower() not in names:
-            raise TengsimError(f"unknown shape {shown(first)} (shapes: {', '.join(SHAPES.names())}; or give TOML files)")
+            raise TengsimError(f"unknown shape {shown(first)} (shapes: {', '.join(SHAPES.names())}; or give TOML "
+                               "files)")
         if len(args.inputs) > 1:
-            raise TengsimError(f"give one shape with its options, or TOML files: got {shown(' '.join(args.inputs), 200)}")
+            raise TengsimError("give one shape with its options, or TOML files: got "
+                               f"{shown(' '.join(args.inputs), 200)}")
         return [("", {"shape": first, **opts})]
     bad = [x for x in args.inputs if not x.lower().endswith(".toml")]
     if bad:
@@ -185,7 +187,8 @@ def _guard(out: Path, folders, inputs) -> None:
         if root != f.resolve().parent and root not in f.resolve().parents:  # pragma: no cover - safe_name
             raise TengsimError(f"--out {out}: {f} would lie outside it")
         for inp in inputs:
-            if isinstance(inp, str) and len(inp) < 4096 and Path(inp).is_file() and Path(inp).resolve() == f.resolve():
+            if isinstance(inp, str) and len(inp) < 4096 and Path(inp).is_file() and \
+                    Path(inp).resolve() == f.resolve():
                 raise TengsimError(f"--out {out}: it would replace the input {inp} ({f.name}); choose another "
                                    "folder")
 

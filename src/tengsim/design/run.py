@@ -430,16 +430,17 @@ def _watcher(plan):
 
 
 def identity(plan) -> str:
-    """What a design's kept grids belong to: the plan (every key as given), the content of every input file it
-    names (a topography's heights: the file's bytes, not its name), tengsim's version and the plugins loaded
-    (a user's shape or law changed between runs gives other grids).  16 hex digits."""
+    """What a design's kept grids belong to: the plan (every key as given but the budget), the content of every
+    input file it names (a topography's heights: the file's bytes, not its name), tengsim's version and the
+    plugins loaded (a user's shape or law changed between runs gives other grids).  16 hex digits."""
     import hashlib
     from pathlib import Path
 
     from tengsim import plugins
     from tengsim._version import __version__
 
-    h = hashlib.sha256(f"{plan!r}|{__version__}|{sorted(plugins._LOADED)!r}".encode())
+    same = dataclasses.replace(plan, budget_s=0.0)  # a larger --budget goes on from the grids a budget stopped
+    h = hashlib.sha256(f"{same!r}|{__version__}|{sorted(plugins._LOADED)!r}".encode())
     for v in (plan.contact_table or {}).values():
         if isinstance(v, str) and len(v) < 4096 and Path(v).is_file():
             with open(v, "rb") as fh:

@@ -130,9 +130,9 @@ def _one_line(read):
         except TengsimError:
             raise
         except (ValueError, TypeError, KeyError, IndexError, OSError, UnicodeError, AttributeError) as exc:
+            why = shown(str(exc).splitlines()[0] if str(exc) else "", 100)[1:-1]
             raise TengsimError(f"area: cannot read {shown(str(path), 200)} as a design or contact result "
-                               f"({type(exc).__name__}: {shown(str(exc).splitlines()[0] if str(exc) else '', 100)[1:-1]})"
-                               ) from None
+                               f"({type(exc).__name__}: {why})") from None
         p, a = np.asarray(table.pressure_Pa), np.asarray(table.area_fraction)
         if p.ndim != 1 or a.shape != p.shape or p.dtype.kind != "f" or a.dtype.kind != "f":
             raise TengsimError(f"area: {shown(str(path), 200)} holds no 1-D numeric table of pressure and area")

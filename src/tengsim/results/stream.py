@@ -135,7 +135,8 @@ class RowStream:
 
         if self.fh is not None:
             self.fh.close()
-        lines = [ln for ln in open(self.path, newline="", encoding="utf-8").read().splitlines(keepends=True) if not ln.startswith("#")]
+        with open(self.path, newline="", encoding="utf-8") as fh:
+            lines = [ln for ln in fh.read().splitlines(keepends=True) if not ln.startswith("#")]
         body = "".join(lines[:1 + keep]) if lines else ""
         io.write_text(self.path, io.header_lines(self._head) + body)
         self.fh = open(self.path, "a", newline="", encoding="utf-8")
