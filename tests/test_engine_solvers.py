@@ -182,7 +182,8 @@ def test_vsr_and_fast_agree_on_whole_path():
 @pytest.mark.parametrize("block,threads", [(97, None), (101, "3")], ids=["blocks", "threads"])
 def test_sweeps_give_the_same_iterates(monkeypatch, block, threads):
     """Element-wise work runs block by block on large grids, and the blocks split over threads;
-    forced here on a small grid (many uneven blocks): that changes nothing but round-off."""
+    forced here on a small grid (many uneven blocks): that changes nothing but round-off (the same H and
+    energy; iteration counts, which round-off may shift, are not compared)."""
     import tengsim.solvers._sweep as S
 
     grid, U0, K = _group_a(dx=0.1)
@@ -195,7 +196,6 @@ def test_sweeps_give_the_same_iterates(monkeypatch, block, threads):
     assert sum(len(g) for g in sw.groups) > 10 and sw.threads == (int(threads) if threads else 1)
     other = FastSolver(1e-8).solve(prob, State.zero(grid.shape))
     assert ref.converged and other.converged
-    assert abs(other.iterations - ref.iterations) <= 2
     assert np.max(np.abs(other.H - ref.H)) < 1e-7
     assert other.energy == pytest.approx(ref.energy, rel=1e-12)
 

@@ -208,3 +208,103 @@ def test_hostile_values_through_a_process(tmp_path, args):
     assert p.returncode == 2, p.stderr[-500:]
     assert len(p.stderr.strip().splitlines()) == 1 and "Traceback" not in p.stderr
     assert list(tmp_path.iterdir()) == []
+
+
+# ---- the newer surfaces: design (one and a comparison), device --area-from, run with device tables ------
+# A design is run here with a budget of 10 ms: every design that parses is refused by its estimate before
+# anything is solved, so what is drawn is judged by the planning (the whole path to the budget's refusal).
+DESIGN = ["design", "pyramid", "--pitch", "1um", "--base", "0.5um", "--height", "0.2um", "--E-star", "5MPa",
+          "--W", "20mJ/m2", "--eps", "50nm", "--p-max", "20kPa", "--p-step", "10kPa", "--tol", "0.05",
+          "--maps", "false", "--quiet", "--budget", "10ms"]
+DESIGN_KEYS = ["--pitch", "--base", "--height", "--E-star", "--W", "--eps", "--p-max", "--p-step", "--p-min",
+               "--sigma", "--eps-r", "--T", "--gap", "--tol", "--dx", "--max-pixels", "--fit-max", "--name",
+               "--maps", "--law", "--boundary", "--solver", "--thickness", "--poisson"]
+DESIGN_TABLE = {"shape": "pyramid", "pitch": "1um", "base": "0.5um", "height": "0.2um", "E_star": "5MPa",
+                "W": "20mJ/m2", "eps": "50nm", "p_max": "20kPa", "p_step": "10kPa", "tol": 0.05, "maps": False,
+                "budget": "10ms"}
+design_keys = st.one_of(st.sampled_from([k[2:].replace("-", "_") for k in DESIGN_KEYS] + ["shape", "budget"]),
+                        st.text(max_size=12))
+
+
+@SETTINGS(30)
+@given(key=st.sampled_from(DESIGN_KEYS), value=st.one_of(number_text, st.text(max_size=60)))
+def test_generated_values_on_design(tmp_path_factory, capsys, key, value):
+    d = tmp_path_factory.mktemp("dv")
+    rc = check(d, [*DESIGN, key, value, "--out", d / "o"], capsys)
+    assert rc == 2  # at most planned: the 10 ms budget refuses every design that parses
+
+
+@SETTINGS(20)
+@given(extra=st.lists(st.dictionaries(design_keys, value, max_size=3), min_size=2, max_size=3),
+       top=st.booleans())
+def test_generated_design_comparisons(tmp_path_factory, capsys, extra, top):
+    d = tmp_path_factory.mktemp("dc")
+    files = []
+    for k, e in enumerate(extra):
+        f = d / f"d{k}.toml"
+        table = {**DESIGN_TABLE, **e}
+        f.write_text("".join(f"{json.dumps(a)} = {toml_value(b)}\n" for a, b in table.items()) if top
+                     else toml_table("design", table))
+        files.append(f)
+    rc = check(d, ["design", *files, "--out", d / "o", "--quiet"], capsys)
+    assert rc == 2
+
+
+def _area_nc(path, p, a, status="ok"):
+    import numpy as np
+    import xarray as xr
+
+    ds = xr.Dataset({"charged_area_fraction": (("branch", "applied_pressure"), np.asarray([a, a], dtype=float))},
+                    coords={"branch": ["approach", "retraction"], "pressure": ("applied_pressure", p)})
+    ds.attrs["status"] = status
+    ds.to_netcdf(path, engine="h5netcdf")
+
+
+area_values = st.lists(st.floats(allow_nan=True, allow_infinity=True), min_size=4, max_size=4)
+
+
+@SETTINGS(25)
+@given(content=st.one_of(st.binary(max_size=2000), st.text(max_size=400).map(str.encode),
+                         st.tuples(area_values, area_values)),
+       suffix=st.sampled_from([".nc", ".csv", ""]))
+def test_generated_area_files_for_the_device(tmp_path_factory, capsys, content, suffix):
+    d = tmp_path_factory.mktemp("af")
+    f = d / f"area{suffix}"
+    if isinstance(content, tuple):
+        if suffix != ".nc":
+            f = d / "area.nc"
+        _area_nc(f, *content)
+    else:
+        f.write_bytes(content)
+    rc = check(d, ["device", "fig7", "--area-from", f, "--t-end", "2ms", "--dt", "1ms", "--quiet",
+                   "--out", d / "o.csv"], capsys)
+    if rc == 0:
+        (d / "o.csv").unlink()
+        (d / "o.json").unlink()
+
+
+device_keys = st.one_of(st.sampled_from(["mass_kg", "stiffness_N_per_m", "area_m2", "thickness_m", "gap_m",
+                                         "eps_r", "sigma_C_per_m2", "load_ohm", "damping_ratio", "area",
+                                         "force_model", "initial_charge"]), st.text(max_size=10))
+waveform_keys = st.one_of(st.sampled_from(["kind", "amplitude_Pa", "frequency_Hz", "duty", "low_Pa", "t_s",
+                                           "pressure_Pa"]), st.text(max_size=10))
+
+
+@SETTINGS(30)
+@given(device=st.dictionaries(device_keys, value, max_size=3),
+       waveform=st.dictionaries(waveform_keys, value, max_size=3),
+       case=st.sampled_from(["fig7", "run", "sweep"]))
+def test_generated_device_tables_through_run(tmp_path_factory, capsys, device, waveform, case):
+    d = tmp_path_factory.mktemp("dt")
+    cfg = d / "dev.toml"
+    text = toml_table("device", device) if device else ""
+    text += toml_table("waveform", waveform) if waveform else ""
+    run = {"case": case, "out": str(d / "o.csv"), "t_end": "2ms", "dt_out": "1ms"}
+    if case == "sweep":
+        run = {"case": case, "out": str(d / "o.csv"), "cycles": 2}
+        text += toml_table("sweep", {"points": 2})
+    cfg.write_text(text + toml_table("run", run))
+    rc = check(d, ["run", cfg, "--quiet"], capsys)
+    if rc == 0:
+        (d / "o.csv").unlink()
+        (d / "o.json").unlink()

@@ -12,6 +12,24 @@ class ConfigValueError(TengsimError):
     combination that cannot be built, e.g. a pyramid wider than its cell)."""
 
 
+class GeometryError(TengsimError):
+    """A size that does not fit (a structure wider than its cell, a grid too fine for its cell), raised where
+    the sizes are dimensionless: ``template`` with ``{name}`` fields and the ``lengths`` (in the shape's
+    lateral unit) that fill them.  The physical layer says it in metres (:meth:`in_metres`), the unit the user
+    gave; a dimensionless run reads the plain numbers."""
+
+    def __init__(self, template: str, **lengths):
+        self.template, self.lengths = template, lengths
+        super().__init__(template.format(**{k: f"{v:g}" for k, v in lengths.items()}))
+
+    def in_metres(self, lateral: float, fmt) -> "GeometryError":
+        """The same error with every length times ``lateral`` (m), written by ``fmt(metres)`` (the physical
+        layer passes :func:`tengsim.units.format_si` with 'm': '24 µm')."""
+        err = GeometryError(self.template, **self.lengths)
+        err.args = (self.template.format(**{k: fmt(v * lateral) for k, v in self.lengths.items()}),)
+        return err
+
+
 SHOWN = 60
 """How many characters of a value an error message echoes (:func:`shown`)."""
 

@@ -8,7 +8,7 @@ import numpy as np
 
 from tengsim import backend
 from tengsim.backend import fft as _bf
-from tengsim.errors import TengsimError, positive
+from tengsim.errors import GeometryError, TengsimError, positive
 
 
 @dataclass(frozen=True)
@@ -38,12 +38,14 @@ class Grid:
         length = positive("cell length", length)
         dx = positive("dx", dx)
         if dx > length / 3:
-            raise TengsimError(f"dx={dx} is too coarse for a cell of length {length} (need >= 3 pixels)")
+            raise GeometryError("dx {dx} is too coarse for a cell of length {length} (need >= 3 pixels)", dx=dx,
+                                length=length)
         from tengsim.resources import MAX_PIXELS_PER_SIDE
 
         if not length / dx <= MAX_PIXELS_PER_SIDE:  # before any count or allocation (also: an overflow to inf)
-            raise TengsimError(f"a cell of length {length:g} at dx={dx:g} is {length / dx:.3g} pixels per side; "
-                               f"at most {MAX_PIXELS_PER_SIDE} are allowed: use a larger dx or a smaller cell")
+            raise GeometryError("a cell of length {length} at dx {dx} is " + f"{length / dx:.3g} pixels per side; "
+                                f"at most {MAX_PIXELS_PER_SIDE} are allowed: use a larger dx or a smaller cell",
+                                length=length, dx=dx)
         n = max(3, int(round(length / dx)))
         # FFT-friendly pixel counts (small prime factors), odd so that a pixel sits on the apex
         n = backend.fast_odd_len(n) if odd else backend.fast_len(n)

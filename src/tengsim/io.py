@@ -109,9 +109,13 @@ def check_writable(path) -> None:
     from tengsim.errors import TengsimError
 
     path = Path(path)
+    parent = path.parent  # the nearest folder that exists: nothing is created by a check
+    while not parent.exists() and parent != parent.parent:
+        parent = parent.parent
     try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".check", dir=path.parent)
+        if not parent.is_dir():
+            raise NotADirectoryError(20, "not a folder", str(parent))
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".check", dir=parent)
         os.close(fd)
         os.unlink(tmp)
     except OSError as exc:
@@ -152,9 +156,79 @@ def check_output(path, inputs=(), *, folder: bool = False, what: str = "--out") 
     return path
 
 
-def write_text(path, text: str) -> None:
+def check_outputs(paths, inputs=(), *, what: str = "--out") -> list:
+    """:func:`check_output` for every file a command will write (a main output and its sidecars, figures):
+    none may be an input, each must be writable.  Returns them as Paths."""
+    return [check_output(p, inputs, what=what) for p in paths]
+
+
+def safe_name(name: str, taken: set, reserved=()) -> str:
+    """A folder name made from a user's label that stays inside its parent: only letters, digits, '.', '_'
+    and '-', never '.' or '..' or a hidden name (leading dots dropped), at most 64 characters, not one of
+    ``reserved`` (a sibling file's name) nor one already in ``taken`` (then '_2', '_3', ... appended);
+    added to ``taken``."""
+    import re
+
+    s = re.sub(r"[^A-Za-z0-9._-]+", "_", str(name)[:256]).strip("_.")[:64].strip("_.") or "design"
+    low = {r.lower() for r in reserved}
+    base, i = s, 2
+    while s in taken or s.lower() in low:
+        s, i = f"{base}_{i}", i + 1
+    taken.add(s)
+    return s
+
+
+def save_figure(fig, path, **kw) -> None:
+    """Save a matplotlib figure atomically (format from the suffix): a full disk or a refused write is an
+    OSError naming ``path``, and no partial file is left under it."""
+    path = Path(path)
     with atomic_path(path) as tmp:
-        tmp.write_text(text)
+        fig.savefig(tmp, format=path.suffix.lstrip(".") or "png", **kw)
+
+
+@contextlib.contextmanager
+def folder_lock(folder, what: str = "--out"):
+    """Hold an exclusive lock on output folder ``folder`` (a file ``.tengsim.lock`` in it) for the block: a
+    second run on the same folder is refused with one line instead of interleaving its files with ours."""
+    from tengsim.errors import TengsimError
+
+    folder = Path(folder)
+    made = [p for p in (folder, *folder.parents) if not p.exists()]  # removed again if left empty
+    folder.mkdir(parents=True, exist_ok=True)
+    lock = folder / ".tengsim.lock"
+    try:
+        fh = open(lock, "a+", encoding="utf-8")
+    except OSError as exc:
+        raise TengsimError(f"cannot write {folder}: {exc.strerror or exc}") from None
+    try:
+        try:
+            import fcntl
+
+            fcntl.flock(fh.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
+            if os.fstat(fh.fileno()).st_ino != os.stat(lock).st_ino:  # removed by its holder as we locked it
+                raise OSError
+        except ImportError:  # pragma: no cover - no fcntl (Windows): no lock
+            pass
+        except OSError:
+            fh.close()
+            raise TengsimError(f"{what} {folder} is in use by another tengsim run; wait for it or choose "
+                               "another folder") from None
+        try:
+            yield folder
+        finally:
+            with contextlib.suppress(OSError):
+                lock.unlink()  # before the unlock: a run that opens it now finds another file and retries
+            for p in made:  # a run refused or stopped before writing anything leaves no empty folder
+                with contextlib.suppress(OSError):
+                    p.rmdir()
+    finally:
+        fh.close()
+
+
+def write_text(path, text: str) -> None:
+    """Write ``text`` atomically, UTF-8 whatever the locale (LC_ALL=C with PYTHONUTF8=0 wrote ASCII only)."""
+    with atomic_path(path) as tmp:
+        tmp.write_text(text, encoding="utf-8")
 
 
 def write_bytes(path, data) -> None:

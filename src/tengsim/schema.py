@@ -204,23 +204,49 @@ def read_config(path) -> dict:
         raw = path.read_bytes()
     except OSError as exc:
         raise TengsimError(f"cannot read config file {str(path)!r}: {exc.strerror}") from None
+    name = shown(str(path), 200)
     if path.suffix.lower() == ".json":
         try:
-            cfg = json.loads(raw.decode())
+            cfg = json.loads(raw.decode("utf-8"))
+        except RecursionError:
+            raise TengsimError(f"config file {name} is nested too deeply (at most {MAX_DEPTH} levels)") from None
         except (ValueError, UnicodeDecodeError) as exc:
-            raise TengsimError(f"config file {str(path)!r} is not valid JSON: {exc}") from None
+            raise TengsimError(f"config file {name} is not valid JSON: {shown(str(exc), 200)[1:-1]}") from None
     else:
         try:
             import tomllib
         except ModuleNotFoundError:  # Python 3.10
             import tomli as tomllib
         try:
-            cfg = tomllib.loads(raw.decode())
+            cfg = tomllib.loads(raw.decode("utf-8"))
+        except RecursionError:
+            raise TengsimError(f"config file {name} is nested too deeply (at most {MAX_DEPTH} levels)") from None
         except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-            raise TengsimError(f"config file {str(path)!r} is not valid TOML: {exc}") from None
+            raise TengsimError(f"config file {name} is not valid TOML: {shown(str(exc), 200)[1:-1]}") from None
     if not isinstance(cfg, dict):
-        raise TengsimError(f"config file {str(path)!r} must hold tables")
+        raise TengsimError(f"config file {name} must hold tables")
+    if _depth(cfg) > MAX_DEPTH:
+        raise TengsimError(f"config file {name} is nested too deeply (at most {MAX_DEPTH} levels)")
     return cfg
+
+
+MAX_DEPTH = 16
+"""The deepest nesting of tables and lists a config may hold (a table of a table of a list is 3): deeper is not a
+configuration, and Python's own recursion (a comparison, a copy) would fail on it."""
+
+
+def _depth(value) -> int:
+    """How deep ``value`` nests dicts and lists (without recursion: a 600-deep list is measured, not crashed on)."""
+    deepest, todo = 0, [(value, 0)]
+    while todo:
+        v, d = todo.pop()
+        if isinstance(v, (dict, list)):
+            d += 1
+            deepest = max(deepest, d)
+            if d > MAX_DEPTH:
+                return d
+            todo.extend((x, d) for x in (v.values() if isinstance(v, dict) else v))
+    return deepest
 
 
 def check_tables(cfg: dict, allowed, where: str = "config") -> None:

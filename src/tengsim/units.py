@@ -28,6 +28,18 @@ _BASE = {
 _NUM = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
 
 
+def _compact(text, name: str = "value") -> str:
+    """``text`` without its spaces ('20 kPa' → '20kPa', '^2' and '²' as '2'), refusing a space inside the
+    number itself ('2 0kPa' is not 20 kPa; '- 5' is not -5): spaces may only stand between the number and its
+    unit, or inside the unit."""
+    raw = str(text).strip()
+    m = re.match(_NUM, raw)
+    if re.match(r"[-+]\s+[\d.]", raw) or (m and re.match(r"\s+[-+]?[\d.]", raw[m.end():])):
+        raise ConfigValueError(f"{name} = {shown(text)}: a space inside a number (write it without spaces, "
+                               "e.g. '20kPa' or '20 kPa')")
+    return raw.replace(" ", "").replace("^2", "2").replace("²", "2")
+
+
 MAX_TEXT = 64
 """The longest text read as a number or a quantity (characters): a longer one is refused unread."""
 MAX_MAGNITUDE = 1e100
@@ -96,7 +108,7 @@ def parse_quantity(text, kind: str | None = None, name: str = "value") -> float:
     if isinstance(text, (int, float)) and not isinstance(text, bool):
         v = read_number(text, name)
     else:
-        s = str(text).strip().replace(" ", "").replace("^2", "2").replace("²", "2")
+        s = _compact(text, name)
         if len(s) > MAX_TEXT or "_" in s:
             read_number(s, name)  # refuses it, naming it
         m = re.fullmatch(f"({_NUM})(.*)", s)
@@ -127,7 +139,7 @@ def quantity_dim(text) -> str | None:
     parse_quantity(text)
     if isinstance(text, (int, float)):
         return None
-    s = str(text).strip().replace(" ", "").replace("^2", "2").replace("²", "2")
+    s = _compact(text)
     unit = re.fullmatch(f"({_NUM})(.*)", s).group(2)
     if not unit:
         return None

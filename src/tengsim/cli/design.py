@@ -10,7 +10,6 @@ Examples::
 from __future__ import annotations
 
 import os
-import re
 import sys
 from pathlib import Path
 
@@ -77,7 +76,7 @@ def help_text(shape: str | None = None) -> str:
     common = {f.name: f for f in common_fields()}
     laws = law_keys()
     out += ["", "the material (required: E_star, W, eps):"]
-    out += [line(k, common[k].help) for k in ("E_star", "W", "eps")]
+    out += [line(k, common[k].help.replace("; or give tabor", "")) for k in ("E_star", "W", "eps")]  # no tabor
     if shape is None:
         out += ["", f"the shape: one of {', '.join(SHAPES.names())}; its keys: tengsim design SHAPE --help"]
     else:
@@ -97,22 +96,32 @@ def help_text(shape: str | None = None) -> str:
 
 
 def _read_toml(path: str) -> dict:
-    try:
-        import tomllib
-    except ModuleNotFoundError:  # Python < 3.11
-        import tomli as tomllib
-    f = Path(path)
-    if not f.is_file():
-        raise TengsimError(f"{path}: no such file (give a registered shape or a TOML file)")
-    try:
-        data = tomllib.loads(f.read_text())
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-        raise TengsimError(f"{path}: not a TOML file: {exc}") from None
-    return dict(data.get("design", data))
+    """The design table of a TOML file: its [design] table, or its top-level keys when it has none; any other
+    table beside [design] is refused by name (one reader: :func:`tengsim.schema.read_config`)."""
+    from tengsim.errors import listed, shown
+    from tengsim.schema import read_config
+
+    if not Path(path).is_file():
+        raise TengsimError(f"{shown(path, 200)[1:-1]}: no such file (give a registered shape or a TOML file)")
+    data = read_config(path)
+    if "design" not in data:
+        tables = [k for k, v in data.items() if isinstance(v, dict)]
+        if tables:
+            raise TengsimError(f"{path}: unknown table(s) {listed(tables)}: a design file holds [design] or the "
+                               "design's keys at its top level")
+        return dict(data)
+    design = data["design"]
+    if not isinstance(design, dict):
+        raise TengsimError(f"{path}: design must be a table ([design] with its keys), got {shown(design)}")
+    others = [k for k in data if k != "design"]
+    if others:
+        raise TengsimError(f"{path}: {listed(others)} beside [design]: a design file holds [design] only")
+    return dict(design)
 
 
 def _tables(args) -> list:
     """[(label, table)] of the designs the command line names."""
+    from tengsim.errors import shown
     from tengsim.registry import SHAPES
 
     opts = {k: getattr(args, k) for k in _keys() if getattr(args, k, None) not in (None, "")}
@@ -120,13 +129,15 @@ def _tables(args) -> list:
     first = args.inputs[0]
     if not first.lower().endswith(".toml"):
         if first.lower() not in names:
-            raise TengsimError(f"unknown shape {first!r} (shapes: {', '.join(SHAPES.names())}; or give TOML files)")
+            raise TengsimError(f"unknown shape {shown(first)} (shapes: {', '.join(SHAPES.names())}; or give TOML "
+                               "files)")
         if len(args.inputs) > 1:
-            raise TengsimError(f"give one shape with its options, or TOML files: got {' '.join(args.inputs)}")
+            raise TengsimError("give one shape with its options, or TOML files: got "
+                               f"{shown(' '.join(args.inputs), 200)}")
         return [("", {"shape": first, **opts})]
     bad = [x for x in args.inputs if not x.lower().endswith(".toml")]
     if bad:
-        raise TengsimError(f"{bad[0]}: several inputs must all be TOML files")
+        raise TengsimError(f"{shown(bad[0])}: several inputs must all be TOML files")
     return [(f"{x}: ", {**_read_toml(x), **opts}) for x in args.inputs]
 
 
@@ -141,13 +152,45 @@ def _check_out(out: Path) -> None:
         raise TengsimError(f"--out {out}: {parent} is not writable")
 
 
-def _slug(name: str, taken: set) -> str:
-    s = re.sub(r"[^A-Za-z0-9._-]+", "_", name).strip("_") or "design"
-    base, i = s, 2
-    while s in taken:
-        s, i = f"{base}_{i}", i + 1
-    taken.add(s)
-    return s
+RESERVED = ("compare.csv", "compare.png")
+"""A comparison's own files in --out: no design's folder may take their names."""
+DESIGN_FILES = ("design.nc", "design.csv", "design.png", "maps.png", "report.md")
+
+
+def _folders(plans) -> list:
+    """The folder (relative to --out) of each design: '' for one design; for several, a safe name made from
+    each design's name (:func:`tengsim.io.safe_name`: never '..', '.', a hidden or reserved name), chosen
+    before anything runs; a design named as the comparison's own files (compare.csv) is refused."""
+    from tengsim.io import safe_name
+
+    if len(plans) == 1:
+        return [""]
+    for p in plans:
+        if p.name.strip().lower() in RESERVED:
+            raise TengsimError(f"design name {p.name!r} is the name of the comparison's own file in --out: "
+                               "choose another name")
+    taken: set = set()
+    return [safe_name(p.name, taken, RESERVED) for p in plans]
+
+
+def _guard(out: Path, folders, inputs) -> None:
+    """Every file the command will write, checked before anything is computed (:func:`tengsim.io.check_output`):
+    none is an input (a topography file, a TOML file), each lies inside --out and can be written."""
+    from tengsim.io import check_output
+
+    check_output(out, inputs, folder=True)
+    files = [out / f / name for f in folders for name in DESIGN_FILES]
+    if len(folders) > 1:
+        files += [out / name for name in RESERVED]
+    root = out.resolve()
+    for f in files:
+        if root != f.resolve().parent and root not in f.resolve().parents:  # pragma: no cover - safe_name
+            raise TengsimError(f"--out {out}: {f} would lie outside it")
+        for inp in inputs:
+            if isinstance(inp, str) and len(inp) < 4096 and Path(inp).is_file() and \
+                    Path(inp).resolve() == f.resolve():
+                raise TengsimError(f"--out {out}: it would replace the input {inp} ({f.name}); choose another "
+                                   "folder")
 
 
 class _Say:
@@ -174,7 +217,7 @@ class _Say:
 
 
 def run(args) -> int:
-    from tengsim.design import plan_design, run_design, write_comparison, write_design
+    from tengsim.design import plan_design
     from tengsim.registry import SHAPES
 
     if args.help:
@@ -189,19 +232,46 @@ def run(args) -> int:
     plans = [plan_design(t, where) for where, t in tables]  # every design checked before anything runs
     out = Path(args.out)
     _check_out(out)
+    folders = _folders(plans)
+    inputs = [*(x for x in args.inputs if x.lower().endswith(".toml")),
+              *(v for _, t in tables for v in t.values() if isinstance(v, str))]
+    _guard(out, folders, inputs)
+    from tengsim.design.run import preflight
+    from tengsim.io import folder_lock
+
+    for (where, _), plan in zip(tables, plans):  # every design's grids, memory, budget, solver, before any runs
+        try:
+            preflight(plan)
+        except TengsimError as exc:
+            raise TengsimError(f"{where}{exc}") from None
+    with folder_lock(out):
+        return _run_locked(args, plans, folders, out)
+
+
+def _run_locked(args, plans, folders, out) -> int:
+    from tengsim.design import run_design, write_comparison, write_design
+
     say = _Say(args.quiet)
     results = []
     try:
         for k, plan in enumerate(plans):  # each finished grid kept in OUT: a killed run resumes from it
             results.append(run_design(plan, progress=say, keep=out / f".design-{k}.resolve.nc"))
+    except KeyboardInterrupt:
+        say.close()
+        kept = [out / f".design-{k}.resolve.nc" for k in range(len(plans))]
+        kept = [str(p) for p in kept if p.exists()]
+        print("tengsim: interrupted: " + (f"the finished grids are kept in {', '.join(kept)}; run the same "
+              "command again to resume from them" if kept else "nothing was kept (no grid had finished)"),
+              file=sys.stderr)
+        return 130
     finally:
         say.close()
     if len(results) == 1:
         paths = write_design(results[0], out)
     else:
-        taken, paths = set(), []
-        for r in results:
-            paths += write_design(r, out / _slug(r.plan.name, taken))
+        paths = []
+        for r, f in zip(results, folders):
+            paths += write_design(r, out / f)
         paths += write_comparison(results, out)
     for k in range(len(plans)):  # the results are saved: the kept grids are no longer needed
         (out / f".design-{k}.resolve.nc").unlink(missing_ok=True)

@@ -27,6 +27,8 @@ DESCRIPTION = (
     "atol, max_step) and [sweep] (r_min_ohm, r_max_ohm, points, steady). Every table given is used or "
     "refused by name; `tengsim device fields` lists every key with its unit and default. " + PRECEDENCE)
 DEFAULT_CYCLES = {"fig7": 5, "run": 5, "sweep": 3}
+MAX_SWEEP_POINTS = 10_000
+"""The most loads one sweep may hold (each is a multi-cycle device run)."""
 
 # CLI option -> (table, key)
 _OPTIONS = {"out": ("run", "out"), "cycles": ("run", "cycles"), "t_end": ("run", "t_end"), "dt": ("run", "dt_out"),
@@ -143,6 +145,49 @@ def _out_path(run: dict, case: str) -> Path:
     return out
 
 
+def _inputs(cfg: dict, cli: dict, source) -> list:
+    """Every file a device run reads: the config file, the area result (a file, or a design folder's
+    design.nc) from --area-from or [device] area."""
+    out = [source] if source else []
+    for area in (cli.get("device", {}).get("area"), (cfg.get("device") or {}).get("area")):
+        if isinstance(area, (str, Path)) and len(str(area)) < 4096:
+            out.append(str(area))
+            if Path(area).is_dir():
+                from tengsim.device.areas import DESIGN_FILE
+
+                out.append(str(Path(area) / DESIGN_FILE))
+    return out
+
+
+def _guard(out: Path, cfg: dict, cli: dict, source) -> None:
+    """The output and its .json sidecar (a .csv output), checked before anything runs: neither may be an input
+    (:func:`tengsim.io.check_outputs`), both must be writable."""
+    from tengsim.io import check_output
+
+    inputs = _inputs(cfg, cli, source)
+    check_output(out, inputs)
+    if out.suffix.lower() == ".csv":
+        check_output(out.with_suffix(".json"), inputs, what=f"the sidecar of --out {out.name}:")
+
+
+def _warn_unconverged(cfg: dict, cli: dict, quiet: bool) -> None:
+    """A warning line when the area comes from a design whose status is not ok (under-resolved, not
+    converged): the device then inherits that design's error."""
+    for path in _inputs(cfg, cli, None):
+        p = Path(path)
+        if p.suffix.lower() != ".nc" or not p.is_file():
+            continue
+        try:
+            from tengsim.io import read_dataset
+
+            status = str(read_dataset(p).attrs.get("status", "ok"))
+        except Exception:  # noqa: BLE001 - the area reader has said what is wrong with it already
+            continue
+        if status != "ok":
+            print(f"tengsim: warning: the area comes from {p}, a design of status {status!r} (not converged to "
+                  "its tolerance): the device's numbers carry its error (see its report.md)", file=sys.stderr)
+
+
 # --- the one path every device run takes ---
 
 def execute(case: str, cfg: dict, cli: dict | None = None, quiet: bool = False, source: str | None = None) -> int:
@@ -168,11 +213,12 @@ def execute(case: str, cfg: dict, cli: dict | None = None, quiet: bool = False, 
     dev_cli = _typed_cli(dc.DEVICE_TABLE, cli.get("device", {}))
     solver = dc.parse_solver(cfg.get("solver", {}))
     out = _out_path(run, case)
+    _guard(out, cfg, cli, source)
+    _warn_unconverged(cfg, cli, quiet)
     if case == "sweep":
         return _sweep(cfg, cli, run, dev_cli, solver, out, quiet, source)
     params, wf = _device_and_waveform(case, cfg, dev_cli)
     from tengsim.device import simulate
-    from tengsim.io import check_writable
 
     if case == "fig8":
         from tengsim.cases.paper import fig8_area_table, fig8_summary
@@ -181,7 +227,6 @@ def execute(case: str, cfg: dict, cli: dict | None = None, quiet: bool = False, 
         cycles = run.get("cycles", n)
         require(cycles <= n, f"cycles = {cycles} but the staircase has {n} steps (give at most {n})")
         wf = dataclasses.replace(wf, amplitudes_Pa=wf.amplitudes_Pa[:cycles])
-        check_writable(out)
         if "area" not in cfg.get("device", {}) and "area" not in dev_cli:  # the slow engine: after every check
             params = params.replace(area=fig8_area_table(bool(run.get("quick", False))))
         res = simulate(params, wf, wf.duration, dt_out=run.get("dt_out", 1e-4), options=solver, progress=not quiet)
@@ -192,7 +237,6 @@ def execute(case: str, cfg: dict, cli: dict | None = None, quiet: bool = False, 
             per = wf.period or wf.duration
             require(per is not None, "give --t-end (or [run] t_end) for a waveform with no period")
             t_end = run.get("cycles", DEFAULT_CYCLES[case]) * per
-        check_writable(out)
         res = simulate(params, wf, t_end, dt_out=run.get("dt_out"), options=solver, progress=not quiet)
         skip = 1 if (wf.period and t_end >= 2 * wf.period - 1e-12) else 0
         if case == "fig7":
@@ -283,13 +327,13 @@ def _sweep(cfg, cli, run, dev_cli, solver, out, quiet, source) -> int:
     r_min, r_max, points = sw_cfg["r_min_ohm"], sw_cfg["r_max_ohm"], sw_cfg["points"]
     require(0 < r_min < r_max, f"need 0 < r_min < r_max, got {r_min!r}, {r_max!r}")
     require(points >= 2, f"points must be >= 2, got {points!r}")
+    from tengsim.resources import check_count
+
+    check_count(points, "the load sweep's points", MAX_SWEEP_POINTS)  # before a load array is made
     cycles = run.get("cycles", DEFAULT_CYCLES["sweep"])
     require(cycles >= 2, f"cycles must be >= 2 for a sweep (the first is dropped), got {cycles!r}")
     params, wf = _device_and_waveform("sweep", cfg, dev_cli)
     loads = np.logspace(np.log10(r_min), np.log10(r_max), points)
-    from tengsim.io import check_writable
-
-    check_writable(out)
     sw = resistance_sweep(params, wf, loads, cycles=cycles, steady=sw_cfg["steady"], dt_out=run.get("dt_out"),
                           options=solver, progress=not quiet)
     from tengsim.io import jsonable

@@ -28,9 +28,26 @@ class Parser(argparse.ArgumentParser):
         self._negative_number_matcher = re.compile(
             r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?(\s*[A-Za-zµμΩ][A-Za-zµμΩ/^²0-9]*)?$|^-(inf|nan)$", re.I)
 
+    argv: list = []
+    """The command line being parsed (set by :func:`_main`): a wrong key points to its command's help."""
+
     def error(self, message):
         # a hostile value echoed by argparse ('invalid int value: ...') is cut, as tengsim's own messages cut it
-        self.exit(2, f"tengsim: error: {cut(message, 60)} (see '{self.prog} --help')\n")
+        self.exit(2, f"tengsim: error: {cut(message, 60)} (see '{help_for(Parser.argv, self.prog)}')\n")
+
+
+def help_for(argv, prog: str = "tengsim") -> str:
+    """The help that lists the keys a command line may use: 'tengsim design pyramid --help' for a design of
+    a shape, 'tengsim contact --help' for a command, else ``prog --help``."""
+    words = [str(w) for w in argv or ()]
+    command = chosen_command(words)
+    if command is None:
+        return f"{prog} --help"
+    rest = words[words.index(command) + 1:]
+    if command == "design" and rest and not rest[0].startswith("-") and not rest[0].lower().endswith(".toml") \
+            and len(rest[0]) < 40 and rest[0].isidentifier():
+        return f"tengsim design {rest[0]} --help"
+    return f"tengsim {command} --help"
 
 
 def cut(message: str, longest: int = 300) -> str:
@@ -119,6 +136,7 @@ def _log_internal_error(exc, argv) -> str:
 def main(argv=None) -> int:
     """Run one command; any fault that is not a user's error is one line plus the path of a log holding
     its traceback (exit code :data:`INTERNAL_ERROR`)."""
+    _printable_streams()
     try:
         return _main(argv)
     except Exception as exc:  # noqa: BLE001 - a bug of tengsim or of a plugin: no traceback on the terminal
@@ -126,6 +144,18 @@ def main(argv=None) -> int:
         msg = " ".join(str(exc).split()) or "(no message)"
         print(f"tengsim: internal error: {type(exc).__name__}: {msg} ({where})", file=sys.stderr)
         return INTERNAL_ERROR
+
+
+def _printable_streams() -> None:
+    """stdout and stderr that never fail on a character their encoding lacks (LC_ALL=C with PYTHONUTF8=0:
+    ASCII): 'µm' is printed as '\\xb5m' instead of a crash after the results were computed."""
+    for stream in (sys.stdout, sys.stderr):
+        enc = str(getattr(stream, "encoding", "") or "").lower().replace("-", "")
+        if enc and enc != "utf8" and hasattr(stream, "reconfigure"):
+            try:
+                stream.reconfigure(errors="backslashreplace")
+            except (ValueError, OSError):  # pragma: no cover - a stream that cannot change
+                pass
 
 
 def _main(argv=None) -> int:
@@ -139,6 +169,7 @@ def _main(argv=None) -> int:
             print(f"tengsim: error: {cut(exc)}", file=sys.stderr)
             return 2
     parser = build_parser(command)
+    Parser.argv = sys.argv[1:] if argv is None else [str(a) for a in argv]
     try:
         args = parser.parse_args(argv)
     except SystemExit as exc:  # a bad option: one line already printed (--help and --version exit as usual)
@@ -158,7 +189,8 @@ def _main(argv=None) -> int:
         print(cut(f"tengsim: error:{where}: {exc.strerror or exc}"), file=sys.stderr)
         return 2
     except KeyboardInterrupt:
-        print("tengsim: interrupted; no partial output was written", file=sys.stderr)
+        print("tengsim: interrupted before its results were written (a run that keeps finished work says "
+              "where above)", file=sys.stderr)
         return 130
 
 

@@ -43,7 +43,7 @@ def _device_period(src: Path, obj):
 
     try:
         if src.suffix.lower() == ".csv":
-            wf = json.loads(src.with_suffix(".json").read_text()).get("waveform", {})
+            wf = json.loads(src.with_suffix(".json").read_text(encoding="utf-8")).get("waveform", {})
         else:
             wf = json.loads(getattr(obj, "attrs", {}).get("waveform", "{}"))
         f = float(wf.get("frequency_Hz") or 0.0)

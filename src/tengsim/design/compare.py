@@ -27,7 +27,11 @@ def write_comparison(results, out_dir) -> list:
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     write_text(out / "compare.csv", csv_text(compare_table(results), missing=""))
+    from tengsim.io import save_figure
+
     fig = compare_figure(results)
-    fig.savefig(out / "compare.png", dpi=110)
-    _plt().close(fig)
+    try:
+        save_figure(fig, out / "compare.png", dpi=110)  # atomic, as every figure
+    finally:
+        _plt().close(fig)
     return [out / "compare.csv", out / "compare.png"]

@@ -20,10 +20,21 @@ import json
 import math
 from dataclasses import dataclass, field
 
-from tengsim.errors import ConfigValueError, TengsimError
+from tengsim.errors import ConfigValueError, TengsimError, listed, shown
 
 PAPER_DEVICE = {"sigma": 5.84e-6, "eps_r": 2.40, "T": 400e-6, "gap": 0.1e-3}
 """The paper's device (Section 5, Fig. 8): σ = 5.84 µC/m², ε_r = 2.40, T = 400 µm, rest gap d0 = 0.1 mm."""
+
+DEVICE_BOUNDS = {"sigma": (1e-9, 1e-2, "1 nC/m2 ... 10 mC/m2 (air breaks down far below the top)"),
+                 "eps_r": (1.0, 1e5, "1 ... 1e5 (vacuum ... the largest ferroelectric permittivities)"),
+                 "T": (1e-9, 1.0, "1 nm ... 1 m"),
+                 "gap": (1e-9, 1.0, "1 nm ... 1 m")}
+"""Physical bounds of the device inputs of Eq. (12) and Eq. (17): a value outside is a typo, not a device."""
+TOL_FLOOR = 1e-4
+"""The smallest design tolerance (0.01 %): each equilibrium is solved to 0.01 × tol, and a grid refinement to
+1e-4 is already far beyond what a design's budget pays for."""
+MAX_NAME = 200
+"""The longest design name (characters): it labels tables, figures and a folder."""
 
 CONTROLLED = ("tabor", "dx", "d_min", "d_max", "d_step", "refine_levels", "maps_at", "control", "f_min", "f_max",
               "f_step", "adaptive", "adapt_tol", "resolve", "resolve_tol", "max_pixels", "resolve_pressures",
@@ -101,14 +112,19 @@ class DesignPlan:
         """'pitch 10 µm, base 5 µm, height 3.5 µm' (lengths in their unit, other numbers plain)."""
         from tengsim.design.units import length_text, pressure_text
 
+        def each(v, text):  # a size may be a pair (a topography's physical_size): 'a × b'
+            if isinstance(v, (tuple, list)):
+                return " × ".join(each(x, text) for x in v)
+            return text(v) if isinstance(v, (int, float)) and not isinstance(v, bool) else str(v)[:80]
+
         out = []
         for k, v in self.shape_params.items():
             if k.endswith("_m"):
-                out.append(f"{k[:-2]} {length_text(v)}")
+                out.append(f"{k[:-2]} {each(v, length_text)}")
             elif k.endswith("_Pa"):
-                out.append(f"{k[:-3]} {pressure_text(v)}")
+                out.append(f"{k[:-3]} {each(v, pressure_text)}")
             else:
-                out.append(f"{k} {v:g}" if isinstance(v, float) else f"{k} {v}")
+                out.append(f"{k} {each(v, lambda x: f'{x:g}')}")
         return ", ".join(out)
 
 
@@ -150,7 +166,7 @@ def plan_design(table: dict, where: str = "") -> DesignPlan:
     if shape in (None, ""):
         raise ConfigValueError(f"{where}give the shape (one of {', '.join(SHAPES.names())})")
     if not isinstance(shape, str) or shape.strip().lower() not in [s.lower() for s in SHAPES.names()]:
-        raise ConfigValueError(f"{where}unknown shape {shape!r} (shapes: {', '.join(SHAPES.names())})")
+        raise ConfigValueError(f"{where}unknown shape {shown(shape)} (shapes: {', '.join(SHAPES.names())})")
     shape = SHAPES.canonical(shape)
     own_names = {f.name for f in design_fields()}
     contact_keys = set(contact_table(shape, "physical").keys())
@@ -159,21 +175,24 @@ def plan_design(table: dict, where: str = "") -> DesignPlan:
         raise ConfigValueError(f"{where}a design takes eps (the interaction range, a length such as '50nm'), "
                                "not tabor: the Tabor number is derived for each shape and printed")
     if refused:
-        raise ConfigValueError(f"{where}{', '.join(refused)}: set by the design itself (the path extends until "
+        raise ConfigValueError(f"{where}{listed(refused)}: set by the design itself (the path extends until "
                                "p_max is reached; the grid is refined to tol)")
     unknown = sorted(k for k in table if k not in own_names and k not in contact_keys)
     if unknown:
-        raise ConfigValueError(f"{where}shape {shape} has no key {', '.join(map(repr, unknown))} (design keys: "
+        raise ConfigValueError(f"{where}shape {shape} has no key {listed(unknown)} (design keys: "
                                f"{', '.join(sorted(own_names))}; [contact] keys of {shape}: "
                                f"{', '.join(k for k in sorted(contact_keys) if k not in CONTROLLED)})")
     if table.get("eps") in (None, ""):
         raise ConfigValueError(f"{where}eps is missing: give the interaction range ε of the law, a length such as "
-                               "'50nm' (docs/design.md, 'Choosing ε')")
+                               "'50nm' (docs/own_design.md, 'Choosing ε')")
     own = _own(table)
     cfg = {k: v for k, v in table.items() if k in contact_keys and k not in own_names and v not in (None, "")}
     cfg["shape"] = shape
+    checked = dict(cfg)
+    if table.get("dx") not in (None, ""):  # the grid checked at the design's own first dx, not the default's
+        checked["dx"] = table["dx"]
     try:
-        plan = plan_contact(cfg)
+        plan = plan_contact(checked)
     except TengsimError as exc:
         raise type(exc)(f"{where}{exc}") from None
     if plan.scaling is None:
@@ -181,10 +200,18 @@ def plan_design(table: dict, where: str = "") -> DesignPlan:
     pressures = _pressures(own, where)
     for k in ("sigma", "eps_r", "T", "gap"):
         if not own[k] > 0:
-            raise ConfigValueError(f"{where}{k} must be > 0, got {table.get(k)!r}")
+            raise ConfigValueError(f"{where}{k} must be > 0, got {shown(table.get(k))}")
+        lo_k, hi_k, text = DEVICE_BOUNDS[k]
+        if not lo_k <= own[k] <= hi_k:
+            raise ConfigValueError(f"{where}{k} = {shown(table.get(k))} is outside {text}")
     tol = own["tol"]
     if not 0 < tol < 0.5:
         raise ConfigValueError(f"{where}tol must be a fraction > 0 and < 0.5 (0.01 = 1 %), got {table.get('tol')!r}")
+    if tol < TOL_FLOOR:
+        raise ConfigValueError(f"{where}tol = {tol:g} is below {TOL_FLOOR:g}: the grids' discretisation error "
+                               f"cannot be driven that low within any budget (give tol >= {TOL_FLOOR:g})")
+    if own["name"] is not None and len(own["name"]) > MAX_NAME:
+        raise ConfigValueError(f"{where}name is {len(own['name'])} characters long: at most {MAX_NAME}")
     if own["dx"] is not None and not own["dx"] > 0:
         raise ConfigValueError(f"{where}dx must be a length > 0, got {table.get('dx')!r}")
     if own["max_pixels"] is not None and own["max_pixels"] < 9:

@@ -138,7 +138,11 @@ def save_design_figures(result, out_dir) -> list:
         if fig is None:
             continue
         path = Path(out_dir) / name
-        fig.savefig(path, dpi=110)
-        plt.close(fig)
+        from tengsim.io import save_figure
+
+        try:
+            save_figure(fig, path, dpi=110)  # atomic: a full disk names the path and leaves no partial file
+        finally:
+            plt.close(fig)
         out.append(path)
     return out

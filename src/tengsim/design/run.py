@@ -221,6 +221,66 @@ def check_budget(plan, est: Estimate, fit_pixels: int | None = None) -> None:
                        "--budget")
 
 
+def preflight(plan) -> None:
+    """Every bound of a design checked from its sizes alone, before any array is allocated or anything is
+    written: the first grid fits the cell (in the user's units), is within ``max_pixels`` and the memory, and
+    its shortest path (D to 2 ε: no structure at all) fits the budget.  The full estimate, with the structure's
+    height, follows in :func:`run_design`; this one needs no gap array (a --dx of 0.02 nm was killed for its
+    memory before any check)."""
+    from tengsim.design.units import length_text, time_text
+    from tengsim.errors import GeometryError
+    from tengsim.resources import check_memory
+    from tengsim.run.plan import _metres, as_plan
+    from tengsim.solvers import make_solver
+
+    cplan = as_plan(plan.contact_table if plan.contact_plan is None else plan.contact_plan)
+    make_solver(cplan.solver, tol=solver_tol(plan))  # a solver this machine lacks (gpu): refused now, one line
+    lateral = cplan.scaling.lateral
+    try:
+        dx = start_dx(plan, cplan)
+        g = cplan.shape.grid(dx)
+    except GeometryError as exc:
+        raise exc.in_metres(lateral, _metres) from None
+    first = f"the first grid {g.nx}×{g.ny} (dx {length_text(g.dx * lateral)})"
+    if plan.max_pixels is not None and g.nx * g.ny > plan.max_pixels:
+        raise TengsimError(f"{plan.name[:80]}: {first} has {g.nx * g.ny} pixels, over max_pixels = "
+                           f"{plan.max_pixels}: give a larger --max-pixels or a coarser --dx")
+    check_memory(g.nx, g.ny, cplan.boundary, cplan.solver)
+    if (cplan.kernel_params or {}).get("thickness") is not None:
+        from tengsim.kernels.film import check_film_pixels
+
+        check_film_pixels(cplan.kernel_params["thickness"], max(g.dx, g.dy), lateral)
+    secs = SECONDS_PER_PIXEL_ROW * _blocks(cplan.shape, g) * ROWS_PER_STEP * (2.0 - D_MIN) / D_STEP
+    if secs > plan.budget_s:
+        raise TengsimError(f"{plan.name[:80]}: {first} alone is estimated at {time_text(secs)}, over the budget "
+                           f"of {time_text(plan.budget_s)}: give a coarser --dx, a coarser --tol (now "
+                           f"{plan.tol:g}) or a larger --budget")
+
+
+class BudgetSpent(TengsimError):
+    """A design stopped at its time budget (what finished is kept; the message says how to go on)."""
+
+
+def _deadline(progress, plan, keep, started):
+    """``progress`` (called per path row) that also stops the run, cleanly, once ``plan.budget_s`` seconds
+    have passed since ``started``: the finished grids stay in ``keep`` and the message says how to go on."""
+    import time
+
+    def call(*a, **k):
+        if time.monotonic() - started > plan.budget_s:
+            from tengsim.design.units import time_text
+
+            where = (f"the finished grids are kept in {keep}: run the same command with a larger --budget to go "
+                     "on from them") if keep is not None and keep.exists() else \
+                "no grid had finished: give a larger --budget, a coarser --dx or a coarser --tol"
+            raise BudgetSpent(f"{plan.name[:80]}: stopped at the budget of {time_text(plan.budget_s)}; {where}")
+        if callable(progress):
+            return progress(*a, **k)
+        return None
+
+    return call
+
+
 def solver_tol(plan) -> float:
     """The solver's tolerance of a design (:data:`SOLVER_TOL_PER_TOL`)."""
     return SOLVER_TOL_PER_TOL * plan.tol
@@ -365,22 +425,57 @@ def _watcher(plan):
     return watch
 
 
-def _checkpoint(keep, plan, d_max, progress):
-    """The refinement's checkpoint in the file ``keep`` for this plan and path (None without ``keep``): each
-    finished grid is kept there, and a run of the same design and path takes its grids back instead of computing
-    them again; one kept by another design is replaced (said)."""
+def identity(plan) -> str:
+    """What a design's kept grids belong to: the plan (every key as given but the budget), the content of every
+    input file it names (a topography's heights: the file's bytes, not its name), tengsim's version and the
+    plugins loaded (a user's shape or law changed between runs gives other grids).  16 hex digits."""
+    import hashlib
+    from pathlib import Path
+
+    from tengsim import plugins
+    from tengsim._version import __version__
+
+    same = dataclasses.replace(plan, budget_s=0.0)  # a larger --budget goes on from the grids a budget stopped
+    h = hashlib.sha256(f"{same!r}|{__version__}|{sorted(plugins._LOADED)!r}".encode())
+    for v in (plan.contact_table or {}).values():
+        if isinstance(v, str) and len(v) < 4096 and Path(v).is_file():
+            with open(v, "rb") as fh:
+                for block in iter(lambda: fh.read(1 << 20), b""):
+                    h.update(block)
+    return h.hexdigest()[:16]
+
+
+def _kept_path(keep, base: str) -> float | None:
+    """The D range (ε) of the grids ``keep`` holds for this design (``base``: :func:`identity`), or None: a run
+    killed in its second pass (a longer path) resumes on that path, not on the first pass's."""
     if keep is None:
         return None
-    import hashlib
+    from tengsim.run.checkpoint import Checkpoint
 
+    found = Checkpoint(keep, "").stored_digest() or ""
+    head, _, d = found.partition("@")
+    try:
+        return float(d) if head == base else None
+    except ValueError:
+        return None
+
+
+def _checkpoint(keep, base, d_max, progress):
+    """The refinement's checkpoint in the file ``keep`` for this design (``base``, :func:`identity`) and path
+    (None without ``keep``): each finished grid is kept there, and a run of the same design and path takes its
+    grids back instead of computing them again; grids of the same design on a shorter path (its first pass)
+    are replaced quietly, those of another design with a line saying so."""
+    if keep is None:
+        return None
     from tengsim.errors import TengsimError as _Err
     from tengsim.run.checkpoint import Checkpoint
 
-    ck = Checkpoint(keep, hashlib.sha256(f"{plan!r}|{d_max!r}".encode()).hexdigest()[:16])
+    ck = Checkpoint(keep, f"{base}@{d_max!r}")
     try:
         found = ck.load()
     except _Err:
-        _say(progress, f"{keep} holds grids of another design or path: they are replaced")
+        if not (ck.stored_digest() or "").startswith(base + "@"):
+            _say(progress, f"{keep} holds grids of another design or input: they are replaced")
         keep.unlink()
         found = None
     if found is not None:
@@ -399,6 +494,10 @@ def run_design(plan, progress=None, keep=None) -> DesignResult:
     from tengsim.design.write import to_dataset
     from tengsim.run.resolve import resolve_plan
 
+    import time
+
+    started = time.monotonic()
+    preflight(plan)
     cplan = dataclasses.replace(as_plan(plan.contact_table if plan.contact_plan is None else plan.contact_plan),
                                 tol=solver_tol(plan))  # the plan plan_design built (planned once)
     dx = start_dx(plan, cplan)
@@ -409,6 +508,10 @@ def run_design(plan, progress=None, keep=None) -> DesignResult:
         _say(progress, line)
     check_budget(plan, est, plan.max_pixels or budget_pixels(plan, cplan, dx, est.d_max))
     d_max, coarse = find_d_max(plan, cplan, dx, progress)
+    base = identity(plan)
+    later = _kept_path(keep, base)
+    if later is not None and later > d_max:  # killed in its second pass: go on on that pass's path
+        d_max = later
     max_pixels = plan.max_pixels or budget_pixels(plan, cplan, dx, d_max)
     _say(progress, cap_line(plan, cplan, dx, d_max, max_pixels))
     res = None
@@ -416,10 +519,10 @@ def run_design(plan, progress=None, keep=None) -> DesignResult:
         from tengsim.continuation import PathSpec
 
         path = PathSpec(D_MIN, d_max, D_STEP, adaptive=True)
-        ck, found = _checkpoint(keep, plan, d_max, progress) or (None, None)
+        ck, found = _checkpoint(keep, base, d_max, progress) or (None, None)
         res = resolve_plan(dataclasses.replace(cplan, path=path, resolve=ResolveSettings(plan.tol, max_pixels, dx)),
                            observe=_observer(plan), watch=_watcher(plan), path_for=grid_path(plan, d_max),
-                           progress=progress if callable(progress) else None,
+                           progress=_deadline(progress, plan, keep, started),
                            checkpoint=None if ck is None else ck.save, start=found)
         if res.scaling is None:  # every grid taken back from the checkpoint file, which keeps the columns only
             res = dataclasses.replace(res, scaling=cplan.scaling)

@@ -66,6 +66,8 @@ def area_table_from_design(path) -> AreaTable:
                            f"{str(exc).splitlines()[0][:80]})") from None
     if AREA_VARIABLE not in ds or "pressure" not in ds.coords:
         raise TengsimError(f"area: {str(p)!r} is no design result (it has no {AREA_VARIABLE!r} over 'pressure')")
+    if ds["pressure"].dtype.kind not in "fiu" or ds["pressure"].ndim != 1 or ds[AREA_VARIABLE].dtype.kind != "f":
+        raise TengsimError(f"area: {str(p)!r}: pressure and {AREA_VARIABLE} must be numbers, pressure 1-D")
     units = str(ds["pressure"].attrs.get("units", "Pa"))
     if units != "Pa":
         raise TengsimError(f"area: {str(p)!r}: pressure in {units!r}, expected 'Pa'")
@@ -114,6 +116,32 @@ def area_table_from_contact(path) -> AreaTable:
     return AreaTable(pres, a)
 
 
+def _one_line(read):
+    """``read(path)`` whose every failure on a file that is not what it should be (text where numbers belong,
+    a 3-D array, random bytes named .csv) is one :class:`TengsimError` naming the file, never a traceback."""
+    import functools
+
+    @functools.wraps(read)
+    def wrapped(path):
+        from tengsim.errors import shown
+
+        try:
+            table = read(path)
+        except TengsimError:
+            raise
+        except (ValueError, TypeError, KeyError, IndexError, OSError, UnicodeError, AttributeError) as exc:
+            why = shown(str(exc).splitlines()[0] if str(exc) else "", 100)[1:-1]
+            raise TengsimError(f"area: cannot read {shown(str(path), 200)} as a design or contact result "
+                               f"({type(exc).__name__}: {why})") from None
+        p, a = np.asarray(table.pressure_Pa), np.asarray(table.area_fraction)
+        if p.ndim != 1 or a.shape != p.shape or p.dtype.kind != "f" or a.dtype.kind != "f":
+            raise TengsimError(f"area: {shown(str(path), 200)} holds no 1-D numeric table of pressure and area")
+        return table
+
+    return wrapped
+
+
+@_one_line
 def area_table_from_file(path) -> AreaTable:
     """The area model of a result on file: a design result (DIR, DIR/design.nc) or a contact result."""
     p = Path(path)

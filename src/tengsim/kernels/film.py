@@ -151,6 +151,27 @@ def _gauss3():
     return 0.5 * x, 0.5 * w  # nodes and weights on [−1/2, 1/2]
 
 
+MAX_PIXEL_PER_THICKNESS = 64
+"""The largest pixel a film's correction is integrated on, in film thicknesses: the correction splits a pixel
+into ⌈dx/T⌉² sub-pixels (9 Gauss points each), so a film of 1e-15 m under a 10 nm pixel asked for 10¹⁶ of them
+(a run past any budget; 1e-30 m: an allocation that could not succeed)."""
+
+
+def check_film_pixels(thickness: float, dx: float, lateral: float | None = None) -> None:
+    """Refuse, before any kernel is built, a pixel more than :data:`MAX_PIXEL_PER_THICKNESS` film thicknesses
+    wide (``lateral``: metres per unit, for a message in metres)."""
+    if not dx <= MAX_PIXEL_PER_THICKNESS * thickness:
+        from tengsim.errors import TengsimError
+        from tengsim.units import format_si
+
+        def say(v):
+            return format_si(v * lateral, "m") if lateral else f"{v:g}"
+
+        raise TengsimError(f"film thickness {say(thickness)} is below 1/{MAX_PIXEL_PER_THICKNESS} of the pixel "
+                           f"(dx {say(dx)}): give a film at least {say(dx / MAX_PIXEL_PER_THICKNESS)} thick, a "
+                           "finer grid, or no film (a half-space)")
+
+
 def film_pixel_correction(X, Y, dx: float, dy: float, thickness: float, poisson: float,
                           substrate: str) -> np.ndarray:
     """∬ over the pixel at offsets (X, Y) of (1/T) h(|r|/T): the layer-minus-half-space influence per κ/π.
@@ -159,6 +180,7 @@ def film_pixel_correction(X, Y, dx: float, dy: float, thickness: float, poisson:
     the layer's influence vanishes); a nearer one is split into k × k sub-pixels, k = ⌈max(dx, dy)/T⌉,
     with 3 × 3 Gauss points each (h is smooth on the scale T, so a film thinner than a pixel still
     has its correction resolved)."""
+    check_film_pixels(thickness, max(dx, dy))
     X, Y = np.broadcast_arrays(np.asarray(X, float), np.asarray(Y, float))
     out = -pixel_influence(X, Y, dx, dy)
     gap = np.hypot(np.maximum(np.abs(X) - dx / 2, 0.0), np.maximum(np.abs(Y) - dy / 2, 0.0))

@@ -45,7 +45,7 @@ def _read_csv(path: Path, allow_empty: bool = False):
     :class:`tengsim.results.RowStream`) a last line without its newline, half written when the run was
     killed, is left out.  ``allow_empty``: a file with no column line gives ({header}, {})."""
     rows, names = [], None
-    with open(path, newline="") as fh:
+    with open(path, newline="", encoding="utf-8") as fh:
         lines = iter(io.StringIO(fh.read(), newline=""))  # lines split as the file's own reader splits them
     header, line = _header(lines)
     body = [line, *lines]

@@ -123,7 +123,7 @@ class RowStream:
                 raise TengsimError(f"--resume: {self.path} was written by another run ({what}); "
                                    "delete it to start afresh")
             if self.fh is None:
-                self.fh = open(self.path, "a", newline="")
+                self.fh = open(self.path, "a", newline="", encoding="utf-8")
         else:  # written with the first row: a run that fails before it leaves nothing behind
             self._head = {"complete": False, "partial_of": str(self.out), "run_digest": digest, **params}
         self._synced = time.monotonic()
@@ -135,10 +135,11 @@ class RowStream:
 
         if self.fh is not None:
             self.fh.close()
-        lines = [ln for ln in open(self.path, newline="").read().splitlines(keepends=True) if not ln.startswith("#")]
+        with open(self.path, newline="", encoding="utf-8") as fh:
+            lines = [ln for ln in fh.read().splitlines(keepends=True) if not ln.startswith("#")]
         body = "".join(lines[:1 + keep]) if lines else ""
         io.write_text(self.path, io.header_lines(self._head) + body)
-        self.fh = open(self.path, "a", newline="")
+        self.fh = open(self.path, "a", newline="", encoding="utf-8")
 
     def _truncate_torn_line(self) -> None:
         """Cut a last line that a kill left half written (no newline): the reader skipped it too."""
@@ -157,7 +158,7 @@ class RowStream:
         cols = [*[k for k in CURVE_COLUMNS if k in row], *[k for k in row if k not in CURVE_COLUMNS]]
         if self.fh is None:  # a new file: header and column names appear whole, then rows are appended
             io.write_text(self.path, io.header_lines(self._head) + io.csv_row(cols))
-            self.fh = open(self.path, "a", newline="")
+            self.fh = open(self.path, "a", newline="", encoding="utf-8")
         if self.columns is None:
             if self.resume is not None:  # a partial file that had no row yet
                 self.fh.write(io.csv_row(cols))

@@ -41,6 +41,20 @@ class Checkpoint:
         kept = {self.KEY: io.dumps({"digest": self.digest, "levels": levels, "phases": list(phases)})}
         dataclasses.replace(res, params={**res.params, **kept}).save(self.path)
 
+    def stored_digest(self) -> str | None:
+        """The digest the kept file was written with (None: no file, or not a checkpoint)."""
+        import json
+
+        from tengsim.results.read import load_result
+
+        if not self.path.is_file():
+            return None
+        try:
+            _, res = load_result(self.path)
+            return str(json.loads(res.params[self.KEY])["digest"])
+        except (TengsimError, KeyError, TypeError, ValueError, OSError):
+            return None
+
     def load(self):
         """(levels, phases, result) kept by an interrupted run of this table, or None if there is none."""
         import json

@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from tengsim.kernels import film
-from tengsim.errors import ConfigValueError, TengsimError, finite, positive, shown
+from tengsim.errors import ConfigValueError, GeometryError, TengsimError, finite, positive, shown
 from tengsim.laws import LJ93, make_law
 from tengsim.continuation import PathSpec
 from tengsim.plugins import KERNELS
@@ -297,6 +297,13 @@ def _cell_area_m2(cls, p, shape, lateral) -> float:
     return getattr(shape, "cell_area", shape.cell**2) * lateral**2
 
 
+def _metres(v: float) -> str:
+    """A length in metres as the user reads it ('24 µm'): for :meth:`GeometryError.in_metres`."""
+    from tengsim.units import format_si
+
+    return format_si(v, "m")
+
+
 def plan_contact(cfg: dict) -> ContactPlan:
     """Validate a [contact] table and build its pieces (no solving)."""
     if not isinstance(cfg, dict):
@@ -354,7 +361,10 @@ def plan_contact(cfg: dict) -> ContactPlan:
         else:
             raise TengsimError(f"physical {name} input needs eps or tabor (tabor has no default in a physical run)")
         lateral = positive("lateral scale", cls.lateral_scale(p, eps))
-        shape = cls.from_si(p, eps)
+        try:
+            shape = cls.from_si(p, eps)
+        except GeometryError as exc:  # said in metres, as the sizes were given
+            raise exc.in_metres(lateral, _metres) from None
         scaling = Scaling(E, W, eps, lateral, _cell_area_m2(cls, p, shape, lateral))
         tabor = scaling.mu
         if vals["tabor"] is not None and abs(tabor - vals["tabor"]) > 1e-8 * vals["tabor"]:
@@ -386,9 +396,14 @@ def plan_contact(cfg: dict) -> ContactPlan:
     _check_maps_out(path.maps_at, cfg.get("out"))
     tol = positive("tol", vals["tol"])
     law = _build_law(law_name, {f.name: vals[f.name] for f in lfields if f.name in given})
-    grid = shape.grid(dx)  # validates dx against the cell
+    try:
+        grid = shape.grid(dx)  # validates dx against the cell
+    except GeometryError as exc:
+        raise (exc.in_metres(lateral, _metres) if lateral is not None else exc) from None
     from tengsim.resources import check_memory
 
+    if kernel_params.get("thickness") is not None:  # a film thinner than its pixel allows: refused now
+        film.check_film_pixels(kernel_params["thickness"], max(grid.dx, grid.dy), lateral)
     check_memory(grid.nx, grid.ny, vals["boundary"], vals["solver"], maps=2 * len(path.maps_at))
     resolve = _resolve(vals, given, dx if raw_dx not in (None, "") else None, scaling)
     return ContactPlan(shape, tabor, dx, path, vals["boundary"], vals["solver"], tol, law, extra, scaling,

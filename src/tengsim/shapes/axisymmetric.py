@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tengsim.errors import TengsimError, positive
+from tengsim.errors import GeometryError, TengsimError, positive
 from tengsim.grid import Grid
 from tengsim.registry import SHAPES
 from tengsim.schema import REQUIRED, Field
@@ -84,7 +84,8 @@ class Hemisphere(Shape):
         positive("cell", self.cell)
         positive("k", self.k)
         if 2 * self.radius > self.cell:
-            raise TengsimError(f"hemisphere diameter {2 * self.radius:g} exceeds its cell {self.cell:g}")
+            raise GeometryError("hemisphere diameter {diameter} exceeds its cell {cell}", diameter=2 * self.radius,
+                                cell=self.cell)
 
     @classmethod
     def lateral_scale(cls, values, eps):

@@ -5,7 +5,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tengsim.errors import TengsimError, positive
+from tengsim.errors import GeometryError, positive
 from tengsim.grid import Grid
 from tengsim.registry import SHAPES
 from tengsim.shapes.base import Shape, _length
@@ -29,8 +29,8 @@ class _FlatTop(Shape):
         positive("height", self.height)
         positive("cell", self.cell)
         if 2 * self.half_width > self.cell:
-            raise TengsimError(f"{type(self).__name__.lower()} width {2 * self.half_width:g} exceeds its cell "
-                               f"{self.cell:g}")
+            raise GeometryError(type(self).__name__.lower() + " width {width} exceeds its cell {cell}",
+                                width=2 * self.half_width, cell=self.cell)
 
     def _on_top(self, X, Y) -> np.ndarray:  # pragma: no cover - abstract
         raise NotImplementedError

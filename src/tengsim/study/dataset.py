@@ -47,7 +47,7 @@ def _read_point(sd, pid):
     f = sd.failed(pid)
     if f.exists():
         try:
-            d = json.loads(f.read_text())
+            d = json.loads(f.read_text(encoding="utf-8"))
         except (OSError, ValueError):
             d = {"message": "unreadable failure record"}
         s = d.get("seconds")
@@ -86,7 +86,7 @@ def collect(root) -> dict:
     """Per study point (in study.json order): axes, id, status, message, scalars, curves."""
     sd = StudyDir(Path(root))
     try:
-        spec = json.loads(sd.spec.read_text())
+        spec = json.loads(sd.spec.read_text(encoding="utf-8"))
     except FileNotFoundError:
         raise TengsimError(f"{root} is not a study directory (no study.json)") from None
     except (OSError, ValueError) as exc:

@@ -48,7 +48,7 @@ def run_study(study, out, *, workers=None, scheduler=None, client=None, resume=F
     say = (lambda m: None) if quiet else (lambda m: print(m, file=stream, flush=True))
     if workers is not None and scheduler is not None:
         raise TengsimError("give either --workers or --scheduler, not both")
-    valid, invalid = validate(study)
+    valid, invalid = validate(study, local=scheduler is None and client is None)
     sd = StudyDir(Path(out))
     if sd.root.exists() and not sd.root.is_dir():
         raise TengsimError(f"--out {sd.root} is a file, not a directory")

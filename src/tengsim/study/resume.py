@@ -22,7 +22,7 @@ def check_resume(study, sd: StudyDir, resume: bool) -> None:
     if not resume:
         raise TengsimError(f"{sd.root} already holds a study; add --resume to continue it, or use another --out")
     try:
-        old = json.loads(sd.spec.read_text())
+        old = json.loads(sd.spec.read_text(encoding="utf-8"))
         old_ids = {p["id"] for p in old["points"]}
         old_axes = {json.dumps(p["axes"], sort_keys=True) for p in old["points"]}
     except (OSError, ValueError, KeyError, TypeError) as exc:
@@ -96,6 +96,6 @@ def verify_points(sd: StudyDir, ids, say=None, who: str = "sweep") -> dict:
 
 
 def append_log(sd, entry):
-    with open(sd.log, "a") as fh:
+    with open(sd.log, "a", encoding="utf-8") as fh:
         fh.write(json.dumps(entry, default=str) + "\n")
         fh.flush()

@@ -25,15 +25,30 @@ def estimated_cost(plan) -> float:
         return 1.0
 
 
-def validate(study) -> tuple[dict, dict]:
+def _solver_error(name: str, seen: dict) -> str | None:
+    """The one-line error of building solver ``name`` on this machine (a 'gpu' where JAX finds none), or None;
+    each name tried once (``seen``)."""
+    if name not in seen:
+        from tengsim.solvers import make_solver
+
+        try:
+            make_solver(name)
+            seen[name] = None
+        except TengsimError as exc:
+            seen[name] = str(exc)
+    return seen[name]
+
+
+def validate(study, local: bool = False) -> tuple[dict, dict]:
     """Plan every distinct point (no solving).  Returns ({id: contact table} of the valid points,
     {id: message} of the invalid ones), the valid ones longest first (:func:`estimated_cost`).
     An error that every point shares is an error in the study file: raised as one TengsimError
-    before anything is written."""
+    before anything is written.  ``local`` (the points run on this machine): a point whose solver this
+    machine cannot build (a GPU it lacks) is invalid too, so a sweep of such points alone is refused."""
     from tengsim.run.plan import plan_contact
     from tengsim.study.observe import device_values
 
-    valid, invalid, first, cost = {}, {}, None, {}
+    valid, invalid, first, cost, solvers = {}, {}, None, {}, {}
     for p in study.points:
         device_values(p.tables["device"])  # a bad device value is a study error
         pid = p.id
@@ -48,6 +63,12 @@ def validate(study) -> tuple[dict, dict]:
             invalid[pid] = str(exc)
             if first is None:
                 first = (p, str(exc))
+            continue
+        bad = _solver_error(plan.solver, solvers) if local else None
+        if bad is not None:
+            invalid[pid] = bad
+            if first is None:
+                first = (p, bad)
             continue
         valid[pid] = p.contact
         cost[pid] = estimated_cost(plan)
