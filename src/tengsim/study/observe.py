@@ -167,7 +167,8 @@ def observe(res, device: dict, settings: dict) -> dict:
     curves["V_OC_at"] = at(settings["pressures"])
     from tengsim.device.sensor import sensor_numbers
 
-    nums = sensor_numbers(P, V, p_range=settings["fit_range"])
+    lo, hi = settings["fit_range"]  # hi: inf (the run's top), None once the settings went through JSON
+    nums = sensor_numbers(P, V, p_range=(lo, math.inf if hi is None else hi))
     f = nums.flat()
     for name, key, k in (("S_V_per_kPa", "sensitivity_V_per_Pa", 1e3), ("S_rel_per_kPa", "sensitivity_rel_per_Pa", 1e3),
                          ("S_to_Pa", "sensitivity_to_Pa", 1.0), ("knee_Pa", "knee_Pa", 1.0),
