@@ -199,7 +199,6 @@ def execute(case: str, cfg: dict, cli: dict | None = None, quiet: bool = False, 
         params, wf = designed.params, designed.waveform
     else:
         params, wf = _device_and_waveform(case, cfg, dev_cli)
-        _note_paper_device(case, cfg, dev_cli, quiet)
     from tengsim.device import simulate
     from tengsim.device.config import check_pressures
     from tengsim.io import check_writable
@@ -213,6 +212,7 @@ def execute(case: str, cfg: dict, cli: dict | None = None, quiet: bool = False, 
         wf = dataclasses.replace(wf, amplitudes_Pa=wf.amplitudes_Pa[:cycles])
         check_pressures(params.area, wf, wf.duration, _area_source(cfg, cli))
         check_writable(out)
+        _note_paper_device(case, cfg, dev_cli, quiet)  # after every check: an error stays one line
         if "area" not in cfg.get("device", {}) and "area" not in dev_cli:  # the slow engine: after every check
             params = params.replace(area=fig8_area_table(bool(run.get("quick", False))))
         res = simulate(params, wf, wf.duration, dt_out=run.get("dt_out", 1e-4), options=solver, progress=not quiet)
@@ -229,6 +229,7 @@ def execute(case: str, cfg: dict, cli: dict | None = None, quiet: bool = False, 
         if designed is not None and not quiet:  # after every check: an error stays one line
             for line in designed.lines():
                 print(f"tengsim: {line}", file=sys.stderr)
+        _note_paper_device(case, cfg, dev_cli, quiet)
         res = simulate(params, wf, t_end, dt_out=run.get("dt_out"), options=solver, progress=not quiet)
         skip = 1 if (wf.period and t_end >= 2 * wf.period - 1e-12) else 0
         if designed is not None:
@@ -368,6 +369,7 @@ def _sweep(cfg, cli, run, dev_cli, solver, out, quiet, source) -> int:
 
     check_pressures(params.area, wf, cycles * wf.period, _area_source(cfg, cli))
     check_writable(out)
+    _note_paper_device("sweep", cfg, dev_cli, quiet)
     sw = resistance_sweep(params, wf, loads, cycles=cycles, steady=sw_cfg["steady"], dt_out=run.get("dt_out"),
                           options=solver, progress=not quiet)
     from tengsim.io import jsonable
