@@ -155,8 +155,8 @@ def _saturation(x, y, span):
     p_sat = float(x[j] + min(max(t, 0.0), 1.0) * (x[j + 1] - x[j]))
     if x[-1] - p_sat >= SATURATION_MIN_WIDTH * (x[-1] - x[0]):
         return p_sat, ""
-    return math.nan, (f"V_OC does not level off by {_kpa(x[-1])}: it leaves {100 * SATURATION_BAND:g} % of its "
-                      f"full-scale change from its top value at {_kpa(p_sat)}, within the top "
+    return math.nan, (f"V_OC does not level off by {_kpa(x[-1])}: it stays within {100 * SATURATION_BAND:g} % of "
+                      f"its full-scale change of its value there only from {_kpa(p_sat)}, less than the top "
                       f"{100 * SATURATION_MIN_WIDTH:g} % of the range")
 
 
