@@ -127,6 +127,9 @@ def test_the_design_and_the_study_report_the_same_sensor_numbers(tiny, tmp_path)
         assert isinstance(v, float) or v.startswith("n/a: "), (k, v)
     report = (tmp_path / "report.md").read_text()
     assert "## As a pressure sensor" in report and f"{s['sensitivity_V_per_Pa'] * 1e3:.4g} V/kPa" in report
+    assert "| n/a |" not in report and "n/a (" in report  # every n/a of the report with its reason
+    for k, v in ds.attrs.items():
+        assert v != "n/a", k
 
 
 def test_no_second_definition_of_sensitivity_in_the_sources():

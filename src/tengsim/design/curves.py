@@ -187,8 +187,30 @@ def summarize(res, plan) -> tuple[dict, dict, list]:
         "charged_area_definition": definition(res, plan),
         "seconds": float(res.params.get("resolve_seconds", res.seconds)),
     }
+    summary["reasons"] = na_reasons(summary, numbers, plan, full)
     conv = convergence(res)
     return summary, conv, notes
+
+
+def na_reasons(summary: dict, numbers, plan, full: float) -> dict:
+    """{number: why it is n/a} for the per-design numbers that are NaN (the sensor's from its own reasons)."""
+    from tengsim.design.units import pressure_text
+
+    top = pressure_text(plan.pressures[-1])
+    why = {"jump_in_Pa": "no jump into contact on the approach (the contact grows without a snap)",
+           "full_contact_Pa": (f"A/S does not reach {FULL_CONTACT_FRACTION:g} of the footprint's by {top}"
+                               if math.isfinite(full) else "the shape has no known full-contact area"),
+           "pull_off_N": "no tensile load on the retraction", "pull_off_Pa": "no tensile load on the retraction",
+           "area_hysteresis": "the retraction reaches none of the asked pressures",
+           "area_at_p_max": f"the approach does not reach {top}", "voc_eq12_at_p_max_V": f"the approach does not "
+           f"reach {top}", "voc_eq17_at_p_max_V": f"the approach does not reach {top}",
+           **numbers.reasons}
+    out = {}
+    for k, text in why.items():
+        v = summary.get(k)
+        if isinstance(v, (int, float)) and not math.isfinite(float(v)):
+            out[k] = text
+    return out
 
 
 def physical_message(text: str, lateral: float) -> str:

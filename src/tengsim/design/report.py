@@ -22,9 +22,9 @@ ROWS = (
 )
 
 
-def value_text(v, unit: str) -> str:
+def value_text(v, unit: str, why: str = "") -> str:
     if v is None or not math.isfinite(float(v)):
-        return "n/a"
+        return f"n/a ({why})" if why else "n/a"
     v = float(v)
     if unit == "kPa":
         return f"{v / 1e3:.4g} kPa"
@@ -80,7 +80,8 @@ def report_text(result, figures) -> str:
     lines += ["", "The per-design numbers below are read from the finest grid's curves; those from A/S (full "
               "contact, sensitivity, linear range, V_OC) move as A/S does.", "",
               "## Numbers", "", "| number | value |", "|---|---|"]
-    lines += [f"| {label} | {value_text(s.get(k), u)} |" for k, label, u in ROWS]
+    why = s.get("reasons") or {}
+    lines += [f"| {label} | {value_text(s.get(k), u, why.get(k, ''))} |" for k, label, u in ROWS]
     lines += sensor_lines(s.get("sensor"))
     if result.notes:
         lines += ["", "Notes:", *[f"- {n}" for n in result.notes]]

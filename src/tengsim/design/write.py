@@ -66,10 +66,10 @@ def to_dataset(res, plan, summary: dict):
         "charged_area_definition": str(summary["charged_area_definition"]),
         "contact_config": json.dumps({k: v for k, v in plan.contact_table.items()}, sort_keys=True, default=str),
     }
-    sensor = summary.get("sensor")
+    sensor, reasons = summary.get("sensor"), summary.get("reasons") or {}
     for k, v in summary.items():
         if k in SUMMARY_UNITS and k != "tabor":
-            why = sensor.reason(k) if sensor is not None and k in NUMBERS else ""
+            why = reasons.get(k, "")
             attrs[k] = float(v) if v is not None and math.isfinite(float(v)) else f"n/a: {why}" if why else "n/a"
     if sensor is not None:
         _sensor_regions(ds, sensor)
@@ -80,6 +80,7 @@ def to_dataset(res, plan, summary: dict):
 
 
 GRID_DIM = "refinement_grid"
+CHANGE_NA = "n/a: one grid, or not present on both of the last two grids"
 REGION_DIM = "sensor_region"
 
 
@@ -129,7 +130,7 @@ def _by_grid(ds, res, plan) -> None:
                                 {"units": "J m-2", "long_name": "energy lost per cycle per unit area on each grid"})
     for label, v in convergence(res).items():
         key = "change_" + re.sub(r"[^A-Za-z0-9]+", "_", label.split("(")[0]).strip("_")  # CF: letters, digits, _
-        ds.attrs[key] = float(v) if math.isfinite(v) else "n/a"
+        ds.attrs[key] = float(v) if math.isfinite(v) else CHANGE_NA
 
 
 def csv_columns(ds) -> dict:
