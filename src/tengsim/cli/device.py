@@ -22,7 +22,8 @@ CONFIG_HELP = ("TOML or JSON file with tables [device], [waveform], [run], [solv
 DESCRIPTION = (
     "Open-circuit voltage, current and power of a contact-separation TENG (paper Section 5). "
     "Cases: fig7 and fig8 are the paper's devices, run is the [device] of --config as given, sweep is a "
-    "load-resistance sweep, design is the device a `tengsim design` result describes (--area-from DIR/design.nc). A config file (--config, or `tengsim run FILE` with [run] case = ...) may hold "
+    "load-resistance sweep, design is the device a `tengsim design` result describes (--area-from DIR/design.nc). "
+    "A config file (--config, or `tengsim run FILE` with [run] case = ...) may hold "
     "[device] (DeviceParams fields, SI or with units), [waveform] (kind and its fields; without kind it "
     "changes the case's waveform), [run] (case, out, cycles, t_end, dt_out, quick), [solver] (method, rtol, "
     "atol, max_step) and [sweep] (r_min_ohm, r_max_ohm, points, steady). Every table given is used or "

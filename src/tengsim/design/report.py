@@ -45,7 +45,8 @@ def sensor_lines(numbers) -> list:
     from tengsim.device.sensor import R2_LINEAR, SATURATION_BAND, describe
 
     return ["", "## As a pressure sensor (V_OC of Eq. 12 on the approach)", "",
-            f"Regions found from the curve (one line where it fits with R² ≥ {R2_LINEAR:g}, else split at the knee; above "
+            f"Regions found from the curve (one line where it fits with R² ≥ {R2_LINEAR:g}, else split at the knee; "
+            "above "
             f"the saturation pressure, where V_OC stays within {100 * SATURATION_BAND:g} % of its full-scale change, "
             "the saturated region); relative sensitivity = (dV_OC/dP)/V₀, V₀ = V_OC at p_min.", "",
             *describe(numbers)]

@@ -283,7 +283,8 @@ def describe(numbers: SensorNumbers) -> list:
     lines = ["| region | pressures | sensitivity | relative sensitivity | R² of its line |", "|---|---|---|---|---|"]
     for r in numbers.regions:
         rel = v(r.relative_per_Pa, 1e3, "kPa⁻¹", "sensitivity_rel_per_Pa")
-        lines.append(f"| {r.name} | {_kpa(r.p_lo_Pa)} to {_kpa(r.p_hi_Pa)} | {v(r.sensitivity_V_per_Pa, 1e3, 'V/kPa')} | "
+        slope = v(r.sensitivity_V_per_Pa, 1e3, "V/kPa")
+        lines.append(f"| {r.name} | {_kpa(r.p_lo_Pa)} to {_kpa(r.p_hi_Pa)} | {slope} | "
                      f"{rel} | {v(r.r2, 1, '') if math.isfinite(r.r2) else 'n/a (V_OC constant)'} |")
     if not numbers.regions:
         lines.append(f"| n/a ({numbers.reason('sensitivity_V_per_Pa')}) | | | | |")
