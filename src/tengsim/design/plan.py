@@ -9,7 +9,7 @@ The table holds
   :func:`tengsim.run.plan.plan_contact` (nothing is retyped here);
 * the design's own keys (:func:`design_fields`): the pressures (``p_min``, ``p_max``, ``p_step``), the device
   inputs of Eq. (12) and Eq. (17) (σ, ε_r, T, rest gap d0: the paper's values by default), the grid (``dx``
-  a length, ``max_pixels``), the convergence tolerance ``tol``, the time budget and the linear-range fit.
+  a length, ``max_pixels``), the convergence tolerance ``tol`` and the time budget.
 
 The path (D range, steps) is not the user's: :mod:`tengsim.design.run` extends it until ``p_max`` is
 reached.
