@@ -197,7 +197,7 @@ def na_reasons(summary: dict, numbers, plan, full: float) -> dict:
     from tengsim.design.units import pressure_text
 
     top = pressure_text(plan.pressures[-1])
-    why = {"jump_in_Pa": "no jump into contact on the approach (the contact grows without a snap)",
+    why = {"jump_in_Pa": "no jump into contact on the approach: the contact grows without a snap",
            "full_contact_Pa": (f"A/S does not reach {FULL_CONTACT_FRACTION:g} of the footprint's by {top}"
                                if math.isfinite(full) else "the shape has no known full-contact area"),
            "pull_off_N": "no tensile load on the retraction", "pull_off_Pa": "no tensile load on the retraction",

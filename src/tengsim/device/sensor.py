@@ -160,13 +160,14 @@ def _saturation(x, y, span):
                       f"{100 * SATURATION_MIN_WIDTH:g} % of the range")
 
 
-def _region(name, x, y, v0):
+def _region(name, x, y, v0, lo=None, hi=None):
+    """The region ``name`` fitted on the samples (x, y), spanning [lo, hi] (default its first and last sample)."""
     if len(x) >= 2:
         slope, _, r2, _ = _fit(x, y)
-    else:  # a region narrower than one sample: its chord
+    else:  # a region narrower than one sample
         slope, r2 = 0.0, math.nan
     rel = slope / v0 if v0 != 0 else math.nan
-    return Region(name, float(x[0]), float(x[-1]), slope, rel, r2)
+    return Region(name, float(x[0] if lo is None else lo), float(x[-1] if hi is None else hi), slope, rel, r2)
 
 
 def _split(x, y):
@@ -221,15 +222,16 @@ def sensor_numbers(pressure_Pa, voc_V, retraction=None, p_range=None) -> SensorN
     if not (single >= R2_LINEAR or math.isnan(single)) and xr.size >= 8:
         k = _split(xr, yr)
         knee = float(xr[k])
-        regions = [_region("below the knee", xr[:k + 1], yr[:k + 1], v0), _region("above the knee", xr[k:], yr[k:], v0)]
+        regions = [_region("below the knee", xr[:k + 1], yr[:k + 1], v0),
+                   _region("above the knee", xr[k:], yr[k:], v0, hi=p_sat if math.isfinite(p_sat) else None)]
     else:
-        regions = [_region(top, xr, yr, v0)]
+        regions = [_region(top, xr, yr, v0, hi=p_sat if math.isfinite(p_sat) else None)]
         reasons["knee_Pa"] = (f"one line fits V_OC from {_kpa(lo)} to {_kpa(float(xr[-1]))} with R² = {single:.4g} "
-                              f">= {R2_LINEAR:g}: no knee") if single >= R2_LINEAR else \
+                              f"≥ {R2_LINEAR:g}: no knee") if single >= R2_LINEAR else \
             f"V_OC is constant from {_kpa(lo)} to {_kpa(float(xr[-1]))}: no knee"
         reasons["sensitivity_above_knee_V_per_Pa"] = reasons["knee_Pa"]
     if math.isfinite(p_sat):
-        regions.append(_region("saturated", x[x >= p_sat], y[x >= p_sat], v0))
+        regions.append(_region("saturated", x[x >= p_sat], y[x >= p_sat], v0, lo=p_sat))
     if v0 == 0:
         reasons["sensitivity_rel_per_Pa"] = f"V_OC is 0 at {_kpa(lo)}: no baseline V0 to divide by"
     lin, r2_lin = _linear_range(x[x <= regions[0].p_hi_Pa], y[x <= regions[0].p_hi_Pa], reasons)
