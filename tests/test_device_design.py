@@ -150,7 +150,10 @@ def test_device_takes_a_load_controlled_contact_result_with_its_snap(tmp_path, c
             first[pi] = li ** 2 / res.params["cell_area_m2"]
     np.testing.assert_allclose(t.area_fraction, list(first.values()), rtol=1e-12)
     out = tmp_path / "dev.csv"
-    cap = _run(["device", "fig7", "--area-from", str(run), "--cycles", "2", "--dt", "1e-3", "--out", str(out)], capsys)
+    wave = tmp_path / "wave.toml"  # inside the table's pressures (Fig. 7's 2.58 kPa lies below its first state)
+    wave.write_text(f'[waveform]\namplitude_Pa = {float(t.pressure_Pa[-1])}\n')
+    cap = _run(["device", "fig7", "--area-from", str(run), "--config", str(wave), "--cycles", "2", "--dt", "1e-3",
+                "--out", str(out)], capsys)
     side = json.loads(out.with_suffix(".json").read_text())
     np.testing.assert_allclose(side["params"]["area"]["pressure_Pa"], t.pressure_Pa)
     assert "power: peak" in cap.out
@@ -159,7 +162,8 @@ def test_device_takes_a_load_controlled_contact_result_with_its_snap(tmp_path, c
 def test_a_relative_area_path_is_read_beside_the_config(tmp_path, capsys, monkeypatch):
     design_file(tmp_path / "proj" / "d1")
     cfg = tmp_path / "proj" / "dev.toml"
-    cfg.write_text('[device]\narea = "d1/design.nc"\n[run]\ncycles = 2\ndt_out = 1e-3\n')
+    cfg.write_text('[device]\narea = "d1/design.nc"\n[waveform]\namplitude_Pa = "10kPa"\n[run]\ncycles = 2\n'
+                   'dt_out = 1e-3\n')
     monkeypatch.chdir(tmp_path)  # not the config's folder
     out = tmp_path / "r.csv"
     _run(["device", "fig7", "--config", str(cfg), "--out", str(out), "--quiet"], capsys)

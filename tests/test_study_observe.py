@@ -43,12 +43,16 @@ def settings(**kw):
 def test_linear_response_gives_exact_sensitivity_and_full_linear_range():
     P = np.linspace(0, 50e3, 51)
     A = 0.05 + 2e-6 * P  # A/S rises 0.002 per kPa
-    o = observe(synthetic(P, A), DEVICE, settings(fit_range=["0kPa", "10kPa"]))
+    o = observe(synthetic(P, A), DEVICE, settings())
     s, c = o["scalars"], o["curves"]
     assert s["S_V_per_kPa"] == pytest.approx(K_V * 2e-3, rel=1e-9)
-    assert s["linear_range_Pa"] == pytest.approx(50e3)
+    assert s["S_rel_per_kPa"] == pytest.approx(2e-3 / 0.05, rel=1e-9)  # (dV/dP)/V0, V0 at 0 kPa
+    assert s["linear_range_Pa"] == pytest.approx(50e3) and s["linear_R2"] == pytest.approx(1.0)
     assert s["V_sat"] == pytest.approx(K_V * A[-1])
-    assert s["P_sat_Pa"] == pytest.approx((0.9 * A[-1] - 0.05) / 2e-6, rel=1e-9)
+    assert math.isnan(s["P_sat_Pa"]) and math.isnan(s["knee_Pa"])  # a line neither saturates nor bends
+    # read over a range of its own: the same line
+    s10 = observe(synthetic(P, A), DEVICE, settings(fit_range=["0kPa", "10kPa"]))["scalars"]
+    assert s10["S_V_per_kPa"] == pytest.approx(K_V * 2e-3, rel=1e-9) and s10["linear_range_Pa"] == pytest.approx(1e4)
     assert s["area_fraction_0"] == pytest.approx(0.05)
     want = (K_V * (0.05 + 2e-6 * np.array([1e3, 1e4]))).tolist() + [math.nan]  # 100 kPa: beyond the run
     assert c["V_OC_at"].tolist() == pytest.approx(want, nan_ok=True)
@@ -62,12 +66,13 @@ def test_saturating_response_ends_linear_range_where_it_bends():
     P = np.linspace(0, 150e3, 301)
     A = np.minimum(0.02 + 4e-6 * P, 0.5)  # linear up to 120 kPa, then flat
     s = observe(synthetic(P, A), DEVICE, settings())["scalars"]
-    assert s["S_V_per_kPa"] == pytest.approx(K_V * 4e-3, rel=1e-9)
-    # flat beyond 120 kPa: V/fit = 0.5/(0.02 + 4e-6 P) drops below 0.9 at P = (0.5/0.9 - 0.02)/4e-6
-    p_end = (0.5 / 0.9 - 0.02) / 4e-6
-    assert p_end - 500 <= s["linear_range_Pa"] <= p_end
+    assert s["S_V_per_kPa"] == pytest.approx(K_V * 4e-3, rel=1e-9)  # the rising region, up to saturation
+    # saturated from where A/S is within 2 % of its full-scale change (0.48) of 0.5: 0.5 - 0.0096
+    p_sat = (0.5 - 0.02 * 0.48 - 0.02) / 4e-6
+    assert s["P_sat_Pa"] == pytest.approx(p_sat, abs=150e3 / 400)
+    assert s["S_to_Pa"] == pytest.approx(p_sat, abs=150e3 / 400)
+    assert s["linear_range_Pa"] == pytest.approx(s["S_to_Pa"], abs=150e3 / 400) and s["linear_R2"] >= 0.99
     assert s["V_sat"] == pytest.approx(K_V * 0.5)
-    assert s["P_sat_Pa"] == pytest.approx((0.45 - 0.02) / 4e-6, rel=1e-9)
 
 
 def test_load_control_skips_states_where_force_falls_back():
@@ -92,7 +97,7 @@ def test_pull_off_and_hysteresis_in_physical_units():
 def test_dimensionless_run_has_no_pressure_observables():
     P = np.linspace(0, 20e3, 11)
     s = observe(synthetic(P, 0.1 + 1e-6 * P, physical=False), DEVICE, settings())
-    for k in ("pull_off_Pa", "S_V_per_kPa", "linear_range_Pa", "V_sat", "P_sat_Pa", "hysteresis_J_m2"):
+    for k in ("pull_off_Pa", "S_V_per_kPa", "S_rel_per_kPa", "linear_range_Pa", "V_sat", "hysteresis_J_m2"):
         assert math.isnan(s["scalars"][k]), k
     assert not math.isnan(s["scalars"]["pull_off_F"]) and not math.isnan(s["scalars"]["area_fraction_0"])
     assert np.all(np.isnan(s["curves"]["V_OC"]))

@@ -373,7 +373,7 @@ PHYSICAL = {
 SLOW_SHAPES = {"topography", "cone", "hemisphere", "flat_punch", "cube", "sinusoid"}
 """Shapes run only in the slow suite (each ~1 s; the topography imports SurfaceTopography, ~2 s): the
 default suite keeps a square, a disc, a line and the array."""
-FILLED = ("pull_off_F", "pull_off_Pa", "area_fraction_0", "S_V_per_kPa", "linear_range_Pa", "V_sat", "P_sat_Pa",
+FILLED = ("pull_off_F", "pull_off_Pa", "area_fraction_0", "S_V_per_kPa", "S_to_Pa", "V_sat",
           "hysteresis", "hysteresis_J_m2", "V_OC_1kPa", "V_OC_10kPa", "V_OC_100kPa")
 """Columns every shape fills in a physical study that reaches 100 kPa."""
 MAY_BE_EMPTY = {
@@ -381,6 +381,13 @@ MAY_BE_EMPTY = {
     "jump_out_D": "no jump-out on the retraction",
     "transition_D": "no known full-contact length for the shape (observe.full_length)",
     "adhesive_full_contact": "no known full-contact length for the shape (observe.full_length)",
+    # the sensor's numbers (tengsim.device.sensor), each NaN with its reason there
+    "knee_Pa": "one line fits V_OC(P) below the saturation (R2 >= 0.99): no knee",
+    "S_above_knee_V_per_kPa": "no knee",
+    "P_sat_Pa": "V_OC does not level off within the range",
+    "S_rel_per_kPa": "V_OC is 0 at the lowest pressure: no baseline V0",
+    "linear_range_Pa": "no line from the lowest pressure fits with R2 >= 0.99 (the reason in the message)",
+    "linear_R2": "as linear_range_Pa",
 }
 """Columns that may be empty, each with its documented reason."""
 

@@ -1,4 +1,5 @@
-"""``tengsim device``: the paper's dynamic cases (fig7, fig8), any configured device (run), load sweep.
+"""``tengsim device``: the paper's dynamic cases (fig7, fig8), any configured device (run), load sweep, the device
+a design describes (design).
 
 A thin shell: the config tables are read by :func:`tengsim.schema.read_config` and typed by the schema
 of :mod:`tengsim.device.config`; the paper's devices come from :mod:`tengsim.cases.paper`.
@@ -21,12 +22,13 @@ CONFIG_HELP = ("TOML or JSON file with tables [device], [waveform], [run], [solv
 DESCRIPTION = (
     "Open-circuit voltage, current and power of a contact-separation TENG (paper Section 5). "
     "Cases: fig7 and fig8 are the paper's devices, run is the [device] of --config as given, sweep is a "
-    "load-resistance sweep. A config file (--config, or `tengsim run FILE` with [run] case = ...) may hold "
+    "load-resistance sweep, design is the device a `tengsim design` result describes (--area-from DIR/design.nc). "
+    "A config file (--config, or `tengsim run FILE` with [run] case = ...) may hold "
     "[device] (DeviceParams fields, SI or with units), [waveform] (kind and its fields; without kind it "
     "changes the case's waveform), [run] (case, out, cycles, t_end, dt_out, quick), [solver] (method, rtol, "
     "atol, max_step) and [sweep] (r_min_ohm, r_max_ohm, points, steady). Every table given is used or "
     "refused by name; `tengsim device fields` lists every key with its unit and default. " + PRECEDENCE)
-DEFAULT_CYCLES = {"fig7": 5, "run": 5, "sweep": 3}
+DEFAULT_CYCLES = {"fig7": 5, "run": 5, "sweep": 3, "design": 5}
 MAX_SWEEP_POINTS = 10_000
 """The most loads one sweep may hold (each is a multi-cycle device run)."""
 
@@ -35,7 +37,15 @@ _OPTIONS = {"out": ("run", "out"), "cycles": ("run", "cycles"), "t_end": ("run",
             "quick": ("run", "quick"), "load_ohm": ("device", "load_ohm"), "damping": ("device", "damping_ratio"),
             "force_model": ("device", "force_model"), "initial_charge": ("device", "initial_charge"),
             "r_min": ("sweep", "r_min_ohm"), "r_max": ("sweep", "r_max_ohm"), "points": ("sweep", "points"),
-            "area_from": ("device", "area")}
+            "area_from": ("device", "area"), "mass": ("device", "mass_kg"),
+            "stiffness": ("device", "stiffness_N_per_m"), "electrode_area": ("device", "area_m2"),
+            "pressure": ("waveform", "amplitude_Pa"), "frequency": ("waveform", "frequency_Hz")}
+DESIGN_HELP = ("The device a design describes, in one step: `tengsim device design --area-from d1/design.nc "
+               "--out dev.csv`. From the design it takes σ, ε_r, T, the rest gap d0 and A/S(P) (approach); what the "
+               "design does not know (mass, stiffness, electrode area, load, waveform) comes from the options, the "
+               "config's [device] and [waveform], or the paper's Fig. 8 device, and the run says which values were "
+               "defaults. The waveform (default: a 2 Hz square wave pressing to the design's p_max) must stay inside "
+               "the design's pressures. " + CONFIG_HELP)
 AREA_FROM_HELP = ("charged-area model from a result on file: a design result DIR/design.nc (or DIR) of "
                   "`tengsim design`, or a physical load-controlled `tengsim contact` result (.nc/.csv); the "
                   "approach branch (overrides [device] area)")
@@ -85,6 +95,17 @@ def register(subparsers) -> None:
     sw.add_argument("--r-max", help="largest load in ohm or with a unit (overrides [sweep] r_max_ohm; default 1e10)")
     sw.add_argument("--points", help="loads, log-spaced (overrides [sweep] points; default 15)")
     sw.set_defaults(func=lambda a: execute("sweep", _read(a.config), _cli(a), a.quiet, a.config))
+    dz = sub.add_parser("design", help="the device a design describes (σ, ε_r, T, rest gap, A/S(P) from "
+                        "--area-from DIR/design.nc)", description=DESIGN_HELP)
+    common(dz, 5)
+    dz.add_argument("--t-end", help="run length in s or with a unit (overrides [run] t_end; default cycles x period)")
+    dz.add_argument("--pressure", help="pressure while pressed, e.g. 20kPa (default: the design's p_max); inside the "
+                                       "design's pressures")
+    dz.add_argument("--frequency", help="square-wave frequency, e.g. 2Hz (default 2 Hz, the paper's Fig. 8)")
+    dz.add_argument("--mass", help="moving plate mass, e.g. 13.45g (default: the paper's Fig. 8 device, 13.45 g)")
+    dz.add_argument("--stiffness", help="spring stiffness, e.g. 5.12kN/m (default 5.12 kN/m, Fig. 8)")
+    dz.add_argument("--electrode-area", help="electrode area S in m2, plain number (default 4e-4, Fig. 8's 4 cm²)")
+    dz.set_defaults(func=lambda a: execute("design", _read(a.config), _cli(a), a.quiet, a.config))
     fl = sub.add_parser("fields", help="list every config table and key (from the dataclasses)")
     fl.set_defaults(func=_cmd_fields)
 
@@ -112,6 +133,10 @@ def _cli(args) -> dict:
 def _typed_cli(table, values: dict) -> dict:
     """CLI values typed by the table's own fields; an error names the option (--load-ohm, not load_ohm)."""
     names = {key: "--" + opt.replace("_", "-") for opt, (_, key) in _OPTIONS.items()}
+    if table is None:  # --pressure, --frequency: the square wave's fields
+        from tengsim.device.config import waveform_table
+
+        table = waveform_table("square")
     out = {}
     for key, raw in values.items():
         if key == "area":  # --area-from: always a file (a design or contact result), never a number
@@ -217,8 +242,14 @@ def execute(case: str, cfg: dict, cli: dict | None = None, quiet: bool = False, 
     _warn_unconverged(cfg, cli, quiet)
     if case == "sweep":
         return _sweep(cfg, cli, run, dev_cli, solver, out, quiet, source)
-    params, wf = _device_and_waveform(case, cfg, dev_cli)
+    designed = None
+    if case == "design":
+        designed = _designed(cfg, cli, dev_cli)
+        params, wf = designed.params, designed.waveform
+    else:
+        params, wf = _device_and_waveform(case, cfg, dev_cli)
     from tengsim.device import simulate
+    from tengsim.device.config import check_pressures
 
     if case == "fig8":
         from tengsim.cases.paper import fig8_area_table, fig8_summary
@@ -227,6 +258,8 @@ def execute(case: str, cfg: dict, cli: dict | None = None, quiet: bool = False, 
         cycles = run.get("cycles", n)
         require(cycles <= n, f"cycles = {cycles} but the staircase has {n} steps (give at most {n})")
         wf = dataclasses.replace(wf, amplitudes_Pa=wf.amplitudes_Pa[:cycles])
+        check_pressures(params.area, wf, wf.duration, _area_source(cfg, cli))
+        _note_paper_device(case, cfg, dev_cli, quiet)  # after every check: an error stays one line
         if "area" not in cfg.get("device", {}) and "area" not in dev_cli:  # the slow engine: after every check
             params = params.replace(area=fig8_area_table(bool(run.get("quick", False))))
         res = simulate(params, wf, wf.duration, dt_out=run.get("dt_out", 1e-4), options=solver, progress=not quiet)
@@ -237,9 +270,21 @@ def execute(case: str, cfg: dict, cli: dict | None = None, quiet: bool = False, 
             per = wf.period or wf.duration
             require(per is not None, "give --t-end (or [run] t_end) for a waveform with no period")
             t_end = run.get("cycles", DEFAULT_CYCLES[case]) * per
+        check_pressures(params.area, wf, t_end, _area_source(cfg, cli),
+                        " (--pressure)" if designed is not None else "")
+        if designed is not None and not quiet:  # after every check: an error stays one line
+            for line in designed.lines():
+                print(f"tengsim: {line}", file=sys.stderr)
+        _note_paper_device(case, cfg, dev_cli, quiet)
         res = simulate(params, wf, t_end, dt_out=run.get("dt_out"), options=solver, progress=not quiet)
         skip = 1 if (wf.period and t_end >= 2 * wf.period - 1e-12) else 0
-        if case == "fig7":
+        if designed is not None:
+            from tengsim.design.device import rest_gap_voltage
+            from tengsim.io import jsonable
+
+            summary = jsonable({**res.summary(skip), **rest_gap_voltage(designed, res),
+                                "designed_device": designed.provenance()})
+        elif case == "fig7":
             from tengsim.cases.paper import fig7_summary
 
             summary = fig7_summary(res, skip)
@@ -279,6 +324,40 @@ def _device_and_waveform(case, cfg, dev_cli):
     if case == "sweep":
         require(getattr(wf, "period", None) is not None, "a load sweep needs a periodic waveform")
     return params, wf
+
+
+def _area_source(cfg, cli) -> str:
+    """Where a run's area table came from, for its errors."""
+    raw = (cli or {}).get("device", {}).get("area") or (cfg.get("device") or {}).get("area")
+    return f"A/S(P) from {raw}" if isinstance(raw, str) else "the [device] area table"
+
+
+def _designed(cfg, cli, dev_cli):
+    """The designed device (:func:`tengsim.design.device.designed_device`) of ``device design``."""
+    from tengsim.design.device import designed_device
+    from tengsim.device import config as dc
+
+    raw = cli.get("device", {}).get("area") or (cfg.get("device") or {}).get("area")
+    require(isinstance(raw, str), "device design needs a design result: give --area-from DIR/design.nc (or [device] "
+                                  "area = 'DIR/design.nc')")
+    dev = {**dc.DEVICE_TABLE.parse({k: v for k, v in (cfg.get("device") or {}).items() if k != "area"},
+                                   defaults=False), **{k: v for k, v in dev_cli.items() if k != "area"}}
+    for opt in ("mass", "stiffness", "electrode_area"):
+        key = _OPTIONS[opt][1]
+        if key in dev_cli and not dev_cli[key] > 0:
+            raise TengsimError(f"--{opt.replace('_', '-')} must be > 0, got {cli['device'][key]!r}")
+    wcli = _typed_cli(None, cli.get("waveform", {}))
+    return designed_device(raw, dev, cfg.get("waveform"), wcli.get("amplitude_Pa"), wcli.get("frequency_Hz"))
+
+
+def _note_paper_device(case, cfg, dev_cli, quiet):
+    """fig7/fig8/sweep with a design's area: the paper's device with the design's A/S, said once."""
+    raw = (cfg.get("device") or {}).get("area")
+    if quiet or case not in ("fig7", "fig8", "sweep") or not ("area" in dev_cli or isinstance(raw, str)):
+        return
+    print(f"tengsim: note: {case} is the paper's device (its σ, ε_r, T, rest gap, mass, spring and waveform) with "
+          "this A/S(P); `tengsim device design --area-from DIR/design.nc` runs the device the design describes",
+          file=sys.stderr)
 
 
 def _write(result, out: Path, summary: dict, quiet: bool, provenance: dict) -> int:
@@ -334,6 +413,10 @@ def _sweep(cfg, cli, run, dev_cli, solver, out, quiet, source) -> int:
     require(cycles >= 2, f"cycles must be >= 2 for a sweep (the first is dropped), got {cycles!r}")
     params, wf = _device_and_waveform("sweep", cfg, dev_cli)
     loads = np.logspace(np.log10(r_min), np.log10(r_max), points)
+    from tengsim.device.config import check_pressures
+
+    check_pressures(params.area, wf, cycles * wf.period, _area_source(cfg, cli))
+    _note_paper_device("sweep", cfg, dev_cli, quiet)
     sw = resistance_sweep(params, wf, loads, cycles=cycles, steady=sw_cfg["steady"], dt_out=run.get("dt_out"),
                           options=solver, progress=not quiet)
     from tengsim.io import jsonable

@@ -6,7 +6,7 @@ Only points whose run status is ok are candidates unless --accept names another 
 (DIR/optimum.json) gives the status of the optimum and of its nearest evaluated neighbours.
 Exit code 0 with a candidate optimum, 1 when no evaluated point is one.
 The study file's [objective] names the observable (maximize = "S_V_per_kPa") and optional bounds on
-others (subject_to = { P_sat_Pa = { min = 1e5 } }); see docs/design.md.
+others (subject_to = { linear_range_Pa = { min = 1e4 } }); see docs/design.md.
 """
 from __future__ import annotations
 

@@ -6,7 +6,10 @@ from pathlib import Path
 import numpy as np
 
 COLUMNS = ("status", "tabor", "jump_in_Pa", "pull_off_N", "pull_off_Pa", "full_contact_Pa",
-           "sensitivity_V_per_Pa", "linear_range_Pa", "hysteresis_J_m2", "area_at_p_max", "voc_eq12_at_p_max_V",
+           "sensitivity_V_per_Pa", "sensitivity_to_Pa", "sensitivity_rel_per_Pa", "knee_Pa",
+           "sensitivity_above_knee_V_per_Pa", "saturation_Pa", "linear_range_Pa", "linear_r2",
+           "voc_hysteresis_fraction",
+           "hysteresis_J_m2", "area_at_p_max", "voc_eq12_at_p_max_V",
            "voc_eq17_at_p_max_V", "grids", "tolerance")
 
 

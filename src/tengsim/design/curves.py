@@ -15,11 +15,10 @@ a round patch (cone, hemisphere, sphere, flat punch) the disc π/4 Λc², a ridg
 **Per design** (:func:`summarize`): jump-in pressure (the nominal pressure on the approach just before it
 first jumps into contact; negative: tensile), pull-off (the most tensile load of the retraction, in N per cell
 and Pa), full-contact pressure (the lowest approach pressure at which A/S reaches 95 % of its full-contact
-value, the footprint's), sensitivity and linear range (V_OC of Eq. 12 on the approach: least-squares line over
-[p_min, fit_max]; the linear range is the highest asked pressure up to which V_OC stays within 10 % of that
-line's value, or of its rise over [p_min, fit_max] where that is larger), hysteresis (the energy lost per cycle
-∮F dD per unit nominal area, J/m², and the largest difference of
-A/S between retraction and approach at an asked pressure).
+value, the footprint's), the sensor's numbers of V_OC (Eq. 12) over [p_min, p_max]: sensitivity per pressure
+region, knee, saturation pressure, linear range with its R², hysteresis of V_OC (:mod:`tengsim.device.sensor`,
+the one definition), and the energy lost per cycle ∮F dD per unit nominal area (J/m²) and the largest
+difference of A/S between retraction and approach at an asked pressure.
 """
 from __future__ import annotations
 
@@ -27,7 +26,6 @@ import math
 
 import numpy as np
 
-LINEAR_TOLERANCE = 0.1
 FULL_CONTACT_FRACTION = 0.95
 
 DEFINITIONS = {
@@ -120,22 +118,19 @@ def _full_fraction(res, plan) -> float:
     return float(area_fraction(res, [full], _params(res, plan))[0])
 
 
-def _linear(ps, V, fit_max):
-    """(slope V/Pa, linear range Pa) of V_OC(P) on the approach (module doc)."""
-    ps, V = np.asarray(ps, float), np.asarray(V, float)
-    ok = np.isfinite(V)
-    fit = ok & (ps <= fit_max * (1 + 1e-12))
-    if np.count_nonzero(fit) < 2:
-        return math.nan, math.nan
-    slope, icpt = np.polyfit(ps[fit], V[fit], 1)
-    line = icpt + slope * ps
-    rise = abs(slope) * (fit_max - ps[0])  # near P = 0 the line's own value is no scale: its rise over the fit
-    last = math.nan
-    for p, v, y, good in zip(ps, V, line, ok):
-        if not good or abs(v - y) > LINEAR_TOLERANCE * max(abs(y), rise, 1e-12):
-            break
-        last = float(p)
-    return float(slope), last
+def sensor(res, plan):
+    """The sensor's numbers (:func:`tengsim.device.sensor.sensor_numbers`) of V_OC (Eq. 12) on the load-controlled
+    approach states over [p_min, p_max], the retraction's for the hysteresis."""
+    from tengsim.device.formulas import voc_polymer
+    from tengsim.device.sensor import sensor_numbers
+
+    st = states(res, plan)
+
+    def voc(b):
+        return voc_polymer(np.clip(st[b]["area"], 0.0, 1.0), plan.sigma, plan.eps_r, plan.T)
+
+    return sensor_numbers(st["approach"]["P"], voc("approach"), (st["retraction"]["P"], voc("retraction")),
+                          (plan.pressures[0], plan.pressures[-1]))
 
 
 def _grids_text(res) -> str:
@@ -169,7 +164,7 @@ def summarize(res, plan) -> tuple[dict, dict, list]:
         else:
             notes.append(f"full contact (A/S >= {FULL_CONTACT_FRACTION:g} × {full:.3g}) is not reached by "
                          f"{pressure_text(plan.pressures[-1])}")
-    slope, lin = _linear(plan.pressures, app["voc_eq12"], plan.fit_max)
+    numbers = sensor(res, plan)
     diff = ret["area"] - app["area"]
     loop = res.loop_energy  # 0 where within its uncertainty, never a negative energy of quadrature error
     summary = {
@@ -179,8 +174,8 @@ def summarize(res, plan) -> tuple[dict, dict, list]:
         "pull_off_N": sc.force(res.pull_off_force),
         "pull_off_Pa": k_p * res.pull_off_force,
         "full_contact_Pa": full_P,
-        "sensitivity_V_per_Pa": slope,
-        "linear_range_Pa": lin,
+        **numbers.flat(),
+        "sensor": numbers,
         "hysteresis_J_m2": sc.work(loop.value) / sc.cell_area,
         "hysteresis_bound_J_m2": sc.work(loop.bound) / sc.cell_area,
         "area_hysteresis": float(np.nanmax(np.abs(diff))) if np.any(np.isfinite(diff)) else math.nan,
@@ -192,8 +187,30 @@ def summarize(res, plan) -> tuple[dict, dict, list]:
         "charged_area_definition": definition(res, plan),
         "seconds": float(res.params.get("resolve_seconds", res.seconds)),
     }
+    summary["reasons"] = na_reasons(summary, numbers, plan, full)
     conv = convergence(res)
     return summary, conv, notes
+
+
+def na_reasons(summary: dict, numbers, plan, full: float) -> dict:
+    """{number: why it is n/a} for the per-design numbers that are NaN (the sensor's from its own reasons)."""
+    from tengsim.design.units import pressure_text
+
+    top = pressure_text(plan.pressures[-1])
+    why = {"jump_in_Pa": "no jump into contact on the approach: the contact grows without a snap",
+           "full_contact_Pa": (f"A/S does not reach {FULL_CONTACT_FRACTION:g} of the footprint's by {top}"
+                               if math.isfinite(full) else "the shape has no known full-contact area"),
+           "pull_off_N": "no tensile load on the retraction", "pull_off_Pa": "no tensile load on the retraction",
+           "area_hysteresis": "the retraction reaches none of the asked pressures",
+           "area_at_p_max": f"the approach does not reach {top}", "voc_eq12_at_p_max_V": f"the approach does not "
+           f"reach {top}", "voc_eq17_at_p_max_V": f"the approach does not reach {top}",
+           **numbers.reasons}
+    out = {}
+    for k, text in why.items():
+        v = summary.get(k)
+        if isinstance(v, (int, float)) and not math.isfinite(float(v)):
+            out[k] = text
+    return out
 
 
 def physical_message(text: str, lateral: float) -> str:

@@ -9,7 +9,7 @@ The table holds
   :func:`tengsim.run.plan.plan_contact` (nothing is retyped here);
 * the design's own keys (:func:`design_fields`): the pressures (``p_min``, ``p_max``, ``p_step``), the device
   inputs of Eq. (12) and Eq. (17) (σ, ε_r, T, rest gap d0: the paper's values by default), the grid (``dx``
-  a length, ``max_pixels``), the convergence tolerance ``tol``, the time budget and the linear-range fit.
+  a length, ``max_pixels``), the convergence tolerance ``tol`` and the time budget.
 
 The path (D range, steps) is not the user's: :mod:`tengsim.design.run` extends it until ``p_max`` is
 reached.
@@ -71,8 +71,6 @@ def design_fields() -> list:
               "in seconds or with a unit, e.g. 600 or '600s' (default 600 s)"),
         Field("maps", "bool", True, help="keep contact pressure maps near 10 %, 50 % and 100 % of p_max (kept "
               "during the finest grid's walk, at the depths the grid before it predicts); false: none"),
-        Field("fit_max", default=None, dim="pressure", help="top of the low-pressure range of the linear fit "
-              "of V_OC(P) (default p_min + (p_max - p_min)/10)"),
     ]
 
 
@@ -96,7 +94,6 @@ class DesignPlan:
     dx: float | None
     max_pixels: int | None
     budget_s: float
-    fit_max: float
     E_star: float
     W: float
     eps: float
@@ -218,17 +215,13 @@ def plan_design(table: dict, where: str = "") -> DesignPlan:
         raise ConfigValueError(f"{where}max_pixels must be >= 9, got {table.get('max_pixels')!r}")
     if not own["budget"] > 0:
         raise ConfigValueError(f"{where}budget must be a time > 0, got {table.get('budget')!r}")
-    lo, hi = pressures[0], pressures[-1]
-    fit_max = own["fit_max"] if own["fit_max"] is not None else lo + (hi - lo) / 10
-    if not lo < fit_max <= hi:
-        raise ConfigValueError(f"{where}fit_max must lie above p_min and at most p_max, got {table.get('fit_max')!r}")
     sp = _shape_params(shape, plan.extra)
     sc = plan.scaling
-    draft = DesignPlan("", shape, {}, sp, (), 0, 0, 0, 0, 0, None, None, 0, 0, 0, 0, 0, 0)
+    draft = DesignPlan("", shape, {}, sp, (), 0, 0, 0, 0, 0, None, None, 0, 0, 0, 0, 0)
     name = own["name"] or f"{shape} {draft.shape_text()}"
     return DesignPlan(name=name, shape=shape, contact_table=cfg, shape_params=sp, pressures=pressures,
                       sigma=own["sigma"], eps_r=own["eps_r"], T=own["T"], gap=own["gap"], tol=tol, dx=own["dx"],
-                      max_pixels=own["max_pixels"], budget_s=own["budget"], fit_max=fit_max, E_star=sc.E_star,
+                      max_pixels=own["max_pixels"], budget_s=own["budget"], E_star=sc.E_star,
                       W=sc.W, eps=sc.eps, tabor=sc.mu, maps=bool(own["maps"]), contact_plan=plan)
 
 

@@ -10,9 +10,6 @@ ROWS = (
     ("pull_off_N", "pull-off force per cell (most tensile load on the retraction)", "N"),
     ("pull_off_Pa", "pull-off pressure", "kPa"),
     ("full_contact_Pa", "full-contact pressure (A/S reaches 95 % of the footprint's)", "kPa"),
-    ("sensitivity_V_per_Pa", "sensitivity dV_OC/dP (Eq. 12, least-squares line over [p_min, fit_max])", "V/kPa"),
-    ("linear_range_Pa", "linear range (V_OC within 10 % of that line, or of its rise over the fit range, up to)",
-     "kPa"),
     ("hysteresis_J_m2", "hysteresis: energy lost per cycle per unit nominal area (∮F dD over the D range both "
                         "branches cover; 0 where within its uncertainty below)", "J/m²"),
     ("hysteresis_bound_J_m2", "hysteresis uncertainty (± : quadrature rule change, solver residual, jump location)",
@@ -25,9 +22,9 @@ ROWS = (
 )
 
 
-def value_text(v, unit: str) -> str:
+def value_text(v, unit: str, why: str = "") -> str:
     if v is None or not math.isfinite(float(v)):
-        return "n/a"
+        return f"n/a ({why})" if why else "n/a"
     v = float(v)
     if unit == "kPa":
         return f"{v / 1e3:.4g} kPa"
@@ -38,6 +35,21 @@ def value_text(v, unit: str) -> str:
 
 def _pct(x) -> str:
     return "n/a (one grid, or not present on both)" if not math.isfinite(x) else f"{100 * x:.2g} %"
+
+
+def sensor_lines(numbers) -> list:
+    """The '## As a pressure sensor' section: V_OC (Eq. 12) per pressure region, knee, saturation, linear range
+    and hysteresis (:mod:`tengsim.device.sensor`), every n/a with its reason."""
+    if numbers is None:
+        return []
+    from tengsim.device.sensor import R2_LINEAR, SATURATION_BAND, describe
+
+    return ["", "## As a pressure sensor (V_OC of Eq. 12 on the approach)", "",
+            f"Regions found from the curve (one line where it fits with R² ≥ {R2_LINEAR:g}, else split at the knee; "
+            "above "
+            f"the saturation pressure, where V_OC stays within {100 * SATURATION_BAND:g} % of its full-scale change, "
+            "the saturated region); relative sensitivity = (dV_OC/dP)/V₀, V₀ = V_OC at p_min.", "",
+            *describe(numbers)]
 
 
 def report_text(result, figures) -> str:
@@ -69,7 +81,9 @@ def report_text(result, figures) -> str:
     lines += ["", "The per-design numbers below are read from the finest grid's curves; those from A/S (full "
               "contact, sensitivity, linear range, V_OC) move as A/S does.", "",
               "## Numbers", "", "| number | value |", "|---|---|"]
-    lines += [f"| {label} | {value_text(s.get(k), u)} |" for k, label, u in ROWS]
+    why = s.get("reasons") or {}
+    lines += [f"| {label} | {value_text(s.get(k), u, why.get(k, ''))} |" for k, label, u in ROWS]
+    lines += sensor_lines(s.get("sensor"))
     if result.notes:
         lines += ["", "Notes:", *[f"- {n}" for n in result.notes]]
     lines += ["", "## Figures", ""] + [f"![{f}]({f})" for f in figures]

@@ -17,6 +17,8 @@ from pathlib import Path
 
 import numpy as np
 
+from tengsim.device.sensor import NUMBERS
+
 BRANCHES = ("approach", "retraction")
 PRESSURE_DIM = "applied_pressure"
 """The dimension the coordinate ``pressure`` runs along: CF takes a dimension named 'pressure' for air pressure
@@ -27,15 +29,16 @@ VARIABLES = {
     "repulsive_area_fraction": ("1", "repulsive contact area (P > 0) over cell area"),
     "voc_eq12": ("V", "open-circuit voltage of the polymer, Eq. 12: sigma (A/S) T / (eps_r eps0)"),
     "voc_eq17": ("V", "open-circuit voltage at the rest gap, Eq. 17: sigma (A/S) d0 / eps0"),
-    "dvoc_dp": ("V Pa-1", "sensitivity dV_OC/dP of voc_eq12"),
+    "dvoc_dp": ("V Pa-1", "local slope dV_OC/dP of voc_eq12 (the sensitivity per region: sensor_region_*)"),
 }
 _CURVE = {"charged_area_fraction": "area", "repulsive_area_fraction": "repulsive", "voc_eq12": "voc_eq12",
           "voc_eq17": "voc_eq17", "dvoc_dp": "dvoc_dp"}
 SUMMARY_UNITS = {"jump_in_Pa": "Pa", "pull_off_N": "N per cell", "pull_off_Pa": "Pa", "full_contact_Pa": "Pa",
-                 "sensitivity_V_per_Pa": "V/Pa", "linear_range_Pa": "Pa", "hysteresis_J_m2": "J/m2",
+                 "hysteresis_J_m2": "J/m2",
                  "hysteresis_bound_J_m2": "J/m2",
                  "area_hysteresis": "1", "area_at_p_max": "1", "voc_eq12_at_p_max_V": "V",
-                 "voc_eq17_at_p_max_V": "V", "tabor": "1", "seconds": "s"}
+                 "voc_eq17_at_p_max_V": "V", "tabor": "1", "seconds": "s",
+                 **{k: u for k, (u, _) in NUMBERS.items()}}
 
 
 def to_dataset(res, plan, summary: dict):
@@ -63,9 +66,13 @@ def to_dataset(res, plan, summary: dict):
         "charged_area_definition": str(summary["charged_area_definition"]),
         "contact_config": json.dumps({k: v for k, v in plan.contact_table.items()}, sort_keys=True, default=str),
     }
+    sensor, reasons = summary.get("sensor"), summary.get("reasons") or {}
     for k, v in summary.items():
         if k in SUMMARY_UNITS and k != "tabor":
-            attrs[k] = float(v) if v is not None and math.isfinite(float(v)) else "n/a"
+            why = reasons.get(k, "")
+            attrs[k] = float(v) if v is not None and math.isfinite(float(v)) else f"n/a: {why}" if why else "n/a"
+    if sensor is not None:
+        _sensor_regions(ds, sensor)
     ds.attrs = attrs
     _by_grid(ds, res, plan)
     ds["branch"].encoding["dtype"] = "S1"  # a char array: CF's checker cannot judge a string coordinate variable
@@ -73,6 +80,24 @@ def to_dataset(res, plan, summary: dict):
 
 
 GRID_DIM = "refinement_grid"
+CHANGE_NA = "n/a: one grid, or not present on both of the last two grids"
+REGION_DIM = "sensor_region"
+
+
+def _sensor_regions(ds, sensor) -> None:
+    """The sensor's pressure regions (:mod:`tengsim.device.sensor`) along ``sensor_region``: their name, pressure
+    range, sensitivity (V Pa-1), relative sensitivity (Pa-1) and the R² of their line."""
+    regs = sensor.regions
+    ds["sensor_region_name"] = (REGION_DIM, np.array([r.name for r in regs], dtype=object),
+                                {"long_name": "pressure region of V_OC(P) (eq. 12, approach)"})
+    for name, attr, units, long in (
+            ("sensor_region_p_lo", "p_lo_Pa", "Pa", "lowest pressure of the region"),
+            ("sensor_region_p_hi", "p_hi_Pa", "Pa", "highest pressure of the region"),
+            ("sensor_region_sensitivity", "sensitivity_V_per_Pa", "V Pa-1", "least-squares slope dV_OC/dP"),
+            ("sensor_region_relative_sensitivity", "relative_per_Pa", "Pa-1",
+             "(dV_OC/dP)/V0, V0 = V_OC at the lowest pressure"),
+            ("sensor_region_r2", "r2", "1", "R2 of the region's least-squares line")):
+        ds[name] = (REGION_DIM, np.array([getattr(r, attr) for r in regs], float), {"units": units, "long_name": long})
 
 
 def _by_grid(ds, res, plan) -> None:
@@ -105,7 +130,7 @@ def _by_grid(ds, res, plan) -> None:
                                 {"units": "J m-2", "long_name": "energy lost per cycle per unit area on each grid"})
     for label, v in convergence(res).items():
         key = "change_" + re.sub(r"[^A-Za-z0-9]+", "_", label.split("(")[0]).strip("_")  # CF: letters, digits, _
-        ds.attrs[key] = float(v) if math.isfinite(v) else "n/a"
+        ds.attrs[key] = float(v) if math.isfinite(v) else CHANGE_NA
 
 
 def csv_columns(ds) -> dict:

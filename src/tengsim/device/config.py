@@ -16,6 +16,8 @@ from __future__ import annotations
 import dataclasses
 import math
 
+import numpy as np
+
 from tengsim.device.areas import area_table_from_file, stable_branch
 from tengsim.device.params import AreaTable, ConstantArea, DeviceParams, SolverOptions
 from tengsim.device.waveforms import WAVEFORMS
@@ -28,12 +30,13 @@ SUFFIX_DIMS = (("_N_per_m", "energy/area"), ("_C_per_m2", "charge/area"), ("_Pa"
 _KINDS = {"float": "float", "int": "int", "str": "str", "bool": "bool", "tuple": "floats", "np.ndarray": "floats"}
 
 TABLES = ("device", "waveform", "run", "solver", "sweep")
-CASES = ("fig7", "fig8", "run", "sweep")
+CASES = ("fig7", "fig8", "run", "sweep", "design")
 RUN_KEYS = {  # the [run] keys each case uses; any other given key is refused with its name
     "fig7": ("case", "out", "cycles", "t_end", "dt_out"),
     "fig8": ("case", "out", "cycles", "dt_out", "quick"),
     "run": ("case", "out", "cycles", "t_end", "dt_out"),
     "sweep": ("case", "out", "cycles", "dt_out"),
+    "design": ("case", "out", "cycles", "t_end", "dt_out"),
 }
 
 
@@ -237,6 +240,33 @@ def parse_run(mapping: dict, case: str, ignored: list | None = None) -> dict:
     return v
 
 
+def waveform_peak(waveform, t_end: float) -> float:
+    """The highest pressure ``waveform`` applies over [0, t_end] (Pa), from its values between its breakpoints."""
+    t = np.linspace(0.0, float(t_end), 20001)
+    b = np.asarray(waveform.breakpoints(0.0, float(t_end)), float)
+    t = np.unique(np.r_[t, b, np.maximum(b - 1e-9 * t_end, 0.0)])
+    return float(np.max(waveform(t)))
+
+
+def check_pressures(area, waveform, t_end: float, source: str = "the area table", hint: str = "") -> None:
+    """Refuse (TengsimError, one line) a waveform whose highest pressure over [0, t_end] lies outside an area
+    table's pressures: beyond its top the table would be held at its last value, not extended.  ``hint``: what
+    the user can give instead (e.g. an option)."""
+    lo_hi = getattr(area, "pressure_Pa", None)
+    if lo_hi is None or t_end is None:
+        return
+    lo, hi = float(lo_hi[0]), float(lo_hi[-1])
+    peak = waveform_peak(waveform, t_end)
+    where = f"{source} ({lo / 1e3:.4g} to {hi / 1e3:.4g} kPa; it is not extended)"
+    if peak > hi * (1 + 1e-9):
+        raise TengsimError(f"the waveform presses to {peak / 1e3:.4g} kPa, beyond the pressures of {where}: give a "
+                           f"waveform within them{hint}, or an area table reaching {peak / 1e3:.4g} kPa (a design "
+                           f"with --p-max {peak / 1e3:.4g}kPa)")
+    if 0 < peak < lo * (1 - 1e-9):
+        raise TengsimError(f"the waveform presses to {peak / 1e3:.4g} kPa, below the pressures of {where}: give a "
+                           f"waveform within them{hint}, or an area table from a lower pressure")
+
+
 def check_device_tables(cfg: dict, where: str = "config") -> None:
     """Refuse tables other than :data:`TABLES` (and values that are not tables)."""
     from tengsim.schema import check_tables
@@ -258,4 +288,4 @@ def fields_help() -> str:
 
 __all__ = ["TABLES", "CASES", "MODES", "RUN_KEYS", "DEVICE_TABLE", "SOLVER_TABLE", "RUN_TABLE", "SWEEP_TABLE", "dim_of",
            "table_from_dataclass", "parse_device", "parse_waveform", "parse_solver", "parse_run", "waveform_table",
-           "check_device_tables", "fields_help"]
+           "check_device_tables", "check_pressures", "fields_help", "waveform_peak"]

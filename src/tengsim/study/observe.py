@@ -16,9 +16,7 @@ from tengsim.run.area import cell_side, full_length, loaded_area, physical_scale
 
 OBSERVABLE_DEFAULTS = {
     "pressures": ("1kPa", "10kPa", "100kPa"),
-    "fit_range": ("0kPa", "10kPa"),
-    "linear_tolerance": 0.1,
-    "saturation_fraction": 0.9,
+    "fit_range": None,
     "grid_max": "150kPa",
     "grid_num": 61,
     "transition_fraction": 0.95,
@@ -34,11 +32,17 @@ SCALARS = {
     "transition_D": ("ε", "approach D where Λc reaches transition_fraction of full contact"),
     "area_fraction_0": ("1", "charged-area fraction A/S at zero load (approach)"),
     "adhesive_full_contact": ("1", "1 if Λc at zero load >= full_contact_fraction × full contact (2N)"),
-    "S_V_per_kPa": ("V/kPa", "dV_OC/dP, least-squares line over fit_range"),
-    "linear_range_Pa": ("Pa", "highest P up to which V_OC stays within linear_tolerance of the fit "
-                        "(fit_range[0] if the first state is off)"),
+    # the sensor's numbers over fit_range (tengsim.device.sensor, the one definition the design uses too)
+    "S_V_per_kPa": ("V/kPa", "sensitivity dV_OC/dP of the lowest pressure region (least-squares slope)"),
+    "S_rel_per_kPa": ("kPa-1", "relative sensitivity (dV_OC/dP)/V0 of that region, V0 = V_OC at fit_range[0]"),
+    "S_to_Pa": ("Pa", "top of that region (the knee, the saturation pressure or the top of the range)"),
+    "knee_Pa": ("Pa", "knee of V_OC(P): where two lines fit better than one (NaN: one line fits, R2 >= 0.99)"),
+    "S_above_knee_V_per_kPa": ("V/kPa", "sensitivity dV_OC/dP above the knee"),
+    "linear_range_Pa": ("Pa", "top of the linear range from fit_range[0] (R2 >= 0.99 of the line over it)"),
+    "linear_R2": ("1", "R2 of the line over the linear range"),
     "V_sat": ("V", "largest V_OC of the run"),
-    "P_sat_Pa": ("Pa", "lowest P where V_OC reaches saturation_fraction × V_sat"),
+    "P_sat_Pa": ("Pa", "saturation pressure: V_OC within 2 % of its full-scale change of its top value from "
+                 "there on (NaN: V_OC does not level off)"),
     "hysteresis": ("3π W ε² m²/n² per cell (∮F dD)", "approach minus retraction ∮ F dD"),
     "hysteresis_J_m2": ("J/m²", "energy lost per cycle per unit nominal area"),
 }
@@ -51,10 +55,9 @@ def parse_observables(table: dict, where: str = "study") -> dict:
     t = Table("observables", [
         Field("pressures", "floats", OBSERVABLE_DEFAULTS["pressures"], dim="pressure",
               help="pressures at which V_OC is reported"),
-        Field("fit_range", "floats", OBSERVABLE_DEFAULTS["fit_range"], dim="pressure",
-              help="low-pressure range [lo, hi] of the sensitivity fit"),
-        Field("linear_tolerance", "float", 0.1, help="relative deviation that ends the linear range"),
-        Field("saturation_fraction", "float", 0.9, help="fraction of V_sat that defines P_sat"),
+        Field("fit_range", "floats", None, dim="pressure",
+              help="pressure range [lo, hi] the sensor's numbers (regions, sensitivity, linear range, "
+                   "saturation) are read over (default: 0 to the top of each run)"),
         Field("grid_max", "float", OBSERVABLE_DEFAULTS["grid_max"], dim="pressure",
               help="top of the common pressure grid (from 0)"),
         Field("grid_num", "int", 61, help="points of the common pressure grid"),
@@ -69,10 +72,10 @@ def parse_observables(table: dict, where: str = "study") -> dict:
         labels = [labels]
     out = t.parse(raw, where=f"{where}: [observables] ")
     defaults = {k: out[k] for k in out}
-    for k in ("pressures", "fit_range", "grid_max"):
+    for k in ("pressures", "grid_max"):
         if defaults[k] == OBSERVABLE_DEFAULTS[k]:
             defaults[k] = t.fields[k].parse(OBSERVABLE_DEFAULTS[k])
-    fr = defaults["fit_range"]
+    fr = defaults["fit_range"] if defaults["fit_range"] is not None else [0.0, math.inf]
     if len(fr) != 2 or not fr[1] > fr[0] >= 0:
         raise TengsimError(f"{where}: [observables] fit_range must be [lo, hi] with 0 <= lo < hi, got {fr!r}")
     if not defaults["grid_max"] > 0 or defaults["grid_num"] < 2:
@@ -162,27 +165,20 @@ def observe(res, device: dict, settings: dict) -> dict:
     curves["V_OC"] = at(grid)
     curves["area_fraction"] = np.where(np.isfinite(curves["V_OC"]), np.interp(grid, P, A), nan)
     curves["V_OC_at"] = at(settings["pressures"])
-    lo, hi = settings["fit_range"]
-    a, b = max(lo, P[0]), min(hi, P[-1])
-    if b > a:  # least squares over the piecewise-linear V_OC(P) sampled evenly on [lo, hi] ∩ the run
-        xs = np.linspace(a, b, 41)
-        slope, icpt = np.polyfit(xs, np.interp(xs, P, V), 1)
-        out["S_V_per_kPa"] = slope * 1e3
-        fit = icpt + slope * P
-        ok = np.abs(V - fit) <= settings["linear_tolerance"] * np.abs(fit)
-        idx = np.flatnonzero(P >= lo)
-        last = float(lo) if len(idx) else nan  # the first state already off the line: no linear range
-        for i in idx:
-            if not ok[i]:
-                break
-            last = P[i]
-        out["linear_range_Pa"] = last
-    vs = float(np.max(V))
-    out["V_sat"] = vs
-    target = settings["saturation_fraction"] * vs
-    i = int(np.flatnonzero(V >= target)[0])
-    if i == 0:
-        out["P_sat_Pa"] = float(P[0])
-    else:
-        out["P_sat_Pa"] = float(P[i - 1] + (target - V[i - 1]) * (P[i] - P[i - 1]) / (V[i] - V[i - 1]))
+    from tengsim.device.sensor import sensor_numbers
+
+    lo, hi = settings["fit_range"]  # hi: inf (the run's top), None once the settings went through JSON
+    nums = sensor_numbers(P, V, p_range=(lo, math.inf if hi is None else hi))
+    f = nums.flat()
+    for name, key, k in (("S_V_per_kPa", "sensitivity_V_per_Pa", 1e3), ("S_rel_per_kPa", "sensitivity_rel_per_Pa", 1e3),
+                         ("S_to_Pa", "sensitivity_to_Pa", 1.0), ("knee_Pa", "knee_Pa", 1.0),
+                         ("S_above_knee_V_per_kPa", "sensitivity_above_knee_V_per_Pa", 1e3),
+                         ("linear_range_Pa", "linear_range_Pa", 1.0), ("linear_R2", "linear_r2", 1.0),
+                         ("P_sat_Pa", "saturation_Pa", 1.0)):
+        out[name] = f[key] * k
+    out["V_sat"] = float(np.max(V))
+    why = [f"{name}: {nums.reason(key)}" for name, key in (("S_V_per_kPa", "sensitivity_V_per_Pa"),
+                                                          ("linear_range_Pa", "linear_range_Pa"))
+           if not math.isfinite(f[key]) and nums.reason(key)]
+    notes = [*notes, *why]
     return {"scalars": out, "curves": curves, "notes": notes}

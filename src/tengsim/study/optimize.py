@@ -1,7 +1,7 @@
 """``tengsim optimize``: differential evolution over a study's range axes, evaluations on Dask, resumable.
 
 The study's ``[objective]`` names one observable to maximise or minimise (tengsim.study.observe.SCALARS)
-and optional bounds on others (``subject_to = { P_sat_Pa = { min = 1e5 } }``, a penalty when violated).
+and optional bounds on others (``subject_to = { linear_range_Pa = { min = 1e4 } }``, a penalty when violated).
 scipy.optimize.differential_evolution calls its ``workers`` map once per generation; the map computes
 the generation's new points on the Dask client (stored exactly like sweep points, DIR/points/<id>.nc),
 then evaluates the objective from the stored results.  With a fixed ``seed`` a resumed run asks for the

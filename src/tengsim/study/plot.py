@@ -10,8 +10,8 @@ from tengsim.errors import TengsimError
 from tengsim.io import read_dataset
 
 MAP_VARS = ("S_V_per_kPa", "linear_range_Pa", "P_sat_Pa", "pull_off_Pa", "area_fraction_0", "V_sat")
-_LABEL = {"S_V_per_kPa": "sensitivity dV_OC/dP (V/kPa)", "linear_range_Pa": "linear range (kPa)",
-          "P_sat_Pa": "saturation pressure, 90 % of V_sat (kPa)", "pull_off_F": "pull-off force per cell (F of Eq. 10)",
+_LABEL = {"S_V_per_kPa": "sensitivity dV_OC/dP, lowest region (V/kPa)", "linear_range_Pa": "linear range (kPa)",
+          "P_sat_Pa": "saturation pressure (kPa)", "pull_off_F": "pull-off force per cell (F of Eq. 10)",
           "pull_off_Pa": "pull-off pressure (kPa; tensile < 0)",
           "area_fraction_0": "charged area A/S at zero load", "V_sat": "saturation voltage V_sat (V)"}
 _KPA = ("linear_range_Pa", "P_sat_Pa", "pull_off_Pa")
