@@ -20,6 +20,7 @@ before the solve).  Checked against the peak RSS of a 525² run (tests/test_reso
 from __future__ import annotations
 
 import os
+from dataclasses import dataclass
 
 from tengsim.errors import TengsimError
 
@@ -121,6 +122,35 @@ def cgroup_room(root: str = "/sys/fs/cgroup") -> int | None:
     except (OSError, ValueError):
         pass
     return max(0, int(limit) - used + cache)
+
+
+@dataclass(frozen=True)
+class CostModel:
+    """Seconds of one solver iteration on a grid of ``points`` solved pixels: ``floor`` + ``per_point`` × points;
+    ``backend`` names the machine and solver the constants were measured on (printed with every estimate)."""
+
+    backend: str
+    floor: float
+    per_point: float
+
+    def iteration_seconds(self, points: float) -> float:
+        return self.floor + self.per_point * float(points)
+
+
+CPU_COST = CostModel("CPU (NumPy fast solver; constant of the 2-core build machine)", 0.0, 5.3e-8)
+"""The NumPy fast solver: 5.3e-8 s per solved pixel and iteration, fitted on four designs (README pyramid, cube,
+grating, hemisphere at ε = 200 nm) on the 2-core build machine (docs/benchmarks.md, "Design estimates")."""
+GPU_COST = CostModel("GPU (JAX solver, float64; constants of one NVIDIA H200)", 6.2e-4, 3.5e-10)
+"""The JAX solver on a GPU: a floor of 0.62 ms per iteration (launches and synchronisation) plus 0.35 ns per
+point, fitted to the H200's cold rough solves at 1024²–8192² (1.02, 1.98, 5.9, 27.5 ms per iteration; the fit
+within 14 % of each; docs/benchmarks.md, "GPU")."""
+GPU_BYTES_PER_POINT = {"float64": 480, "float32": 240}
+"""Peak device memory of the JAX solver per grid point (measured on the H200: 468–482 and 234–239 B)."""
+
+
+def cost_model(gpu: bool) -> CostModel:
+    """The cost model of the backend a run solves on: :data:`GPU_COST` on a GPU, else :data:`CPU_COST`."""
+    return GPU_COST if gpu else CPU_COST
 
 
 def _gib(b: float) -> str:
