@@ -27,11 +27,10 @@ from jax import lax
 from jax.scipy.linalg import solve_triangular
 
 from tengsim.laws.safe import SafeLaw
+from tengsim.solvers._constants import (APPROX_SLOPE, C1, C2, CURVATURE_EPS, EPS_E, FIRST_MOVE, GROW, MAX_EVAL,
+                                        SAFEGUARD)
 
 F64 = jnp.float64
-C1, C2, MAX_EVAL, FIRST_MOVE = 1e-4, 0.9, 40, 0.25  # tengsim.solvers._linesearch.WolfeLineSearch's defaults
-#: the approximate Wolfe test's energy slack, relative: the NumPy solver's in float64; float32 fields round E at ~1e-7
-EPS_E = {"float64": 1e-11, "float32": 1e-6}
 
 
 def law_twin(cls, fields, values):
@@ -84,7 +83,11 @@ def build(shape, padded, periodic, pinned, law_cls, law_fields, dtype, memory, r
                 phis, P = fast_sum(g, jnp, total)
                 return phis, P.astype(dt)
 
-            return lax.cond(jnp.min(g) < law.g_safe, plain, own, g)
+            # both sums in the same pass over g, one selected: no conditional (a host synchronisation per
+            # line-search trial on a GPU) for a choice made on the device
+            low = jnp.min(g) < law.g_safe
+            (p1, P1), (p2, P2) = plain(g), own(g)
+            return jnp.where(low, p1, p2), jnp.where(low, P1, P2)
 
         def law_sweep(g):
             phis, P = law_phis(g)
@@ -147,7 +150,7 @@ def build(shape, padded, periodic, pinned, law_cls, law_fields, dtype, memory, r
                 e, de, phis, sp, gt, Pt = evaluate(a, *ev)
                 fin = jnp.isfinite(e)
                 wolfe = (e <= E0 + C1 * a * slope0) & (jnp.abs(de) <= -C2 * slope0)
-                approx = (e <= E_lo + eps_E) & (C2 * slope0 <= de) & (de <= -0.8 * slope0)
+                approx = (e <= E_lo + eps_E) & (C2 * slope0 <= de) & (de <= -APPROX_SLOPE * slope0)
                 acc = fin & (wolfe | approx)
                 better = fin & (e <= E_lo + eps_E) & (~s["has_best"] | (jnp.abs(de) < s["best_de"]))
                 to_hi = ~fin | (e > E0 + C1 * a * slope0 + eps_E) | (de > 0)
@@ -161,7 +164,8 @@ def build(shape, padded, periodic, pinned, law_cls, law_fields, dtype, memory, r
                 width = hi - lo
                 sec = has_de_hi & (de_hi > de_lo)
                 cand = jnp.where(sec, lo - de_lo * width / jnp.where(sec, de_hi - de_lo, 1.0), lo + 0.5 * width)
-                nxt = jnp.where(has_hi, jnp.minimum(jnp.maximum(cand, lo + 0.1 * width), hi - 0.1 * width), 2.0 * a)
+                nxt = jnp.where(has_hi, jnp.minimum(jnp.maximum(cand, lo + SAFEGUARD * width), hi - SAFEGUARD * width),
+                                GROW * a)
                 return dict(i=s["i"] + 1, alpha=nxt, lo=lo, de_lo=de_lo, hi=hi, has_hi=has_hi, de_hi=de_hi,
                             has_de_hi=has_de_hi, best_de=jnp.where(better, jnp.abs(de), s["best_de"]),
                             best_a=jnp.where(better, a, s["best_a"]), has_best=s["has_best"] | better,
@@ -180,13 +184,16 @@ def build(shape, padded, periodic, pinned, law_cls, law_fields, dtype, memory, r
             gamma, cS, cY = coefficients(c)
             d, Kd, dw, dKd, dr, sum_d = direction(c, gamma, cS, cY)
 
-            def reset(_):
-                zm = jnp.zeros(m, F64)
-                one = jnp.ones((), F64)
-                return (*direction(dict(c, k=jnp.int32(0)), one, zm, zm), jnp.int32(0), one, zm, zm)
-
-            d, Kd, dw, dKd, dr, sum_d, k, gamma, cS, cY = lax.cond(
-                dr < 0, lambda _: (d, Kd, dw, dKd, dr, sum_d, c["k"], gamma, cS, cY), reset, None)
+            # not a descent direction: restart from steepest descent in the K metric, d = −G, K d = −r (what
+            # the memory's direction is with no pairs), selected element-wise: no conditional
+            ok = dr < 0
+            zm = jnp.zeros(m, F64)
+            d = jnp.where(ok, d, -c["G"])
+            Kd = jnp.where(ok, Kd, -c["r"])
+            dw, dKd, dr, sum_d = (jnp.where(ok, dw, dot(d, c["w"])), jnp.where(ok, dKd, dot(d, Kd)),
+                                  jnp.where(ok, dr, dot(d, c["r"])), jnp.where(ok, sum_d, total(d)))
+            k, gamma = jnp.where(ok, c["k"], jnp.int32(0)), jnp.where(ok, gamma, 1.0)
+            cS, cY = jnp.where(ok, cS, zm), jnp.where(ok, cY, zm)
             c = dict(c, k=k)
             E_best = jnp.minimum(c["E_best"], c["E"])
             kmax = jnp.max(jnp.abs(Kd)).astype(F64)
@@ -237,7 +244,7 @@ def build(shape, padded, periodic, pinned, law_cls, law_fields, dtype, memory, r
             # the memory's update (KMetricLBFGS.update)
             sy, yy = dA * alpha * dky, dA * yky
             sks = dA * alpha * alpha * jnp.abs(dKd)
-            store = (sy > 1e-14 * jnp.maximum(sks, 1e-300)) & (yy > 0)
+            store = (sy > CURVATURE_EPS * jnp.maximum(sks, 1e-300)) & (yy > 0)
             k = c["k"]
             idx = jnp.arange(m)
             act = idx < k
@@ -257,12 +264,11 @@ def build(shape, padded, periodic, pinned, law_cls, law_fields, dtype, memory, r
             pSn = pS.at[slot].set(alpha * (dA * drn))
             pYn = pY.at[slot].set(dA * yrn)
 
-            def write(_):
-                B = c["B"].at[2 * slot].set(d * a).at[2 * slot + 1].set(y)
-                KB = c["KB"].at[2 * slot].set(Kd * a).at[2 * slot + 1].set(ky)
-                return B, KB
-
-            B, KB = lax.cond(store, write, lambda _: (c["B"], c["KB"]), None)
+            # the pair written into its two rows in place when stored, the rows kept otherwise (no conditional)
+            r0, r1 = 2 * slot, 2 * slot + 1
+            B = c["B"].at[r0].set(jnp.where(store, d * a, c["B"][r0])).at[r1].set(jnp.where(store, y, c["B"][r1]))
+            KB = c["KB"].at[r0].set(jnp.where(store, Kd * a, c["KB"][r0])).at[r1].set(
+                jnp.where(store, ky, c["KB"][r1]))
             k2 = jnp.where(store, jnp.minimum(k + 1, m), k)
             age = jnp.where(store, c["age"].at[slot].set(c["count"]), c["age"])
             SY = jnp.where(store, SYn, SY)
