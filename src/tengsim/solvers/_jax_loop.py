@@ -27,6 +27,7 @@ from jax import lax
 from jax.scipy.linalg import solve_triangular
 
 from tengsim.laws.safe import SafeLaw
+from tengsim.solvers import _jax_fft
 from tengsim.solvers._constants import (APPROX_SLOPE, C1, C2, CURVATURE_EPS, EPS_E, FIRST_MOVE, GROW, MAX_EVAL,
                                         SAFEGUARD)
 
@@ -42,17 +43,21 @@ def law_twin(cls, fields, values):
     return t
 
 
-def build(shape, padded, periodic, pinned, law_cls, law_fields, dtype, memory, resync):
-    """The solve as a function of traced arguments (see :func:`solve`'s signature), for jax.jit."""
+def build(shape, padded, periodic, pinned, law_cls, law_fields, dtype, memory, resync, mesh=None):
+    """The solve as a function of traced arguments (see :func:`solve`'s signature), for jax.jit; ``mesh``: the
+    devices the grid's rows are split over (tengsim.solvers._jax_fft), None for one device."""
     nx, ny = shape
     m = int(memory)
     dt = jnp.dtype(dtype)
+    conv = _jax_fft.convolution(shape, padded, periodic, dt, mesh)
+    if mesh is None:
+        def rows_split(a):
+            return a
+    else:
+        rows_sharding = _jax_fft.field_sharding(mesh, 2, 1)
 
-    def conv(x, spec):
-        if periodic:
-            return jnp.fft.irfft2(jnp.fft.rfft2(x.reshape(shape)) * spec, s=shape).astype(dt).ravel()
-        y = jnp.fft.irfft2(jnp.fft.rfft2(x.reshape(shape), s=padded) * spec, s=padded)
-        return y[:nx, :ny].astype(dt).ravel()
+        def rows_split(a):  # the memory's rows split along the points like every field
+            return lax.with_sharding_constraint(a, rows_sharding)
 
     def dot(a, b):  # a·b accumulated in float64 (one fused pass, no float64 copy of a float32 field)
         return jnp.sum(a.astype(F64) * b.astype(F64))
@@ -297,7 +302,8 @@ def build(shape, padded, periodic, pinned, law_cls, law_fields, dtype, memory, r
         qw = dot(q, w)
         E = dA * (0.5 * qw + phis)
         n = g0.shape[0]
-        c0 = dict(q=q, w=w, g=g, P=P, r=r, G=G, B=jnp.zeros((2 * m, n), dt), KB=jnp.zeros((2 * m, n), dt),
+        c0 = dict(q=q, w=w, g=g, P=P, r=r, G=G, B=rows_split(jnp.zeros((2 * m, n), dt)),
+                  KB=rows_split(jnp.zeros((2 * m, n), dt)),
                   SY=jnp.zeros((m, m), F64), YY=jnp.zeros((m, m), F64), pS=jnp.zeros(m, F64),
                   pY=jnp.zeros(m, F64), age=jnp.zeros(m, jnp.int32), k=jnp.int32(0), count=jnp.int32(0),
                   phis=phis, sum_p=sum_p, qw=qw, E=E, E_best=E, mean_q=mean_q,

@@ -25,6 +25,9 @@ def gpu_visible() -> bool:
     if not any(_has_module(m) for m in GPU_PLUGINS):
         return False
     try:
+        from tengsim.solvers.jax_fast import prepare_environment
+
+        prepare_environment()  # before JAX starts: the share of the GPU's memory it may take
         import jax
 
         return bool(jax.devices("gpu"))
