@@ -446,7 +446,7 @@ def _checkpoint(keep, plan, d_max, progress):
 def run_design(plan, progress=None, keep=None) -> DesignResult:
     """Run one design (module doc).  ``progress``: a :class:`tengsim.progress.Progress`-like callable (the
     path's progress) and/or an object with ``say(text)``, which gets the lines said before and during the run
-    (the Tabor number, the grids, memory and estimated time).  ``keep`` (a file path, or None): where each
+    (the Tabor number, the solver, the grids, memory and expected time).  ``keep`` (a file path, or None): where each
     finished grid is kept (:func:`_checkpoint`), so a killed run of the same design resumes from it."""
     from tengsim.run.plan import ResolveSettings, as_plan
     from tengsim.design.curves import summarize

@@ -43,6 +43,18 @@ def law_twin(cls, fields, values):
     return t
 
 
+def row_products(M, v):
+    """M @ v (the L-BFGS rows' products with a field) accumulated in float64.  float64 fields: the plain matmul.
+    float32 fields: each row's sum in float64, the converts fused into one reduction over M (no float64 copy of
+    M).  A float32 matmul accumulates the n products in float32, with an error growing with n (CPU: 3e-7 of the
+    sum of |terms| at 65 536 points, 8e-6 at 4.2 million); the products of L-BFGS rows with a near-converged
+    gradient cancel, so their relative error is larger still, and the directions built from them stopped a
+    float32 solve short of its tolerance at 4096² and 8192² (docs/benchmarks.md, "GPU")."""
+    if M.dtype == F64:
+        return jnp.matmul(M, v)
+    return jnp.sum(M.astype(F64) * v.astype(F64)[None, :], axis=1)
+
+
 def build(shape, padded, periodic, pinned, law_cls, law_fields, dtype, memory, resync, mesh=None):
     """The solve as a function of traced arguments (see :func:`solve`'s signature), for jax.jit; ``mesh``: the
     devices the grid's rows are split over (tengsim.solvers._jax_fft), None for one device."""
@@ -62,8 +74,8 @@ def build(shape, padded, periodic, pinned, law_cls, law_fields, dtype, memory, r
     def dot(a, b):  # a·b accumulated in float64 (one fused pass, no float64 copy of a float32 field)
         return jnp.sum(a.astype(F64) * b.astype(F64))
 
-    def rows(M, v):  # M @ v over the stored rows: in the fields' precision (a float64 M @ v would copy M)
-        return jnp.matmul(M, v).astype(F64)
+    def rows(M, v):  # M @ v over the stored rows, accumulated in float64 (:func:`row_products`)
+        return row_products(M, v)
 
     def total(a):
         return jnp.sum(a, dtype=F64)
@@ -133,7 +145,7 @@ def build(shape, padded, periodic, pinned, law_cls, law_fields, dtype, memory, r
             gt = Kd * a.astype(dt) + g
             phis, Pt = law_phis(gt)
             Pt = Pt.astype(dt)
-            dpk = dot(Pt - P, Kd)
+            dpk = dot(Pt.astype(F64) - P.astype(F64), Kd)  # the pressure change exact in float64 (small steps)
             e = dA * (0.5 * qw + a * dw + 0.5 * a * a * dKd + phis)
             de = slope + dA * (a * dKd - dpk)
             return e, de, phis, total(Pt), gt, Pt
@@ -321,4 +333,4 @@ def build(shape, padded, periodic, pinned, law_cls, law_fields, dtype, memory, r
     return solve
 
 
-__all__ = ["build", "law_twin"]
+__all__ = ["build", "law_twin", "row_products"]
