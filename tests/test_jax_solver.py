@@ -329,3 +329,22 @@ def test_shards_refused_in_one_line_where_they_cannot_split():
     n = len(jax.devices("cpu"))
     with pytest.raises(TengsimError, match=f"only {n} CPU device"):
         JaxSolver(device="cpu", shards=n + 7).solve(pb, st)
+
+
+def test_gpu_memory_fraction_and_a_solve_too_large_for_the_device(monkeypatch):
+    """tengsim lets JAX take 95 % of a GPU (JAX's own default 75 % cannot hold 16384² in float64 on one H200) unless
+    the user chose; a solve over what the device allows is refused in one line naming the devices it needs."""
+    from types import SimpleNamespace
+
+    monkeypatch.delenv("XLA_PYTHON_CLIENT_MEM_FRACTION", raising=False)
+    monkeypatch.delenv("XLA_PYTHON_CLIENT_PREALLOCATE", raising=False)
+    jax_fast.prepare_environment()
+    assert os.environ["XLA_PYTHON_CLIENT_MEM_FRACTION"] == jax_fast.MEM_FRACTION
+    monkeypatch.setenv("XLA_PYTHON_CLIENT_MEM_FRACTION", "0.5")
+    jax_fast.prepare_environment()
+    assert os.environ["XLA_PYTHON_CLIENT_MEM_FRACTION"] == "0.5"
+    h200 = SimpleNamespace(platform="gpu", id=0, memory_stats=lambda: {"bytes_limit": int(0.95 * 141e9)})
+    jax_fast.check_device_memory(h200, 16384 ** 2, "float64")  # 129 GB: fits at 0.95
+    with pytest.raises(TengsimError, match=r"over 4 or more devices"):
+        jax_fast.check_device_memory(h200, 32768 ** 2, "float64")
+    jax_fast.check_device_memory(h200, 32768 ** 2, "float64", shards=8)
