@@ -164,7 +164,8 @@ def shard_row(n, shards, device, tol, max_iter, ref):
     F = float(eq.P.sum()) * grid.area
     xb = xla_bytes((n, n), "float64")
     return dict(case=f"rough {n}² on {shards} devices", n=n, dtype="float64", device=device, iterations=eq.iterations,
-                converged=eq.converged, residual=eq.residual, total_s=run, per_iter_ms=1e3 * run / max(eq.iterations, 1),
+                converged=eq.converged, residual=eq.residual, total_s=run,
+                per_iter_ms=1e3 * run / max(eq.iterations, 1),
                 compile_s=compile_stats()["compile_seconds"] - c0, F=F, device_peak_B_per_pt=None,
                 xla_B_per_pt=None if xb is None else xb / (n * n), rss_MiB=rss_mib(), cpu_s=None, cpu_iterations=None,
                 cpu_note="one-device F", dF_rel=None if ref is None else abs(F - ref) / abs(ref), speedup=None)

@@ -69,7 +69,8 @@ def count(comps: dict, name: str, depth: int = 0) -> dict:
         if op == "while":
             body, cond = _refs(line, "body")[0], _refs(line, "condition")[0]
             b, c = count(comps, body, depth + 1), count(comps, cond, depth + 1)
-            whiles.append(dict(body=body, body_kernels=b["total"], cond_kernels=c["total"], conditionals=b["conditionals"]))
+            whiles.append(dict(body=body, body_kernels=b["total"], cond_kernels=c["total"],
+                               conditionals=b["conditionals"]))
             total += b["total"] + c["total"]  # one trip
             conds += b["conditionals"]
         elif op == "conditional":
@@ -122,7 +123,8 @@ def main(argv=None) -> int:
     import jax
 
     print(f"| cell | kernels per iteration (1 line-search trial) | of which the line-search trial | host "
-          f"synchronisations per iteration (while trips + conditionals) | backend {jax.default_backend()}, JAX {jax.__version__}, {a.n}², {a.dtype} |")
+          f"synchronisations per iteration (while trips + conditionals) | backend {jax.default_backend()}, "
+          f"JAX {jax.__version__}, {a.n}², {a.dtype} |")
     print("|---|---|---|---|---|")
     for boundary in ("periodic", "free"):
         c = loop_counts(compiled_text(a.n, boundary, a.dtype))

@@ -351,7 +351,8 @@ def test_estimate_uses_the_backends_cost_and_names_it(monkeypatch):
     assert gpu.backend == GPU_COST.backend and "GPU" in gpu.lines()[1]
     g = cp.shape.grid(dx)
     rows_its = gpu.cost.rows * gpu.cost.iterations
-    assert gpu.cost.grid_seconds(cp.shape, g) == pytest.approx(rows_its * (GPU_COST.floor + GPU_COST.per_point * g.nx * g.ny))
+    per_iteration = GPU_COST.floor + GPU_COST.per_point * g.nx * g.ny
+    assert gpu.cost.grid_seconds(cp.shape, g) == pytest.approx(rows_its * per_iteration)
     assert gpu.seconds < cpu.seconds
     assert dr.budget_pixels(plan, dataclasses.replace(cp, solver="gpu"), dx, 25.0) > dr.budget_pixels(plan, cp, dx, 25.0)
 

@@ -200,7 +200,8 @@ class Estimate:
         from tengsim.design.units import bytes_text, length_text, time_text
 
         g = ", ".join(f"{nx}×{ny} (dx {length_text(d)})" for nx, ny, d in self.grids)
-        rows = f", {self.cost.rows:.0f} rows of about {self.cost.iterations:.0f} iterations per grid" if self.cost else ""
+        rows = (f", {self.cost.rows:.0f} rows of about {self.cost.iterations:.0f} iterations per grid"
+                if self.cost else "")
         return [f"grids: {g} (refined by √2 until converged; the last two are used only if needed)",
                 f"memory: {bytes_text(self.memory_bytes)} on the finest; expected time: {time_text(self.seconds)} "
                 f"(the first two grids and half the third, D path to about {self.d_max:.0f} ε{rows}) on "
