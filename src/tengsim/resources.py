@@ -138,14 +138,13 @@ class CostModel:
 
 
 CPU_COST = CostModel("CPU (NumPy fast solver; constant of the 2-core build machine)", 0.0, 5.3e-8)
-"""The NumPy fast solver: 5.3e-8 s per solved pixel and iteration, fitted on four designs (README pyramid, cube,
-grating, hemisphere at ε = 200 nm) on the 2-core build machine (docs/benchmarks.md, "Design estimates")."""
+"""The NumPy fast solver: seconds per solved pixel and iteration, fitted on four designs on the 2-core build machine
+(docs/benchmarks.md, "Design estimates")."""
 GPU_COST = CostModel("GPU (JAX solver, float64; constants of one NVIDIA H200)", 6.2e-4, 3.5e-10)
-"""The JAX solver on a GPU: a floor of 0.62 ms per iteration (launches and synchronisation) plus 0.35 ns per
-point, fitted to the H200's cold rough solves at 1024²–8192² (1.02, 1.98, 5.9, 27.5 ms per iteration; the fit
-within 14 % of each; docs/benchmarks.md, "GPU")."""
+"""The JAX solver on a GPU: a floor per iteration (launches and synchronisations) plus a per-point term, fitted to
+one H200's cold rough solves at 1024²–8192² (docs/benchmarks.md, "GPU")."""
 GPU_BYTES_PER_POINT = {"float64": 480, "float32": 240}
-"""Peak device memory of the JAX solver per grid point (measured on the H200: 468–482 and 234–239 B)."""
+"""Peak device memory of the JAX solver per grid point, rounded up from the H200's (docs/benchmarks.md, "GPU")."""
 
 
 def cost_model(gpu: bool) -> CostModel:

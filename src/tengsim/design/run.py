@@ -44,15 +44,14 @@ D_MIN = -1.0
 D_STEP = 0.4
 """Largest D step (ε) of the adaptive walk (refine_levels 4: smallest 0.025 ε)."""
 ROWS_PER_STEP = 2.0
-"""Path rows per d_step of D range on each grid, approach and retraction together (measured on four designs: the
-first grid walks to d_max, each finer one to a little past where the grid before reached p_max; 28–128 rows,
-1.8–2.2 × the range over d_step)."""
+"""Path rows per d_step of D range on each grid, approach and retraction together (the first grid walks to d_max,
+each finer one to a little past where the grid before reached p_max; docs/benchmarks.md, "Design estimates")."""
 ITERATIONS_PER_COARSE = 4.0
-"""A refinement grid's solver iterations per path row over the coarse pre-run's mean (:func:`find_d_max`): the README
-pyramid takes 22 per row on its 15² coarse grid and about 90 on its 245²–585² grids (measured on the GPU)."""
+"""A refinement grid's solver iterations per path row over the coarse pre-run's mean (:func:`find_d_max`;
+docs/benchmarks.md, "Design estimates")."""
 THIRD_GRID_SHARE = 0.5
-"""The expected run counts the third grid at this weight: of the four designs measured (docs/benchmarks.md,
-"Design estimates") two converged on two grids and two needed a third."""
+"""The expected run counts the third grid at this weight: some designs converge on two grids, others need a third
+(docs/benchmarks.md, "Design estimates")."""
 LEVELS_ESTIMATED = 3
 EXTEND_TRIES = 6
 SOLVER_TOL_PER_TOL = 0.01

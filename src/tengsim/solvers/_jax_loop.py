@@ -11,9 +11,11 @@ What differs is only the bookkeeping JAX needs: arrays of fixed shape.  The memo
 present; a slot is active when its index is below the count k (as in the NumPy ring, the active slots
 are always 0 … k − 1), its age orders the pairs, and inactive slots are masked out of the small
 triangular solves (identity rows, zero right-hand sides), so they contribute exact zeros.  Python's
-``None`` (no bracket end yet, no best point) becomes a flag.  Scalars (energies, slopes, inner products) are
-accumulated in float64 even when the fields are float32 (the convert fused into the reduction: no
-extra pass over memory); the rows' products B @ v and the law stay in the fields' precision.
+``None`` (no bracket end yet, no best point) becomes a flag.  Scalars (energies, slopes, inner products, the
+rows' products B @ v: :func:`row_products`) are accumulated in float64 even when the fields are float32 (the
+convert fused into the reduction: no extra pass over memory); the law stays in the fields' precision.  Choices
+the NumPy solver makes with ``if`` (a restart to steepest descent, the law's own sum or the safe extension's)
+are selects on the device where both sides are cheap, so that an iteration waits for the host less often.
 
 Everything here is built by :func:`build` for one static configuration (grid, kernel kind, law class,
 dtype, memory, resync); every number that varies between equilibria (g0, the start, the kernel's
@@ -46,10 +48,9 @@ def law_twin(cls, fields, values):
 def row_products(M, v):
     """M @ v (the L-BFGS rows' products with a field) accumulated in float64.  float64 fields: the plain matmul.
     float32 fields: each row's sum in float64, the converts fused into one reduction over M (no float64 copy of
-    M).  A float32 matmul accumulates the n products in float32, with an error growing with n (CPU: 3e-7 of the
-    sum of |terms| at 65 536 points, 8e-6 at 4.2 million); the products of L-BFGS rows with a near-converged
-    gradient cancel, so their relative error is larger still, and the directions built from them stopped a
-    float32 solve short of its tolerance at 4096² and 8192² (docs/benchmarks.md, "GPU")."""
+    M).  A float32 matmul accumulates the n products in float32, with an error growing with n; the products of
+    L-BFGS rows with a near-converged gradient cancel, so their relative error is larger still, and the directions
+    built from them stopped float32 solves short of their tolerance on large grids (docs/benchmarks.md, "GPU")."""
     if M.dtype == F64:
         return jnp.matmul(M, v)
     return jnp.sum(M.astype(F64) * v.astype(F64)[None, :], axis=1)
@@ -281,8 +282,7 @@ def build(shape, padded, periodic, pinned, law_cls, law_fields, dtype, memory, r
             pSn = pS.at[slot].set(alpha * (dA * drn))
             pYn = pY.at[slot].set(dA * yrn)
 
-            # a conditional: the rows written in place (a select instead made XLA keep a copy of the rows,
-            # +216 B per point in float64)
+            # a conditional: the rows written in place (a select instead made XLA keep a copy of the rows)
             def write(_):
                 B = c["B"].at[2 * slot].set(d * a).at[2 * slot + 1].set(y)
                 KB = c["KB"].at[2 * slot].set(Kd * a).at[2 * slot + 1].set(ky)

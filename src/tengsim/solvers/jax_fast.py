@@ -74,9 +74,9 @@ def clear_cache() -> None:
 
 
 MEM_FRACTION = "0.95"
-"""The share of a GPU's memory JAX may take (JAX's default is 0.75: a 16384² float64 solve, ≈ 128 GB at the
-measured 480 B per point, would not fit one 141 GB H200).  Set before JAX starts, unless the user set
-XLA_PYTHON_CLIENT_MEM_FRACTION (or XLA_PYTHON_CLIENT_PREALLOCATE=false) themselves."""
+"""The share of a GPU's memory JAX may take (JAX's default, 0.75, leaves a 16384² float64 solve off one H200).
+Set before JAX starts, unless the user set XLA_PYTHON_CLIENT_MEM_FRACTION (or XLA_PYTHON_CLIENT_PREALLOCATE=false)
+themselves."""
 
 
 def prepare_environment() -> None:
