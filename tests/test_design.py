@@ -1,12 +1,14 @@
 """tengsim design / tengsim.design: a small pyramid design, converged, checked against a grid √2 finer; its files
 (CF-1.10 NetCDF, CSV, report, figures in physical units); bad input refused in one line, nothing written; two
 designs compared."""
+import dataclasses
 import math
 
 import numpy as np
 import pytest
 
 from tengsim.cli.main import main
+from tengsim.errors import TengsimError
 from tengsim.design import plan_design, run_design, write_design
 from tengsim.design.write import CHANGE_NA
 
@@ -102,7 +104,7 @@ def test_files_cf_report_and_labels(small, tmp_path):
     (["--pitch", "10uu"], "10uu"),
     (["--p-max", "0kPa"], "p_max"),
     (["--eps", ""], "eps"),
-    (["--dx", "1nm"], "--dx"),  # a 1000² grid: estimated over the 10 min budget
+    (["--dx", "0.25nm"], "--dx"),  # a 4000² grid: expected over the 10 min budget
 ])
 def test_bad_input_one_line_exit_2_nothing_written(tmp_path, capsys, bad, words):
     argv = list(CLI_SMALL)
@@ -310,8 +312,7 @@ def test_budget_cap_lies_between_plain_grids():
 
     from tengsim.cli.design import _read_toml
     from tengsim.run.plan import plan_contact
-    from tengsim.design.run import D_MIN, D_STEP, ROWS_PER_STEP, SECONDS_PER_PIXEL_ROW, _blocks, budget_pixels
-    from tengsim.design.run import height_eps, start_dx
+    from tengsim.design.run import budget_pixels, height_eps, run_cost, start_dx
 
     plan = plan_design(_read_toml(str(Path(__file__).parent.parent / "examples" / "own_design" / "pyramid.toml")))
     cp = plan_contact(plan.contact_table)
@@ -319,13 +320,66 @@ def test_budget_cap_lies_between_plain_grids():
     d_max = 1.2 * height_eps(cp, dx) + 2.0
     cap = budget_pixels(plan, cp, dx, d_max)
     assert cap >= 585 * 585
-    rows = ROWS_PER_STEP * (d_max - D_MIN) / D_STEP
+    cost = run_cost(cp, d_max)
     plain = [cp.shape.grid(dx / math.sqrt(2.0) ** k) for k in range(8)]
     below = [g for g in plain if g.nx * g.ny <= cap]
     nxt = plain[len(below)]
     assert nxt.nx * nxt.ny > cap  # the cap lies before the next plain grid, which the budget does not pay for
-    secs = sum(SECONDS_PER_PIXEL_ROW * _blocks(cp.shape, g) * rows for g in below)
+    secs = sum(cost.grid_seconds(cp.shape, g) for g in below)
     assert secs <= plan.budget_s  # the plain grids up to the cap fit the budget
+
+
+def test_estimate_uses_the_backends_cost_and_names_it(monkeypatch):
+    """The design's expected time is the CPU model's where JAX sees no GPU and the GPU model's (a floor per
+    iteration plus a per-point term) where it does, and its line names the backend assumed; on the GPU the
+    same design is expected faster at these sizes (the GPU solves the whole grid, the CPU a mirrored quarter)."""
+    from pathlib import Path
+
+    from tengsim.cli.design import _read_toml
+    from tengsim.design import run as dr
+    from tengsim.resources import CPU_COST, GPU_COST
+    from tengsim.run.plan import plan_contact
+    from tengsim.solvers import choice
+
+    plan = plan_design(_read_toml(str(Path(__file__).parent.parent / "examples" / "own_design" / "pyramid.toml")))
+    cp = plan_contact(plan.contact_table)
+    assert cp.solver == "fast" and "no GPU" in cp.solver_note  # auto, on this machine
+    dx = dr.start_dx(plan, cp)
+    cpu = dr.estimate(plan, cp, dx, 25.0)
+    assert cpu.backend == CPU_COST.backend and "CPU" in cpu.lines()[1]
+    monkeypatch.setattr(choice, "gpu_visible", lambda: True)
+    gpu = dr.estimate(plan, dataclasses.replace(cp, solver="gpu"), dx, 25.0)
+    assert gpu.backend == GPU_COST.backend and "GPU" in gpu.lines()[1]
+    g = cp.shape.grid(dx)
+    rows_its = gpu.cost.rows * gpu.cost.iterations
+    per_iteration = GPU_COST.floor + GPU_COST.per_point * g.nx * g.ny
+    assert gpu.cost.grid_seconds(cp.shape, g) == pytest.approx(rows_its * per_iteration)
+    assert gpu.seconds < cpu.seconds
+    assert dr.budget_pixels(plan, dataclasses.replace(cp, solver="gpu"), dx, 25.0) > dr.budget_pixels(plan, cp, dx, 25.0)
+
+
+def test_auto_picks_the_gpu_where_jax_sees_one(monkeypatch):
+    from tengsim.solvers import choice
+
+    assert choice.choose("fast") == ("fast", "")
+    monkeypatch.setattr(choice, "gpu_visible", lambda: False)
+    assert choice.choose("auto")[0] == "fast" and "no GPU" in choice.choose("auto")[1]
+    with pytest.raises(TengsimError, match="no GPU"):
+        choice.choose("gpu")
+    monkeypatch.setattr(choice, "gpu_visible", lambda: True)
+    assert choice.choose("auto")[0] == "gpu"
+
+
+def test_solver_gpu_without_a_gpu_one_line_exit_2_nothing_written(tmp_path, capsys):
+    from tengsim.solvers.choice import gpu_visible
+
+    if gpu_visible():
+        pytest.skip("this machine has a GPU")
+    out = tmp_path / "never"
+    assert main([*CLI_SMALL, "--solver", "gpu", "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "gpu" in err and "no GPU" in err, err
+    assert not out.exists()
 
 
 def test_report_table_cells_hold_no_pipe():

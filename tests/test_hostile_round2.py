@@ -356,11 +356,12 @@ def test_geometry_errors_are_in_the_users_units_and_the_given_dx_is_honoured(her
     line = refused(capsys, ["design", "hemisphere", "--pitch", "1um", "--radius", "2um", "--E-star", "2MPa",
                             "--W", "40mJ/m2", "--eps", "20nm", "--p-max", "50kPa", "--out", "o"], here)
     assert "4 µm exceeds its cell 1 µm" in line
-    # a 1 mm pitch at dx 20 µm: judged at the given dx (by its budget), not refused by the default dx's grid
+    # a 1 mm pitch at dx 20 µm: judged at the given dx (by its budget, here 1 s), not refused by the default dx's
+    # grid (a path of thousands of rows: the budget refuses it, in seconds, not the pixels per side)
     line = refused(capsys, ["design", "pyramid", "--pitch", "1mm", "--base", "0.5mm", "--height", "0.2mm",
                             "--E-star", "5MPa", "--W", "20mJ/m2", "--eps", "50nm", "--p-max", "20kPa", "--dx", "20um",
-                            "--out", "o"], here)
-    assert "pixels per side" not in line and "dx=" not in line
+                            "--budget", "1s", "--out", "o"], here)
+    assert "pixels per side" not in line and "dx=" not in line and "budget" in line
 
 
 def test_a_wrong_key_points_to_the_shapes_help_and_help_lists_only_keys_taken(capsys):

@@ -71,6 +71,20 @@ class KernelLike(Protocol):
 
 
 @runtime_checkable
+class FourierKernelLike(KernelLike, Protocol):
+    """A kernel that multiplies in Fourier space, which the JAX solver (tengsim.solvers.jax_fast) runs on its
+    device: w = irfft2(rfft2(p, s=padded_shape) · spectrum) cropped to the grid.  ``padded_shape`` is the grid's
+    shape (periodic) or the zero-padded one (free cell); ``spectrum`` the multiplier on the rfft2 layout of
+    ``padded_shape``; ``pinned_mean`` True when the mean of p is not set by K (periodic half-space: K̂(0) = 0)."""
+
+    padded_shape: tuple
+    pinned_mean: bool
+
+    @property
+    def spectrum(self) -> np.ndarray: ...
+
+
+@runtime_checkable
 class SolverLike(Protocol):
     """Finds one stable equilibrium of a :class:`tengsim.solvers.Problem` from a start state."""
 

@@ -20,6 +20,7 @@ before the solve).  Checked against the peak RSS of a 525² run (tests/test_reso
 from __future__ import annotations
 
 import os
+from dataclasses import dataclass
 
 from tengsim.errors import TengsimError
 
@@ -121,6 +122,34 @@ def cgroup_room(root: str = "/sys/fs/cgroup") -> int | None:
     except (OSError, ValueError):
         pass
     return max(0, int(limit) - used + cache)
+
+
+@dataclass(frozen=True)
+class CostModel:
+    """Seconds of one solver iteration on a grid of ``points`` solved pixels: ``floor`` + ``per_point`` × points;
+    ``backend`` names the machine and solver the constants were measured on (printed with every estimate)."""
+
+    backend: str
+    floor: float
+    per_point: float
+
+    def iteration_seconds(self, points: float) -> float:
+        return self.floor + self.per_point * float(points)
+
+
+CPU_COST = CostModel("CPU (NumPy fast solver; constant of the 2-core build machine)", 0.0, 5.3e-8)
+"""The NumPy fast solver: seconds per solved pixel and iteration, fitted on four designs on the 2-core build machine
+(docs/benchmarks.md, "Design estimates")."""
+GPU_COST = CostModel("GPU (JAX solver, float64; constants of one NVIDIA H200)", 6.2e-4, 3.5e-10)
+"""The JAX solver on a GPU: a floor per iteration (launches and synchronisations) plus a per-point term, fitted to
+one H200's cold rough solves at 1024²–8192² (docs/benchmarks.md, "GPU")."""
+GPU_BYTES_PER_POINT = {"float64": 480, "float32": 240}
+"""Peak device memory of the JAX solver per grid point, rounded up from the H200's (docs/benchmarks.md, "GPU")."""
+
+
+def cost_model(gpu: bool) -> CostModel:
+    """The cost model of the backend a run solves on: :data:`GPU_COST` on a GPU, else :data:`CPU_COST`."""
+    return GPU_COST if gpu else CPU_COST
 
 
 def _gib(b: float) -> str:

@@ -1,5 +1,8 @@
-"""The one seam for arrays and FFTs: every array the solvers allocate and every Fourier transform of
-the package goes through here (NumPy arrays, scipy's pocketfft today; a GPU backend plugs in here).
+"""The seam for the NumPy solvers' arrays and FFTs: every array the NumPy solvers (fast, vsr, homotopy, the
+mirror and MPI kernels) allocate and every Fourier transform they and the kernels' builds make goes through
+here (NumPy arrays, scipy's pocketfft).  The JAX solver (tengsim.solvers.jax_fast) does not: its loop is one
+compiled program on its device, with ``jnp.fft`` inside it (tengsim.solvers._jax_fft); it takes from a
+kernel only its spectrum and padded shape (tengsim.registry.FourierKernelLike), built here on the host.
 
 - the array namespace :data:`xp` and its allocators :func:`empty`, :func:`zeros`; the small solve
   :func:`solve_upper` (the L-BFGS memory's triangular systems, on backend arrays); :func:`sync` brings

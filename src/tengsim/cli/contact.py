@@ -75,6 +75,8 @@ def run(args) -> int:
         run_contact(plan)
         return 0
     line = None if args.quiet or plan.scaling is None else f"tengsim: {physical_line(plan, 'eps' in cfg)}"
+    if plan.solver_note and not args.quiet:  # the solver 'auto' chose, said before the run
+        line = "\n".join(x for x in (line, f"tengsim: {plan.solver_note}") if x)
     stream = open_stream(out, args.resume, args.quiet)
     res = run_streamed(lambda bar: run_contact(plan, progress=_Announced(bar, line), sink=stream), stream,
                        args.quiet)

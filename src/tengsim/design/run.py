@@ -4,11 +4,14 @@
 
 1. **Grid.**  The first dx is the user's (a length) or :func:`start_dx`: the finer of
    :func:`tengsim.run.resolve.default_dx` (the law's process zone over the pixels the status asks for, and the
-   pixel-snap limit) and the process zone over :data:`START_ZONE_PIXELS`.  Before anything runs,
-   :func:`estimate` prints the grids (first, and the next two of √2 refinement), the memory of the finest
-   and an estimated time: :data:`SECONDS_PER_PIXEL_ROW` × pixels × rows per grid (docs/benchmarks.md, "Design
-   time constant"); an estimate above the plan's budget is refused (a :class:`tengsim.errors.TengsimError`
-   naming max_pixels and tol) before anything is solved or written.
+   pixel-snap limit) and the process zone over :data:`START_ZONE_PIXELS`.  After the coarse pre-run of step 2
+   (the path's range and the solver's iterations per row, on a cheap grid) and before the refinement,
+   :func:`estimate` prints the grids (first, and the next two of √2 refinement), the memory of the finest,
+   the solver ``auto`` chose and the expected time: the first two grids and half the third, each rows ×
+   iterations × the backend's cost per iteration (:class:`Cost`, :mod:`tengsim.resources`: the CPU's or the
+   GPU's model, named in the line); :func:`cap_line` the worst case up to the budget's largest grid.  An
+   expected time above the plan's budget is refused (a :class:`tengsim.errors.TengsimError` naming max_pixels
+   and tol) before the refinement is solved or anything written.
 2. **Path.**  An adaptive D walk (:class:`tengsim.continuation.path.PathSpec`) from D = -1 ε to a d_max found on a grid
    twice as coarse as the default first grid: from 1.2 × the structure's height (+2 ε), extended in chunks (the
    last rows' dP/dD, extrapolated to 1.3 × the pressure still missing) until the approach reaches p_max, at
@@ -34,15 +37,20 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from tengsim.errors import TengsimError
+from tengsim.resources import CostModel, cost_model
 
-SECONDS_PER_PIXEL_ROW = 6.4e-6
-"""Wall seconds per (pixel of the solved block) × (path row), one core: measured on the 2-core build machine
-(docs/benchmarks.md, 'Design time constant'); used for the printed estimate only."""
 D_MIN = -1.0
 D_STEP = 0.4
 """Largest D step (ε) of the adaptive walk (refine_levels 4: smallest 0.025 ε)."""
-ROWS_PER_STEP = 2.9
-"""Path rows per d_step of D range, approach and retraction together (measured: adaptive steps)."""
+ROWS_PER_STEP = 2.0
+"""Path rows per d_step of D range on each grid, approach and retraction together (the first grid walks to d_max,
+each finer one to a little past where the grid before reached p_max; docs/benchmarks.md, "Design estimates")."""
+ITERATIONS_PER_COARSE = 4.0
+"""A refinement grid's solver iterations per path row over the coarse pre-run's mean (:func:`find_d_max`;
+docs/benchmarks.md, "Design estimates")."""
+THIRD_GRID_SHARE = 0.5
+"""The expected run counts the third grid at this weight: some designs converge on two grids, others need a third
+(docs/benchmarks.md, "Design estimates")."""
 LEVELS_ESTIMATED = 3
 EXTEND_TRIES = 6
 SOLVER_TOL_PER_TOL = 0.01
@@ -139,74 +147,117 @@ def height_eps(cplan, dx) -> float:
 
 
 @dataclass(frozen=True)
+class Cost:
+    """What a design's run costs per grid, known after the coarse pre-run (:func:`find_d_max`): the backend's
+    :class:`tengsim.resources.CostModel`, the path rows per grid and the solver iterations per row."""
+
+    model: CostModel
+    rows: float
+    iterations: float
+    gpu: bool = False
+
+    def grid_seconds(self, shape, grid) -> float:
+        """Seconds of one grid's walk (the GPU solves the whole grid: the JAX solver has no mirror symmetry)."""
+        points = grid.nx * grid.ny if self.gpu else _blocks(shape, grid)
+        return self.rows * self.iterations * self.model.iteration_seconds(points)
+
+
+def on_gpu(cplan) -> bool:
+    """Whether the plan's solver runs on a GPU ('gpu', or 'jax' where JAX sees one)."""
+    from tengsim.solvers.choice import gpu_visible
+
+    name = cplan.solver if isinstance(cplan.solver, str) else getattr(cplan.solver, "name", "")
+    return name == "gpu" or (name == "jax" and gpu_visible()) or getattr(cplan.solver, "device", "") == "gpu"
+
+
+def run_cost(cplan, d_max: float, coarse=None) -> Cost:
+    """The :class:`Cost` of a design's grids: rows from the path's D range (:data:`ROWS_PER_STEP`), iterations per
+    row from the coarse pre-run ``coarse`` (× :data:`ITERATIONS_PER_COARSE`; 20 per row without one)."""
+    its = 20.0
+    if coarse is not None:
+        it = np.asarray(coarse.table.get("iterations", ()), dtype=float)
+        if it.size and np.isfinite(it).all():
+            its = float(np.mean(it))
+    gpu = on_gpu(cplan)
+    return Cost(cost_model(gpu), ROWS_PER_STEP * (d_max - D_MIN) / D_STEP, ITERATIONS_PER_COARSE * its, gpu)
+
+
+@dataclass(frozen=True)
 class Estimate:
     grids: tuple  # ((nx, ny, dx_m), ...)
     memory_bytes: int
     seconds: float
     d_max: float
+    backend: str = ""
+    cost: Cost | None = None
 
     def lines(self) -> list:
         from tengsim.design.units import bytes_text, length_text, time_text
 
         g = ", ".join(f"{nx}×{ny} (dx {length_text(d)})" for nx, ny, d in self.grids)
+        rows = (f", {self.cost.rows:.0f} rows of about {self.cost.iterations:.0f} iterations per grid"
+                if self.cost else "")
         return [f"grids: {g} (refined by √2 until converged; the last two are used only if needed)",
-                f"memory: {bytes_text(self.memory_bytes)} on the finest; estimated time: {time_text(self.seconds)} "
-                f"(all {len(self.grids)} grids, D path to about {self.d_max:.0f} ε)"]
+                f"memory: {bytes_text(self.memory_bytes)} on the finest; expected time: {time_text(self.seconds)} "
+                f"(the first two grids and half the third, D path to about {self.d_max:.0f} ε{rows}) on "
+                f"{self.backend}"]
 
 
-def estimate(plan, cplan, dx: float, d_max: float) -> Estimate:
-    """Grids, memory and time of the refinement (module doc, step 1)."""
+def estimate(plan, cplan, dx: float, d_max: float, coarse=None) -> Estimate:
+    """Grids, memory and expected time of the refinement (module doc, step 1): the first two grids and
+    :data:`THIRD_GRID_SHARE` of the third, at the cost :func:`run_cost` of the backend the plan solves on."""
     from tengsim.resources import estimate_bytes
 
+    cost = run_cost(cplan, d_max, coarse)
     grids, secs = [], 0.0
-    rows = ROWS_PER_STEP * (d_max - D_MIN) / D_STEP
-    for g in refinement_grids(cplan.shape, dx, LEVELS_ESTIMATED):  # the grids the refinement will walk
+    for k, g in enumerate(refinement_grids(cplan.shape, dx, LEVELS_ESTIMATED)):  # the grids the refinement walks
         if plan.max_pixels is not None and g.nx * g.ny > plan.max_pixels and grids:
             break
         grids.append((g.nx, g.ny, g.dx * cplan.scaling.lateral))
-        secs += SECONDS_PER_PIXEL_ROW * _blocks(cplan.shape, g) * rows
+        secs += cost.grid_seconds(cplan.shape, g) * (THIRD_GRID_SHARE if k >= 2 else 1.0)
     nx, ny, _ = grids[-1]
-    return Estimate(tuple(grids), estimate_bytes(nx, ny, cplan.boundary, cplan.solver), secs, d_max)
+    return Estimate(tuple(grids), estimate_bytes(nx, ny, cplan.boundary, cplan.solver), secs, d_max,
+                    cost.model.backend, cost)
 
 
-def budget_pixels(plan, cplan, dx: float, d_max: float) -> int:
-    """The largest grid (nx·ny) the refinement may reach within the plan's time budget (the estimate summed
+def budget_pixels(plan, cplan, dx: float, d_max: float, coarse=None) -> int:
+    """The largest grid (nx·ny) the refinement may reach within the plan's time budget (the cost summed
     over the grids dx, dx/√2, ... up to it): the default max_pixels, so no default run runs past its budget."""
-    rows = ROWS_PER_STEP * (d_max - D_MIN) / D_STEP
+    cost = run_cost(cplan, d_max, coarse)
     secs, top = 0.0, 9
     for k in range(12):
         g = cplan.shape.grid(dx / math.sqrt(2.0) ** k)
-        cost = SECONDS_PER_PIXEL_ROW * _blocks(cplan.shape, g) * rows
-        if secs + cost > plan.budget_s and k > 0:  # the grid between the last that fits and this one that the
+        step = cost.grid_seconds(cplan.shape, g)
+        if secs + step > plan.budget_s and k > 0:  # the grid between the last that fits and this one that the
             # budget still pays for (a grid's time goes as its pixels): the refinement's grids keep a shape's
             # edges in place and so are up to resolve.PHASE_SPAN larger than the plain √2 sequence
-            return max(top, int(g.nx * g.ny * (plan.budget_s - secs) / cost))
-        secs += cost
+            return max(top, int(g.nx * g.ny * (plan.budget_s - secs) / step))
+        secs += step
         top = g.nx * g.ny
     return top
 
 
-def cap_line(plan, cplan, dx: float, d_max: float, cap: int) -> str:
-    """What the refinement costs at most: the grids dx, dx/√2, ... up to ``cap`` pixels, and their summed estimate."""
+def cap_line(plan, cplan, dx: float, d_max: float, cap: int, coarse=None) -> str:
+    """The worst case: the grids dx, dx/√2, ... up to ``cap`` pixels, and their summed cost."""
     from tengsim.design.units import time_text
 
-    rows = ROWS_PER_STEP * (d_max - D_MIN) / D_STEP
+    cost = run_cost(cplan, d_max, coarse)
     secs, last = 0.0, None
     for k in range(16):
         g = cplan.shape.grid(dx / math.sqrt(2.0) ** k)
         if g.nx * g.ny > cap and last is not None:
             break
-        secs += SECONDS_PER_PIXEL_ROW * _blocks(cplan.shape, g) * rows
+        secs += cost.grid_seconds(cplan.shape, g)
         last = g
     side = max(last.nx, math.isqrt(int(cap)))
     if side > last.nx:  # one more grid, beyond the plain sequence's last (budget_pixels): its time as its pixels
-        secs += SECONDS_PER_PIXEL_ROW * _blocks(cplan.shape, last) * rows * side * side / (last.nx * last.ny)
+        secs += cost.grid_seconds(cplan.shape, last) * side * side / (last.nx * last.ny)
     return (f"at most: refinement up to {side}×{side} (the budget's largest grid; --max-pixels sets it), "
             f"about {time_text(secs)} in all")
 
 
 def check_budget(plan, est: Estimate, fit_pixels: int | None = None) -> None:
-    """Refuse an estimate over the plan's budget, naming what to change: a max_pixels that fits (when the
+    """Refuse an expected time over the plan's budget, naming what to change: a max_pixels that fits (when the
     first two grids do) or a coarser dx."""
     from tengsim.design.units import length_text, time_text
 
@@ -216,9 +267,9 @@ def check_budget(plan, est: Estimate, fit_pixels: int | None = None) -> None:
     what = f"a coarser --dx (the first grid's is {length_text(est.grids[0][2])})"
     if fit_pixels and two and fit_pixels >= two:
         what = f"--max-pixels {fit_pixels} (the grids that fit the budget), {what}"
-    raise TengsimError(f"this design is estimated at {time_text(est.seconds)}, over the budget of "
-                       f"{time_text(plan.budget_s)}: give {what}, a coarser --tol (now {plan.tol:g}) or a larger "
-                       "--budget")
+    raise TengsimError(f"this design is expected to take {time_text(est.seconds)} on {est.backend.split(' (')[0]}, "
+                       f"over the budget of {time_text(plan.budget_s)}: give {what}, a coarser --tol (now "
+                       f"{plan.tol:g}) or a larger --budget")
 
 
 def preflight(plan) -> None:
@@ -250,7 +301,7 @@ def preflight(plan) -> None:
         from tengsim.kernels.film import check_film_pixels
 
         check_film_pixels(cplan.kernel_params["thickness"], max(g.dx, g.dy), lateral)
-    secs = SECONDS_PER_PIXEL_ROW * _blocks(cplan.shape, g) * ROWS_PER_STEP * (2.0 - D_MIN) / D_STEP
+    secs = run_cost(cplan, 2.0).grid_seconds(cplan.shape, g)  # the shortest path, on the backend's cost model
     if secs > plan.budget_s:
         raise TengsimError(f"{plan.name[:80]}: {first} alone is estimated at {time_text(secs)}, over the budget "
                            f"of {time_text(plan.budget_s)}: give a coarser --dx, a coarser --tol (now "
@@ -306,20 +357,19 @@ def _reach(res, p_max):
     return bool(len(hit)), (float(D[hit[0]]) if len(hit) else math.nan), float(np.max(P)), slope
 
 
-def find_d_max(plan, cplan, dx, progress=None):
+def find_d_max(plan, cplan, dx, progress=None, guard=None):
     """(d_max, the coarse result): the D range that reaches p_max on a grid twice as coarse as the first
-    (module doc, step 2)."""
+    (module doc, step 2); ``guard`` (called per path row, e.g. :func:`_deadline`) may stop it."""
     from tengsim.design.units import pressure_text
 
     p_max = plan.pressures[-1]
-    coarse = 2 * dx
-    if plan.dx is None:  # the default grid's (the cell over 9 pixels at most): cheap, whatever the first grid
-        from tengsim.run.resolve import default_dx
+    from tengsim.run.resolve import default_dx
 
-        coarse = 2 * max(dx, default_dx(cplan.shape, cplan.law, cplan.coupling, cplan.boundary))
+    # the default grid's (the cell over 9 pixels at most): cheap, whatever the first grid (a --dx too)
+    coarse = 2 * max(dx, default_dx(cplan.shape, cplan.law, cplan.coupling, cplan.boundary))
     d_max = 1.2 * height_eps(cplan, dx) + 2.0
     for _ in range(EXTEND_TRIES):
-        res = _simulate(cplan, coarse, d_max)
+        res = _simulate(cplan, coarse, d_max, **({} if guard is None else {"progress": guard}))
         ok, D_hit, top, slope = _reach(res, p_max)
         if ok:
             return 1.1 * D_hit + 1.0, res
@@ -487,7 +537,7 @@ def _checkpoint(keep, base, d_max, progress):
 def run_design(plan, progress=None, keep=None) -> DesignResult:
     """Run one design (module doc).  ``progress``: a :class:`tengsim.progress.Progress`-like callable (the
     path's progress) and/or an object with ``say(text)``, which gets the lines said before and during the run
-    (the Tabor number, the grids, memory and estimated time).  ``keep`` (a file path, or None): where each
+    (the Tabor number, the solver, the grids, memory and expected time).  ``keep`` (a file path, or None): where each
     finished grid is kept (:func:`_checkpoint`), so a killed run of the same design resumes from it."""
     from tengsim.run.plan import ResolveSettings, as_plan
     from tengsim.design.curves import summarize
@@ -501,19 +551,22 @@ def run_design(plan, progress=None, keep=None) -> DesignResult:
     cplan = dataclasses.replace(as_plan(plan.contact_table if plan.contact_plan is None else plan.contact_plan),
                                 tol=solver_tol(plan))  # the plan plan_design built (planned once)
     dx = start_dx(plan, cplan)
-    est = estimate(plan, cplan, dx, 1.2 * height_eps(cplan, dx) + 2.0)
     _say(progress, f"{plan.name}: Tabor number {cplan.tabor:.3g} (from eps = {plan.eps * 1e9:.3g} nm), "
                    f"lateral unit {cplan.scaling.lateral * 1e9:.3g} nm")
+    if cplan.solver_note:
+        _say(progress, cplan.solver_note)
+    d_max, coarse = find_d_max(plan, cplan, dx, progress,  # the path's range and iterations, on a cheap grid
+                               guard=_deadline(None, plan, keep, started))
+    est = estimate(plan, cplan, dx, d_max, coarse)
     for line in est.lines():
         _say(progress, line)
-    check_budget(plan, est, plan.max_pixels or budget_pixels(plan, cplan, dx, est.d_max))
-    d_max, coarse = find_d_max(plan, cplan, dx, progress)
     base = identity(plan)
     later = _kept_path(keep, base)
     if later is not None and later > d_max:  # killed in its second pass: go on on that pass's path
         d_max = later
-    max_pixels = plan.max_pixels or budget_pixels(plan, cplan, dx, d_max)
-    _say(progress, cap_line(plan, cplan, dx, d_max, max_pixels))
+    max_pixels = plan.max_pixels or budget_pixels(plan, cplan, dx, d_max, coarse)
+    check_budget(plan, est, max_pixels)
+    _say(progress, cap_line(plan, cplan, dx, d_max, max_pixels, coarse))
     res = None
     for _ in range(2):
         from tengsim.continuation import PathSpec

@@ -66,6 +66,11 @@ class FreeKernel(_Film):
         self.periodic = False
         self.pinned_mean = False
 
+    @property
+    def spectrum(self) -> np.ndarray:
+        """K̂ on the rfft2 layout of the padded grid (:class:`tengsim.registry.FourierKernelLike`)."""
+        return self._spectrum
+
     def apply(self, p: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
         """w = K p on the cell (one convolution), into ``out`` if given."""
         return self._conv(np.asarray(p, dtype=float), out)
@@ -111,6 +116,11 @@ class PeriodicKernel(_Film):
         self._conv = PeriodicConvolver(g.shape, mult)
         self.padded_shape = g.shape
         self.periodic = True
+
+    @property
+    def spectrum(self) -> np.ndarray:
+        """The multiplier on the rfft2 layout of the grid (:class:`tengsim.registry.FourierKernelLike`)."""
+        return self._spectrum
 
     def apply(self, p: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
         """w = K p (one convolution), into ``out`` if given."""

@@ -133,7 +133,7 @@ def common_fields() -> list:
               help="film on its substrate: bonded (no slip) or frictionless (needs thickness)"),
         Field("poisson", default=0.5, help="Poisson ratio ν of the film, -1 < ν <= 0.5; E* keeps its meaning, "
               "E = E*(1 - ν²) (needs thickness)"),
-        Field("solver", "str", "fast", choices=SOLVERS.names, help="solver: " + SOLVERS.help()),
+        Field("solver", "str", "auto", choices=SOLVERS.names, help="solver: " + SOLVERS.help()),
         Field("tol", default=1e-6, help="max residual of Eq. (9) in ε"),
         Field("symmetry", "str", "auto", choices=("auto", "off"),
               help="auto: solve on the irreducible quarter (half) of the cell when the shape and its grid are "

@@ -209,9 +209,17 @@ class ContactPlan:
     symmetry: str = "auto"
     grid: object = None
     config: dict = field(default_factory=dict)
+    solver_note: str = ""
+    """Why the solver is the one it is when ``auto`` chose it (printed before the run); '' otherwise."""
 
     def __post_init__(self):
+        from tengsim.solvers.choice import choose
+
         mu = positive("tabor", self.tabor)
+        solver, note = choose(self.solver)  # 'auto': gpu where JAX sees one, else fast; 'gpu' without one: refused
+        if note:
+            object.__setattr__(self, "solver", solver)
+            object.__setattr__(self, "solver_note", note)
         if self.scaling is not None and abs(self.scaling.mu - mu) > 1e-9 * mu:
             raise TengsimError(f"tabor = {mu:g} does not match the scaling's μ = {self.scaling.mu:g}")
         law = make_law(self.law) if isinstance(self.law, str) else (self.law or LJ93())

@@ -11,9 +11,11 @@ What differs is only the bookkeeping JAX needs: arrays of fixed shape.  The memo
 present; a slot is active when its index is below the count k (as in the NumPy ring, the active slots
 are always 0 … k − 1), its age orders the pairs, and inactive slots are masked out of the small
 triangular solves (identity rows, zero right-hand sides), so they contribute exact zeros.  Python's
-``None`` (no bracket end yet, no best point) becomes a flag.  Scalars (energies, slopes, inner products) are
-accumulated in float64 even when the fields are float32 (the convert fused into the reduction: no
-extra pass over memory); the rows' products B @ v and the law stay in the fields' precision.
+``None`` (no bracket end yet, no best point) becomes a flag.  Scalars (energies, slopes, inner products, the
+rows' products B @ v: :func:`row_products`) are accumulated in float64 even when the fields are float32 (the
+convert fused into the reduction: no extra pass over memory); the law stays in the fields' precision.  Choices
+the NumPy solver makes with ``if`` (a restart to steepest descent, the law's own sum or the safe extension's)
+are selects on the device where both sides are cheap, so that an iteration waits for the host less often.
 
 Everything here is built by :func:`build` for one static configuration (grid, kernel kind, law class,
 dtype, memory, resync); every number that varies between equilibria (g0, the start, the kernel's
@@ -27,11 +29,11 @@ from jax import lax
 from jax.scipy.linalg import solve_triangular
 
 from tengsim.laws.safe import SafeLaw
+from tengsim.solvers import _jax_fft
+from tengsim.solvers._constants import (APPROX_SLOPE, C1, C2, CURVATURE_EPS, EPS_E, FIRST_MOVE, GROW, MAX_EVAL,
+                                        SAFEGUARD)
 
 F64 = jnp.float64
-C1, C2, MAX_EVAL, FIRST_MOVE = 1e-4, 0.9, 40, 0.25  # tengsim.solvers._linesearch.WolfeLineSearch's defaults
-#: the approximate Wolfe test's energy slack, relative: the NumPy solver's in float64; float32 fields round E at ~1e-7
-EPS_E = {"float64": 1e-11, "float32": 1e-6}
 
 
 def law_twin(cls, fields, values):
@@ -43,23 +45,38 @@ def law_twin(cls, fields, values):
     return t
 
 
-def build(shape, padded, periodic, pinned, law_cls, law_fields, dtype, memory, resync):
-    """The solve as a function of traced arguments (see :func:`solve`'s signature), for jax.jit."""
+def row_products(M, v):
+    """M @ v (the L-BFGS rows' products with a field) accumulated in float64.  float64 fields: the plain matmul.
+    float32 fields: each row's sum in float64, the converts fused into one reduction over M (no float64 copy of
+    M).  A float32 matmul accumulates the n products in float32, with an error growing with n; the products of
+    L-BFGS rows with a near-converged gradient cancel, so their relative error is larger still, and the directions
+    built from them stopped float32 solves short of their tolerance on large grids (docs/benchmarks.md, "GPU")."""
+    if M.dtype == F64:
+        return jnp.matmul(M, v)
+    return jnp.sum(M.astype(F64) * v.astype(F64)[None, :], axis=1)
+
+
+def build(shape, padded, periodic, pinned, law_cls, law_fields, dtype, memory, resync, mesh=None):
+    """The solve as a function of traced arguments (see :func:`solve`'s signature), for jax.jit; ``mesh``: the
+    devices the grid's rows are split over (tengsim.solvers._jax_fft), None for one device."""
     nx, ny = shape
     m = int(memory)
     dt = jnp.dtype(dtype)
+    conv = _jax_fft.convolution(shape, padded, periodic, dt, mesh)
+    if mesh is None:
+        def rows_split(a):
+            return a
+    else:
+        rows_sharding = _jax_fft.field_sharding(mesh, 2, 1)
 
-    def conv(x, spec):
-        if periodic:
-            return jnp.fft.irfft2(jnp.fft.rfft2(x.reshape(shape)) * spec, s=shape).astype(dt).ravel()
-        y = jnp.fft.irfft2(jnp.fft.rfft2(x.reshape(shape), s=padded) * spec, s=padded)
-        return y[:nx, :ny].astype(dt).ravel()
+        def rows_split(a):  # the memory's rows split along the points like every field
+            return lax.with_sharding_constraint(a, rows_sharding)
 
     def dot(a, b):  # a·b accumulated in float64 (one fused pass, no float64 copy of a float32 field)
         return jnp.sum(a.astype(F64) * b.astype(F64))
 
-    def rows(M, v):  # M @ v over the stored rows: in the fields' precision (a float64 M @ v would copy M)
-        return jnp.matmul(M, v).astype(F64)
+    def rows(M, v):  # M @ v over the stored rows, accumulated in float64 (:func:`row_products`)
+        return row_products(M, v)
 
     def total(a):
         return jnp.sum(a, dtype=F64)
@@ -84,7 +101,11 @@ def build(shape, padded, periodic, pinned, law_cls, law_fields, dtype, memory, r
                 phis, P = fast_sum(g, jnp, total)
                 return phis, P.astype(dt)
 
-            return lax.cond(jnp.min(g) < law.g_safe, plain, own, g)
+            # both sums in the same pass over g, one selected: no conditional (a host synchronisation per
+            # line-search trial on a GPU) for a choice made on the device
+            low = jnp.min(g) < law.g_safe
+            (p1, P1), (p2, P2) = plain(g), own(g)
+            return jnp.where(low, p1, p2), jnp.where(low, P1, P2)
 
         def law_sweep(g):
             phis, P = law_phis(g)
@@ -125,7 +146,7 @@ def build(shape, padded, periodic, pinned, law_cls, law_fields, dtype, memory, r
             gt = Kd * a.astype(dt) + g
             phis, Pt = law_phis(gt)
             Pt = Pt.astype(dt)
-            dpk = dot(Pt - P, Kd)
+            dpk = dot(Pt.astype(F64) - P.astype(F64), Kd)  # the pressure change exact in float64 (small steps)
             e = dA * (0.5 * qw + a * dw + 0.5 * a * a * dKd + phis)
             de = slope + dA * (a * dKd - dpk)
             return e, de, phis, total(Pt), gt, Pt
@@ -147,7 +168,7 @@ def build(shape, padded, periodic, pinned, law_cls, law_fields, dtype, memory, r
                 e, de, phis, sp, gt, Pt = evaluate(a, *ev)
                 fin = jnp.isfinite(e)
                 wolfe = (e <= E0 + C1 * a * slope0) & (jnp.abs(de) <= -C2 * slope0)
-                approx = (e <= E_lo + eps_E) & (C2 * slope0 <= de) & (de <= -0.8 * slope0)
+                approx = (e <= E_lo + eps_E) & (C2 * slope0 <= de) & (de <= -APPROX_SLOPE * slope0)
                 acc = fin & (wolfe | approx)
                 better = fin & (e <= E_lo + eps_E) & (~s["has_best"] | (jnp.abs(de) < s["best_de"]))
                 to_hi = ~fin | (e > E0 + C1 * a * slope0 + eps_E) | (de > 0)
@@ -161,7 +182,8 @@ def build(shape, padded, periodic, pinned, law_cls, law_fields, dtype, memory, r
                 width = hi - lo
                 sec = has_de_hi & (de_hi > de_lo)
                 cand = jnp.where(sec, lo - de_lo * width / jnp.where(sec, de_hi - de_lo, 1.0), lo + 0.5 * width)
-                nxt = jnp.where(has_hi, jnp.minimum(jnp.maximum(cand, lo + 0.1 * width), hi - 0.1 * width), 2.0 * a)
+                nxt = jnp.where(has_hi, jnp.minimum(jnp.maximum(cand, lo + SAFEGUARD * width), hi - SAFEGUARD * width),
+                                GROW * a)
                 return dict(i=s["i"] + 1, alpha=nxt, lo=lo, de_lo=de_lo, hi=hi, has_hi=has_hi, de_hi=de_hi,
                             has_de_hi=has_de_hi, best_de=jnp.where(better, jnp.abs(de), s["best_de"]),
                             best_a=jnp.where(better, a, s["best_a"]), has_best=s["has_best"] | better,
@@ -180,13 +202,16 @@ def build(shape, padded, periodic, pinned, law_cls, law_fields, dtype, memory, r
             gamma, cS, cY = coefficients(c)
             d, Kd, dw, dKd, dr, sum_d = direction(c, gamma, cS, cY)
 
-            def reset(_):
-                zm = jnp.zeros(m, F64)
-                one = jnp.ones((), F64)
-                return (*direction(dict(c, k=jnp.int32(0)), one, zm, zm), jnp.int32(0), one, zm, zm)
-
-            d, Kd, dw, dKd, dr, sum_d, k, gamma, cS, cY = lax.cond(
-                dr < 0, lambda _: (d, Kd, dw, dKd, dr, sum_d, c["k"], gamma, cS, cY), reset, None)
+            # not a descent direction: restart from steepest descent in the K metric, d = −G, K d = −r (what
+            # the memory's direction is with no pairs), selected element-wise: no conditional
+            ok = dr < 0
+            zm = jnp.zeros(m, F64)
+            d = jnp.where(ok, d, -c["G"])
+            Kd = jnp.where(ok, Kd, -c["r"])
+            dw, dKd, dr, sum_d = (jnp.where(ok, dw, dot(d, c["w"])), jnp.where(ok, dKd, dot(d, Kd)),
+                                  jnp.where(ok, dr, dot(d, c["r"])), jnp.where(ok, sum_d, total(d)))
+            k, gamma = jnp.where(ok, c["k"], jnp.int32(0)), jnp.where(ok, gamma, 1.0)
+            cS, cY = jnp.where(ok, cS, zm), jnp.where(ok, cY, zm)
             c = dict(c, k=k)
             E_best = jnp.minimum(c["E_best"], c["E"])
             kmax = jnp.max(jnp.abs(Kd)).astype(F64)
@@ -237,7 +262,7 @@ def build(shape, padded, periodic, pinned, law_cls, law_fields, dtype, memory, r
             # the memory's update (KMetricLBFGS.update)
             sy, yy = dA * alpha * dky, dA * yky
             sks = dA * alpha * alpha * jnp.abs(dKd)
-            store = (sy > 1e-14 * jnp.maximum(sks, 1e-300)) & (yy > 0)
+            store = (sy > CURVATURE_EPS * jnp.maximum(sks, 1e-300)) & (yy > 0)
             k = c["k"]
             idx = jnp.arange(m)
             act = idx < k
@@ -257,6 +282,7 @@ def build(shape, padded, periodic, pinned, law_cls, law_fields, dtype, memory, r
             pSn = pS.at[slot].set(alpha * (dA * drn))
             pYn = pY.at[slot].set(dA * yrn)
 
+            # a conditional: the rows written in place (a select instead made XLA keep a copy of the rows)
             def write(_):
                 B = c["B"].at[2 * slot].set(d * a).at[2 * slot + 1].set(y)
                 KB = c["KB"].at[2 * slot].set(Kd * a).at[2 * slot + 1].set(ky)
@@ -291,7 +317,8 @@ def build(shape, padded, periodic, pinned, law_cls, law_fields, dtype, memory, r
         qw = dot(q, w)
         E = dA * (0.5 * qw + phis)
         n = g0.shape[0]
-        c0 = dict(q=q, w=w, g=g, P=P, r=r, G=G, B=jnp.zeros((2 * m, n), dt), KB=jnp.zeros((2 * m, n), dt),
+        c0 = dict(q=q, w=w, g=g, P=P, r=r, G=G, B=rows_split(jnp.zeros((2 * m, n), dt)),
+                  KB=rows_split(jnp.zeros((2 * m, n), dt)),
                   SY=jnp.zeros((m, m), F64), YY=jnp.zeros((m, m), F64), pS=jnp.zeros(m, F64),
                   pY=jnp.zeros(m, F64), age=jnp.zeros(m, jnp.int32), k=jnp.int32(0), count=jnp.int32(0),
                   phis=phis, sum_p=sum_p, qw=qw, E=E, E_best=E, mean_q=mean_q,
@@ -309,4 +336,4 @@ def build(shape, padded, periodic, pinned, law_cls, law_fields, dtype, memory, r
     return solve
 
 
-__all__ = ["build", "law_twin"]
+__all__ = ["build", "law_twin", "row_products"]

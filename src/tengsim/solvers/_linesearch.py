@@ -20,6 +20,8 @@ from typing import NamedTuple
 import numpy as np
 
 from tengsim import backend
+from tengsim.solvers._constants import (APPROX_SLOPE, C1, C2, EPS_E, FIRST_MOVE, GROW, MAX_EVAL,
+                                        SAFEGUARD)
 
 
 class Ray(NamedTuple):
@@ -52,8 +54,8 @@ class WolfeLineSearch:
     as the next trial buffers.
     """
 
-    def __init__(self, law, sweeper, dA, g_trial, P_trial, sum_p=False, c1=1e-4, c2=0.9, max_eval=40,
-                 first_move=0.25, lines=None, red=None):
+    def __init__(self, law, sweeper, dA, g_trial, P_trial, sum_p=False, c1=C1, c2=C2, max_eval=MAX_EVAL,
+                 first_move=FIRST_MOVE, lines=None, red=None):
         self.law, self.sweeper, self.dA = law, sweeper, float(dA)
         # a SafeLaw: its own hot path unchecked, the gaps' minimum checked once per sweep (laws.safe)
         self.unchecked = hasattr(law, "energy_pressure_unchecked")
@@ -153,7 +155,7 @@ class WolfeLineSearch:
         :meth:`evaluate`'s answer at ``alpha0`` when the caller has swept it already (the trial
         buffers then hold g(α0), P(α0))."""
         E0, slope0, c1, c2 = ray.E0, ray.slope, self.c1, self.c2
-        eps_E = 1e-11 * max(1.0, abs(E0))
+        eps_E = EPS_E["float64"] * max(1.0, abs(E0))
         E_lo = min(E0, E_ref)
         alpha = alpha0
         lo, de_lo = 0.0, slope0
@@ -168,7 +170,7 @@ class WolfeLineSearch:
                 hi, de_hi = alpha, None
             else:
                 wolfe = e <= E0 + c1 * alpha * slope0 and abs(de) <= -c2 * slope0
-                approx = e <= E_lo + eps_E and c2 * slope0 <= de <= -0.8 * slope0
+                approx = e <= E_lo + eps_E and c2 * slope0 <= de <= -APPROX_SLOPE * slope0
                 if wolfe or approx:
                     return Trial(alpha, e, phis, sp)
                 if e <= E_lo + eps_E and (best is None or abs(de) < best[0]):
@@ -178,14 +180,14 @@ class WolfeLineSearch:
                 else:
                     lo, de_lo = alpha, de
             if hi is None:
-                alpha = 2.0 * alpha
+                alpha = GROW * alpha
                 continue
             width = hi - lo
             if de_hi is not None and de_hi > de_lo:
                 cand = lo - de_lo * width / (de_hi - de_lo)
             else:
                 cand = lo + 0.5 * width
-            alpha = min(max(cand, lo + 0.1 * width), hi - 0.1 * width)
+            alpha = min(max(cand, lo + SAFEGUARD * width), hi - SAFEGUARD * width)
         if best is not None:
             e, _, phis, sp = self.evaluate(best[1], ray)  # the buffers must hold the accepted point
             return Trial(best[1], e, phis, sp)

@@ -1,30 +1,37 @@
 """The fast solver compiled with JAX: the same L-BFGS, end to end in one jit-compiled loop, on a GPU or a CPU.
 
 :class:`JaxSolver` runs the algorithm of :class:`tengsim.solvers.FastSolver` (traced in
-tengsim.solvers._jax_loop) as one ``lax.while_loop``: no Python between iterations, every array on the
-device, the convolution ``jnp.fft`` inside the compiled program.  It therefore sits beside the
-package's FFT seam (tengsim.backend.fft, which serves NumPy arrays to scipy's pocketfft on the host) rather
-than in it: a JAX array inside a traced loop cannot go through a host FFT, and the kernels' spectra are
-all the loop takes from them.  Any kernel that multiplies in Fourier space runs: the free cell (zero
-padded), the periodic one and both with a film; the mirror-block kernel (a DCT-I, which JAX lacks) is
-refused ("mirror kernel is CPU only"), and so is a slab-distributed (MPI) kernel.  Every law whose
-``_raw`` takes an array namespace ``xp`` (all the built-in ones) runs, its parameters traced.
+tengsim.solvers._jax_loop, with the same constants, tengsim.solvers._constants) as one ``lax.while_loop``:
+no Python between iterations, every array on the device, the convolution ``jnp.fft`` inside the compiled
+program (tengsim.solvers._jax_fft).  It therefore sits beside the NumPy solvers' seam (tengsim.backend,
+NumPy arrays and scipy's pocketfft on the host) rather than in it: a JAX array inside a traced loop cannot go
+through a host FFT.  From a kernel it takes only what :class:`tengsim.registry.FourierKernelLike` declares
+(spectrum, padded shape, periodic, pinned mean): the free cell (zero padded), the periodic one and both with
+a film; the mirror-block kernel (a DCT-I, which JAX lacks) is refused ("mirror kernel is CPU only"), and so is
+a slab-distributed (MPI) kernel.  Every law whose ``_raw`` takes an array namespace ``xp`` (all the built-in
+ones) runs, its parameters traced.
 
-Registered solvers: ``jax`` (JAX's default device: the GPU when JAX has one, else the CPU) and
-``gpu`` (a GPU or a one-line error), both float64; ``JaxSolver(dtype="float32")`` from the API.
-Results equal the NumPy solver's: in float64 step for step to round-off, and where round-off grows
-(a long path, an adhesive rough surface) the same equilibria to the tolerance (tests/test_jax_solver.py).
-float32 fields (scalars still accumulated in float64, the rows' products and the law in float32): the
-tolerance is raised to ``F32_TOL`` (2e-5) at least; float32 is for soft laws and for memory (how close
-each precision comes, and the bytes per point: docs/benchmarks.md, "GPU").
+Registered solvers: ``jax`` (JAX's default device: the GPU when JAX has one, else the CPU) and ``gpu`` (a GPU
+or a one-line error), both float64; ``auto`` (tengsim.solvers.choice) picks ``gpu`` where JAX sees one.
+From the API: ``JaxSolver(dtype="float32")`` and ``JaxSolver(shards=N)``, the grid's rows split over N devices
+(a slab FFT with all-to-all; equal to the one-device solve to round-off).  Results equal the NumPy solver's:
+in float64 step for step to round-off, and where round-off grows (a long path, an adhesive rough surface) the
+same equilibria to the tolerance (tests/test_jax_solver.py).  float32 fields keep every scalar (energies,
+slopes, inner products, the L-BFGS coefficients) in float64; its tolerance is raised to :data:`F32_TOL` at
+least, and where it stops short of that is in docs/benchmarks.md ("GPU").
+
+Memory: JAX may take :data:`MEM_FRACTION` of a GPU (set before JAX starts, unless the user set it), and a
+solve larger than the device allows is refused in one line naming the shards it needs
+(:func:`check_device_memory`, from the bytes per point measured: tengsim.resources.GPU_BYTES_PER_POINT).
 
 Compilation: one per static configuration (grid shape, kernel kind, law class, dtype, memory, resync,
-device), cached in this module and shared by every solver object and every equilibrium of a path; D
+device, shards), cached in this module and shared by every solver object and every equilibrium of a path; D
 (through g0), the law's parameters, the kernel's spectrum, tol and max_iter are traced arguments.
 :func:`compile_stats` reports how many compilations were made and how long they took; each
 equilibrium's ``message`` names the compile time it paid (0 when cached).
 
-JAX is imported only when a JaxSolver is made: ``import tengsim`` does not import it.
+JAX is imported only when a JaxSolver is made (or ``auto`` asks whether a GPU is there, on a machine with a GPU
+plugin of JAX installed): ``import tengsim`` does not import it.
 """
 from __future__ import annotations
 
@@ -66,8 +73,39 @@ def clear_cache() -> None:
         _STATS.update(compiles=0, compile_seconds=0.0, calls=0)
 
 
+MEM_FRACTION = "0.95"
+"""The share of a GPU's memory JAX may take (JAX's default, 0.75, leaves a 16384² float64 solve off one H200).
+Set before JAX starts, unless the user set XLA_PYTHON_CLIENT_MEM_FRACTION (or XLA_PYTHON_CLIENT_PREALLOCATE=false)
+themselves."""
+
+
+def prepare_environment() -> None:
+    """Let JAX take :data:`MEM_FRACTION` of a GPU (called before JAX is first imported by tengsim)."""
+    import os
+
+    if "XLA_PYTHON_CLIENT_PREALLOCATE" not in os.environ:
+        os.environ.setdefault("XLA_PYTHON_CLIENT_MEM_FRACTION", MEM_FRACTION)
+
+
+def check_device_memory(dev, points: int, dtype: str, shards: int = 1, padded: int = 0) -> None:
+    """Refuse (one line) a solve whose measured bytes per point (tengsim.resources.GPU_BYTES_PER_POINT) over the
+    devices exceed what the device lets JAX allocate; nothing is checked where the device does not say.
+    ``padded``: the free cell's zero-padded points (its spectrum and transform buffers, 24 B each more)."""
+    from tengsim.resources import GPU_BYTES_PER_POINT
+
+    stats = getattr(dev, "memory_stats", lambda: None)() if dev.platform != "cpu" else None
+    limit = (stats or {}).get("bytes_limit")
+    need = (GPU_BYTES_PER_POINT[dtype] * points + 24 * padded) / max(int(shards), 1)
+    if limit and need > limit:
+        more = -(-int(need * max(int(shards), 1)) // int(limit))
+        raise TengsimError(f"{points:.3g} points in {dtype} need about {need / 2**30:.0f} GiB per device, "
+                           f"{dev.platform.upper()} {dev.id} allows {limit / 2**30:.0f} GiB: split the grid "
+                           f"over {more} or more devices (JaxSolver(shards=...)), use a coarser grid or float32")
+
+
 def _jax():
     """jax, with float64 enabled; a one-line TengsimError when it is not installed."""
+    prepare_environment()
     try:
         import jax
     except ImportError:
@@ -118,14 +156,12 @@ def _kernel_form(kernel):
         raise TengsimError("the jax solver runs on one device: a slab-distributed (MPI) kernel is CPU only")
     if hasattr(kernel, "mirror") or type(kernel).__name__ == "MirrorKernel":
         raise TengsimError("mirror kernel is CPU only (JAX has no DCT-I): use --symmetry off with the jax solver")
-    spec = getattr(kernel, "_spectrum", None)
-    padded = getattr(kernel, "padded_shape", None)
-    if spec is None or padded is None or not hasattr(kernel, "periodic"):
+    from tengsim.registry import FourierKernelLike
+
+    if not isinstance(kernel, FourierKernelLike):
         raise TengsimError(f"kernel {type(kernel).__name__} does not multiply in Fourier space: the jax solver "
                            f"cannot run it; use --solver fast")
-    periodic = bool(kernel.periodic)
-    pinned = bool(getattr(kernel, "pinned_mean", periodic))
-    return periodic, tuple(int(n) for n in padded), spec, pinned
+    return bool(kernel.periodic), tuple(int(n) for n in kernel.padded_shape), kernel.spectrum, bool(kernel.pinned_mean)
 
 
 @dataclass(frozen=True)
@@ -141,6 +177,9 @@ class JaxSolver:
     resync: int = 25
     device: str = "auto"
     dtype: str = "float64"
+    shards: int = 1
+    """Devices the grid's rows are split over (a slab FFT with all-to-all, tengsim.solvers._jax_fft): 1 is one
+    device; N > 1 takes the first N of the device's platform (the grid's rows must divide by N)."""
     name: str = "jax"
     resumes_from_state: ClassVar[bool] = True  # continuation.persist may go on from its capped state
     compiles: ClassVar[bool] = True  # compiled before its first solve on a grid (seconds, once per configuration)
@@ -154,6 +193,8 @@ class JaxSolver:
             raise TengsimError(f"resync must be >= 1, got {self.resync!r}")
         if self.device not in DEVICES:
             raise TengsimError(f"device must be one of {', '.join(DEVICES)}, got {self.device!r}")
+        if int(self.shards) < 1:
+            raise TengsimError(f"shards must be >= 1, got {self.shards!r}")
         if self.dtype not in DTYPES:
             raise TengsimError(f"dtype must be one of {', '.join(DTYPES)}, got {self.dtype!r}")
         find_device(self.device)  # the one-line error now, before a run writes anything
@@ -162,7 +203,7 @@ class JaxSolver:
     def effective_tol(self) -> float:
         return self.tol if self.dtype == "float64" else max(self.tol, F32_TOL)
 
-    def _compiled(self, key, args, dev):
+    def _compiled(self, key, args, dev, mesh=None):
         with _LOCK:
             fn = _CACHE.get(key)
         if fn is not None:
@@ -170,10 +211,13 @@ class JaxSolver:
         jax = _jax()
         from tengsim.solvers import _jax_loop
 
-        shape, padded, periodic, pinned, cls, names, dtype, memory, resync, _ = key
-        solve = _jax_loop.build(shape, padded, periodic, pinned, cls, names, dtype, memory, resync)
+        shape, padded, periodic, pinned, cls, names, dtype, memory, resync = key[:9]
+        solve = _jax_loop.build(shape, padded, periodic, pinned, cls, names, dtype, memory, resync, mesh)
         t0 = time.perf_counter()
-        with jax.default_device(dev):
+        if mesh is None:
+            with jax.default_device(dev):
+                fn = jax.jit(solve).lower(*args).compile()
+        else:  # the shardings are the arguments' own (put by solve)
             fn = jax.jit(solve).lower(*args).compile()
         dt = time.perf_counter() - t0
         with _LOCK:
@@ -196,6 +240,21 @@ class JaxSolver:
         _SPECTRA[key] = (spec, arr)
         return arr
 
+    def _mesh(self, dev, shape):
+        """None on one device; else the mesh of the first ``shards`` devices of ``dev``'s platform."""
+        n = int(self.shards)
+        if n == 1:
+            return None
+        jax = _jax()
+        from tengsim.solvers import _jax_fft
+
+        devs = jax.devices(dev.platform)
+        if len(devs) < n:
+            raise TengsimError(f"shards = {n}: JAX has only {len(devs)} {dev.platform.upper()} device(s)")
+        if shape[0] % n:
+            raise TengsimError(f"shards = {n}: the grid's {shape[0]} rows do not split into {n} equal slabs")
+        return _jax_fft.make_mesh(devs[:n])
+
     def solve(self, problem: Problem, start: State) -> Equilibrium:
         t0 = time.perf_counter()
         if problem.weights is not None:
@@ -208,13 +267,27 @@ class JaxSolver:
         g0 = np.asarray(problem.g0, dtype=float)
         shape = g0.shape
         dtype = self.dtype
-        put = lambda a: jax.device_put(np.ascontiguousarray(a, dtype=dtype).ravel(), dev)  # noqa: E731
-        f64 = lambda v: jax.device_put(np.float64(v), dev)  # noqa: E731
-        args = (put(g0), put(start.q), put(start.w), self._spectrum(problem.kernel, spec, dtype, dev),
-                tuple(f64(v) for v in values), f64(self.effective_tol), jax.device_put(np.int32(self.max_iter), dev),
-                f64(problem.dA), f64(g0.size))
-        key = (shape, padded, periodic, pinned, cls, names, dtype, int(self.memory), int(self.resync), str(dev))
-        fn, compile_s = self._compiled(key, args, dev)
+        mesh = self._mesh(dev, shape)
+        if mesh is None:
+            field_at = scalar_at = dev
+            spec_dev = self._spectrum(problem.kernel, spec, dtype, dev)
+        else:
+            from tengsim.solvers import _jax_fft
+
+            field_at, scalar_at = _jax_fft.field_sharding(mesh), _jax_fft.replicated(mesh)
+            cdt = np.complex128 if dtype == "float64" else np.complex64
+            spec_dev = jax.device_put(_jax_fft.pad_spectrum(np.asarray(spec).astype(
+                cdt if np.iscomplexobj(spec) else dtype), mesh.devices.size), _jax_fft.spectrum_sharding(mesh))
+        put = lambda a: jax.device_put(np.ascontiguousarray(a, dtype=dtype).ravel(), field_at)  # noqa: E731
+        f64 = lambda v: jax.device_put(np.float64(v), scalar_at)  # noqa: E731
+        args = (put(g0), put(start.q), put(start.w), spec_dev,
+                tuple(f64(v) for v in values), f64(self.effective_tol),
+                jax.device_put(np.int32(self.max_iter), scalar_at), f64(problem.dA), f64(g0.size))
+        key = (shape, padded, periodic, pinned, cls, names, dtype, int(self.memory), int(self.resync), str(dev),
+               int(self.shards))
+        if key not in _CACHE:
+            check_device_memory(dev, g0.size, dtype, self.shards, 0 if periodic else int(np.prod(padded)))
+        fn, compile_s = self._compiled(key, args, dev, mesh)
         out = jax.device_get(fn(*args))
         _STATS["calls"] += 1
         return _result(problem, out, shape, self.max_iter, compile_s, t0)
