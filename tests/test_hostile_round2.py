@@ -403,3 +403,9 @@ def test_check_writable_creates_nothing(tmp_path):
     check_output(tmp_path / "a" / "b" / "o.csv")
     check_output(tmp_path / "c" / "d", folder=True)
     assert list(tmp_path.iterdir()) == []
+
+
+def test_a_very_soft_material_is_refused_before_the_default_grids_kernel_is_made(here, capsys):
+    """E* = 197 Pa puts the default grid at 65 625²: its kernel (136 GiB) was allocated to measure the pixel
+    snap number, before any memory check (found by the property test on design values)."""
+    refused(capsys, ["design", *S, "--E-star", "197", "--out", "o"], here, contains="memory")

@@ -108,6 +108,9 @@ def default_dx(shape, law, coupling: float, boundary: str = "free") -> float:
     if math.isfinite(lD) and lD > 0:
         dx = min(dx, lD / status.RESOLUTION)  # the zone spans the pixels the status asks for
     g = shape.grid(dx)
+    from tengsim.resources import check_memory
+
+    check_memory(g.nx, g.ny, boundary)  # the kernel below is the grid's: one line, not an allocation that fails
     s = status.pixel_snap_number(law, make_kernel(boundary, g, coupling))
     if s > status.SNAP_LIMIT:
         dx = g.dx * status.SNAP_LIMIT / s
