@@ -19,6 +19,7 @@ import tengsim.observers  # noqa: F401  (registers 'summary', 'array_area')
 import tengsim.shapes  # noqa: F401  (registers every built-in shape)
 import tengsim.solvers  # noqa: F401  (registers 'fast', 'vsr')
 import tengsim.solvers.homotopy  # noqa: F401  (registers 'homotopy')
+import tengsim.solvers.pk  # noqa: F401  (registers 'pk')
 import tengsim.solvers.jax_fast  # noqa: F401  (registers 'jax', 'gpu'; imports JAX only when one is made)
 from tengsim.errors import TengsimError
 from tengsim.registry import KERNELS, LAWS, OBSERVERS, SHAPES, SOLVERS
