@@ -38,7 +38,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import ClassVar
 
 import numpy as np
@@ -48,6 +48,9 @@ from tengsim.errors import TengsimError
 from tengsim.registry import SOLVERS
 from tengsim.solvers._pk_core import Convolution, constrained_cg, preconditioner
 from tengsim.solvers.types import Equilibrium, Problem, State
+
+#: the largest pixel snap number of a Maugis–Dugdale ramp (PKSolver._ramp)
+RAMP_SNAP = 0.5
 
 #: the laws 'pk' solves, by class name (their hard-wall limits, module doc)
 SUPPORTED = ("Repulsive", "MaugisDugdale", "Exponential")
@@ -61,11 +64,23 @@ class WallModel:
     tension: float = 0.0
     length: float = 0.0
     work: float = 0.0
+    ramp: float = 0.0          # md: the width (ε) of the smoothstep at the zone's end; 0: a sharp step
+
+    @property
+    def sharp(self) -> bool:
+        """A zone that is a set of pixels (sharp Maugis–Dugdale): updated until it no longer changes."""
+        return self.kind == "md" and self.ramp == 0.0
 
     def adhesive(self, u, out):
         """p_a at the gap above the wall u >= 0 (in contact u = 0: −σ0), into ``out``."""
-        if self.kind == "md":
+        if self.sharp:
             np.less_equal(u, self.length, out=out)
+            out *= -self.tension
+        elif self.kind == "md":                      # the law's smoothstep, t = 1 inside, 0 beyond
+            np.subtract(self.length + 0.5 * self.ramp, u, out=out)
+            out *= 1.0 / self.ramp
+            np.clip(out, 0.0, 1.0, out=out)
+            out *= out * (3.0 - 2.0 * out)
             out *= -self.tension
         else:
             np.maximum(u, 0.0, out=out)
@@ -78,7 +93,7 @@ class WallModel:
         """ΣΦ over the pixels (W per pixel area) at gaps above the wall u."""
         if self.kind == "wall":
             return 0.0
-        if self.kind == "md":
+        if self.kind == "md":                        # (the ramp's energy as the sharp step's: O(ramp²))
             z = u <= self.length
             return float(-self.tension * np.sum(self.length - np.maximum(u, 0.0), where=z))
         return float(-self.work * np.exp(-np.maximum(u, 0.0) / self.length).sum())
@@ -91,7 +106,7 @@ def wall_model(law) -> WallModel:
         return WallModel("wall")
     if name == "MaugisDugdale":
         s0 = float(law.tension)
-        return WallModel("md", s0, float(law.work) / s0, float(law.work))
+        return WallModel("md", s0, float(law.work) / s0, float(law.work))  # the ramp: PKSolver
     if name == "Exponential":
         W, rho = float(law.work), float(law.range)
         return WallModel("exp", W / rho, rho, W)
@@ -114,6 +129,7 @@ class PKSolver:
     max_iter: int = 1000
     max_zone: int = 500
     precondition: bool = True
+    md_zone: str = "ramp"
     name: str = "pk"
     monitor: object = None
     monitor_every: int = 50
@@ -124,6 +140,8 @@ class PKSolver:
     def __post_init__(self):
         if not (isinstance(self.tol, (int, float)) and self.tol > 0 and math.isfinite(self.tol)):
             raise TengsimError(f"tol must be a finite number > 0, got {self.tol!r}")
+        if self.md_zone not in ("ramp", "sharp"):
+            raise TengsimError(f"md_zone must be 'ramp' or 'sharp', got {self.md_zone!r}")
         for key in ("max_iter", "max_zone", "monitor_every"):
             v = getattr(self, key)
             if isinstance(v, bool) or not isinstance(v, int) or v < 1:
@@ -144,6 +162,17 @@ class PKSolver:
         return self._solve(problem, start, float(mean_pressure))
 
     # ---- the solve ---------------------------------------------------------------------------
+    @staticmethod
+    def _ramp(law, conv, shape) -> float:
+        """The zone's ramp (ε): the law's smoothing, widened where a pixel would be stiffer than it
+        (pixel snap number 1.5 σ0 K_ii / ramp above ``RAMP_SNAP``; K_ii, a pixel's own compliance, by one
+        convolution of a unit pixel)."""
+        unit = backend.zeros(int(np.prod(shape)))
+        i = np.ravel_multi_index(tuple(n // 2 for n in shape), shape)
+        unit[i] = 1.0
+        kii = float(conv(unit, backend.empty(unit.size))[i])
+        return max(float(law.smoothing), 1.5 * float(law.tension) * kii / RAMP_SNAP)
+
     def _solve(self, problem: Problem, start: State, load):
         t0 = time.perf_counter()
         if problem.weights is not None:
@@ -153,6 +182,8 @@ class PKSolver:
         shape = np.shape(problem.g0)
         conv = Convolution(problem.kernel, shape)
         pre = preconditioner(problem.kernel, shape) if self.precondition else None
+        if model.kind == "md" and self.md_zone == "ramp":
+            model = replace(model, ramp=self._ramp(problem.law, conv, shape))
         g0 = backend.xp.ascontiguousarray(problem.g0, dtype=float).ravel()
         q0 = backend.xp.asarray(start.q, dtype=float).ravel()
         w0 = backend.xp.asarray(start.w, dtype=float).ravel()
@@ -202,7 +233,7 @@ class PKSolver:
                 break
             model.adhesive(u, pa_new)
             pa_new[pc > 0] = -s0
-            if model.kind == "md":
+            if model.sharp:
                 moved = int(np.count_nonzero(pa_new != pa))
                 res = core.residual
                 if moved == 0:
