@@ -51,6 +51,8 @@ from tengsim.solvers.types import Equilibrium, Problem, State
 
 #: the largest pixel snap number of a Maugis–Dugdale ramp (PKSolver._ramp)
 RAMP_SNAP = 0.5
+#: zone updates of the ramp's polish after the sharp zone's solve (then the sharp state stands)
+RAMP_UPDATES = 60
 
 #: the laws 'pk' solves, by class name (their hard-wall limits, module doc)
 SUPPORTED = ("Repulsive", "MaugisDugdale", "Exponential")
@@ -130,6 +132,7 @@ class PKSolver:
     max_zone: int = 500
     precondition: bool = True
     md_zone: str = "ramp"
+    anderson: int = 5
     name: str = "pk"
     monitor: object = None
     monitor_every: int = 50
@@ -197,7 +200,18 @@ class PKSolver:
             its, ok, res, zones = core.iterations, core.converged, core.residual, 0
             msg = "converged" if ok else f"not converged in {self.max_iter} iterations (residual {res:.3g} ε)"
         else:
-            p, Kp, u, c, its, ok, res, zones, msg = self._cohesive(model, conv, h0, q0, w0, load, mon, pre)
+            its0 = zones0 = 0
+            sharp = None
+            if model.ramp > 0:                        # the sharp zone first: it jumps in few updates
+                sharp = self._cohesive(replace(model, ramp=0.0), conv, h0, q0, w0, load, mon, pre, self.max_zone)
+                if sharp[5]:
+                    q0, w0, its0, zones0 = sharp[0], sharp[1], sharp[4], sharp[7]
+            limit = self.max_zone if sharp is None else RAMP_UPDATES
+            p, Kp, u, c, its, ok, res, zones, msg = self._cohesive(model, conv, h0, q0, w0, load, mon, pre, limit)
+            its, zones = its + its0, zones + zones0
+            if not ok and sharp is not None and sharp[5]:  # the ramp's fixed point cycles: the sharp zone's state
+                p, Kp, u, c, _, ok, res, _, msg = sharp
+                msg = f"{msg} (sharp Dugdale zone: the ramp did not settle in {RAMP_UPDATES} updates)"
         w = Kp
         H = (g0 + c) + w - 1.0
         E = problem.dA * (0.5 * float(np.dot(p, w)) + model.energy(u))
@@ -206,7 +220,7 @@ class PKSolver:
                          msg if zones == 0 else f"{msg} ({zones} cohesive-zone updates)")
         return eq, float(c)
 
-    def _cohesive(self, model: WallModel, conv, h0, q0, w0, load, mon, pre):
+    def _cohesive(self, model: WallModel, conv, h0, q0, w0, load, mon, pre, limit):
         n = h0.size
         s0 = model.tension
         Ka, pa, pa_new, hh, u_prev, used = (backend.empty(n) for _ in range(6))
@@ -214,10 +228,11 @@ class PKSolver:
         model.adhesive(h0 + w0, pa)
         pc = np.maximum(q0 - pa, 0.0)
         pc[(h0 + w0) > self.tol] = 0.0
-        beta, last_move = 1.0, math.inf
+        last_move = math.inf
         its, zones, ok, res, c = 0, 0, False, math.inf, 0.0
         core = None
-        for zones in range(1, self.max_zone + 1):
+        mix = None if model.sharp else _Anderson(n, self.anderson)
+        for zones in range(1, limit + 1):
             used[:] = pa                              # the zone this contact solve carries
             conv(used, Ka)
             np.add(h0, Ka, out=hh)
@@ -225,7 +240,9 @@ class PKSolver:
             if core_load is not None and not core_load > 0:
                 raise TengsimError(f"load control needs a compressive contact: the mean pressure {load:.6g} W/ε "
                                    f"is below the cohesive zone's tension {float(pa.mean()):.6g} W/ε")
-            core = constrained_cg(conv, hh, pc, self.tol, self.max_iter, core_load, mon, pre)
+            # the contact solve to a tolerance the zone's last move allows (inexact early updates)
+            tol_in = self.tol if model.sharp else max(self.tol, min(1e-2 * last_move, 1e-2))
+            core = constrained_cg(conv, hh, pc, tol_in, self.max_iter, core_load, mon, pre)
             its += core.iterations
             pc, u, c = core.p, core.u, core.c
             if not core.converged:
@@ -244,13 +261,12 @@ class PKSolver:
                 move = float(np.max(np.abs(u - u_prev))) if zones > 1 else math.inf
                 u_prev[:] = u
                 res = max(core.residual, move if math.isfinite(move) else 0.0)
-                if zones > 1 and move <= self.tol:
+                if zones > 1 and move <= self.tol and tol_in <= self.tol:
                     ok = True
                     break
-                if move > last_move:
-                    beta = max(beta / 2.0, 1.0 / 64.0)
                 last_move = move
-                pa += beta * (pa_new - pa)
+                mix.step(pa, pa_new)                  # pa <- the next zone (Anderson-mixed fixed point)
+                np.clip(pa, -s0, 0.0, out=pa)
         p = pc + used
         # K p = K p_c + K p_a (the last zone's K p_a is in Ka: the core's Kp is K p_c)
         Kp = core.Kp + Ka
@@ -259,8 +275,40 @@ class PKSolver:
         elif core is not None and not core.converged:
             msg = f"contact solve not converged in {self.max_iter} iterations (residual {res:.3g} ε)"
         else:
-            msg = f"cohesive zone not settled in {self.max_zone} updates (last move {res:.3g} ε)"
+            msg = f"cohesive zone not settled in {limit} updates (last move {res:.3g} ε)"
         return p, Kp, u, c, its, ok, res, zones, msg
+
+
+class _Anderson:
+    """Anderson mixing (type II, memory ``m``) of the fixed point x = G(x) of a cohesive zone's tractions:
+    ``step(x, gx)`` moves x in place to x + f − (ΔX + ΔF) γ, γ the least-squares fit of f = G(x) − x
+    by the stored differences (m = 0: the plain update x = G(x)).  Memory is dropped when the residual
+    grows tenfold (a jump: the old differences describe another branch)."""
+
+    def __init__(self, n: int, m: int):
+        self.m, self.X, self.F = int(m), [], []
+        self.x_old = self.f_old = None
+        self.f_norm = math.inf
+
+    def step(self, x, gx):
+        f = gx - x
+        fn = float(np.dot(f, f))
+        if fn > 100.0 * self.f_norm:
+            self.X, self.F = [], []
+        self.f_norm = fn
+        if self.m and self.x_old is not None:
+            self.X.append(x - self.x_old)
+            self.F.append(f - self.f_old)
+            if len(self.X) > self.m:
+                self.X.pop(0)
+                self.F.pop(0)
+        self.x_old, self.f_old = x.copy(), f
+        if not self.F:
+            x += f
+            return
+        Fm = np.stack(self.F, axis=1)
+        gamma = np.linalg.lstsq(Fm, f, rcond=1e-10)[0]
+        x += f - (np.stack(self.X, axis=1) + Fm) @ gamma
 
 
 SOLVERS.register("pk", PKSolver, summary="Polonsky–Keer constrained CG: hard wall, Maugis–Dugdale, exponential")
