@@ -33,6 +33,12 @@ from tengsim.backend import fft as _bf
 from tengsim.solvers._kernelcall import takes_out
 
 
+#: iterations without a new lowest residual after which a preconditioned solve goes on without its
+#: preconditioner (from its best pressure): the |q| preconditioner's steps can cycle on a contact set that
+#: a displacement-controlled cold start has yet to find
+STALL = 40
+
+
 @dataclass
 class CoreResult:
     """What :func:`constrained_cg` returns: the contact pressure ``p``, ``Kp`` = K p, the gap above the
@@ -79,6 +85,12 @@ class Preconditioner:
         q = np.hypot(*np.meshgrid(qx, qy, indexing="ij"))
         q[0, 0] = min(2 * np.pi / (g.nx * g.dx), 2 * np.pi / (g.ny * g.dy))
         self.mult = q / (2.0 * float(kernel.coupling))
+        w = np.full(self.mult.shape[1], 2.0)       # the rfft layout's columns, each standing for two
+        w[0] = 1.0
+        if g.ny % 2 == 0:
+            w[-1] = 1.0
+        #: M⁻¹'s diagonal (its value at zero offset): the step a pixel's own gap takes through M⁻¹
+        self.diag = float((self.mult * w).sum()) / (g.nx * g.ny)
         self.shape = tuple(shape)
         self.threads = _bf.threads(self.shape)
         self.direct = _bf.has_direct()
@@ -130,7 +142,8 @@ def constrained_cg(conv: Convolution, h, p, tol: float, max_iter: int, load: flo
     elif load is not None:
         p *= load / float(p.mean())
     delta, G_old, c = 0.0, 1.0, 0.0
-    res = math.inf
+    res = best = math.inf
+    p_best, it_best, stalled = (backend.empty(n) if precond is not None else None), 0, False
     for it in range(max_iter + 1):
         conv(p, Kp)
         np.add(h, Kp, out=u)
@@ -147,6 +160,13 @@ def constrained_cg(conv: Convolution, h, p, tol: float, max_iter: int, load: flo
             monitor(it, res)
         if res <= tol or nS == 0 or it == max_iter:
             break
+        if p_best is not None:                        # the preconditioned CG's safeguard (below)
+            if res < best:
+                best, it_best = res, it
+                p_best[:] = p
+            elif it - it_best > STALL:
+                stalled = True
+                break
         np.multiply(u, S, out=work)                   # the gradient on S
         if precond is not None:                       # z = P_S M⁻¹ P_S u (one FFT pair)
             precond(work, z)
@@ -168,17 +188,24 @@ def constrained_cg(conv: Convolution, h, p, tol: float, max_iter: int, load: flo
         tau = float(np.dot(work, t)) / rt
         p -= tau * t
         np.maximum(p, 0.0, out=p)
+        left = nS - int(np.count_nonzero(p)) if precond is not None else 0   # pixels the step released
         np.less(u, 0.0, out=S)                        # overlaps out of contact enter (S reused)
         S &= p == 0
         if S.any():
             np.multiply(u, S, out=work)
-            p -= tau * work
+            p -= (tau if precond is None else tau * precond.diag) * work
             delta = 0.0
-        else:
-            delta = 1.0
+        else:                                         # preconditioned: restart where the set shrank too
+            delta = 0.0 if left > 0 else 1.0
         if load is not None:
             m = float(p.mean())
             if not m > 0:
                 break
             p *= load / m
+    if stalled:  # no progress in STALL iterations: on from the best pressure without the preconditioner
+        p[:] = p_best
+        rest = constrained_cg(conv, h, p, tol, max_iter - it, load, monitor, None)
+        rest.iterations += it
+        rest.n_conv = conv.count - n0
+        return rest
     return CoreResult(p, Kp, u, c, it, conv.count - n0, res, bool(res <= tol))

@@ -162,7 +162,8 @@ class PKSolver:
             raise TengsimError(f"mean_pressure must be finite, got {mean_pressure!r}")
         if start is None:
             start = State.zero(np.shape(problem.g0))
-        return self._solve(problem, start, float(mean_pressure))
+        eq, c = self._solve(problem, start, float(mean_pressure))
+        return eq, -c                                 # the gap's correction c is an approach of −c
 
     # ---- the solve ---------------------------------------------------------------------------
     @staticmethod
@@ -191,6 +192,14 @@ class PKSolver:
         q0 = backend.xp.asarray(start.q, dtype=float).ravel()
         w0 = backend.xp.asarray(start.w, dtype=float).ravel()
         h0 = g0 - 1.0
+        K = problem.kernel
+        if load is None and bool(getattr(K, "pinned_mean", getattr(K, "periodic", False))) and not h0.mean() > 0:
+            # the mean gap of a periodic half-space is the mean of g0: at or below the wall no state exists
+            msg = (f"the mean gap {h0.mean() + 1.0:.6g} ε is at or below the wall (1 ε) on a periodic half-space: "
+                   "no state under displacement control; use load control (solve_load)")
+            z = backend.zeros(shape)
+            return Equilibrium(State(z, z.copy()), np.reshape(h0, shape).copy(), z.copy(), math.inf, False, 0, 0,
+                               math.nan, time.perf_counter() - t0, msg), 0.0
         every = self.monitor_every
         mon = None if self.monitor is None else (
             lambda it, res: self.monitor(it, res, math.nan) if it % every == 0 else None)
