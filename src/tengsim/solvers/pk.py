@@ -150,6 +150,11 @@ class PKSolver:
             if isinstance(v, bool) or not isinstance(v, int) or v < 1:
                 raise TengsimError(f"{key} must be an integer >= 1, got {v!r}")
 
+    @staticmethod
+    def solves(law) -> bool:
+        """Can this solver solve ``law`` (its hard-wall limit; module doc)?"""
+        return supports(law)
+
     def solve(self, problem: Problem, start: State) -> Equilibrium:
         """The equilibrium at the problem's gap g0 (displacement control), from ``start``."""
         return self._solve(problem, start, None)[0]
