@@ -181,3 +181,31 @@ def test_rough_cell_against_penalty_wall():
     assert dp[2] < 0.6 * dp[1] < 0.36 * dp[0]
     assert dg[2] < 0.6 * dg[1] < 0.36 * dg[0]
     assert da[2] <= da[0]
+
+
+# ---- design: a cohesive law with a wall runs on 'pk' and says so ------------------------------------------
+class _Said:
+    def __init__(self):
+        self.lines = []
+
+    def say(self, text):
+        self.lines.append(text)
+
+
+@pytest.mark.parametrize("law, solver, expect", [("md", None, "pk"), ("exp", None, "pk"), ("lj93", None, "fast"),
+                                                 ("md", "homotopy", "homotopy")])
+def test_design_chooses_pk_for_cohesive_laws(law, solver, expect):
+    """`tengsim design ... --law md` (or exp) runs on 'pk' and says so in one line; LJ93 keeps the fast
+    solver, and a design that names its solver keeps it."""
+    from tengsim.design.plan import plan_design
+    from tengsim.design.run import choose_solver
+
+    table = {"shape": "pyramid", "pitch": "10um", "base": "5um", "height": "3.5um", "E_star": "1MPa",
+             "W": "50mJ/m2", "eps": "200nm", "p_max": "100kPa", "p_step": "5kPa", "law": law}
+    if solver:
+        table["solver"] = solver
+    plan = plan_design(table)
+    said = _Said()
+    cplan = choose_solver(plan, plan.contact_plan, said)
+    assert cplan.solver == expect
+    assert any("solver: pk" in line for line in said.lines) == (expect == "pk")
