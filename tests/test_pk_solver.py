@@ -209,3 +209,17 @@ def test_design_chooses_pk_for_cohesive_laws(law, solver, expect):
     cplan = choose_solver(plan, plan.contact_plan, said)
     assert cplan.solver == expect
     assert any("solver: pk" in line for line in said.lines) == (expect == "pk")
+
+
+@pytest.mark.parametrize("kind", [PeriodicKernel, FreeKernel])
+def test_film_kernels_against_penalty_wall(kind):
+    """A film (thickness 10, ν = 0.3, bonded) under the rough cell, periodic and free: the hard wall's mean
+    pressure within 0.5 % of the fast solver's with the k = 36 penalty wall (measured 0.17 %, 0.16 %: the
+    half-space's 0.19 %, the penalty's compression)."""
+    grid, g0, _ = _rough()
+    K = kind(grid, 3.0, thickness=10.0, poisson=0.3)
+    hard = PKSolver(1e-8).solve(Problem(g0, Repulsive(), K), State.zero(g0.shape))
+    assert hard.converged, hard.message
+    f = FastSolver(1e-6, max_iter=20000).solve(Problem(g0, Repulsive(exponent=36.0), K), State.zero(g0.shape))
+    assert f.converged, f.message
+    assert f.P.mean() == pytest.approx(hard.P.mean(), rel=5e-3)
