@@ -53,6 +53,8 @@ from tengsim.solvers.types import Equilibrium, Problem, State
 RAMP_SNAP = 0.5
 #: zone updates of the ramp's polish after the sharp zone's solve (then the sharp state stands)
 RAMP_UPDATES = 60
+#: the gap residual (ε) of the sharp zone's solve when it is only the ramp's start
+SHARP_TOL = 1e-3
 
 #: the laws 'pk' solves, by class name (their hard-wall limits, module doc)
 SUPPORTED = ("Repulsive", "MaugisDugdale", "Exponential")
@@ -217,13 +219,17 @@ class PKSolver:
             its0 = zones0 = 0
             sharp = None
             if model.ramp > 0:                        # the sharp zone first: it jumps in few updates
-                sharp = self._cohesive(replace(model, ramp=0.0), conv, h0, q0, w0, load, mon, pre, self.max_zone)
+                sharp = self._cohesive(replace(model, ramp=0.0), conv, h0, q0, w0, load, mon, pre, self.max_zone,
+                                       max(self.tol, SHARP_TOL))     # only a start: loosely
                 if sharp[5]:
                     q0, w0, its0, zones0 = sharp[0], sharp[1], sharp[4], sharp[7]
             limit = self.max_zone if sharp is None else RAMP_UPDATES
             p, Kp, u, c, its, ok, res, zones, msg = self._cohesive(model, conv, h0, q0, w0, load, mon, pre, limit)
             its, zones = its + its0, zones + zones0
             if not ok and sharp is not None and sharp[5]:  # the ramp's fixed point cycles: the sharp zone's state
+                sharp = self._cohesive(replace(model, ramp=0.0), conv, h0, sharp[0], sharp[1], load, mon, pre,
+                                       self.max_zone)
+                its, zones = its + sharp[4], zones + sharp[7]
                 p, Kp, u, c, _, ok, res, _, msg = sharp
                 msg = f"{msg} (sharp Dugdale zone: the ramp did not settle in {RAMP_UPDATES} updates)"
         w = Kp
@@ -234,14 +240,15 @@ class PKSolver:
                          msg if zones == 0 else f"{msg} ({zones} cohesive-zone updates)")
         return eq, float(c)
 
-    def _cohesive(self, model: WallModel, conv, h0, q0, w0, load, mon, pre, limit):
+    def _cohesive(self, model: WallModel, conv, h0, q0, w0, load, mon, pre, limit, tol=None):
+        tol = self.tol if tol is None else tol
         n = h0.size
         s0 = model.tension
         Ka, pa, pa_new, hh, u_prev, used = (backend.empty(n) for _ in range(6))
         # the first zone from the start state's gap; its contact pressure from its pressure
         model.adhesive(h0 + w0, pa)
         pc = np.maximum(q0 - pa, 0.0)
-        pc[(h0 + w0) > self.tol] = 0.0
+        pc[(h0 + w0) > tol] = 0.0
         last_move = math.inf
         its, zones, ok, res, c = 0, 0, False, math.inf, 0.0
         core = None
@@ -255,7 +262,7 @@ class PKSolver:
                 raise TengsimError(f"load control needs a compressive contact: the mean pressure {load:.6g} W/ε "
                                    f"is below the cohesive zone's tension {float(pa.mean()):.6g} W/ε")
             # the contact solve to a tolerance the zone's last move allows (inexact early updates)
-            tol_in = self.tol if model.sharp else max(self.tol, min(1e-2 * last_move, 1e-2))
+            tol_in = tol if model.sharp else max(tol, min(1e-2 * last_move, 1e-2))
             core = constrained_cg(conv, hh, pc, tol_in, self.max_iter, core_load, mon, pre)
             its += core.iterations
             pc, u, c = core.p, core.u, core.c
@@ -275,7 +282,7 @@ class PKSolver:
                 move = float(np.max(np.abs(u - u_prev))) if zones > 1 else math.inf
                 u_prev[:] = u
                 res = max(core.residual, move if math.isfinite(move) else 0.0)
-                if zones > 1 and move <= self.tol and tol_in <= self.tol:
+                if zones > 1 and move <= tol and tol_in <= tol:
                     ok = True
                     break
                 last_move = move
