@@ -85,7 +85,7 @@ class Preconditioner:
         q = np.hypot(*np.meshgrid(qx, qy, indexing="ij"))
         q[0, 0] = min(2 * np.pi / (g.nx * g.dx), 2 * np.pi / (g.ny * g.dy))
         self.mult = q / (2.0 * float(kernel.coupling))
-        w = np.full(self.mult.shape[1], 2.0)       # the rfft layout's columns, each standing for two
+        w = 2.0 + backend.zeros(self.mult.shape[1])  # the rfft layout's columns, each standing for two
         w[0] = 1.0
         if g.ny % 2 == 0:
             w[-1] = 1.0
@@ -94,7 +94,7 @@ class Preconditioner:
         self.shape = tuple(shape)
         self.threads = _bf.threads(self.shape)
         self.direct = _bf.has_direct()
-        self.cb = np.empty(self.mult.shape, complex) if self.direct else None
+        self.cb = backend.empty(self.mult.shape, complex) if self.direct else None
 
     def __call__(self, x, out):
         x2, o2 = x.reshape(self.shape), out.reshape(self.shape)
