@@ -53,6 +53,8 @@ from tengsim.solvers.types import Equilibrium, Problem, State
 RAMP_SNAP = 0.5
 #: zone updates of the ramp's polish after the sharp zone's solve (then the sharp state stands)
 RAMP_UPDATES = 60
+#: zone updates of the ramp from a warm start before the sharp zone is asked (0: always the sharp zone first)
+RAMP_WARM = 0
 #: the gap residual (ε) of the sharp zone's solve when it is only the ramp's start
 SHARP_TOL = 1e-3
 
@@ -216,22 +218,17 @@ class PKSolver:
             its, ok, res, zones = core.iterations, core.converged, core.residual, 0
             msg = "converged" if ok else f"not converged in {self.max_iter} iterations (residual {res:.3g} ε)"
         else:
-            its0 = zones0 = 0
-            sharp = None
-            if model.ramp > 0:                        # the sharp zone first: it jumps in few updates
-                sharp = self._cohesive(replace(model, ramp=0.0), conv, h0, q0, w0, load, mon, pre, self.max_zone,
-                                       max(self.tol, SHARP_TOL))     # only a start: loosely
-                if sharp[5]:
-                    q0, w0, its0, zones0 = sharp[0], sharp[1], sharp[4], sharp[7]
-            limit = self.max_zone if sharp is None else RAMP_UPDATES
-            p, Kp, u, c, its, ok, res, zones, msg = self._cohesive(model, conv, h0, q0, w0, load, mon, pre, limit)
-            its, zones = its + its0, zones + zones0
-            if not ok and sharp is not None and sharp[5]:  # the ramp's fixed point cycles: the sharp zone's state
-                sharp = self._cohesive(replace(model, ramp=0.0), conv, h0, sharp[0], sharp[1], load, mon, pre,
-                                       self.max_zone)
-                its, zones = its + sharp[4], zones + sharp[7]
-                p, Kp, u, c, _, ok, res, _, msg = sharp
-                msg = f"{msg} (sharp Dugdale zone: the ramp did not settle in {RAMP_UPDATES} updates)"
+            out = None
+            if model.ramp > 0 and RAMP_WARM and bool(np.any(q0)):   # warm: the ramp from the start, if quick
+                out = self._cohesive(model, conv, h0, q0, w0, load, mon, pre, RAMP_WARM)
+                spent = (out[4], out[7])
+                out = out if out[5] else None
+            else:
+                spent = (0, 0)
+            if out is None:
+                out = self._ramp_after_sharp(model, conv, h0, q0, w0, load, mon, pre)
+            p, Kp, u, c, its, ok, res, zones, msg = out
+            its, zones = its + spent[0], zones + spent[1]
         w = Kp
         H = (g0 + c) + w - 1.0
         E = problem.dA * (0.5 * float(np.dot(p, w)) + model.energy(u))
@@ -239,6 +236,25 @@ class PKSolver:
                          float(res), bool(ok), int(its), int(conv.count), E, time.perf_counter() - t0,
                          msg if zones == 0 else f"{msg} ({zones} cohesive-zone updates)")
         return eq, float(c)
+
+    def _ramp_after_sharp(self, model, conv, h0, q0, w0, load, mon, pre):
+        """A cohesive solve; with a ramp (md), the sharp zone's solve first (it jumps in few updates) as its
+        start, and the sharp state if the ramp does not settle in RAMP_UPDATES updates."""
+        if model.ramp == 0:
+            return self._cohesive(model, conv, h0, q0, w0, load, mon, pre, self.max_zone)
+        its = zones = 0
+        sharp = self._cohesive(replace(model, ramp=0.0), conv, h0, q0, w0, load, mon, pre, self.max_zone,
+                               max(self.tol, SHARP_TOL))     # only a start: loosely
+        if sharp[5]:
+            q0, w0, its, zones = sharp[0], sharp[1], sharp[4], sharp[7]
+        out = self._cohesive(model, conv, h0, q0, w0, load, mon, pre, RAMP_UPDATES if sharp[5] else self.max_zone)
+        its, zones = its + out[4], zones + out[7]
+        if not out[5] and sharp[5]:  # the ramp's fixed point cycles: the sharp zone's state, to tol
+            out = self._cohesive(replace(model, ramp=0.0), conv, h0, sharp[0], sharp[1], load, mon, pre,
+                                 self.max_zone)
+            its, zones = its + out[4], zones + out[7]
+            out = out[:8] + (f"{out[8]} (sharp Dugdale zone: the ramp did not settle in {RAMP_UPDATES} updates)",)
+        return out[:4] + (its,) + out[5:7] + (zones,) + out[8:]
 
     def _cohesive(self, model: WallModel, conv, h0, q0, w0, load, mon, pre, limit, tol=None):
         tol = self.tol if tol is None else tol
