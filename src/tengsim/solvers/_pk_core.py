@@ -127,9 +127,10 @@ def _residual(u, S, work):
 
 
 def constrained_cg(conv: Convolution, h, p, tol: float, max_iter: int, load: float | None = None,
-                   monitor=None, precond=None) -> CoreResult:
+                   monitor=None, precond=None, Kp0=None) -> CoreResult:
     """Polonsky–Keer's constrained CG (module doc) from the start pressure ``p`` (>= 0, a flat array; the
-    solve's own: overwritten).  ``h``: the gap above the wall at p = 0 (flat, ε).  ``load``: the mean of
+    solve's own: overwritten).  ``Kp0``: K p of that start if known (displacement control: saves the first
+    convolution).  ``h``: the gap above the wall at p = 0 (flat, ε).  ``load``: the mean of
     p under load control (W/ε; None: displacement control).  ``monitor(it, residual)``: progress."""
     n = h.size
     n0 = conv.count
@@ -145,7 +146,10 @@ def constrained_cg(conv: Convolution, h, p, tol: float, max_iter: int, load: flo
     res = best = math.inf
     p_best, it_best, stalled = (backend.empty(n) if precond is not None else None), 0, False
     for it in range(max_iter + 1):
-        conv(p, Kp)
+        if it == 0 and Kp0 is not None and load is None:
+            Kp[:] = Kp0
+        else:
+            conv(p, Kp)
         np.add(h, Kp, out=u)
         S = p > 0
         nS = int(np.count_nonzero(S))

@@ -279,7 +279,8 @@ class PKSolver:
                                    f"is below the cohesive zone's tension {float(pa.mean()):.6g} W/ε")
             # the contact solve to a tolerance the zone's last move allows (inexact early updates)
             tol_in = tol if model.sharp else max(tol, min(1e-2 * last_move, 1e-2))
-            core = constrained_cg(conv, hh, pc, tol_in, self.max_iter, core_load, mon, pre)
+            core = constrained_cg(conv, hh, pc, tol_in, self.max_iter, core_load, mon, pre,
+                                  None if core is None else core.Kp)   # K p_c: the last solve's
             its += core.iterations
             pc, u, c = core.p, core.u, core.c
             if not core.converged:
@@ -344,7 +345,9 @@ class _Anderson:
             x += f
             return
         Fm = np.stack(self.F, axis=1)
-        gamma = np.linalg.lstsq(Fm, f, rcond=1e-10)[0]
+        A = Fm.T @ Fm                                  # the normal equations (m × m), scaled to unit diagonal
+        d = np.sqrt(np.maximum(np.diag(A), 1e-300))
+        gamma = np.linalg.lstsq(A / np.outer(d, d), (Fm.T @ f) / d, rcond=1e-10)[0] / d
         x += f - (np.stack(self.X, axis=1) + Fm) @ gamma
 
 
