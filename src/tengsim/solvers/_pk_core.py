@@ -15,7 +15,9 @@ One iteration (Polonsky & Keer 1999, Eqs. 7–17; as in Tamaas and ASPHER): u = 
 set S = {p > 0} (one convolution), the conjugate direction t = u + δ (G/G_old) t_old on S, r = K t
 (the second convolution), the exact step τ = u·t / r·t along −t, the projection p >= 0, and the
 pixels out of contact that overlap the wall (u < 0, p = 0) entering with p = −τ u (then δ = 0: the
-conjugacy restarts).  So two convolutions (FFT pairs) an iteration, plus one to start.  Converged when
+conjugacy restarts).  So two convolutions (FFT pairs) an iteration, plus one to start; with the |q|
+preconditioner (:class:`Preconditioner`: the direction is z = P_S M⁻¹ P_S u, the overlap step scaled by M⁻¹'s
+diagonal, the conjugacy restarted whenever the set shrinks) one FFT pair more.  Converged when
 max |u| over S and the largest overlap max(−u, 0) off S are both <= ``tol`` (ε): the residual of the
 hard-wall problem in the gap, the unit of Eq. (9)'s.
 

@@ -28,8 +28,11 @@ softer than a pixel, pixel snap number < 1, and says so when it does not).  The 
 gives the first zone, so a path's warm starts keep its branch (approach and retraction differ, jumps
 are the walker's).
 
-Cost: two convolutions an iteration of the contact solve, one to start it, and one per zone update
-(K p_a); ``Equilibrium.n_conv`` counts them all, ``iterations`` the contact solves' iterations.
+Cost: two kernel convolutions an iteration of the contact solve and one FFT pair of its preconditioner
+(tengsim.solvers._pk_core), one convolution to start it (none when a zone update goes on from the last
+solve's K p_c), and one per zone update (K p_a); ``Equilibrium.n_conv`` counts the kernel's, ``iterations``
+the contact solves' iterations.  The Maugis–Dugdale ramp: the sharp zone's solve first (loosely, to
+``SHARP_TOL``: it jumps in few updates), then the ramp from it (Anderson-mixed, ``anderson`` differences).
 The returned state is q = P = p, w = K p, H = g0 + w − 1 (load control: g0 moved by the approach's
 correction, :meth:`PKSolver.solve_load`); ``residual`` is the hard-wall residual in ε (the largest
 gap over the contact, overlap of the wall, or move of the last zone update).
