@@ -332,6 +332,21 @@ def _deadline(progress, plan, keep, started):
     return call
 
 
+#: laws a design runs on the constrained solver 'pk' (their hard-wall limit) unless it names its solver
+PK_LAWS = ("MaugisDugdale", "Exponential")
+
+
+def choose_solver(plan, cplan, progress=None):
+    """The contact plan a design runs: a cohesive law with a wall (``md``, ``exp``) on the constrained solver
+    'pk' (tengsim.solvers.pk) unless the design's table names a solver; said in one line."""
+    table = plan.contact_table if isinstance(plan.contact_table, dict) else {}
+    if table.get("solver") in (None, "", "auto") and type(cplan.law).__name__ in PK_LAWS:
+        cplan = dataclasses.replace(cplan, solver="pk", solver_note="")
+        _say(progress, "solver: pk (Polonsky–Keer constrained CG with a cohesive zone: the law's hard-wall "
+                       "limit; give solver = 'fast' or 'homotopy' for the penalty wall)")
+    return cplan
+
+
 def solver_tol(plan) -> float:
     """The solver's tolerance of a design (:data:`SOLVER_TOL_PER_TOL`)."""
     return SOLVER_TOL_PER_TOL * plan.tol
@@ -550,6 +565,7 @@ def run_design(plan, progress=None, keep=None) -> DesignResult:
     preflight(plan)
     cplan = dataclasses.replace(as_plan(plan.contact_table if plan.contact_plan is None else plan.contact_plan),
                                 tol=solver_tol(plan))  # the plan plan_design built (planned once)
+    cplan = choose_solver(plan, cplan, progress)
     dx = start_dx(plan, cplan)
     _say(progress, f"{plan.name}: Tabor number {cplan.tabor:.3g} (from eps = {plan.eps * 1e9:.3g} nm), "
                    f"lateral unit {cplan.scaling.lateral * 1e9:.3g} nm")

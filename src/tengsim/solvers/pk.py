@@ -1,0 +1,357 @@
+"""The constrained solver 'pk': Polonsky & Keer's (1999) constrained conjugate gradient on the contact
+pressures for a hard wall, and its cohesive extension (Rey, Anciaux & Molinari, Comput. Mech. 2017) for
+Maugis–Dugdale and exponential adhesion outside the contact.
+
+Laws.  The solver solves the hard-wall limit of a law with a wall, the wall at g = 1 (h = 0):
+
+* ``repulsive`` (:class:`~tengsim.laws.Repulsive`, P = c g^-k) as its limit k → ∞: no pressure for
+  g > 1, any pressure >= 0 at g = 1, no overlap g < 1 (a hard wall; the penalty law's own wall is soft
+  on the scale ε, a few ε of compression at the loads of a Hertz check);
+* ``md`` (:class:`~tengsim.laws.MaugisDugdale`) as its limits wall_stiffness → ∞, smoothing → 0: the
+  Dugdale tension σ0 = ``tension`` wherever 1 <= g <= 1 + h0 (h0 = W/σ0 = ``law.work``/σ0, so the
+  work of adhesion is the law's W), nothing beyond, and at g = 1 any pressure >= −σ0;
+* ``exp`` (:class:`~tengsim.laws.Exponential`) as its limit wall_stiffness → ∞: the attraction
+  −(W/ρ) exp(−(g − 1)/ρ) for g >= 1, ρ = ``range``, W = ``law.work``, any pressure >= −W/ρ at g = 1.
+
+Any other law (LJ93's smooth repulsion, a plugin's law) is refused with one line naming the solvers
+that can ('fast', or 'homotopy' where the law is stiff at the pixel scale).
+
+Cohesive laws (Rey et al. 2017: the adhesive tractions outside the contact are a load of the
+non-adhesive problem).  The pressure is p = p_c + p_a: p_a the law's tension where the gap is within
+its range (the contact included: −σ0 there), p_c >= 0 the contact pressure, solved by the constrained
+CG (tengsim.solvers._pk_core) with the initial gap g0 − 1 + K p_a.  The cohesive zone is then updated
+from the new gap and the contact solve repeated from its last pressure until the zone no longer
+changes (Maugis–Dugdale: a set of pixels, so this ends exactly; every state it ends in is a stable
+equilibrium of the sharp Dugdale law) or, for the exponential law, until the gap moves by less than
+``tol`` (a damped fixed point, halving its step when the change grows; it converges where the law is
+softer than a pixel, pixel snap number < 1, and says so when it does not).  The start state's gap
+gives the first zone, so a path's warm starts keep its branch (approach and retraction differ, jumps
+are the walker's).
+
+Cost: two kernel convolutions an iteration of the contact solve and one FFT pair of its preconditioner
+(tengsim.solvers._pk_core), one convolution to start it (none when a zone update goes on from the last
+solve's K p_c), and one per zone update (K p_a); ``Equilibrium.n_conv`` counts the kernel's, ``iterations``
+the contact solves' iterations.  The Maugis–Dugdale ramp: the sharp zone's solve first (loosely, to
+``SHARP_TOL``: it jumps in few updates), then the ramp from it (Anderson-mixed, ``anderson`` differences).
+The returned state is q = P = p, w = K p, H = g0 + w − 1 (load control: g0 moved by the approach's
+correction, :meth:`PKSolver.solve_load`); ``residual`` is the hard-wall residual in ε (the largest
+gap over the contact, overlap of the wall, or move of the last zone update).
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, replace
+from typing import ClassVar
+
+import numpy as np
+
+from tengsim import backend
+from tengsim.errors import TengsimError
+from tengsim.registry import SOLVERS
+from tengsim.solvers._pk_core import Convolution, constrained_cg, preconditioner
+from tengsim.solvers.types import Equilibrium, Problem, State
+
+#: the largest pixel snap number of a Maugis–Dugdale ramp (PKSolver._ramp)
+RAMP_SNAP = 0.5
+#: zone updates of the ramp's polish after the sharp zone's solve (then the sharp state stands)
+RAMP_UPDATES = 60
+#: zone updates of the ramp from a warm start before the sharp zone is asked (0: always the sharp zone first)
+RAMP_WARM = 0
+#: the gap residual (ε) of the sharp zone's solve when it is only the ramp's start
+SHARP_TOL = 1e-3
+
+#: the laws 'pk' solves, by class name (their hard-wall limits, module doc)
+SUPPORTED = ("Repulsive", "MaugisDugdale", "Exponential")
+
+
+@dataclass(frozen=True)
+class WallModel:
+    """The hard-wall limit of a law: ``kind`` 'wall', 'md' or 'exp'; σ0 (W/ε), h0 or ρ (ε), W (W)."""
+
+    kind: str
+    tension: float = 0.0
+    length: float = 0.0
+    work: float = 0.0
+    ramp: float = 0.0          # md: the width (ε) of the smoothstep at the zone's end; 0: a sharp step
+
+    @property
+    def sharp(self) -> bool:
+        """A zone that is a set of pixels (sharp Maugis–Dugdale): updated until it no longer changes."""
+        return self.kind == "md" and self.ramp == 0.0
+
+    def adhesive(self, u, out):
+        """p_a at the gap above the wall u >= 0 (in contact u = 0: −σ0), into ``out``."""
+        if self.sharp:
+            np.less_equal(u, self.length, out=out)
+            out *= -self.tension
+        elif self.kind == "md":                      # the law's smoothstep, t = 1 inside, 0 beyond
+            np.subtract(self.length + 0.5 * self.ramp, u, out=out)
+            out *= 1.0 / self.ramp
+            np.clip(out, 0.0, 1.0, out=out)
+            out *= out * (3.0 - 2.0 * out)
+            out *= -self.tension
+        else:
+            np.maximum(u, 0.0, out=out)
+            out *= -1.0 / self.length
+            np.exp(out, out=out)
+            out *= -self.tension
+        return out
+
+    def energy(self, u) -> float:
+        """ΣΦ over the pixels (W per pixel area) at gaps above the wall u."""
+        if self.kind == "wall":
+            return 0.0
+        if self.kind == "md":                        # (the ramp's energy as the sharp step's: O(ramp²))
+            z = u <= self.length
+            return float(-self.tension * np.sum(self.length - np.maximum(u, 0.0), where=z))
+        return float(-self.work * np.exp(-np.maximum(u, 0.0) / self.length).sum())
+
+
+def wall_model(law) -> WallModel:
+    """The hard-wall limit of ``law`` (module doc), or one line naming the solvers that can solve it."""
+    name = type(law).__name__
+    if name == "Repulsive":
+        return WallModel("wall")
+    if name == "MaugisDugdale":
+        s0 = float(law.tension)
+        return WallModel("md", s0, float(law.work) / s0, float(law.work))  # the ramp: PKSolver
+    if name == "Exponential":
+        W, rho = float(law.work), float(law.range)
+        return WallModel("exp", W / rho, rho, W)
+    raise TengsimError(f"solver 'pk' solves hard walls only (laws repulsive, md, exp); law {name} has a "
+                       "smooth repulsion: use solver 'fast' (or 'homotopy' for a law stiff at the pixel scale)")
+
+
+def supports(law) -> bool:
+    """Can 'pk' solve ``law`` (its hard-wall limit)?"""
+    return type(law).__name__ in SUPPORTED
+
+
+@dataclass(frozen=True)
+class PKSolver:
+    """Polonsky–Keer constrained CG on the contact pressures, with Maugis–Dugdale / exponential cohesive
+    zones (module doc).  ``tol``: the gap residual (ε); ``max_iter``: iterations of one contact solve;
+    ``max_zone``: zone updates of a cohesive solve; ``monitor(iteration, residual)``: progress."""
+
+    tol: float = 1e-6
+    max_iter: int = 1000
+    max_zone: int = 500
+    precondition: bool = True
+    md_zone: str = "ramp"
+    anderson: int = 5
+    name: str = "pk"
+    monitor: object = None
+    monitor_every: int = 50
+    weighted_block: ClassVar[bool] = False
+    splits_over_mpi: ClassVar[bool] = False
+    resumes_from_state: ClassVar[bool] = False
+
+    def __post_init__(self):
+        if not (isinstance(self.tol, (int, float)) and self.tol > 0 and math.isfinite(self.tol)):
+            raise TengsimError(f"tol must be a finite number > 0, got {self.tol!r}")
+        if self.md_zone not in ("ramp", "sharp"):
+            raise TengsimError(f"md_zone must be 'ramp' or 'sharp', got {self.md_zone!r}")
+        for key in ("max_iter", "max_zone", "monitor_every"):
+            v = getattr(self, key)
+            if isinstance(v, bool) or not isinstance(v, int) or v < 1:
+                raise TengsimError(f"{key} must be an integer >= 1, got {v!r}")
+
+    @staticmethod
+    def solves(law) -> bool:
+        """Can this solver solve ``law`` (its hard-wall limit; module doc)?"""
+        return supports(law)
+
+    def solve(self, problem: Problem, start: State) -> Equilibrium:
+        """The equilibrium at the problem's gap g0 (displacement control), from ``start``."""
+        return self._solve(problem, start, None)[0]
+
+    def solve_load(self, problem: Problem, mean_pressure: float, start: State | None = None):
+        """Load control: the equilibrium whose mean pressure over the cell is ``mean_pressure`` (W/ε).
+        Returns (equilibrium, dD): dD (ε) the rigid approach beyond the one in ``problem.g0`` that
+        carries the load (the equilibrium's H includes it)."""
+        if not math.isfinite(mean_pressure):
+            raise TengsimError(f"mean_pressure must be finite, got {mean_pressure!r}")
+        if start is None:
+            start = State.zero(np.shape(problem.g0))
+        eq, c = self._solve(problem, start, float(mean_pressure))
+        return eq, -c                                 # the gap's correction c is an approach of −c
+
+    # ---- the solve ---------------------------------------------------------------------------
+    @staticmethod
+    def _ramp(law, conv, shape) -> float:
+        """The zone's ramp (ε): the law's smoothing, widened where a pixel would be stiffer than it
+        (pixel snap number 1.5 σ0 K_ii / ramp above ``RAMP_SNAP``; K_ii, a pixel's own compliance, by one
+        convolution of a unit pixel)."""
+        unit = backend.zeros(int(np.prod(shape)))
+        i = np.ravel_multi_index(tuple(n // 2 for n in shape), shape)
+        unit[i] = 1.0
+        kii = float(conv(unit, backend.empty(unit.size))[i])
+        return max(float(law.smoothing), 1.5 * float(law.tension) * kii / RAMP_SNAP)
+
+    def _solve(self, problem: Problem, start: State, load):
+        t0 = time.perf_counter()
+        if problem.weights is not None:
+            raise TengsimError("solver 'pk' does not solve weighted (mirror-block) problems; "
+                               "use solver 'fast' for a mirror-symmetric cell")
+        model = wall_model(problem.law)
+        shape = np.shape(problem.g0)
+        conv = Convolution(problem.kernel, shape)
+        pre = preconditioner(problem.kernel, shape) if self.precondition else None
+        if model.kind == "md" and self.md_zone == "ramp":
+            model = replace(model, ramp=self._ramp(problem.law, conv, shape))
+        g0 = backend.xp.ascontiguousarray(problem.g0, dtype=float).ravel()
+        q0 = backend.xp.asarray(start.q, dtype=float).ravel()
+        w0 = backend.xp.asarray(start.w, dtype=float).ravel()
+        h0 = g0 - 1.0
+        K = problem.kernel
+        if load is None and bool(getattr(K, "pinned_mean", getattr(K, "periodic", False))) and not h0.mean() > 0:
+            # the mean gap of a periodic half-space is the mean of g0: at or below the wall no state exists
+            msg = (f"the mean gap {h0.mean() + 1.0:.6g} ε is at or below the wall (1 ε) on a periodic half-space: "
+                   "no state under displacement control; use load control (solve_load)")
+            z = backend.zeros(shape)
+            return Equilibrium(State(z, z.copy()), np.reshape(h0, shape).copy(), z.copy(), math.inf, False, 0, 0,
+                               math.nan, time.perf_counter() - t0, msg), 0.0
+        every = self.monitor_every
+        mon = None if self.monitor is None else (
+            lambda it, res: self.monitor(it, res, math.nan) if it % every == 0 else None)
+        if model.kind == "wall":
+            core = constrained_cg(conv, h0, np.maximum(q0, 0.0), self.tol, self.max_iter, load, mon, pre)
+            p, Kp, u, c = core.p, core.Kp, core.u, core.c
+            its, ok, res, zones = core.iterations, core.converged, core.residual, 0
+            msg = "converged" if ok else f"not converged in {self.max_iter} iterations (residual {res:.3g} ε)"
+        else:
+            out = None
+            if model.ramp > 0 and RAMP_WARM and bool(np.any(q0)):   # warm: the ramp from the start, if quick
+                out = self._cohesive(model, conv, h0, q0, w0, load, mon, pre, RAMP_WARM)
+                spent = (out[4], out[7])
+                out = out if out[5] else None
+            else:
+                spent = (0, 0)
+            if out is None:
+                out = self._ramp_after_sharp(model, conv, h0, q0, w0, load, mon, pre)
+            p, Kp, u, c, its, ok, res, zones, msg = out
+            its, zones = its + spent[0], zones + spent[1]
+        w = Kp
+        H = (g0 + c) + w - 1.0
+        E = problem.dA * (0.5 * float(np.dot(p, w)) + model.energy(u))
+        eq = Equilibrium(State(p.reshape(shape), w.reshape(shape)), H.reshape(shape), p.reshape(shape).copy(),
+                         float(res), bool(ok), int(its), int(conv.count), E, time.perf_counter() - t0,
+                         msg if zones == 0 else f"{msg} ({zones} cohesive-zone updates)")
+        return eq, float(c)
+
+    def _ramp_after_sharp(self, model, conv, h0, q0, w0, load, mon, pre):
+        """A cohesive solve; with a ramp (md), the sharp zone's solve first (it jumps in few updates) as its
+        start, and the sharp state if the ramp does not settle in RAMP_UPDATES updates."""
+        if model.ramp == 0:
+            return self._cohesive(model, conv, h0, q0, w0, load, mon, pre, self.max_zone)
+        its = zones = 0
+        sharp = self._cohesive(replace(model, ramp=0.0), conv, h0, q0, w0, load, mon, pre, self.max_zone,
+                               max(self.tol, SHARP_TOL))     # only a start: loosely
+        if sharp[5]:
+            q0, w0, its, zones = sharp[0], sharp[1], sharp[4], sharp[7]
+        out = self._cohesive(model, conv, h0, q0, w0, load, mon, pre, RAMP_UPDATES if sharp[5] else self.max_zone)
+        its, zones = its + out[4], zones + out[7]
+        if not out[5] and sharp[5]:  # the ramp's fixed point cycles: the sharp zone's state, to tol
+            out = self._cohesive(replace(model, ramp=0.0), conv, h0, sharp[0], sharp[1], load, mon, pre,
+                                 self.max_zone)
+            its, zones = its + out[4], zones + out[7]
+            out = out[:8] + (f"{out[8]} (sharp Dugdale zone: the ramp did not settle in {RAMP_UPDATES} updates)",)
+        return out[:4] + (its,) + out[5:7] + (zones,) + out[8:]
+
+    def _cohesive(self, model: WallModel, conv, h0, q0, w0, load, mon, pre, limit, tol=None):
+        tol = self.tol if tol is None else tol
+        n = h0.size
+        s0 = model.tension
+        Ka, pa, pa_new, hh, u_prev, used = (backend.empty(n) for _ in range(6))
+        # the first zone from the start state's gap; its contact pressure from its pressure
+        model.adhesive(h0 + w0, pa)
+        pc = np.maximum(q0 - pa, 0.0)
+        pc[(h0 + w0) > tol] = 0.0
+        last_move = math.inf
+        its, zones, ok, res, c = 0, 0, False, math.inf, 0.0
+        core = None
+        mix = None if model.sharp else _Anderson(n, self.anderson)
+        for zones in range(1, limit + 1):
+            used[:] = pa                              # the zone this contact solve carries
+            conv(used, Ka)
+            np.add(h0, Ka, out=hh)
+            core_load = None if load is None else load - float(pa.mean())
+            if core_load is not None and not core_load > 0:
+                raise TengsimError(f"load control needs a compressive contact: the mean pressure {load:.6g} W/ε "
+                                   f"is below the cohesive zone's tension {float(pa.mean()):.6g} W/ε")
+            # the contact solve to a tolerance the zone's last move allows (inexact early updates)
+            tol_in = tol if model.sharp else max(tol, min(1e-2 * last_move, 1e-2))
+            core = constrained_cg(conv, hh, pc, tol_in, self.max_iter, core_load, mon, pre,
+                                  None if core is None else core.Kp)   # K p_c: the last solve's
+            its += core.iterations
+            pc, u, c = core.p, core.u, core.c
+            if not core.converged:
+                res = core.residual
+                break
+            model.adhesive(u, pa_new)
+            pa_new[pc > 0] = -s0
+            if model.sharp:
+                moved = int(np.count_nonzero(pa_new != pa))
+                res = core.residual
+                if moved == 0:
+                    ok = True
+                    break
+                pa[:] = pa_new
+            else:
+                move = float(np.max(np.abs(u - u_prev))) if zones > 1 else math.inf
+                u_prev[:] = u
+                res = max(core.residual, move if math.isfinite(move) else 0.0)
+                if zones > 1 and move <= tol and tol_in <= tol:
+                    ok = True
+                    break
+                last_move = move
+                mix.step(pa, pa_new)                  # pa <- the next zone (Anderson-mixed fixed point)
+                np.clip(pa, -s0, 0.0, out=pa)
+        p = pc + used
+        # K p = K p_c + K p_a (the last zone's K p_a is in Ka: the core's Kp is K p_c)
+        Kp = core.Kp + Ka
+        if ok:
+            msg = "converged"
+        elif core is not None and not core.converged:
+            msg = f"contact solve not converged in {self.max_iter} iterations (residual {res:.3g} ε)"
+        else:
+            msg = f"cohesive zone not settled in {limit} updates (last move {res:.3g} ε)"
+        return p, Kp, u, c, its, ok, res, zones, msg
+
+
+class _Anderson:
+    """Anderson mixing (type II, memory ``m``) of the fixed point x = G(x) of a cohesive zone's tractions:
+    ``step(x, gx)`` moves x in place to x + f − (ΔX + ΔF) γ, γ the least-squares fit of f = G(x) − x
+    by the stored differences (m = 0: the plain update x = G(x)).  Memory is dropped when the residual
+    grows tenfold (a jump: the old differences describe another branch)."""
+
+    def __init__(self, n: int, m: int):
+        self.m, self.X, self.F = int(m), [], []
+        self.x_old = self.f_old = None
+        self.f_norm = math.inf
+
+    def step(self, x, gx):
+        f = gx - x
+        fn = float(np.dot(f, f))
+        if fn > 100.0 * self.f_norm:
+            self.X, self.F = [], []
+        self.f_norm = fn
+        if self.m and self.x_old is not None:
+            self.X.append(x - self.x_old)
+            self.F.append(f - self.f_old)
+            if len(self.X) > self.m:
+                self.X.pop(0)
+                self.F.pop(0)
+        self.x_old, self.f_old = x.copy(), f
+        if not self.F:
+            x += f
+            return
+        Fm = np.stack(self.F, axis=1)
+        A = Fm.T @ Fm                                  # the normal equations (m × m), scaled to unit diagonal
+        d = np.sqrt(np.maximum(np.diag(A), 1e-300))
+        gamma = np.linalg.lstsq(A / np.outer(d, d), (Fm.T @ f) / d, rcond=1e-10)[0] / d
+        x += f - (np.stack(self.X, axis=1) + Fm) @ gamma
+
+
+SOLVERS.register("pk", PKSolver, summary="Polonsky–Keer constrained CG: hard wall, Maugis–Dugdale, exponential")
