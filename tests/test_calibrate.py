@@ -187,3 +187,32 @@ def test_not_a_design_refused(tmp_path, capsys):
     rc = main(["calibrate", str(tmp_path / "d.toml"), "--data", str(tmp_path / "m.csv"), "--out", str(tmp_path / "o")])
     err = capsys.readouterr().err.strip()
     assert rc == 2 and "not a design" in err and not (tmp_path / "o").exists()
+
+
+@pytest.mark.slow
+def test_design_with_the_fitted_material_writes_bands(fitted, tmp_path):
+    """tengsim design --material: the design at the fitted material, and a band from the material's uncertainty
+    points (one design per distinct (E*, W, ε)) that holds the best curve and is as wide as σ's interval or wider."""
+    import csv
+
+    _, out, args = fitted
+    d = _toml(tmp_path / "new.toml", {**G1, "p_max": "20kPa", "p_step": "5kPa"})
+    rc = main(["design", str(d), "--material", str(out / "material.toml"), "--out", str(tmp_path / "new"), "--quiet"])
+    assert rc == 0
+    rows = list(csv.DictReader(ln for ln in (tmp_path / "new" / "bands.csv").read_text().splitlines()
+                               if not ln.startswith("#")))
+    assert len(rows) == 5
+    for r in rows:
+        v, lo, hi = (float(r[k]) for k in ("voc_eq12_V", "voc_eq12_lower_V", "voc_eq12_upper_V"))
+        assert lo <= v <= hi and hi > lo
+        a, alo, ahi = (float(r[k]) for k in ("area_fraction", "area_fraction_lower", "area_fraction_upper"))
+        assert alo <= a <= ahi
+    assert "all_ok: true" in (tmp_path / "new" / "bands.csv").read_text()
+
+
+def test_material_file_refused_when_not_one(tmp_path, capsys):
+    (tmp_path / "m.toml").write_text("[design]\nW = '25mJ/m2'\npitch = '1um'\n")
+    d = _toml(tmp_path / "d.toml", {**G1, "W": "25mJ/m2", "p_max": "10kPa"})
+    rc = main(["design", str(d), "--material", str(tmp_path / "m.toml"), "--out", str(tmp_path / "o")])
+    err = capsys.readouterr().err.strip()
+    assert rc == 2 and "not a material key" in err and not (tmp_path / "o").exists()

@@ -294,7 +294,7 @@ def identifiability(f: Fit, prob) -> list:
                 if k is not None and math.isfinite(k):
                     expo = f"{b}^{-k:.2g}" if abs(k) > 1e-3 else b
                     out.append(f"{a} and {b} trade off along {a}·{expo} ≈ const (correlation {r:+.2f}): the data fix "
-                               f"the combination, not each alone.")
+                               f"that combination better than either alone.")
                 else:
                     out.append(f"{a} and {b} trade off (correlation {r:+.2f}).")
     return out

@@ -72,7 +72,8 @@ def read_material(path) -> dict:
 
 def predict_bands(plan, result, material: dict, progress=None) -> dict | None:
     """{'pressure', 'area_lower', 'area_upper', 'voc_lower', 'voc_upper' (approach, Eq. 12), 'points', 'statuses'}:
-    the envelope over the design run at each of the material's points (module doc); None without points."""
+    the envelope over the design run at each of the material's points (module doc; one design per
+    distinct (E*, W, ε): σ scales V_OC); None without points."""
     from tengsim.design import plan_design, run_design
 
     if not material["points"]:
@@ -83,21 +84,40 @@ def predict_bands(plan, result, material: dict, progress=None) -> dict | None:
     statuses = [result.status]
     table = dict(plan.contact_table)
     own = {k: getattr(plan, k) for k in ("eps_r", "T", "gap", "tol")}
-    for i, pt in enumerate(material["points"]):
+    from tengsim.calibrate.problem import KINDS
+    from tengsim.units import parse_quantity
+
+    def si(pt, k):
+        return round(parse_quantity(pt[k], KINDS[k], k), 12) if k in pt else None
+
+    solved = {(round(plan.E_star, 12), round(plan.W, 12), round(plan.eps, 12)): A[0]}  # the design itself
+    contact = [k for k in MATERIAL_KEYS if k != "sigma"]
+    todo = {}
+    for pt in material["points"]:
+        key = tuple(si(pt, k) if k in pt else round(getattr(plan, k), 12) for k in contact)
+        if key not in solved:
+            todo.setdefault(key, pt)
+    for i, (key, pt) in enumerate(todo.items()):  # σ enters linearly: one design per (E*, W, ε)
         if progress is not None:
-            progress(f"band: design {i + 1}/{len(material['points'])} at " + ", ".join(f"{k} {v}" for k, v in pt.items()))
-        t = {**{k: v for k, v in table.items() if k not in MATERIAL_KEYS}, **own, **pt,
-             "p_min": plan.pressures[0], "p_max": plan.pressures[-1],
+            progress(f"band: design {i + 1}/{len(todo)} at " + ", ".join(f"{k} {pt[k]}" for k in contact if k in pt))
+        t = {**{k: v for k, v in table.items() if k not in MATERIAL_KEYS}, **own,
+             **{k: pt[k] for k in contact if k in pt}, "p_min": plan.pressures[0], "p_max": plan.pressures[-1],
              "p_step": (plan.pressures[-1] - plan.pressures[0]) / max(len(plan.pressures) - 1, 1), "maps": False}
         r = run_design(plan_design(t))
         statuses.append(r.status)
         a = np.asarray(r.dataset["charged_area_fraction"].sel(branch="approach").values, float)
-        v = np.asarray(r.dataset["voc_eq12"].sel(branch="approach").values, float)
         if len(a) != len(A[0]):
             a = np.interp(plan.pressures, np.asarray(r.dataset["pressure"].values), a)
-            v = np.interp(plan.pressures, np.asarray(r.dataset["pressure"].values), v)
+        solved[key] = a
+    A, V = [A[0]], [V[0]]
+    from tengsim.device.params import EPS0
+
+    k12 = plan.T / (plan.eps_r * EPS0)  # V_OC per σ per A/S (Eq. 12)
+    for pt in material["points"]:
+        key = tuple(si(pt, k) if k in pt else round(getattr(plan, k), 12) for k in contact)
+        a = solved[key]
         A.append(a)
-        V.append(v)
+        V.append((si(pt, "sigma") if "sigma" in pt else plan.sigma) * k12 * a)
     A, V = np.array(A), np.array(V)
     return {"pressure": np.asarray(plan.pressures, float), "area": A[0], "area_lower": np.nanmin(A, axis=0),
             "area_upper": np.nanmax(A, axis=0), "voc": V[0], "voc_lower": np.nanmin(V, axis=0),

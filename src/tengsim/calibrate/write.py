@@ -110,7 +110,7 @@ def to_dataset(cal):
         ds[v].encoding["dtype"] = "S1"
     ds.attrs = {"noise_model": noise_text(cal), "voc_model": prob.voc, "interval_method":
                 "profile likelihood (threshold %.4g)" % f.threshold, "noise_scale": float(f.scale),
-                "surrogate_loo_error": float(cal.surrogate_error) if math.isfinite(cal.surrogate_error) else "n/a",
+                "surrogate_error_at_best": float(cal.surrogate_error) if math.isfinite(cal.surrogate_error) else "n/a",
                 "surrogate_within_noise": int(cal.surrogate_ok), "identifiability": " ".join(f.words),
                 "free": ",".join(prob.free), "fixed": json.dumps(prob.fixed, sort_keys=True),
                 "designs": json.dumps(list(prob.names)), "data": json.dumps([c.source for c in prob.curves])}
@@ -144,6 +144,8 @@ def material_text(cal) -> str:
 
 
 def report_text(cal, figures) -> str:
+    from tengsim.calibrate.fit import inflation
+
     f, prob = cal.fit, cal.problem
     out = ["# Calibration", "", f"Fitted: {', '.join(label(k) for k in prob.free)} to {prob.n_points} points of "
            f"{len(prob.curves)} measured curve(s), jointly (one material); V_OC by {prob.voc.replace('eq', 'Eq. ')}.", "",
@@ -169,10 +171,11 @@ def report_text(cal, figures) -> str:
             "(log W, log ε), interpolated by a thin-plate spline (E* as a pressure scale: no solve of its own).",
             f"* Designs: {cal.nodes_solved} solved, {cal.nodes_cached} taken back from designs/ "
             f"({len(cal.nodes_failed)} not converged and left out), {cal.zooms} zoom(s); {cal.seconds:.0f} s.",
-            f"* Interpolation error (leave-one-out at the nodes of the region that fits, rms, residual units): "
-            f"{cal.surrogate_error:.3g} against the noise {f.scale:.3g}: "
-            + ("within half the noise." if cal.surrogate_ok else "**above half the noise: the intervals may be too "
-               "wide or shifted; narrow --bounds or add --nodes**.")]
+            f"* Interpolation error (a design solved at the best fit against the interpolation there, rms over the "
+            f"data points, residual units): {cal.surrogate_error:.3g} against the noise {f.scale:.3g}: "
+            + ("within half the noise." if cal.surrogate_ok else "**above half the noise: the intervals are widened "
+               "for it; narrow --bounds, add --nodes or --zooms for tighter ones**.")
+            + f" The intervals make room for it (threshold × {inflation(prob.n_points, cal.surrogate_error, f.scale):.3g})."]
     if cal.nodes_failed:
         out += ["", "Nodes left out:", ""] + [f"* {x}" for x in cal.nodes_failed]
     out += ["", "## Files", "", "fit.nc (CF-1.10, SI), fit.csv, material.toml (`tengsim design --material`), "
