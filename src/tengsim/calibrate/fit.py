@@ -233,6 +233,11 @@ def fit(model: Model, box=None, polish: bool = True, model_error: float = 0.0) -
     cnames, corr = _correlation(model, pts, dev, dmin, b, c, scale)
     fitres = Fit(best, interval, profile, cnames, corr, thr, dmin, scale, (), region, box, theta, pts, dev, sig)
     words = tuple(identifiability(fitres, prob))
+    grow = inflation(n, model_error, scale)
+    if grow > 1.5:
+        words += (f"These intervals are widened ×{math.sqrt(grow):.2g} for the interpolation's own error "
+                  f"({model_error:.3g} against the noise {scale:.3g}): with more designs (--nodes, --zooms, tighter "
+                  "--bounds) they narrow to what the data alone allow.",)
     return Fit(best, interval, profile, cnames, corr, thr, dmin, scale, words, region, box, theta, pts, dev, sig)
 
 

@@ -5,9 +5,10 @@ parameters and bounds, that the voltage can be reached).  :func:`calibrate` then
 
 1. lays an n × n grid of nodes (default 4 × 4) over the bounds of (W_eff, ε) (the axes that are free), prints how
    many designs it will solve and the designs' own time estimate, and solves each (kept in ``DIR/designs``);
-2. fits (:func:`tengsim.calibrate.fit.fit`) and measures the interpolation's leave-one-out error at the nodes inside
-   the region that fits; if it is above half the data's noise, lays a new n × n grid over the box of that region
-   (15 % margin) and fits again, at most ``zooms`` times;
+2. fits (:func:`tengsim.calibrate.fit.fit`) and measures the interpolation's error: designs solved at the best fit
+   and at both ends of each free contact parameter's interval (:func:`_check`), the largest; if it is above half the data's noise, lays a new n × n grid over the box of that region (15 % margin, at
+   least half the previous box) and fits again, at most ``zooms`` times; the intervals make room for the last
+   error measured (:func:`tengsim.calibrate.fit.inflation`);
 3. returns a frozen :class:`Calibration` (the fit, its bands, the surrogate's error, the nodes' account).
 """
 from __future__ import annotations
@@ -241,7 +242,7 @@ def calibrate(prob, out_dir, n_nodes: int = 4, zooms: int = 2, progress=None) ->
         if math.isfinite(err) and err <= LOO_PER_NOISE * result.scale or zoom == zooms:
             break
         box_uv = _region_box(model, result, ((u0, u1), (v0, v1)), box_uv)
-        _say(progress, f"interpolation error at the best fit {err:.3g} (noise {result.scale:.3g}): zooming on the "
+        _say(progress, f"interpolation error {err:.3g} (noise {result.scale:.3g}): zooming on the "
                        "region that fits")
         grid(box_uv)
         model = Model(prob, surr, geo)
@@ -315,31 +316,57 @@ def _region_box(model, f, full, prev):
     return tuple(out)
 
 
+def check_points(f, prob) -> list:
+    """Log contact parameters where the interpolation is checked: the best fit and, for each free contact
+    parameter, both ends of its 95 % interval (the others at their profile optimum there): a check at the best fit
+    alone can sit on a design, where the interpolation is exact however wrong it is between designs (a curve that
+    turns from partial to full contact between two of them)."""
+    pts = [f.theta]
+    for j, name in enumerate(prob.contact_free):
+        axis = f.grid_theta[:, j]
+        for end in f.interval[name][:2]:
+            t = math.log(end)
+            near = np.flatnonzero(np.abs(axis - t) <= np.min(np.abs(axis - t)) + 1e-12)
+            p = f.grid_theta[near[np.argmin(f.grid_dev[near])]]
+            if all(np.max(np.abs(p - q)) > 1e-6 for q in pts):
+                pts.append(p)
+    return pts
+
+
 def _check(model, f, solve, base, pmax) -> float:
-    """The interpolation's error at the best fit, measured: each geometry's design solved there (a check point, not
-    a node: kept in designs/ but not interpolated), its A/S at the data pressures against the surrogate's, as
-    residuals (σ̂ × factor × ΔA / weight), rms over every data point."""
+    """The interpolation's error, measured: at each of :func:`check_points` each geometry's design is solved (a
+    check, not a node: kept in designs/ but not interpolated), its A/S at the data pressures against the
+    interpolation's, as residuals (σ̂ × factor × ΔA / weight); the largest over the points of the rms over the
+    data points."""
     from tengsim.calibrate.surrogate import _interp_rows, node_table
 
-    ph = model.physical(f.theta[None, :])
-    u = float(np.log(ph["W"][0]) + math.log(model.prob.E_ref) - np.log(ph["E_star"][0]))
-    v, lam = float(np.log(ph["eps"][0])), float(ph["E_star"][0] / model.prob.E_ref)
     keys = list(dict.fromkeys(model.geo))
-    todo = [(k, u, v, node_table(base[k], math.exp(u), math.exp(v), model.prob.E_ref, pmax[k])) for k in keys]
-    nodes = dict(zip(keys, solve(todo, "check at the best fit")))
-    errs, off = [], 0
-    for i, c in enumerate(model.prob.curves):
-        node = nodes[model.geo[i]]
-        w = model.w[off:off + c.n]
-        off += c.n
-        if not node.ok:
-            return math.inf
-        sur = model.surrogates[model.geo[i]].area(u, v, lam, c.pressure, c.branch)[0]
-        own = np.array([_interp_rows(node.pressures, np.nan_to_num(node.area[b])[None, :],
-                                     np.array([[p / lam]]))[0, 0] for p, b in zip(c.pressure, c.branch)])
-        errs.append(f.best["sigma"] * model.prob.factor(i) * (sur - own) / w)
-    e = np.concatenate(errs)
-    return float(np.sqrt(np.mean(e ** 2)))
+    pts = check_points(f, model.prob)
+    todo, where = [], []
+    for theta in pts:
+        ph = model.physical(theta[None, :])
+        u = float(np.log(ph["W"][0]) + math.log(model.prob.E_ref) - np.log(ph["E_star"][0]))
+        v, lam = float(np.log(ph["eps"][0])), float(ph["E_star"][0] / model.prob.E_ref)
+        where.append((u, v, lam))
+        todo += [(k, u, v, node_table(base[k], math.exp(u), math.exp(v), model.prob.E_ref, pmax[k])) for k in keys]
+    nodes = solve(todo, f"checks at the best fit and the interval ends ({len(pts)} points)")
+    worst = 0.0
+    for m, (u, v, lam) in enumerate(where):
+        got = dict(zip(keys, nodes[m * len(keys):(m + 1) * len(keys)]))
+        errs, off = [], 0
+        for i, c in enumerate(model.prob.curves):
+            node = got[model.geo[i]]
+            w = model.w[off:off + c.n]
+            off += c.n
+            if not node.ok:
+                continue
+            sur = model.surrogates[model.geo[i]].area(u, v, lam, c.pressure, c.branch)[0]
+            own = np.array([_interp_rows(node.pressures, np.nan_to_num(node.area[b])[None, :],
+                                         np.array([[p / lam]]))[0, 0] for p, b in zip(c.pressure, c.branch)])
+            errs.append(f.best["sigma"] * model.prob.factor(i) * (sur - own) / w)
+        if errs:
+            worst = max(worst, float(np.sqrt(np.mean(np.concatenate(errs) ** 2))))
+    return worst
 
 
 def say_to_stderr(quiet=False):
