@@ -171,8 +171,8 @@ def report_text(cal, figures) -> str:
             "(log W, log ε), interpolated by a thin-plate spline (E* as a pressure scale: no solve of its own).",
             f"* Designs: {cal.nodes_solved} solved, {cal.nodes_cached} taken back from designs/ "
             f"({len(cal.nodes_failed)} not converged and left out), {cal.zooms} zoom(s); {cal.seconds:.0f} s.",
-            f"* Interpolation error (a design solved at the best fit against the interpolation there, rms over the "
-            f"data points, residual units): {cal.surrogate_error:.3g} against the noise {f.scale:.3g}: "
+            f"* Interpolation error (designs solved at the best fit and at both ends of each interval against the "
+            f"interpolation there, the largest rms over the data points, residual units): {cal.surrogate_error:.3g} against the noise {f.scale:.3g}: "
             + ("within half the noise." if cal.surrogate_ok else "**above half the noise: the intervals are widened "
                "for it; narrow --bounds, add --nodes or --zooms for tighter ones**.")
             + f" The intervals make room for it (threshold × {inflation(prob.n_points, cal.surrogate_error, f.scale):.3g})."]
