@@ -244,7 +244,7 @@ def fit(model: Model, box=None, polish: bool = True, model_error: float = 0.0) -
 def _correlation(model, pts, dev, dmin, b, c, scale):
     """Correlation of the log parameters under the likelihood on the grid (module doc)."""
     prob = model.prob
-    wts = np.exp(-0.5 * (dev - dmin) * (1.0 if prob.known_errors else 1.0))
+    wts = np.exp(-0.5 * (dev - dmin))
     wts = wts / wts.sum()
     cols, names = [], []
     extra_var = None
@@ -270,8 +270,6 @@ def _correlation(model, pts, dev, dmin, b, c, scale):
 
 def identifiability(f: Fit, prob) -> list:
     """Plain words: what each parameter is, the range that fits, and the trade-offs (|correlation| > 0.9)."""
-    from tengsim.calibrate.problem import DEFAULT_BOUNDS  # noqa: F401 - the bounds are prob's
-
     out = []
     for name in prob.free:
         lo, hi, olo, ohi = f.interval[name]
