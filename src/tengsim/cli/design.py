@@ -52,6 +52,8 @@ def register(sub):
     for k, h in _keys().items():
         p.add_argument("--" + k.replace("_", "-"), dest=k, help=str(h).replace("%", "%%"))
     p.add_argument("--out", help="output folder (created; several designs: one subfolder each)")
+    p.add_argument("--material", help="a material.toml (tengsim calibrate): its E_star, W, eps, sigma replace the "
+                   "design's; with its uncertainty points, also bands.csv, bands.png (95 %% band of A/S, V_OC)")
     p.add_argument("--quiet", action="store_true", help="no progress lines")
     p.set_defaults(func=run)
 
@@ -229,6 +231,13 @@ def run(args) -> int:
     if not args.out:
         raise TengsimError("--out DIR is required (the folder the design's files go to)")
     tables = _tables(args)
+    material = None
+    if getattr(args, "material", None):  # the fitted material replaces the design's own (options given win)
+        from tengsim.calibrate.material import read_material
+
+        material = read_material(args.material)
+        tables = [(w, {**t, **{k: v for k, v in material["values"].items() if getattr(args, k, None) in (None, "")}})
+                  for w, t in tables]
     plans = [plan_design(t, where) for where, t in tables]  # every design checked before anything runs
     out = Path(args.out)
     _check_out(out)
@@ -273,6 +282,13 @@ def _run_locked(args, plans, folders, out) -> int:
         for r, f in zip(results, folders):
             paths += write_design(r, out / f)
         paths += write_comparison(results, out)
+    if material is not None and material["points"]:  # the prediction's band: the design at each uncertainty point
+        from tengsim.calibrate.material import predict_bands, write_bands
+
+        taken = set()
+        for r in results:
+            folder = out if len(results) == 1 else out / _slug(r.plan.name, taken)
+            paths += write_bands(predict_bands(r.plan, r, material, say.say), folder, r.plan.name)
     for k in range(len(plans)):  # the results are saved: the kept grids are no longer needed
         (out / f".design-{k}.resolve.nc").unlink(missing_ok=True)
     if not args.quiet:

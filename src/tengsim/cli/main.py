@@ -15,7 +15,7 @@ import sys
 
 from tengsim.errors import TengsimError
 
-SUBCOMMANDS = ["design", "contact", "device", "reproduce", "run", "plot", "sweep", "optimize"]
+SUBCOMMANDS = ["design", "calibrate", "contact", "device", "reproduce", "run", "plot", "sweep", "optimize"]
 
 
 class Parser(argparse.ArgumentParser):

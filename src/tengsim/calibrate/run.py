@@ -1,0 +1,373 @@
+"""A calibration, start to finish: the problem checked, the nodes solved (kept in DIR), the fit, zoomed in.
+
+:func:`plan_calibration` checks everything before anything is solved or written (the designs, the curves, the free
+parameters and bounds, that the voltage can be reached).  :func:`calibrate` then
+
+1. lays an n × n grid of nodes (default 4 × 4) over the bounds of (W_eff, ε) (the axes that are free), prints how
+   many designs it will solve and the designs' own time estimate, and solves each (kept in ``DIR/designs``);
+2. fits (:func:`tengsim.calibrate.fit.fit`) and measures the interpolation's error: designs solved at the best fit
+   and at both ends of each free contact parameter's interval (:func:`_check`), the largest; if it is above half the data's noise, lays a new n × n grid over the box of that region (15 % margin, at
+   least half the previous box) and fits again, at most ``zooms`` times; the intervals make room for the last
+   error measured (:func:`tengsim.calibrate.fit.inflation`);
+3. returns a frozen :class:`Calibration` (the fit, its bands, the surrogate's error, the nodes' account).
+"""
+from __future__ import annotations
+
+import math
+import sys
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from tengsim.errors import TengsimError
+
+LOO_PER_NOISE = 0.5
+"""Zooming stops when the interpolation's leave-one-out error (rms over the nodes of the fitted region, in the
+residual's units) is at most this fraction of the data's noise; whatever it is, the intervals make room for it
+(:func:`tengsim.calibrate.fit.inflation`).  It includes each node's own discretisation error (a design converged to
+its tol), which no interpolation removes: give the designs a tol below the data's relative noise."""
+MARGIN = 0.15
+
+
+@dataclass(frozen=True)
+class Calibration:
+    problem: object
+    fit: object
+    model: object = field(repr=False)
+    bands: tuple = field(repr=False)
+    plot_pressures: tuple = field(repr=False)
+    surrogate_error: float = math.nan
+    surrogate_ok: bool = False
+    nodes_solved: int = 0
+    nodes_cached: int = 0
+    nodes_failed: tuple = ()
+    seconds: float = 0.0
+    zooms: int = 0
+
+
+def _say(progress, text):
+    if progress is not None:
+        progress(text)
+
+
+def _read_design_file(path) -> dict:
+    try:
+        import tomllib
+    except ModuleNotFoundError:  # pragma: no cover
+        import tomli as tomllib
+    p = Path(path)
+    if not p.is_file():
+        raise TengsimError(f"{path}: no such file (give a design TOML that tengsim design accepts)")
+    try:
+        data = tomllib.loads(p.read_text())
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        raise TengsimError(f"{path}: not a TOML file: {str(exc).splitlines()[0]}") from None
+    t = data.get("design", data)
+    if not isinstance(t, dict) or "shape" not in t:
+        raise TengsimError(f"{path}: not a design (no shape key in [design] or at the top level)")
+    return dict(t)
+
+
+def plan_calibration(designs, data, free=None, bounds=None, noise="relative", voc="eq12"):
+    """The checked :class:`tengsim.calibrate.problem.Problem`.  ``designs``: design TOML paths or [design] tables,
+    one per curve (or one for all); ``data``: CSV paths or :class:`Curve` s."""
+    from tengsim.calibrate.data import Curve, read_curve
+    from tengsim.calibrate.problem import (DEFAULT_BOUNDS, NOISES, PARAMS, VOC_MODELS, Problem, check_reachable,
+                                           count_check, parse_bounds, parse_free, text)
+    from tengsim.design import plan_design
+
+    designs, data = list(designs), list(data)
+    if not data:
+        raise TengsimError("--data: give at least one measured curve (CSV)")
+    if len(designs) == 1 and len(data) > 1:
+        designs = designs * len(data)
+    if len(designs) != len(data):
+        raise TengsimError(f"{len(designs)} designs for {len(data)} measured curves: give one design per curve "
+                           "(or one for all)")
+    if noise not in NOISES:
+        raise TengsimError(f"--noise {noise!r}: relative or absolute")
+    if voc not in VOC_MODELS:
+        raise TengsimError(f"--voc {voc!r}: eq12 or eq17")
+    free = parse_free(free)
+    user = parse_bounds(bounds)
+    bnds = {k: user.get(k, DEFAULT_BOUNDS[k]) for k in PARAMS}
+    tables, names = [], []
+    for d in designs:
+        t = _read_design_file(d) if not isinstance(d, dict) else dict(d)
+        tables.append(t)
+        names.append(str(d) if not isinstance(d, dict) else t.get("name", t.get("shape")))
+    # the material: fixed values from the designs (one material), starting values for the free ones
+    fixed = {}
+    for k in PARAMS:
+        vals = set()
+        for where, t in zip(names, tables):
+            if t.get(k) not in (None, ""):
+                from tengsim.calibrate.problem import KINDS
+                from tengsim.units import parse_quantity
+
+                try:
+                    vals.add(round(parse_quantity(t[k], KINDS[k], k), 15))
+                except TengsimError as exc:
+                    raise TengsimError(f"{where}: {exc}") from None
+        if k in free:
+            continue
+        if k == "sigma" and not vals:
+            from tengsim.design import PAPER_DEVICE
+
+            vals = {PAPER_DEVICE["sigma"]}
+        if not vals:
+            raise TengsimError(f"{k} is neither free nor given in the designs: give it in the design files or add "
+                               f"it to --free")
+        if len(vals) > 1:
+            raise TengsimError(f"the designs give different {k} ({', '.join(text(k, v) for v in sorted(vals))}): one "
+                               f"material is fitted; give one value or free it")
+        fixed[k] = vals.pop()
+    E_ref = fixed.get("E_star", math.sqrt(bnds["E_star"][0] * bnds["E_star"][1]))
+    mid = {k: math.sqrt(bnds[k][0] * bnds[k][1]) for k in ("W", "eps")}
+    plans = []
+    for where, t in zip(names, tables):
+        probe = {**t, "W": fixed.get("W", mid["W"]), "eps": fixed.get("eps", mid["eps"]), "E_star": E_ref}
+        if "p_max" not in probe:
+            probe["p_max"] = 1e3
+        try:
+            plans.append(plan_design(probe, f"{where}: "))
+        except TengsimError as exc:
+            raise TengsimError(f"{exc} (not a design tengsim design accepts)") from None
+    curves = [c if isinstance(c, Curve) else read_curve(c) for c in data]
+    prob = Problem(tuple(plans), tuple(tables), tuple(curves), free, bnds, fixed, noise, voc, E_ref, tuple(names))
+    count_check(prob)
+    check_reachable(prob)
+    return prob
+
+
+def _node_ranges(prob):
+    """(u range, v range, dims): log W_eff and log ε over the bounds (a fixed axis: its value)."""
+    lw = [math.log(x) for x in (prob.bounds["W"] if "W" in prob.free else (prob.fixed["W"],) * 2)]
+    le = [math.log(x) for x in (prob.bounds["E_star"] if "E_star" in prob.free else (prob.fixed["E_star"],) * 2)]
+    lr = math.log(prob.E_ref)
+    u = (lw[0] + lr - le[1], lw[1] + lr - le[0])
+    v = tuple(math.log(x) for x in (prob.bounds["eps"] if "eps" in prob.free else (prob.fixed["eps"],) * 2))
+    dims = tuple(k for k, r in enumerate((u, v)) if r[1] > r[0] + 1e-12)
+    return u, v, dims
+
+
+def _p_max(prob, key, geo):
+    from tengsim.calibrate.surrogate import nice_up
+
+    top = max(float(c.pressure.max()) for c, g in zip(prob.curves, geo) if g == key)
+    lam_min = prob.bounds["E_star"][0] / prob.E_ref if "E_star" in prob.free else 1.0
+    return nice_up(1.05 * top / lam_min)
+
+
+def calibrate(prob, out_dir, n_nodes: int = 4, zooms: int = 2, progress=None) -> Calibration:
+    """Run the calibration of the checked problem ``prob`` (module doc); nodes kept in ``out_dir/designs``."""
+    from tengsim.calibrate.fit import Model, band, fit
+    from tengsim.calibrate.surrogate import (POINTS_PER_CURVE, Surrogate, geometry_key, grid_points, node_table,
+                                             solve_node,
+                                             estimate_seconds)
+    from tengsim.design.units import time_text
+
+    t0 = time.perf_counter()
+    folder = Path(out_dir) / "designs"
+    geo = tuple(geometry_key(t) for t in prob.tables)
+    keys = list(dict.fromkeys(geo))
+    base = {k: prob.tables[geo.index(k)] for k in keys}
+    pmax = {k: _p_max(prob, k, geo) for k in keys}
+    (u0, u1), (v0, v1), dims = _node_ranges(prob)
+    span = (max(u1 - u0, 1e-12), max(v1 - v0, 1e-12))
+    surr = {k: Surrogate(np.linspace(0, pmax[k], POINTS_PER_CURVE), [], span, dims) for k in keys}
+    count = {"solved": 0, "cached": 0}
+    failed = []
+
+    def solve(todo, title):
+        from tengsim.calibrate.surrogate import node_key
+
+        new = [x for x in todo if not (folder / f"{node_key(x[3])}.nc").is_file()
+               and not (folder / f"{node_key(x[3])}.failed.txt").is_file()]
+        if new:
+            try:
+                est = sum(estimate_seconds(x[3]) for x in new)
+            except TengsimError:
+                est = math.nan
+            _say(progress, f"{title}: {len(todo)} designs ({len(todo) - len(new)} kept in {folder}), {len(new)} to "
+                           f"solve; estimated {time_text(est) if math.isfinite(est) else 'n/a'} (the designs' own "
+                           "estimate; tiny designs take longer)")
+        done_t, n_done, out = 0.0, 0, []
+        for m, (k, u, v, table) in enumerate(todo):
+            node = solve_node(table, folder, u, v)
+            out.append(node)
+            if node.cached:
+                count["cached"] += 1
+            else:
+                count["solved"] += 1
+                n_done += 1
+                done_t += node.seconds
+                left = done_t / n_done * (len(new) - n_done)
+                _say(progress, f"design {m + 1}/{len(todo)} (W {math.exp(u) * 1e3:.4g} mJ/m², ε "
+                               f"{math.exp(v) * 1e9:.4g} nm): {'ok' if node.ok else node.message} in "
+                               f"{node.seconds:.0f} s; about {time_text(max(left, 0))} left")
+            if not node.ok:
+                failed.append(f"W {math.exp(u) * 1e3:.4g} mJ/m², ε {math.exp(v) * 1e9:.4g} nm: {node.message}")
+        return out
+
+    def grid(box):
+        us = grid_points(*box[0], n_nodes if 0 in dims else 1)
+        vs = grid_points(*box[1], n_nodes if 1 in dims else 1)
+        du = (us[1] - us[0]) / span[0] if len(us) > 1 else 1.0
+        dv = (vs[1] - vs[0]) / span[1] if len(vs) > 1 else 1.0
+        todo = []
+        for k in keys:
+            have = [(n.u, n.v) for n in surr[k].nodes]
+            for u in us:
+                for v in vs:  # a node closer than a third of the new spacing to one solved: not solved again (two
+                    # designs that close differ by their discretisation errors, which a spline would chase)
+                    if not any(abs(u - a) / span[0] < du / 3 + 1e-12 and abs(v - b) / span[1] < dv / 3 + 1e-12
+                               for a, b in have):
+                        todo.append((k, u, v, node_table(base[k], math.exp(u), math.exp(v), prob.E_ref, pmax[k])))
+        for (k, *_), node in zip(todo, solve(todo, "the (W, ε) grid")):
+            surr[k].nodes.append(node)
+            surr[k]._rbf.clear()
+
+    box_uv = ((u0, u1), (v0, v1))
+    grid(box_uv)
+    model = Model(prob, surr, geo)
+    result = _fit_in_box(model, fit)
+    err, zoom = 0.0, 0
+    for zoom in range(zooms + 1):
+        if not dims:
+            break
+        err = _check(model, result, solve, base, pmax)
+        if math.isfinite(err) and err <= LOO_PER_NOISE * result.scale or zoom == zooms:
+            break
+        box_uv = _region_box(model, result, ((u0, u1), (v0, v1)), box_uv)
+        _say(progress, f"interpolation error {err:.3g} (noise {result.scale:.3g}): zooming on the "
+                       "region that fits")
+        grid(box_uv)
+        model = Model(prob, surr, geo)
+        result = _fit_in_box(model, fit)
+    if math.isfinite(err) and err > 0:  # the intervals with room for the model's own error
+        result = _fit_in_box(model, lambda m, box=None: fit(m, box, model_error=err))
+    loo = err
+    solved, cached = count["solved"], count["cached"]
+    P_plot = [np.linspace(0.0, float(c.pressure.max()), 61) for c in prob.curves]
+    B_plot = [np.full(61, "approach" if "approach" in c.branch else c.branch[0]) for c in prob.curves]
+    bands = band(model, result, P_plot, B_plot)
+    return Calibration(prob, result, model, tuple(bands), tuple(P_plot), loo,
+                       bool(math.isfinite(loo) and loo <= LOO_PER_NOISE * result.scale), solved, cached,
+                       tuple(dict.fromkeys(failed)), time.perf_counter() - t0, zoom)
+
+
+def _fit_in_box(model, fit):
+    """The fit on the bounds, then on the box of the region that fits (a finer grid there), grown while that
+    region touches a side of the box that is not a bound."""
+    from tengsim.calibrate.problem import log_bounds
+
+    f = fit(model)
+    lb = log_bounds(model.prob)
+    if not len(lb):
+        return f
+    for _ in range(4):
+        reg = f.grid_theta[f.grid_dev <= f.dev_min + 2 * f.threshold]
+        lo, hi = reg.min(axis=0), reg.max(axis=0)
+        pad = np.maximum(MARGIN * (hi - lo), (f.box[:, 1] - f.box[:, 0]) / 40)
+        box = np.stack([np.maximum(lo - pad, lb[:, 0]), np.minimum(hi + pad, lb[:, 1])], axis=1)
+        g = fit(model, box)
+        reg2 = g.grid_theta[g.grid_dev <= g.dev_min + g.threshold]
+        step = (box[:, 1] - box[:, 0]) / 80
+        touch = ((reg2.min(axis=0) <= box[:, 0] + step) & (box[:, 0] > lb[:, 0] + 1e-9)) | \
+                ((reg2.max(axis=0) >= box[:, 1] - step) & (box[:, 1] < lb[:, 1] - 1e-9))
+        f = g
+        if not touch.any():
+            break
+    return f
+
+
+def _uv(model, theta):
+    ph = model.physical(theta)
+    return np.log(ph["W"]) + math.log(model.prob.E_ref) - np.log(ph["E_star"]), np.log(ph["eps"])
+
+
+def _region_box(model, f, full, prev):
+    """The next grid's box in (log W_eff, log ε): the region that fits (deviance within twice the threshold,
+    :data:`MARGIN` more on each side), at least half the previous box on each axis (an interpolation that is not
+    yet within the noise may place the region wrongly; halving keeps the zoom from outrunning it), within the
+    bounds."""
+    reg = f.grid_theta[f.grid_dev <= f.dev_min + 2 * f.threshold]
+    if not len(reg):
+        reg = f.theta[None, :]
+    u, v = _uv(model, reg)
+    bu, bv = _uv(model, f.theta[None, :])
+    out = []
+    for vals, best, (lo, hi), (plo, phi) in zip((u, v), (bu[0], bv[0]), full, prev):
+        a, b = float(vals.min()), float(vals.max())
+        pad = max(MARGIN * (b - a), 0.02 * (hi - lo))
+        a, b = a - pad, b + pad
+        half = 0.5 * (phi - plo)
+        if b - a < half:
+            c = best
+            a, b = c - 0.5 * half, c + 0.5 * half
+        if a < lo:
+            a, b = lo, min(hi, b + (lo - a))
+        if b > hi:
+            a, b = max(lo, a - (b - hi)), hi
+        out.append((a, b))
+    return tuple(out)
+
+
+def check_points(f, prob) -> list:
+    """Log contact parameters where the interpolation is checked: the best fit and, for each free contact
+    parameter, both ends of its 95 % interval (the others at their profile optimum there): a check at the best fit
+    alone can sit on a design, where the interpolation is exact however wrong it is between designs (a curve that
+    turns from partial to full contact between two of them)."""
+    pts = [f.theta]
+    for j, name in enumerate(prob.contact_free):
+        axis = f.grid_theta[:, j]
+        for end in f.interval[name][:2]:
+            t = math.log(end)
+            near = np.flatnonzero(np.abs(axis - t) <= np.min(np.abs(axis - t)) + 1e-12)
+            p = f.grid_theta[near[np.argmin(f.grid_dev[near])]]
+            if all(np.max(np.abs(p - q)) > 1e-6 for q in pts):
+                pts.append(p)
+    return pts
+
+
+def _check(model, f, solve, base, pmax) -> float:
+    """The interpolation's error, measured: at each of :func:`check_points` each geometry's design is solved (a
+    check, not a node: kept in designs/ but not interpolated), its A/S at the data pressures against the
+    interpolation's, as residuals (σ̂ × factor × ΔA / weight); the largest over the points of the rms over the
+    data points."""
+    from tengsim.calibrate.surrogate import _interp_rows, node_table
+
+    keys = list(dict.fromkeys(model.geo))
+    pts = check_points(f, model.prob)
+    todo, where = [], []
+    for theta in pts:
+        ph = model.physical(theta[None, :])
+        u = float(np.log(ph["W"][0]) + math.log(model.prob.E_ref) - np.log(ph["E_star"][0]))
+        v, lam = float(np.log(ph["eps"][0])), float(ph["E_star"][0] / model.prob.E_ref)
+        where.append((u, v, lam))
+        todo += [(k, u, v, node_table(base[k], math.exp(u), math.exp(v), model.prob.E_ref, pmax[k])) for k in keys]
+    nodes = solve(todo, f"checks at the best fit and the interval ends ({len(pts)} points)")
+    worst = 0.0
+    for m, (u, v, lam) in enumerate(where):
+        got = dict(zip(keys, nodes[m * len(keys):(m + 1) * len(keys)]))
+        errs, off = [], 0
+        for i, c in enumerate(model.prob.curves):
+            node = got[model.geo[i]]
+            w = model.w[off:off + c.n]
+            off += c.n
+            if not node.ok:
+                continue
+            sur = model.surrogates[model.geo[i]].area(u, v, lam, c.pressure, c.branch)[0]
+            own = np.array([_interp_rows(node.pressures, np.nan_to_num(node.area[b])[None, :],
+                                         np.array([[p / lam]]))[0, 0] for p, b in zip(c.pressure, c.branch)])
+            errs.append(f.best["sigma"] * model.prob.factor(i) * (sur - own) / w)
+        if errs:
+            worst = max(worst, float(np.sqrt(np.mean(np.concatenate(errs) ** 2))))
+    return worst
+
+
+def say_to_stderr(quiet=False):
+    return None if quiet else (lambda text: print(f"tengsim: {text}", file=sys.stderr, flush=True))

@@ -1,0 +1,219 @@
+"""The model of a measured curve: converged designs on a grid of (W, ε), interpolated, with its own error.
+
+**What the contact depends on.**  A design solves the dimensionless problem (heights in ε, Eq. 9) whose coupling is
+κ = W ℓ/(E* ε²) and whose pressures are in units of W/ε (:class:`tengsim.units.Scaling`).  Multiplying W and E* by
+the same λ keeps κ and multiplies every pressure by λ, so A/S(P; W, ε, E*) = A/S(P/λ; W/λ, ε, E_ref) with
+λ = E*/E_ref.  The contact is therefore solved only on the plane (W_eff = W E_ref/E*, ε): a free E* costs no
+solve of its own, only a wider pressure range.
+
+**Nodes.**  Each node is one converged design (:func:`tengsim.design.run_design`, status ok at the design's own
+tol) at (W_eff, ε), kept in ``DIR/designs/KEY.nc`` as soon as it is solved (KEY: a hash of the design's table), so a
+killed calibration loses at most the design in progress and a rerun takes every solved node back.  A node whose
+design is not ok (or fails) is recorded and left out: no model value comes from an unconverged design.
+
+**Interpolation.**  A/S at the design's pressures, per branch, is interpolated between the nodes by a thin-plate
+spline in (log W_eff, log ε) (each axis over its bound range), then linearly in pressure at P/λ.  Its error is
+measured by leave-one-out at the nodes of the region that fits (:meth:`Surrogate.loo`) and reported beside the
+data's noise.
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from tengsim.errors import TengsimError
+
+POINTS_PER_CURVE = 21
+"""Pressures of a node's design, 0 to p_max (A/S is linear between them; more make the refinement judge more)."""
+
+
+def geometry_key(table: dict) -> str:
+    """The design without its material: curves on the same geometry share nodes."""
+    rest = {k: v for k, v in table.items() if k not in ("W", "eps", "E_star", "sigma", "name")}
+    return json.dumps(rest, sort_keys=True, default=str)
+
+
+def node_table(table: dict, W: float, eps: float, E_ref: float, p_max: float) -> dict:
+    """The design table of a node (SI numbers for the material and pressures)."""
+    t = {k: v for k, v in table.items() if k not in ("p_min", "p_max", "p_step", "name", "fit_max", "maps")}
+    t.update({"W": float(W), "eps": float(eps), "E_star": float(E_ref), "p_min": 0.0, "p_max": float(p_max),
+              "p_step": float(p_max) / (POINTS_PER_CURVE - 1), "maps": False})
+    return t
+
+
+def node_key(table: dict) -> str:
+    return hashlib.sha256(json.dumps(table, sort_keys=True, default=str).encode()).hexdigest()[:16]
+
+
+@dataclass
+class Node:
+    u: float  # log W_eff
+    v: float  # log eps
+    ok: bool
+    pressures: np.ndarray | None = None
+    area: dict | None = None  # branch -> A/S at pressures
+    message: str = ""
+    seconds: float = 0.0
+    cached: bool = False
+
+
+def _load(path: Path):
+    from tengsim.io import read_dataset
+
+    ds = read_dataset(path)
+    P = np.asarray(ds["pressure"].values, float)
+    A = {b: np.asarray(ds["charged_area_fraction"].sel(branch=b).values, float) for b in ("approach", "retraction")}
+    return P, A, str(ds.attrs.get("status")), float(ds.attrs.get("seconds", 0.0) or 0.0)
+
+
+def solve_node(table: dict, folder: Path, u: float, v: float, progress=None) -> Node:
+    """The node's design, taken back from ``folder`` or solved and kept there (module doc)."""
+    from tengsim.design import plan_design, run_design
+    from tengsim.io import write_dataset, write_text
+
+    key = node_key(table)
+    nc, bad = folder / f"{key}.nc", folder / f"{key}.failed.txt"
+    if nc.is_file():
+        P, A, status, secs = _load(nc)
+        return Node(u, v, status == "ok", P, A, "" if status == "ok" else f"status {status}", secs, True)
+    if bad.is_file():
+        return Node(u, v, False, message=bad.read_text().strip(), cached=True)
+    folder.mkdir(parents=True, exist_ok=True)
+    t0 = time.perf_counter()
+    try:
+        res = run_design(plan_design(table), progress=progress, keep=folder / f"{key}.resolve.nc")
+    except TengsimError as exc:
+        if "memory" not in str(exc):  # the design's own answer is kept; a machine short of memory is not
+            write_text(bad, str(exc) + "\n")
+        (folder / f"{key}.resolve.nc").unlink(missing_ok=True)
+        return Node(u, v, False, message=str(exc), seconds=time.perf_counter() - t0)
+    write_dataset(res.dataset, nc)
+    (folder / f"{key}.resolve.nc").unlink(missing_ok=True)
+    P = np.asarray(res.dataset["pressure"].values, float)
+    A = {b: np.asarray(res.dataset["charged_area_fraction"].sel(branch=b).values, float)
+         for b in ("approach", "retraction")}
+    ok = res.status == "ok"
+    return Node(u, v, ok, P, A, "" if ok else f"status {res.status}", time.perf_counter() - t0)
+
+
+def _fill(y):
+    """NaN (a branch that does not reach a pressure) replaced by the nearest finite value along pressure."""
+    y = np.array(y, float)
+    ok = np.isfinite(y)
+    if ok.all() or not ok.any():
+        return np.nan_to_num(y)
+    idx = np.arange(len(y))
+    return np.interp(idx, idx[ok], y[ok])
+
+
+@dataclass
+class Surrogate:
+    """A/S(P) of one geometry on the (log W_eff, log ε) plane (module doc).  ``span``: each axis's bound range
+    (its scale); ``dims``: the axes that vary (0: W_eff, 1: ε)."""
+
+    pressures: np.ndarray
+    nodes: list
+    span: tuple
+    dims: tuple
+    _rbf: dict = field(default_factory=dict, repr=False)
+
+    def good(self) -> list:
+        return [n for n in self.nodes if n.ok]
+
+    def _coords(self, nodes_or_uv) -> np.ndarray:
+        uv = np.array([[n.u, n.v] for n in nodes_or_uv]) if isinstance(nodes_or_uv, list) else np.asarray(nodes_or_uv)
+        return np.stack([uv[:, d] / self.span[d] for d in self.dims], axis=1) if self.dims else np.zeros((len(uv), 1))
+
+    def _build(self, nodes, branch):
+        from scipy.interpolate import RBFInterpolator
+
+        Y = np.stack([_fill(n.area[branch]) for n in nodes])
+        if not self.dims or len(nodes) == 1:
+            return lambda x: np.broadcast_to(Y.mean(axis=0), (len(x), Y.shape[1]))
+        if len(nodes) > len(self.dims) + 1:
+            return RBFInterpolator(self._coords(nodes), Y, kernel="thin_plate_spline", degree=1)
+        return RBFInterpolator(self._coords(nodes), Y, kernel="linear", degree=0)  # too few nodes for a spline
+
+    def rbf(self, branch):
+        if branch not in self._rbf:
+            good = self.good()
+            if not good:
+                raise TengsimError("no converged design among the nodes: narrow the bounds or loosen the design's tol")
+            self._rbf[branch] = self._build(good, branch)
+        return self._rbf[branch]
+
+    def area(self, u, v, lam, pressures, branches) -> np.ndarray:
+        """A/S (K, n) at points (u, v, λ) (arrays of K) and the pressures (n, Pa) on their branches."""
+        u, v, lam = (np.atleast_1d(np.asarray(x, float)) for x in (u, v, lam))
+        uv = np.stack([u, v], axis=1)
+        pressures, branches = np.asarray(pressures, float), np.asarray(branches)
+        out = np.empty((len(u), len(pressures)))
+        for b in np.unique(branches):
+            sel = np.flatnonzero(branches == b)
+            grid = self.rbf(str(b))(self._coords(uv))  # (K, m)
+            out[:, sel] = _interp_rows(self.pressures, grid, pressures[sel][None, :] / lam[:, None])
+        return np.clip(out, 0.0, 1.0)
+
+    def loo(self, which, pressures, branches) -> np.ndarray:
+        """(len(which), n): A/S predicted at each node of ``which`` (indices into :meth:`good`) from the other
+        nodes, minus the node's own, at ``pressures`` (λ = 1)."""
+        good = self.good()
+        out = []
+        for j in which:
+            rest = [n for k, n in enumerate(good) if k != j]
+            row = np.empty(len(pressures))
+            for b in np.unique(branches):
+                sel = np.flatnonzero(np.asarray(branches) == b)
+                pred = self._build(rest, str(b))(self._coords([good[j]]))
+                own = _fill(good[j].area[str(b)])[None, :]
+                row[sel] = (_interp_rows(self.pressures, pred, np.asarray(pressures)[sel][None, :])
+                            - _interp_rows(self.pressures, own, np.asarray(pressures)[sel][None, :]))[0]
+            out.append(row)
+        return np.array(out).reshape(len(which), len(pressures))
+
+
+def _interp_rows(xp, Y, x):
+    """Row-wise linear interpolation: Y (K, m) tabulated at xp (m,), evaluated at x (K or 1, n); clamped."""
+    x = np.broadcast_to(x, (Y.shape[0], x.shape[1]))
+    i = np.clip(np.searchsorted(xp, x) - 1, 0, len(xp) - 2)
+    x0, x1 = xp[i], xp[i + 1]
+    w = np.clip((x - x0) / (x1 - x0), 0.0, 1.0)
+    rows = np.arange(Y.shape[0])[:, None]
+    return Y[rows, i] * (1 - w) + Y[rows, i + 1] * w
+
+
+def estimate_seconds(table: dict) -> float:
+    """The design's own printed estimate (s) for a node table (:func:`tengsim.design.run.estimate`)."""
+    import dataclasses
+
+    from tengsim.design import plan_design
+    from tengsim.design.run import estimate, height_eps, solver_tol, start_dx
+    from tengsim.run.plan import as_plan
+
+    plan = plan_design(table)
+    cplan = dataclasses.replace(as_plan(plan.contact_plan), tol=solver_tol(plan))
+    dx = start_dx(plan, cplan)
+    return float(estimate(plan, cplan, dx, 1.2 * height_eps(cplan, dx) + 2.0).seconds)
+
+
+def grid_points(lo, hi, n) -> np.ndarray:
+    return np.array([0.5 * (lo + hi)]) if n <= 1 or hi <= lo else np.linspace(lo, hi, n)
+
+
+def same(a, b) -> bool:
+    return abs(a - b) < 1e-9 * max(1.0, abs(a), abs(b))
+
+
+def nice_up(x: float) -> float:
+    """x rounded up to 1, 2, 2.5 or 5 × a power of ten."""
+    e = 10 ** math.floor(math.log10(x))
+    for m in (1, 2, 2.5, 5, 10):
+        if m * e >= x * (1 - 1e-12):
+            return m * e
+    return 10 * e

@@ -1,0 +1,73 @@
+r"""``tengsim calibrate``: fit σ, W, ε (and E*) to measured V_OC(P), with uncertainty (thin shell over
+:mod:`tengsim.calibrate`).
+
+Examples::
+
+    tengsim calibrate pyramid.toml --data measured.csv --free sigma,W,eps --out fit/
+    tengsim calibrate a.toml b.toml --data a.csv b.csv --free sigma,W,eps,E_star --bounds eps=50nm:300nm --out fit/
+    tengsim design new.toml --material fit/material.toml --out new/     # the prediction, with bands
+"""
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+from tengsim.errors import TengsimError
+
+SUMMARY = "fit σ, W, ε (and E*) to measured V_OC(P): intervals, identifiability, a material for design"
+
+USAGE = ("tengsim calibrate DESIGN.toml [DESIGN2.toml ...] --data measured.csv [measured2.csv ...] "
+         "[--free sigma,W,eps] [--bounds W=20mJ/m2:200mJ/m2,...] --out DIR")
+DESCRIPTION = (
+    "Fits the material (σ, W, ε and optionally E*) to measured open-circuit voltage against pressure, one design "
+    "(a TOML that tengsim design accepts) per measured curve, all curves jointly. σ is profiled in closed form; W "
+    "and ε come from converged designs on a grid in (W, ε), interpolated, their error reported; E* scales the "
+    "pressure. Writes DIR/report.md, fit.nc, fit.csv, fit.png, residuals.png, profiles.png and material.toml "
+    "(tengsim design --material); every solved design is kept in DIR/designs (a rerun takes them back). "
+    "CSV: a header, pressure_kPa or pressure_Pa, voc_V, optional branch and voc_err_V, '#' comments.")
+
+
+def register(sub):
+    p = sub.add_parser("calibrate", allow_abbrev=False, usage=USAGE, description=DESCRIPTION,
+                       help="fit the material to measured V_OC(P), with 95 %% intervals")
+    p.add_argument("designs", nargs="+", metavar="DESIGN.toml", help="the design each curve was measured on (one, "
+                   "or one per --data file)")
+    p.add_argument("--data", nargs="+", required=True, metavar="CSV", help="measured curves (CSV)")
+    p.add_argument("--free", default="sigma,W,eps", help="the parameters to fit among sigma, W, eps, E_star "
+                   "(default sigma,W,eps; the others as the designs give them)")
+    p.add_argument("--bounds", default=None, help="NAME=LOW:HIGH,... with units (defaults: sigma 0.01uC/m2:500uC/m2, "
+                   "W 10mJ/m2:1000mJ/m2, eps 20nm:400nm, E_star 0.1MPa:10MPa)")
+    p.add_argument("--noise", default="relative", choices=("relative", "absolute"),
+                   help="noise model when no voc_err_V column is given (default relative; its scale is estimated)")
+    p.add_argument("--voc", default="eq12", choices=("eq12", "eq17"),
+                   help="the V_OC model the data are compared with (default eq12: σ (A/S) T/(ε_r ε0))")
+    p.add_argument("--nodes", type=int, default=4, help="designs per free axis of each (W, ε) grid (default 4)")
+    p.add_argument("--zooms", type=int, default=2, help="new grids on the region that fits, at most (default 2)")
+    p.add_argument("--out", required=True, help="output folder (created; not on bad input)")
+    p.add_argument("--quiet", action="store_true", help="no progress lines")
+    p.set_defaults(func=run)
+
+
+def run(args) -> int:
+    from tengsim.calibrate import calibrate, plan_calibration, write_calibration
+    from tengsim.calibrate.run import say_to_stderr
+    from tengsim.cli.design import _check_out
+
+    if not 2 <= args.nodes <= 9:
+        raise TengsimError(f"--nodes {args.nodes}: 2 to 9 designs per axis")
+    if not 0 <= args.zooms <= 5:
+        raise TengsimError(f"--zooms {args.zooms}: 0 to 5")
+    prob = plan_calibration(args.designs, args.data, args.free, args.bounds, args.noise, args.voc)
+    out = Path(args.out)
+    _check_out(out)
+    say = say_to_stderr(args.quiet)
+    cal = calibrate(prob, out, n_nodes=args.nodes, zooms=args.zooms, progress=say)
+    paths = write_calibration(cal, out)
+    if say:
+        for w in cal.fit.words:
+            say(w)
+        say(f"wrote {len(paths)} files in {out} (report: {out / 'report.md'})")
+    if not cal.surrogate_ok:
+        print(f"tengsim: warning: the interpolation's error ({cal.surrogate_error:.3g}) is above half the noise "
+              f"({cal.fit.scale:.3g}): see {out / 'report.md'}", file=sys.stderr)
+    return 0
