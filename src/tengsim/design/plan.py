@@ -9,7 +9,11 @@ The table holds
   :func:`tengsim.run.plan.plan_contact` (nothing is retyped here);
 * the design's own keys (:func:`design_fields`): the pressures (``p_min``, ``p_max``, ``p_step``), the device
   inputs of Eq. (12) and Eq. (17) (σ, ε_r, T, rest gap d0: the paper's values by default), the grid (``dx``
-  a length, ``max_pixels``), the convergence tolerance ``tol``, the time budget and the linear-range fit.
+  a length, ``max_pixels``), the convergence tolerance ``tol``, the time budget, the linear-range fit and the
+  charged-area definition ``area``.
+
+The boundary is ``periodic`` unless given: a pattern's design is the array it describes (``free``, one isolated
+cell on a half-space, is named as such; :data:`BOUNDARY_WHY`).
 
 The path (D range, steps) is not the user's: :mod:`tengsim.design.run` extends it until ``p_max`` is
 reached.
@@ -62,7 +66,19 @@ def design_fields() -> list:
               "during the finest grid's walk, at the depths the grid before it predicts); false: none"),
         Field("fit_max", default=None, dim="pressure", help="top of the low-pressure range of the linear fit "
               "of V_OC(P) (default p_min + (p_max - p_min)/10)"),
+        Field("area", "str", "contact", help="charged-area definition: 'contact' (default: the 2-D area where "
+              "the gap is below the law's peak-tension separation, any shape) or 'paper' (the paper's Λc², from "
+              "the contact length through the apex; for its pyramids)"),
     ]
+
+
+BOUNDARY_WHY = {
+    "periodic": "the periodic array the shape's cell describes: every cell pressed beside its neighbours, whose "
+                "deformation it feels",
+    "free": "one isolated cell on an elastic half-space (the paper's Eq. 9): a single structure, or an array "
+            "whose pitch is large against each contact",
+}
+"""Why each boundary: the report's line (docs/own_design.md, 'Array or isolated structure')."""
 
 
 @dataclass(frozen=True)
@@ -91,6 +107,9 @@ class DesignPlan:
     eps: float
     tabor: float
     maps: bool = True
+    area: str = "contact"
+    boundary: str = "periodic"
+    boundary_given: bool = False
     extra: dict = field(default_factory=dict)
     contact_plan: object = field(default=None, compare=False, repr=False)
 
@@ -172,6 +191,14 @@ def plan_design(table: dict, where: str = "") -> DesignPlan:
     own = _own(table)
     cfg = {k: v for k, v in table.items() if k in contact_keys and k not in own_names and v not in (None, "")}
     cfg["shape"] = shape
+    boundary_given = "boundary" in cfg
+    cfg.setdefault("boundary", "periodic")  # a pattern's design is the array it describes
+    from tengsim.run.area import check_definition
+
+    try:
+        area = check_definition(own["area"])
+    except TengsimError as exc:
+        raise type(exc)(f"{where}{exc}") from None
     try:
         plan = plan_contact(cfg)
     except TengsimError as exc:
@@ -202,7 +229,8 @@ def plan_design(table: dict, where: str = "") -> DesignPlan:
     return DesignPlan(name=name, shape=shape, contact_table=cfg, shape_params=sp, pressures=pressures,
                       sigma=own["sigma"], eps_r=own["eps_r"], T=own["T"], gap=own["gap"], tol=tol, dx=own["dx"],
                       max_pixels=own["max_pixels"], budget_s=own["budget"], fit_max=fit_max, E_star=sc.E_star,
-                      W=sc.W, eps=sc.eps, tabor=sc.mu, maps=bool(own["maps"]), contact_plan=plan)
+                      W=sc.W, eps=sc.eps, tabor=sc.mu, maps=bool(own["maps"]), area=area,
+                      boundary=str(plan.boundary), boundary_given=boundary_given, contact_plan=plan)
 
 
 def _pressures(own: dict, where: str) -> tuple:
