@@ -139,6 +139,25 @@ def _full_fraction(res, plan) -> float:
     return float(area_fraction(res, [full], _params(res, plan))[0])
 
 
+def design_status(res, p_max: float) -> str:
+    """The status of the rows a design's numbers are read from: every row at a nominal pressure up to the first
+    approach state at or past ``p_max`` (the walk may run a little deeper, where a periodic array in full
+    contact presses the law's wall: rows no number reads), and the refinement's own status."""
+    from tengsim import status as _status
+
+    t = res.table
+    s = np.asarray(t.get("status"), dtype=str) if t.get("status") is not None else None
+    if s is None or "pressure_Pa" not in t:
+        return str(res.status)
+    P = np.asarray(t["pressure_Pa"], float)
+    br = np.asarray(t["branch"]).astype(str)
+    past = np.flatnonzero((br == "approach") & (P >= p_max))
+    top = P[past[0]] if len(past) else np.inf
+    keep = ~(P > top * (1 + 1e-12))
+    refined = res.params.get("resolve_status")
+    return str(_status.overall([*s[keep].tolist(), *([str(refined)] if refined else [])]))
+
+
 def crossing(P, A, level) -> float:
     """The pressure at which A(P) first reaches ``level``, linear between the two states around it (the first
     state itself if it is there already); NaN if never."""
@@ -207,7 +226,7 @@ def summarize(res, plan) -> tuple[dict, dict, list]:
     if pull >= 0:  # the retraction never pulls (a law without tension): no pull-off, not the least push
         notes.append("no pull-off: the retraction carries no tensile load")
     summary = {
-        "status": res.status,
+        "status": design_status(res, plan.pressures[-1]),
         "tabor": sc.mu,
         "jump_in_Pa": k_p * jin.F_before if jin else math.nan,
         "pull_off_N": sc.force(pull) if pull < 0 else math.nan,
