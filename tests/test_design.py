@@ -139,7 +139,11 @@ def test_comparison_of_two_designs_one_table_one_figure(tmp_path):
     out = tmp_path / "cmp"
     assert main(["design", str(a), str(b), "--out", str(out), "--quiet"]) == 0
     rows = [r for r in (out / "compare.csv").read_text().splitlines() if not r.startswith("#")]
-    assert len(rows) == 3 and rows[1].startswith("pyramid A") and rows[2].startswith("cone B")
+    assert len(rows) == 3
+    head = rows[0].split(",")
+    body = [dict(zip(head, r.split(","))) for r in rows[1:]]
+    assert {b["design"] for b in body} == {"pyramid A", "cone B"} and [b["rank"] for b in body] == ["1", "2"]
+    assert float(body[0]["area_at_p_max"]) >= float(body[1]["area_at_p_max"])  # ranked by the charged area
     assert (out / "compare.png").stat().st_size > 0
     assert (out / "pyramid_A" / "design.nc").exists() and (out / "cone_B" / "design.nc").exists()
 
