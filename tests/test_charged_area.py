@@ -144,3 +144,23 @@ def test_repulsive_law_charges_its_wall_area():
         if np.all(eq.H[U0 <= U0.min() + 1e-9] <= 0):                         # the whole top on the wall
             assert s["charged_fraction"] == pytest.approx(top, rel=0.01)
     assert rows[-1][2]["charged_fraction"] >= 0.9 * top                       # pressed: nearly the whole top
+
+
+def test_flat_mesa_topography_gives_its_top():
+    """A height map with flat round mesas (a measured-surface stand-in; the 'topography' shape reads the same
+    U0 from a file), periodic, pressed onto its tops: A/S = the mesa's top (pixels) within 1 %, growing with the
+    mesa's radius (the old Λc measured the tensile minimum inside the flat face: A/S ≈ 0)."""
+    from tengsim.shapes.heightmap import HeightMap
+    n, cell = 50, 5.0
+    x = (np.arange(n) - n // 2) * cell / n
+    r = np.hypot(x[:, None], x[None, :])
+    areas = []
+    for radius in (1.2, 1.5):
+        z = np.where(r <= radius, 8.0, 0.0)
+        shape = HeightMap(z, cell)
+        grid, U0, rows = _walk(shape, LJ93(), [0.5, 1.0], periodic=True, dx=cell / n)
+        top = np.count_nonzero(U0 <= U0.min() + 1e-9) / U0.size
+        for D, eq, s in rows:
+            assert s["charged_fraction"] == pytest.approx(top, rel=0.01), (radius, D)
+        areas.append(rows[-1][2]["charged_fraction"])
+    assert areas[1] > areas[0]
