@@ -103,8 +103,8 @@ def maps_figure(result):
         ax.set_title(f"approach, {nominal:.3g} kPa{extra}", fontsize=9)
         fig.colorbar(im, ax=ax, label="contact pressure (kPa; < 0 adhesive)")
     if g_c is not None:
-        fig.text(0.01, 0.01, f"black contour: the charged area's edge, gap = {g_c:.4g} ε (the law's peak-tension "
-                 "separation; the 2-D charged area lies inside)", fontsize=7)
+        fig.supxlabel(f"black contour: the charged area's edge, gap = {g_c:.4g} ε (the law's peak-tension "
+                      "separation; the 2-D charged area lies inside)", fontsize=8)
     fig.suptitle(title(result.plan, result.status), fontsize=10)
     return fig
 
