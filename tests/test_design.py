@@ -149,16 +149,19 @@ def test_comparison_of_two_designs_one_table_one_figure(tmp_path):
 
 
 def test_shipped_design_examples_plan():
-    """examples/own_design/*.toml (the README's comparison) are valid designs of the issue's pyramid and cone."""
+    """examples/own_design/*.toml (the README's comparisons) are valid designs: the issue's pyramid and cone, and the
+    cube, grating and hemisphere arrays (docs/own_design.md), periodic by default."""
     from pathlib import Path
 
     from tengsim.cli.design import _read_toml
 
     files = sorted((Path(__file__).parent.parent / "examples" / "own_design").glob("*.toml"))
     plans = [plan_design(_read_toml(str(f))) for f in files]
-    assert {p.shape for p in plans} == {"pyramid", "cone"}
+    assert {p.shape for p in plans} == {"pyramid", "cone", "cube", "line", "hemisphere"}
     for p in plans:
-        assert p.shape_params["pitch_m"] == pytest.approx(10e-6) and p.eps == pytest.approx(200e-9)
+        pitch = 10e-6 if p.shape in ("pyramid", "cone") else 20e-6
+        assert p.shape_params["pitch_m"] == pytest.approx(pitch) and p.eps == pytest.approx(200e-9)
+        assert p.boundary == "periodic" and not p.boundary_given and p.area == "contact"
 
 
 def test_help_per_shape_is_short(capsys):
