@@ -62,3 +62,21 @@ def test_paper_definition_stays_available(cube):
     assert not np.allclose(a, c)                              # Λc² of a flat top without a tensile peak: not its top
     with pytest.raises(Exception, match="area must be one of"):
         plan_design({**CUBE, "area": "greenwood"})
+
+
+def test_a_result_written_without_the_column_reads_with_the_papers_area(cube, tmp_path):
+    """A contact file of an older tengsim (no charged_fraction column) still reads; its A/S is the paper's, said."""
+    from tengsim.results.read import load_result
+    from tengsim.results.write import save
+    from tengsim.run.area import loaded_area
+    path = tmp_path / "new.csv"
+    save(cube.finest, path)
+    lines = path.read_text().splitlines()
+    head = next(i for i, l in enumerate(lines) if not l.startswith("#"))
+    j = lines[head].split(",").index("charged_fraction")
+    old = lines[:head] + [",".join(c for k, c in enumerate(l.split(",")) if k != j) for l in lines[head:]]
+    (tmp_path / "old.csv").write_text("\n".join(old) + "\n")
+    _, res = load_result(tmp_path / "old.csv")
+    assert "charged_fraction" not in res.table
+    F, L, A, notes = loaded_area(res)
+    assert len(A) == len(F) > 2 and any("paper's definition" in n for n in notes)
