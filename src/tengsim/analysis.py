@@ -112,13 +112,26 @@ def charged_area(H: np.ndarray, grid: Grid, g_c: float, opening: float = 1.0, pe
     s^opening (``opening`` 1.5 for a law whose peak tension starts at its wall, :attr:`~tengsim.laws.Law.
     edge_opening`).  A step (a flat top in contact beside a land that is not) counts its top's pixels
     exactly.  ``periodic``: the lines wrap around the cell (the periodic kernel)."""
-    s = np.asarray(H, dtype=float) + 1.0 - float(g_c)
-    f = np.sign(s) * np.abs(s) ** (1.0 / float(opening))
-    f = np.where(s <= 0, np.minimum(f, -1e-300), f)  # a gap at g_c itself is inside (a closed wall)
-    nx, ny = f.shape
-    ax = _scan_length(f, periodic) if nx > 1 else float(np.count_nonzero(f < 0))
-    ay = _scan_length(f.T, periodic) if ny > 1 else float(np.count_nonzero(f < 0))
+    H = np.asarray(H, dtype=float)
+
+    def level(h):
+        s = h + (1.0 - float(g_c))
+        f = np.sign(s) * np.abs(s) ** (1.0 / float(opening))
+        return np.where(s <= 0, np.minimum(f, -1e-300), f)  # a gap at g_c itself is inside (a closed wall)
+
+    nx, ny = H.shape
+    ax = ay = 0.0
+    for j in range(0, ny, _LINES):  # a few lines at a time: the scan's temporaries stay small beside the maps
+        f = level(H[:, j:j + _LINES])
+        ax += _scan_length(f, periodic) if nx > 1 else float(np.count_nonzero(f < 0))
+    for i in range(0, nx, _LINES):
+        f = level(H[i:i + _LINES, :].T)
+        ay += _scan_length(f, periodic) if ny > 1 else float(np.count_nonzero(f < 0))
     return float(0.5 * (ax + ay) * grid.area)
+
+
+_LINES = 32
+"""Lines measured at a time by :func:`charged_area`."""
 
 
 def apex_index(U0: np.ndarray) -> tuple[int, int]:
