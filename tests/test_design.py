@@ -13,9 +13,11 @@ from tengsim.design import plan_design, run_design, write_design
 from tengsim.design.write import CHANGE_NA
 
 SMALL = {"shape": "pyramid", "pitch": "1um", "base": "0.5um", "height": "0.2um", "E_star": "5MPa", "W": "20mJ/m2",
-         "eps": "50nm", "p_max": "50kPa", "p_step": "5kPa"}
+         "eps": "50nm", "p_max": "50kPa", "p_step": "5kPa", "boundary": "free"}
+# the isolated cell (given): this strongly adhesive array, periodic (the default), snaps into full contact and its
+# walk past p_max presses the law's wall (test_periodic_default_and_area_definition below runs the default)
 CLI_SMALL = ["design", "pyramid", "--pitch", "1um", "--base", "0.5um", "--height", "0.2um", "--E-star", "5MPa",
-             "--W", "20mJ/m2", "--eps", "50nm", "--p-max", "50kPa", "--p-step", "5kPa", "--quiet"]
+             "--W", "20mJ/m2", "--eps", "50nm", "--p-max", "50kPa", "--p-step", "5kPa", "--boundary", "free", "--quiet"]
 
 
 @pytest.fixture(scope="module")
@@ -41,7 +43,7 @@ def test_small_design_ok_and_within_1pct_of_a_grid_sqrt2_finer(small):
     cplan = plan_contact(small.plan.contact_table)
     path = PathSpec(res.params["d_min"], res.params["d_max"], res.params["d_step"], adaptive=True)
     finer = simulate(cplan.shape, cplan.tabor, res.grid.dx / math.sqrt(2), path, law=cplan.law,
-                     scaling=cplan.scaling, extra_params=cplan.extra)
+                     scaling=cplan.scaling, extra_params=cplan.extra, boundary=cplan.boundary)
     assert finer.grid.nx > res.grid.nx
     a = small.dataset["charged_area_fraction"].sel(branch="approach").values
     b = branch_curves(finer, small.plan)["approach"]["area"]
@@ -67,8 +69,12 @@ def test_dataset_contract_and_physics(small):
     # Eq. 12 and Eq. 17 from A/S with the paper's σ, ε_r, T and rest gap
     assert np.allclose(ds["voc_eq12"].values, 5.84e-6 * A * 400e-6 / (2.40 * eps0), equal_nan=True)
     assert np.allclose(ds["voc_eq17"].values, 5.84e-6 * A * 0.1e-3 / eps0, equal_nan=True)
-    # a pyramid's square patch never covers more than its footprint (base²/pitch² = 0.25)
-    assert np.nanmax(A) <= 0.25 + 0.01
+    # the charged area (gap below the LJ peak separation 3^(1/6)) holds the repulsive area (P > 0: gap below 1),
+    # and never more than the cell
+    R = ds["repulsive_area_fraction"].values
+    ok = np.isfinite(A) & np.isfinite(R)
+    assert np.all(A[ok] >= R[ok] - 1e-9) and np.nanmax(A) <= 1.0
+    assert ds.attrs["boundary"] == "free" and ds.attrs["area_definition"] == "contact"
 
 
 def test_files_cf_report_and_labels(small, tmp_path):
@@ -136,22 +142,29 @@ def test_comparison_of_two_designs_one_table_one_figure(tmp_path):
     out = tmp_path / "cmp"
     assert main(["design", str(a), str(b), "--out", str(out), "--quiet"]) == 0
     rows = [r for r in (out / "compare.csv").read_text().splitlines() if not r.startswith("#")]
-    assert len(rows) == 3 and rows[1].startswith("pyramid A") and rows[2].startswith("cone B")
+    assert len(rows) == 3
+    head = rows[0].split(",")
+    body = [dict(zip(head, r.split(","))) for r in rows[1:]]
+    assert {b["design"] for b in body} == {"pyramid A", "cone B"} and [b["rank"] for b in body] == ["1", "2"]
+    assert float(body[0]["area_at_p_max"]) >= float(body[1]["area_at_p_max"])  # ranked by the charged area
     assert (out / "compare.png").stat().st_size > 0
     assert (out / "pyramid_A" / "design.nc").exists() and (out / "cone_B" / "design.nc").exists()
 
 
 def test_shipped_design_examples_plan():
-    """examples/own_design/*.toml (the README's comparison) are valid designs of the issue's pyramid and cone."""
+    """examples/own_design/*.toml (the README's comparisons) are valid designs: the issue's pyramid and cone, and the
+    cube, grating and hemisphere arrays (docs/own_design.md), periodic by default."""
     from pathlib import Path
 
     from tengsim.cli.design import _read_toml
 
     files = sorted((Path(__file__).parent.parent / "examples" / "own_design").glob("*.toml"))
     plans = [plan_design(_read_toml(str(f))) for f in files]
-    assert {p.shape for p in plans} == {"pyramid", "cone"}
+    assert {p.shape for p in plans} == {"pyramid", "cone", "cube", "line", "hemisphere"}
     for p in plans:
-        assert p.shape_params["pitch_m"] == pytest.approx(10e-6) and p.eps == pytest.approx(200e-9)
+        pitch = 10e-6 if p.shape in ("pyramid", "cone") else 20e-6
+        assert p.shape_params["pitch_m"] == pytest.approx(pitch) and p.eps == pytest.approx(200e-9)
+        assert p.boundary == "periodic" and not p.boundary_given and p.area == "contact"
 
 
 def test_help_per_shape_is_short(capsys):

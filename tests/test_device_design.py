@@ -128,7 +128,8 @@ def test_one_config_serves_a_run_and_a_sweep(tmp_path, capsys):
 
 def test_device_takes_a_load_controlled_contact_result_with_its_snap(tmp_path, capsys):
     """A physical load-controlled run repeats the pressure at its snap (fold and landing rows): the device
-    keeps the first state reached there, refuses nothing, and A/S is λc²/L² of the approach rows."""
+    keeps the first state reached there, refuses nothing, and A/S is the result's own charged_fraction column (the
+    2-D charged area) of the approach rows."""
     from tengsim.device.areas import area_table_from_contact
     from tengsim.results.read import load_result
 
@@ -143,11 +144,11 @@ def test_device_takes_a_load_controlled_contact_result_with_its_snap(tmp_path, c
     assert np.any(np.diff(p[p >= 0]) == 0) or np.any(np.isclose(np.diff(p[p >= 0]), 0, atol=1e-6 * p.max()))
     t = area_table_from_contact(run)
     assert np.all(np.diff(t.pressure_Pa) > 0) and t.pressure_Pa[-1] == pytest.approx(20e3, rel=1e-3)
-    L = np.asarray(res.table["contact_length_m"])[a]
+    L = np.asarray(res.table["charged_fraction"])[a]
     first = {}
     for pi, li in zip(p, L):  # the first state reached at each pressure (>= 0)
         if pi >= 0 and not any(abs(pi - q) <= 1e-9 * max(abs(q), abs(pi)) for q in first):
-            first[pi] = li ** 2 / res.params["cell_area_m2"]
+            first[pi] = li
     np.testing.assert_allclose(t.area_fraction, list(first.values()), rtol=1e-12)
     out = tmp_path / "dev.csv"
     wave = tmp_path / "wave.toml"  # inside the table's pressures (Fig. 7's 2.58 kPa lies below its first state)

@@ -28,6 +28,8 @@ def synthetic(P_Pa, area, D_retract=None, F_retract=None, physical=True):
     rows["D"] = np.r_[D, Dr]
     rows["F"] = np.r_[F, Fr]
     rows["contact_length"] = np.r_[L, L[::-1][: len(Dr)]]
+    a = np.asarray(area, float)
+    rows["charged_fraction"] = np.r_[a, a[::-1][: len(Dr)]]  # the 2-D charged area (the default definition)
     rows["converged"] = np.ones(n + len(Dr), bool)
     rows["jump"] = np.zeros(n + len(Dr), bool)
     params = {"shape": "Pyramid", "N": SC.N, "cell": SC.cell}

@@ -1,4 +1,5 @@
-"""Per-state analysis: force (Eq. 10), contact length by Greenwood's tensile peak, contact areas."""
+"""Per-state analysis: force (Eq. 10), contact length by Greenwood's tensile peak, contact areas (the charged
+area of Eq. 12 measured on the 2-D gap map, :func:`charged_area`; the repulsive area)."""
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -57,6 +58,82 @@ def repulsive_area(P: np.ndarray, grid: Grid) -> float:
     return float(np.count_nonzero(P > 0) * grid.area)
 
 
+#: The paper's law's peak-tension separation 3^{1/6} (LJ 9-3, Eq. 8), used when no law is given.
+PAPER_PEAK_SEPARATION = 3.0 ** (1.0 / 6.0)
+
+
+def law_edge(law) -> tuple[float, float]:
+    """(g_c, opening) of a law for :func:`charged_area`: its ``peak_separation`` (else its ``g_peak``, else 1)
+    and its ``edge_opening`` (else 1)."""
+    g = getattr(law, "peak_separation", None)
+    if g is None:
+        g = getattr(law, "g_peak", None)
+    return (1.0 if g is None else float(g)), float(getattr(law, "edge_opening", 1.0) or 1.0)
+
+
+def _scan_length(f: np.ndarray, periodic: bool) -> float:
+    """Σ over the lines along axis 0 of the length (in pixels) where f < 0: the pixels with f < 0, and at each
+    crossing a correction within ±½ pixel from the outside of the edge: the line through the first two
+    outside pixels (f_o, f_oo) puts the edge at d = f_o/(f_oo − f_o) pixels from the first (the outside is
+    where the gap opens smoothly; the inside may be flat, a wall).  Where that line does not cross within
+    the pixel pair (a step: a flat top beside a flat land), the edge is the pixels' common border."""
+    inside = f < 0
+    total = float(np.count_nonzero(inside))
+    n = f.shape[0]
+    if n < 2:
+        return total
+    for step in (1, -1):
+        if periodic:
+            ins_o, fo, foo = (np.roll(a, -step * k, axis=0) for a, k in ((inside, 1), (f, 1), (f, 2)))
+        else:
+            ins_o = np.zeros_like(inside)
+            fo = np.full_like(f, np.nan)
+            foo = np.full_like(f, np.nan)
+            if step == 1:
+                ins_o[:-1], fo[:-1], foo[:-2] = inside[1:], f[1:], f[2:]
+            else:
+                ins_o[1:], fo[1:], foo[2:] = inside[:-1], f[:-1], f[:-2]
+        edge = inside & ~ins_o & np.isfinite(fo)
+        m = foo - fo
+        with np.errstate(invalid="ignore", divide="ignore"):
+            d = np.where(edge & (m > 0), fo / np.where(m > 0, m, 1.0), np.inf)
+        total += float(np.sum(np.where(edge & (d < 1.0), 0.5 - d, 0.0)))
+    return total
+
+
+def charged_area(H: np.ndarray, grid: Grid, g_c: float, opening: float = 1.0, periodic: bool = False) -> float:
+    """The charged contact area (ℓ²): the area where the gap g = H + 1 is at most ``g_c``, the separation of the
+    law's peak tension (:attr:`tengsim.laws.Law.peak_separation`; Greenwood's contact edge), on the 2-D map:
+    no apex, axis or patch shape assumed, so the same for every shape, array, rough or measured surface.
+
+    Measured line by line along X and along Y (the mean of the two): the pixels inside, and each edge
+    placed within its pixel pair from the outside profile (:func:`_scan_length`) of the level function
+    f = sign(g − g_c)|g − g_c|^(1/opening), linear in the distance from an edge where the gap opens as
+    s^opening (``opening`` 1.5 for a law whose peak tension starts at its wall, :attr:`~tengsim.laws.Law.
+    edge_opening`).  A step (a flat top in contact beside a land that is not) counts its top's pixels
+    exactly.  ``periodic``: the lines wrap around the cell (the periodic kernel)."""
+    H = np.asarray(H, dtype=float)
+
+    def level(h):
+        s = h + (1.0 - float(g_c))
+        f = np.sign(s) * np.abs(s) ** (1.0 / float(opening))
+        return np.where(s <= 0, np.minimum(f, -1e-300), f)  # a gap at g_c itself is inside (a closed wall)
+
+    nx, ny = H.shape
+    ax = ay = 0.0
+    for j in range(0, ny, _LINES):  # a few lines at a time: the scan's temporaries stay small beside the maps
+        f = level(H[:, j:j + _LINES])
+        ax += _scan_length(f, periodic) if nx > 1 else float(np.count_nonzero(f < 0))
+    for i in range(0, nx, _LINES):
+        f = level(H[i:i + _LINES, :].T)
+        ay += _scan_length(f, periodic) if ny > 1 else float(np.count_nonzero(f < 0))
+    return float(0.5 * (ax + ay) * grid.area)
+
+
+_LINES = 32
+"""Lines measured at a time by :func:`charged_area`."""
+
+
 def apex_index(U0: np.ndarray) -> tuple[int, int]:
     """Grid index of the highest point (smallest initial gap); the centre pixel wins ties."""
     m = U0.min()
@@ -73,16 +150,22 @@ class StateSummary:
     F: float
     contact_length: float
     area_repulsive: float
+    charged_fraction: float
     min_gap: float
     max_pressure: float
     min_pressure: float
 
 
-def summarize(P: np.ndarray, H: np.ndarray, grid: Grid, apex: tuple[int, int]) -> StateSummary:
+def summarize(P: np.ndarray, H: np.ndarray, grid: Grid, apex: tuple[int, int], law=None,
+              periodic: bool = False) -> StateSummary:
+    """The scalar outputs of one equilibrium; the charged area with ``law``'s peak separation (the paper's
+    law without one) on a free (or ``periodic``) cell."""
+    g_c, opening = (PAPER_PEAK_SEPARATION, 1.0) if law is None else law_edge(law)
     return StateSummary(
         F=force(P, grid),
         contact_length=contact_length(P, grid, apex),
         area_repulsive=repulsive_area(P, grid),
+        charged_fraction=charged_area(H, grid, g_c, opening, periodic) / (grid.nx * grid.ny * grid.area),
         min_gap=float(H.min()),
         max_pressure=float(P.max()),
         min_pressure=float(P.min()),

@@ -36,13 +36,15 @@ class Context:
 
 @OBSERVERS.register("summary")
 class Summary:
-    """Force (Eq. 10), Greenwood contact length Λc, repulsive area, min gap, max/min pressure."""
+    """Force (Eq. 10), Greenwood contact length Λc, repulsive area, charged area (the 2-D area inside the law's
+    peak-tension separation, :func:`tengsim.analysis.charged_area`), min gap, max/min pressure."""
 
-    columns = ("F", "contact_length", "area_repulsive", "min_gap", "max_pressure", "min_pressure")
+    columns = ("F", "contact_length", "area_repulsive", "charged_fraction", "min_gap", "max_pressure", "min_pressure")
     units = {"min_gap": "ε", "max_pressure": "W/ε (Eq. 8)", "min_pressure": "W/ε (Eq. 8)"}
 
     def __call__(self, eq, ctx: Context) -> dict:
-        return asdict(summarize(eq.P, eq.H, ctx.grid, ctx.apex))
+        return asdict(summarize(eq.P, eq.H, ctx.grid, ctx.apex, ctx.law,
+                                bool(getattr(ctx.kernel, "periodic", False))))
 
 
 def resolve(observers) -> list:

@@ -258,6 +258,7 @@ class _Units:
             "F": f"3π W ℓ²/ε = {self.force(1.0):.6g} N per cell (Eq. 10)",
             "contact_length": f"ℓ = {self.lateral:.6g} m (Λc)",
             "area_repulsive": f"ℓ² = {self.lateral**2:.6g} m²",
+            "charged_fraction": "1 (A/S)",
             "residual": "ε (max |r| of Eq. 9)",
             "min_gap": f"ε = {self.eps:.6g} m",
             "F_N": "N (force per cell)",

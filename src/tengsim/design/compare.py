@@ -13,9 +13,23 @@ COLUMNS = ("status", "tabor", "jump_in_Pa", "pull_off_N", "pull_off_Pa", "full_c
            "voc_eq17_at_p_max_V", "grids", "tolerance")
 
 
+def ranked(results) -> list:
+    """The designs ranked by their charged area A/S at p_max (largest first; NaN last): V_OC (Eq. 12 and 17) goes
+    as A/S, a device's power as its square."""
+    def key(r):
+        a = r.summary.get("area_at_p_max")
+        return -float(a) if a is not None and np.isfinite(float(a)) else np.inf
+    return sorted(results, key=key)
+
+
 def compare_table(results) -> dict:
-    """{column: array}: one row per design (its name, shape and the per-design numbers, SI)."""
-    cols = {"design": np.array([r.plan.name for r in results]), "shape": np.array([r.plan.shape for r in results])}
+    """{column: array}: one row per design, ranked by A/S at p_max (:func:`ranked`; its name, shape, boundary,
+    charged-area definition and the per-design numbers, SI)."""
+    results = ranked(results)
+    cols = {"rank": np.arange(1, len(results) + 1),
+            "design": np.array([r.plan.name for r in results]), "shape": np.array([r.plan.shape for r in results]),
+            "boundary": np.array([getattr(r.plan, "boundary", "") for r in results]),
+            "area_definition": np.array([getattr(r.plan, "area", "contact") for r in results])}
     for c in COLUMNS:
         vals = [r.summary.get(c) for r in results]
         cols[c] = np.array(vals, dtype=object if any(isinstance(v, str) for v in vals) else float)

@@ -6,19 +6,21 @@ retraction, the states whose load is below every earlier one.  Each asked pressu
 interpolated in pressure between the two states around it on that branch; NaN outside the pressures a branch
 reaches.  At a snap (the load drops while D grows) the branch keeps the first state reached at a pressure.
 
-**Charged area A/S** (the area that makes the charge, Eq. 12): the area inside the contact boundary, from
-Greenwood's contact length Λc (the tensile-peak length along X through the apex, :mod:`tengsim.observers`) by
-the shape of the patch (:func:`tengsim.run.area.area_fraction`): a square patch (pyramid, cube) Λc²,
-a round patch (cone, hemisphere, sphere, flat punch) the disc π/4 Λc², a ridge (line, sinusoid) the strip
-Λc × L, over the cell area.  The repulsive area (pixels with P > 0) is reported beside it.
+**Charged area A/S** (the area that makes the charge, Eq. 12), by the plan's definition
+(:data:`tengsim.run.area.DEFINITIONS`): by default ``contact``, the 2-D area where the gap is below the law's
+peak-tension separation, measured on each state's map (:func:`tengsim.analysis.charged_area`: the same for
+every shape); or ``paper``, the paper's construction from Greenwood's contact length Λc along X through the
+apex (:func:`tengsim.run.area.area_fraction`: Λc² for a square patch, π/4 Λc² for a disc, Λc × L for a ridge,
+over the cell area).  The repulsive area (pixels with P > 0) is reported beside it.
 
 **Per design** (:func:`summarize`): jump-in pressure (the nominal pressure on the approach just before it
 first jumps into contact; negative: tensile), pull-off (the most tensile load of the retraction, in N per cell
-and Pa), full-contact pressure (the lowest approach pressure at which A/S reaches 95 % of its full-contact
-value, the footprint's), the sensor's numbers of V_OC (Eq. 12) over [p_min, p_max]: sensitivity per pressure
-region, knee, saturation pressure, linear range with its R², hysteresis of V_OC (:mod:`tengsim.device.sensor`,
-the one definition), and the energy lost per cycle ∮F dD per unit nominal area (J/m²) and the largest
-difference of A/S between retraction and approach at an asked pressure.
+and Pa; none where the retraction never pulls: no tension), full-contact pressure (the approach pressure at
+which A/S reaches 95 % of its full-contact value, the footprint's, interpolated between the two states around
+it; none beyond the asked range), the sensor's numbers of V_OC (Eq. 12) over [p_min, p_max]: sensitivity per
+pressure region, knee, saturation pressure, linear range with its R², hysteresis of V_OC
+(:mod:`tengsim.device.sensor`, the one definition), and the energy lost per cycle ∮F dD per unit nominal area
+(J/m²) and the largest difference of A/S between retraction and approach at an asked pressure.
 """
 from __future__ import annotations
 
@@ -29,12 +31,12 @@ import numpy as np
 FULL_CONTACT_FRACTION = 0.95
 
 DEFINITIONS = {
-    "square": "A/S = Λc²/S: the square patch of side Λc, Greenwood's contact length (the tensile-peak length "
-              "along X through the apex), over the cell area S",
-    "disc": "A/S = (π/4)Λc²/S: the disc of diameter Λc, Greenwood's contact length (the tensile-peak length "
-            "along X through the apex), over the cell area S",
-    "line": "A/S = Λc/L: the strip of width Λc, Greenwood's contact length (the tensile-peak length across the "
-            "ridge), over the cell width L",
+    "square": "the paper's definition, A/S = Λc²/S: the square patch of side Λc, Greenwood's contact length (the "
+              "tensile-peak length along X through the apex), over the cell area S",
+    "disc": "the paper's definition, A/S = (π/4)Λc²/S: the disc of diameter Λc, Greenwood's contact length (the "
+            "tensile-peak length along X through the apex), over the cell area S",
+    "line": "the paper's definition, A/S = Λc/L: the strip of width Λc, Greenwood's contact length (the "
+            "tensile-peak length across the ridge), over the cell width L",
 }
 
 
@@ -42,9 +44,20 @@ def _params(res, plan) -> dict:
     return {**res.params, "config": {"shape": plan.shape}}
 
 
-def definition(res, plan) -> str:
-    from tengsim.run.area import family
+def area_definition(plan) -> str:
+    """The plan's charged-area definition: 'contact' (default) or 'paper'."""
+    return getattr(plan, "area", "contact") or "contact"
 
+
+def definition(res, plan) -> str:
+    """The charged-area definition in words (the report's line)."""
+    from tengsim.run.area import CHARGED_COLUMN, family
+
+    if area_definition(plan) == "contact" and CHARGED_COLUMN in res.table:
+        law = res.params.get("law") or "the law"
+        return ("the 2-D contact area, A/S = area where the gap is below the separation of the law's peak tension "
+                f"({law}; Greenwood's contact edge; a law without tension: its wall's gap), measured on the "
+                "contact map, over the cell area S")
     return DEFINITIONS[family(_params(res, plan))]
 
 
@@ -74,18 +87,24 @@ def _at(P, y, ps):
 
 def states(res, plan) -> dict:
     """{'approach'|'retraction': {'P' (Pa, increasing), 'area' (A/S), 'repulsive' (fraction)}} of the
-    load-controlled states (module doc)."""
-    from tengsim.run.area import area_fraction, load_control
+    load-controlled states (module doc), A/S by the plan's definition."""
+    from tengsim.run.area import CHARGED_COLUMN, area_fraction, load_control
 
     sc = res.scaling
     k_p = sc.pressure(1.0)
     cell = sc.cell_area
     p = _params(res, plan)
-    F, L = load_control(res)
+    contact = area_definition(plan) == "contact" and CHARGED_COLUMN in res.table
+    col = CHARGED_COLUMN if contact else "contact_length"
+
+    def area(v):
+        return np.clip(np.asarray(v, float), 0.0, 1.0) if contact else area_fraction(res, v, p)
+
+    F, L = load_control(res, col)
     _, R = load_control(res, "area_repulsive")
-    out = {"approach": {"P": k_p * F, "area": area_fraction(res, L, p), "repulsive": R * sc.lateral**2 / cell}}
-    Fr, (Lr, Rr) = _retraction_states(res, ("contact_length", "area_repulsive"))
-    out["retraction"] = {"P": k_p * Fr, "area": area_fraction(res, Lr, p), "repulsive": Rr * sc.lateral**2 / cell}
+    out = {"approach": {"P": k_p * F, "area": area(L), "repulsive": R * sc.lateral**2 / cell}}
+    Fr, (Lr, Rr) = _retraction_states(res, (col, "area_repulsive"))
+    out["retraction"] = {"P": k_p * Fr, "area": area(Lr), "repulsive": Rr * sc.lateral**2 / cell}
     return out
 
 
@@ -133,6 +152,39 @@ def sensor(res, plan):
                           (plan.pressures[0], plan.pressures[-1]))
 
 
+def design_status(res, p_max: float) -> str:
+    """The status of the rows a design's numbers are read from: every row at a nominal pressure up to the first
+    approach state at or past ``p_max`` (the walk may run a little deeper, where a periodic array in full
+    contact presses the law's wall: rows no number reads), and the refinement's own status."""
+    from tengsim import status as _status
+
+    t = res.table
+    s = np.asarray(t.get("status"), dtype=str) if t.get("status") is not None else None
+    if s is None or "pressure_Pa" not in t:
+        return str(res.status)
+    P = np.asarray(t["pressure_Pa"], float)
+    br = np.asarray(t["branch"]).astype(str)
+    past = np.flatnonzero((br == "approach") & (P >= p_max))
+    top = P[past[0]] if len(past) else np.inf
+    keep = ~(P > top * (1 + 1e-12))
+    refined = res.params.get("resolve_status")
+    return str(_status.overall([*s[keep].tolist(), *([str(refined)] if refined else [])]))
+
+
+def crossing(P, A, level) -> float:
+    """The pressure at which A(P) first reaches ``level``, linear between the two states around it (the first
+    state itself if it is there already); NaN if never."""
+    P, A = np.asarray(P, float), np.asarray(A, float)
+    hit = np.flatnonzero(A >= level)
+    if not len(hit):
+        return math.nan
+    i = int(hit[0])
+    if i == 0 or not A[i] > A[i - 1]:
+        return float(P[i])
+    return float(P[i - 1] + (level - A[i - 1]) * (P[i] - P[i - 1]) / (A[i] - A[i - 1]))
+
+
+
 def _grids_text(res) -> str:
     from tengsim.design.units import length_text
 
@@ -158,21 +210,23 @@ def summarize(res, plan) -> tuple[dict, dict, list]:
     full = _full_fraction(res, plan)
     full_P = math.nan
     if math.isfinite(full):
-        hit = np.flatnonzero(st["area"] >= FULL_CONTACT_FRACTION * full)
-        if len(hit):
-            full_P = float(st["P"][hit[0]])
-        else:
+        full_P = crossing(st["P"], st["area"], FULL_CONTACT_FRACTION * full)
+        if not full_P <= plan.pressures[-1] * (1 + 1e-9):
+            full_P = math.nan
             notes.append(f"full contact (A/S >= {FULL_CONTACT_FRACTION:g} × {full:.3g}) is not reached by "
                          f"{pressure_text(plan.pressures[-1])}")
     numbers = sensor(res, plan)
     diff = ret["area"] - app["area"]
     loop = res.loop_energy  # 0 where within its uncertainty, never a negative energy of quadrature error
+    pull = float(res.pull_off_force)
+    if pull >= 0:  # the retraction never pulls (a law without tension): no pull-off, not the least push
+        notes.append("no pull-off: the retraction carries no tensile load")
     summary = {
-        "status": res.status,
+        "status": design_status(res, plan.pressures[-1]),
         "tabor": sc.mu,
         "jump_in_Pa": k_p * jin.F_before if jin else math.nan,
-        "pull_off_N": sc.force(res.pull_off_force),
-        "pull_off_Pa": k_p * res.pull_off_force,
+        "pull_off_N": sc.force(pull) if pull < 0 else math.nan,
+        "pull_off_Pa": k_p * pull if pull < 0 else math.nan,
         "full_contact_Pa": full_P,
         **numbers.flat(),
         "sensor": numbers,

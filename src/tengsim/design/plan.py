@@ -9,7 +9,11 @@ The table holds
   :func:`tengsim.run.plan.plan_contact` (nothing is retyped here);
 * the design's own keys (:func:`design_fields`): the pressures (``p_min``, ``p_max``, ``p_step``), the device
   inputs of Eq. (12) and Eq. (17) (σ, ε_r, T, rest gap d0: the paper's values by default), the grid (``dx``
-  a length, ``max_pixels``), the convergence tolerance ``tol`` and the time budget.
+  a length, ``max_pixels``), the convergence tolerance ``tol``, the time budget and the charged-area
+  definition ``area``.
+
+The boundary is ``periodic`` unless given: a pattern's design is the array it describes (``free``, one isolated
+cell on a half-space, is named as such; :data:`BOUNDARY_WHY`).
 
 The path (D range, steps) is not the user's: :mod:`tengsim.design.run` extends it until ``p_max`` is
 reached.
@@ -71,7 +75,19 @@ def design_fields() -> list:
               "in seconds or with a unit, e.g. 600 or '600s' (default 600 s)"),
         Field("maps", "bool", True, help="keep contact pressure maps near 10 %, 50 % and 100 % of p_max (kept "
               "during the finest grid's walk, at the depths the grid before it predicts); false: none"),
+        Field("area", "str", "contact", help="charged-area definition: 'contact' (default: the 2-D area where "
+              "the gap is below the law's peak-tension separation, any shape) or 'paper' (the paper's Λc², from "
+              "the contact length through the apex; for its pyramids)"),
     ]
+
+
+BOUNDARY_WHY = {
+    "periodic": "the periodic array the shape's cell describes: every cell pressed beside its neighbours, whose "
+                "deformation it feels",
+    "free": "one isolated cell on an elastic half-space (the paper's Eq. 9): a single structure, or an array "
+            "whose pitch is large against each contact",
+}
+"""Why each boundary: the report's line (docs/own_design.md, 'Array or isolated structure')."""
 
 
 @dataclass(frozen=True)
@@ -99,6 +115,9 @@ class DesignPlan:
     eps: float
     tabor: float
     maps: bool = True
+    area: str = "contact"
+    boundary: str = "periodic"
+    boundary_given: bool = False
     extra: dict = field(default_factory=dict)
     contact_plan: object = field(default=None, compare=False, repr=False)
 
@@ -185,7 +204,15 @@ def plan_design(table: dict, where: str = "") -> DesignPlan:
     own = _own(table)
     cfg = {k: v for k, v in table.items() if k in contact_keys and k not in own_names and v not in (None, "")}
     cfg["shape"] = shape
-    checked = dict(cfg)
+    boundary_given = "boundary" in cfg
+    cfg.setdefault("boundary", "periodic")  # a pattern's design is the array it describes
+    from tengsim.run.area import check_definition
+
+    try:
+        area = check_definition(own["area"])
+    except TengsimError as exc:
+        raise type(exc)(f"{where}{exc}") from None
+    checked = dict(cfg)  # after the boundary's default
     if table.get("dx") not in (None, ""):  # the grid checked at the design's own first dx, not the default's
         checked["dx"] = table["dx"]
     try:
@@ -222,7 +249,8 @@ def plan_design(table: dict, where: str = "") -> DesignPlan:
     return DesignPlan(name=name, shape=shape, contact_table=cfg, shape_params=sp, pressures=pressures,
                       sigma=own["sigma"], eps_r=own["eps_r"], T=own["T"], gap=own["gap"], tol=tol, dx=own["dx"],
                       max_pixels=own["max_pixels"], budget_s=own["budget"], E_star=sc.E_star,
-                      W=sc.W, eps=sc.eps, tabor=sc.mu, maps=bool(own["maps"]), contact_plan=plan)
+                      W=sc.W, eps=sc.eps, tabor=sc.mu, maps=bool(own["maps"]), area=area,
+                      boundary=str(plan.boundary), boundary_given=boundary_given, contact_plan=plan)
 
 
 def _pressures(own: dict, where: str) -> tuple:

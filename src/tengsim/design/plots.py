@@ -85,6 +85,7 @@ def maps_figure(result):
     lat = sc.lateral * 1e6
     a = res.branch("approach")
     asked = dict(result.summary.get("map_pressures_asked", {}))
+    g_c = _peak_separation(result.plan)
     fig, axes = plt.subplots(1, len(maps), figsize=(4.3 * len(maps), 4.1), constrained_layout=True, squeeze=False)
     for ax, m in zip(axes[0], maps):
         Pmap = np.asarray(m["P"], float) * unit / 1e3
@@ -92,6 +93,7 @@ def maps_figure(result):
         hx, hy = nx * res.grid.dx * lat / 2, ny * res.grid.dy * lat / 2
         lim = float(np.nanmax(np.abs(Pmap))) or 1.0
         im = ax.imshow(Pmap.T, origin="lower", extent=[-hx, hx, -hy, hy], cmap="RdBu_r", vmin=-lim, vmax=lim)
+        _edge_contour(ax, m, g_c, hx, hy)
         ax.set_xlabel("x (µm)")
         ax.set_ylabel("y (µm)")
         i = int(np.argmin(np.abs(np.asarray(a["D"], float) - m["D"])))
@@ -100,8 +102,33 @@ def maps_figure(result):
         extra = f" (asked {want / 1e3:.3g} kPa)" if want is not None else ""
         ax.set_title(f"approach, {nominal:.3g} kPa{extra}", fontsize=9)
         fig.colorbar(im, ax=ax, label="contact pressure (kPa; < 0 adhesive)")
+    if g_c is not None:
+        fig.supxlabel(f"black contour: the charged area's edge, gap = {g_c:.4g} ε (the law's peak-tension "
+                      "separation; the 2-D charged area lies inside)", fontsize=8)
     fig.suptitle(title(result.plan, result.status), fontsize=10)
     return fig
+
+
+def _peak_separation(plan):
+    """The law's peak-tension separation g_c (ε) of a plan, None if it cannot be had."""
+    from tengsim.analysis import law_edge
+
+    law = getattr(getattr(plan, "contact_plan", None), "law", None)
+    return None if law is None else law_edge(law)[0]
+
+
+def _edge_contour(ax, m, g_c, hx, hy):
+    """The contour g = g_c (the charged area's edge) of a kept map's gap H (g = H + 1), in black."""
+    H = m.get("H") if isinstance(m, dict) else None
+    if H is None or g_c is None:
+        return
+    g = np.asarray(H, float) + 1.0
+    if not (np.nanmin(g) <= g_c <= np.nanmax(g)):
+        return
+    nx, ny = g.shape
+    x = (np.arange(nx) + 0.5) / nx * 2 * hx - hx
+    y = (np.arange(ny) + 0.5) / ny * 2 * hy - hy
+    ax.contour(x, y, g.T, levels=[g_c], colors="k", linewidths=0.9)
 
 
 def compare_figure(results):

@@ -3,13 +3,14 @@ from __future__ import annotations
 
 import math
 
+from tengsim.design.plan import BOUNDARY_WHY
 from tengsim.design.units import length_text, pressure_text
 
 ROWS = (
     ("jump_in_Pa", "jump-in pressure (approach, just before the first jump into contact; < 0 tensile)", "kPa"),
     ("pull_off_N", "pull-off force per cell (most tensile load on the retraction)", "N"),
     ("pull_off_Pa", "pull-off pressure", "kPa"),
-    ("full_contact_Pa", "full-contact pressure (A/S reaches 95 % of the footprint's)", "kPa"),
+    ("full_contact_Pa", "full-contact pressure (A/S reaches 95 % of the footprint's; interpolated)", "kPa"),
     ("hysteresis_J_m2", "hysteresis: energy lost per cycle per unit nominal area (∮F dD over the D range both "
                         "branches cover; 0 where within its uncertainty below)", "J/m²"),
     ("hysteresis_bound_J_m2", "hysteresis uncertainty (± : quadrature rule change, solver residual, jump location)",
@@ -66,7 +67,11 @@ def report_text(result, figures) -> str:
              f"rest gap d0 = {length_text(p.gap)} (defaults: the paper's 5.84 µC/m², 2.40, 400 µm, 0.1 mm).",
              f"Pressures: {pressure_text(p.pressures[0])} to {pressure_text(p.pressures[-1])}, "
              f"{len(p.pressures)} values.",
-             "", f"Charged area: {s['charged_area_definition']}; the repulsive area (P > 0) is given beside it.", "",
+             "", f"Charged area ({'the default' if p.area == 'contact' else 'area = paper'}): "
+                 f"{s['charged_area_definition']}; the repulsive area (P > 0) is given beside it"
+                 f"{'; the contour on the maps is its edge' if p.area == 'contact' else ''}.",
+             "", f"Boundary: {p.boundary} ({'given' if p.boundary_given else 'the default for a pattern'}): "
+                 f"{BOUNDARY_WHY.get(p.boundary, 'as given')}.", "",
              "## How converged", "", "| number | change between the last two grids |", "|---|---|"]
     lines += [f"| {k} | {_pct(v)} |" for k, v in result.convergence.items()]
     tab = result.finest.params.get("resolution") or {}

@@ -64,6 +64,7 @@ def to_dataset(res, plan, summary: dict):
         "gap_m": plan.gap, "status": str(summary["status"]), "grids": str(summary["grids"]),
         "tolerance": float(plan.tol), "solver_tolerance_eps": float(res.params.get("tol", math.nan)),
         "charged_area_definition": str(summary["charged_area_definition"]),
+        "area_definition": str(getattr(plan, "area", "contact")), "boundary": str(getattr(plan, "boundary", "")),
         "contact_config": json.dumps({k: v for k, v in plan.contact_table.items()}, sort_keys=True, default=str),
     }
     sensor, reasons = summary.get("sensor"), summary.get("reasons") or {}

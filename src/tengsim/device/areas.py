@@ -89,8 +89,8 @@ def area_table_from_design(path) -> AreaTable:
 
 def area_table_from_contact(path) -> AreaTable:
     """The :class:`AreaTable` of a physical ``tengsim contact`` result (.nc or .csv): its approach rows at
-    nominal pressures >= 0, A/S = λc²/L² (paper Eq. 12's area: the contact length squared over the cell
-    area), one row per pressure (at a load-controlled snap the first state reached).  A displacement-
+    nominal pressures >= 0, A/S its ``charged_fraction`` column (the 2-D charged area of each state, the
+    design's default; a file without it: the paper's λc²/L²), one row per pressure (at a load-controlled snap the first state reached).  A displacement-
     controlled approach, whose force falls after the jump-in, is refused at the row where it falls (run
     it with control = load)."""
     from tengsim.results.read import load_result
@@ -109,7 +109,10 @@ def area_table_from_contact(path) -> AreaTable:
     if rows.size < 2:
         raise TengsimError(f"{where}: the approach has {rows.size} state(s) at a pressure >= 0; the device "
                            "needs at least 2")
-    frac = np.asarray(t["contact_length_m"], float)[rows] ** 2 / float(cell)
+    if "charged_fraction" in t:  # the result's own 2-D charged area (tengsim.analysis.charged_area)
+        frac = np.asarray(t["charged_fraction"], float)[rows]
+    else:  # a result written before it: the paper's λc²/L²
+        frac = np.asarray(t["contact_length_m"], float)[rows] ** 2 / float(cell)
     pres, a = stable_branch(p[rows], np.clip(frac, 0.0, 1.0), where=where, rows=rows,
                             hint=" on the approach (a displacement-controlled run's force falls after a jump: "
                                  "run it with --control load)")

@@ -126,6 +126,21 @@ class Law:
         0 for a law without tension."""
         return self._numeric_softening
 
+    @property
+    def peak_separation(self) -> float:
+        """The gap (ε) that bounds the charged contact area (:func:`tengsim.analysis.charged_area`): the
+        separation of the law's peak tension ``g_peak`` (Greenwood's contact edge; for an axisymmetric
+        contact the tensile-peak radius; a plateau's start: Maugis' contact radius a); for a law without
+        tension, the gap 1 where its wall sets in (the paper's contact gap, P(1) = the wall's scale)."""
+        g = self.g_peak
+        return 1.0 if g is None else float(g)
+
+    #: How the gap opens just outside the charged area's edge, g − g_peak ∝ s^edge_opening (s the distance
+    #: from the edge): 1 where the gap crosses ``peak_separation`` with a slope (the peak lies beyond the
+    #: contact gap: LJ 9-3, a wall without tension); 1.5 where the peak tension starts at the wall's edge
+    #: (Maugis–Dugdale, exponential: the edge of a cohesive zone).  It locates the edge within a pixel.
+    edge_opening = 1.0
+
     def params(self) -> dict:
         """The law's parameters (its dataclass fields; public attributes otherwise) and its class name."""
         if dataclasses.is_dataclass(self):
@@ -217,7 +232,10 @@ def numeric_softening(law, g_lo: float, g_hi: float) -> float:
 
 class WallLaw(Law):
     """A law whose linear wall (:func:`_wall`, stiffness ``wall_stiffness``) starts at g = 1 with its peak
-    tension ``tension`` there (Maugis–Dugdale, exponential): the declared numbers these laws share."""
+    tension ``tension`` there (Maugis–Dugdale, exponential): the declared numbers these laws share.  The peak
+    starts at the wall's edge g = 1, where a contact's gap opens as (r − a)^{3/2} (``edge_opening``)."""
+
+    edge_opening = 1.5
 
     @property
     def max_tension(self) -> float:

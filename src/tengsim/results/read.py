@@ -18,8 +18,9 @@ from tengsim.results.columns import CURVE_COLUMNS
 from tengsim.results.result import ContactResult
 
 BOOL_COLUMNS = ("converged", "on_grid", "jump", "in_law_range")
-# written by every tengsim version; later additions (in_law_range, process_zone, status) are taken when present
-LATER_COLUMNS = ("in_law_range", "process_zone", "status")
+# written by every tengsim version; later additions (in_law_range, process_zone, status, charged_fraction) are
+# taken when present (a file without charged_fraction: A/S by the paper's Λc, tengsim.run.area.loaded_area)
+LATER_COLUMNS = ("in_law_range", "process_zone", "status", "charged_fraction")
 REQUIRED_CONTACT = tuple(k for k in CURVE_COLUMNS if k not in LATER_COLUMNS)
 SWEEP_COLUMNS = ("R", "energy_per_cycle", "average_power")
 

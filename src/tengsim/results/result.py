@@ -85,7 +85,7 @@ class ContactResult:
         lat = self.params.get("lateral_unit", "ℓ")
         u = {"D": "ε (rigid approach, Eq. 7)", "F": f"3π W ℓ²/ε with ℓ = {lat} (per cell, Eq. 10)",
              "contact_length": f"ℓ = {lat} (Λc, Eq. 7)", "residual": "ε (max |r| of Eq. 9)",
-             "area_repulsive": f"ℓ² with ℓ = {lat}", "min_gap": "ε",
+             "area_repulsive": f"ℓ² with ℓ = {lat}", "charged_fraction": "1 (A/S of the cell)", "min_gap": "ε",
              "max_pressure": "W/ε (Eq. 8)", "min_pressure": "W/ε (Eq. 8)"}
         u.update(self.units)
         return {k: v for k, v in u.items() if k in self.table}

@@ -21,6 +21,7 @@ _CF_COLUMNS = {
     "F": ("force per cell F (Eq. 10; positive: compressive)", "force"),
     "contact_length": ("Greenwood contact length Λc (tensile-peak distance along X)", "lateral"),
     "area_repulsive": ("area per cell where the pressure is repulsive (P > 0)", "area"),
+    "charged_fraction": ("charged-area fraction A/S of the cell: the gap below the law's peak-tension separation", "1"),
     "residual": ("largest |r| of Eq. (9) at the accepted state", "eps"),
     "iterations": ("solver iterations", "1"),
     "n_conv": ("convolutions (FFT pairs) the solve spent", "1"),

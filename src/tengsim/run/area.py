@@ -1,8 +1,15 @@
-"""The charged-area fraction A/S of a contact result (Eq. 12: V_OC = σT/(ε_r ε0) × A/S), from its contact
-length Λc and its shape: the patch family and cell of the shape, the result's scale to pressure, the approach
-states a pressed device passes, and the observer of A/S at named pressures that automatic refinement
-(``resolve_pressures``) converges.  Read by the refinement (:mod:`tengsim.run.resolve`), the study
-(:mod:`tengsim.study.observe`) and the designer (:mod:`tengsim.design`).
+"""The charged-area fraction A/S of a contact result (Eq. 12: V_OC = σT/(ε_r ε0) × A/S), by one of two
+definitions (:data:`DEFINITIONS`):
+
+* ``contact`` (the default): the 2-D area where the gap is below the law's peak-tension separation, measured
+  on each state's gap map (:func:`tengsim.analysis.charged_area`, the result's ``charged_fraction`` column);
+  the same code for every shape, array, rough or measured surface;
+* ``paper``: the paper's construction for its pyramids, from Greenwood's contact length Λc along X through
+  the apex and the shape's patch family (Λc²/S, (π/4)Λc²/S or Λc/L), kept to reproduce the paper's figures.
+
+Also: the result's scale to pressure, the approach states a pressed device passes, and the observer of A/S
+at named pressures that automatic refinement (``resolve_pressures``) converges.  Read by the refinement
+(:mod:`tengsim.run.resolve`), the study (:mod:`tengsim.study.observe`) and the designer (:mod:`tengsim.design`).
 """
 from __future__ import annotations
 
@@ -129,6 +136,28 @@ def full_length(params: dict) -> float:
         return math.nan
 
 
+DEFINITIONS = {
+    "contact": "A/S = the area where the gap is below the law's peak-tension separation (Greenwood's contact "
+               "edge; for a law without tension, its wall's gap), measured on the 2-D contact map, over the cell "
+               "area S",
+    "paper": "the paper's A/S: Λc²/S (square patch), (π/4)Λc²/S (disc) or Λc/L (strip), Λc Greenwood's contact "
+             "length (the tensile-peak length along X through the apex), S the cell area",
+}
+"""The charged-area definitions: ``contact`` (the default, the 2-D map) and ``paper`` (the paper's Λc)."""
+
+CHARGED_COLUMN = "charged_fraction"
+
+
+def check_definition(definition: str) -> str:
+    """``definition`` if it names one of :data:`DEFINITIONS`; a TengsimError otherwise."""
+    from tengsim.errors import ConfigValueError
+
+    d = str(definition).strip().lower()
+    if d not in DEFINITIONS:
+        raise ConfigValueError(f"area must be one of {', '.join(DEFINITIONS)}, got {definition!r}")
+    return d
+
+
 # ---- the observables ----------------------------------------------------------------------------
 
 def load_control(res, column: str = "contact_length"):
@@ -153,13 +182,22 @@ def load_control(res, column: str = "contact_length"):
     return np.array(Fk), np.array(Lk)
 
 
-def loaded_area(res, params: dict | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray, list]:
-    """(F, Λc, A/S, notes) of the approach states a pressed device passes (:func:`load_control`): A/S is
-    :func:`area_fraction` of Λc, or, for a run with the ``array_area`` observer, its
-    ``area_fraction_greenwood`` column (Σ over the array's cells).  ``params`` as in :func:`area_fraction`."""
+def loaded_area(res, params: dict | None = None, definition: str = "contact"
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray, list]:
+    """(F, Λc, A/S, notes) of the approach states a pressed device passes (:func:`load_control`).  A/S by
+    ``definition`` (:data:`DEFINITIONS`): ``contact``, the result's ``charged_fraction`` column (a result
+    written without it falls back to the paper's, with a note); ``paper``, :func:`area_fraction` of Λc, or,
+    for a run with the ``array_area`` observer, its ``area_fraction_greenwood`` column (Σ over the array's
+    cells).  ``params`` as in :func:`area_fraction`."""
+    definition = check_definition(definition)
     p = res.params if params is None else params
     Fk, Lk = load_control(res)
     notes = []
+    if definition == "contact" and CHARGED_COLUMN in res.table:
+        return Fk, Lk, np.clip(load_control(res, CHARGED_COLUMN)[1], 0.0, 1.0), notes
+    if definition == "contact" and len(Fk):
+        notes.append("A/S by the paper's definition (Λc): the result has no charged_fraction column (written "
+                     "by an older tengsim); run it again for the 2-D charged area")
     if "area_fraction_greenwood" in res.table:  # the array_area observer: the sum over the cells
         A = np.clip(load_control(res, "area_fraction_greenwood")[1], 0.0, 1.0)
     else:
@@ -175,12 +213,13 @@ def area_name(pressure_Pa: float) -> str:
     return f"A_S_at_{pressure_Pa:.6g}Pa".replace("+", "").replace(".", "p")
 
 
-def area_at(pressures, cfg: dict | None = None):
+def area_at(pressures, cfg: dict | None = None, definition: str = "contact"):
     """The observer ``res -> {area_name(P): A/S at P}`` that automatic refinement (``resolve_pressures``,
     :func:`tengsim.run.resolve.run_contact`) also converges: the charged-area fraction of Eq. (12) at each
     nominal pressure P (Pa) on the approach (linear in F between loaded states; NaN outside the states the
     run reaches or for a run without a physical scale).  V_OC (Eq. 12) is σT/(ε_r ε0) × A/S, so its relative
-    change is A/S's.  ``cfg``: the run's [contact] table (the shape's name for the patch family)."""
+    change is A/S's.  ``cfg``: the run's [contact] table (the shape's name for the patch family);
+    ``definition``: :data:`DEFINITIONS`."""
     pressures = [float(p) for p in pressures]
 
     def observe_area(res) -> dict:
@@ -189,7 +228,7 @@ def area_at(pressures, cfg: dict | None = None):
         if scale is None:
             return out
         params = res.params if cfg is None else {**res.params, "config": cfg}
-        Fk, _, A, _ = loaded_area(res, params)
+        Fk, _, A, _ = loaded_area(res, params, definition)
         known = np.isfinite(A)
         if np.count_nonzero(known) < 2:
             return out
