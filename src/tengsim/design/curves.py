@@ -13,8 +13,9 @@ every shape); or ``paper``, the paper's construction from Greenwood's contact le
 apex (:func:`tengsim.run.area.area_fraction`: Λc² for a square patch, π/4 Λc² for a disc, Λc × L for a ridge,
 over the cell area).  The repulsive area (pixels with P > 0) is reported beside it.
 
-**Per design** (:func:`summarize`): jump-in pressure (the nominal pressure on the approach just before it
-first jumps into contact; negative: tensile), pull-off (the most tensile load of the retraction, in N per cell
+**Per design** (:func:`summarize`): jump-in pressure (:func:`snap_in`: the nominal pressure of a pressed device
+on the approach just before it first snaps into contact within [p_min, p_max], the load-controlled branch's first
+fold; the start, an adhesive apex drawn in at zero load, is the branch's first state, not a snap), pull-off (the most tensile load of the retraction, in N per cell
 and Pa; none where the retraction never pulls: no tension), full-contact pressure (the approach pressure at
 which A/S reaches 95 % of its full-contact value, the footprint's, interpolated between the two states around
 it; none beyond the asked range), the sensor's numbers of V_OC (Eq. 12) over [p_min, p_max]: sensitivity per
@@ -185,6 +186,38 @@ def crossing(P, A, level) -> float:
 
 
 
+SNAP_DROP = 1e-3
+"""A fold is a snap where the path's load falls, before it is regained, by more than this fraction of p_max (a
+smaller dip is the solver's noise, and the area it skips is nothing a device shows)."""
+
+
+def snap_in(P, area, p_range) -> float:
+    """The nominal pressure just before a pressed device first snaps into contact within ``p_range`` = (p_min,
+    p_max), Pa; NaN if it does not.  ``P`` and ``area`` are the approach's path states in order (D increasing).
+    Under a load the device passes the states whose P is above every earlier one, from zero load on
+    (:func:`tengsim.run.area.load_control`); a fold is a state after which P falls by more than
+    :data:`SNAP_DROP` × p_max before a later state exceeds it: the device snaps from the fold to that state.  It
+    is a snap into contact where the area grows across it.  A fold past p_max is never taken (beyond it the walk
+    may press the law's wall: rows no number reads), nor a jump the D-controlled walk records that the load does
+    not make."""
+    P, area = np.asarray(P, float), np.asarray(area, float)
+    lo, hi = float(p_range[0]), float(p_range[-1])
+    drop = SNAP_DROP * abs(hi)
+    best, i_best, low = 0.0, None, math.inf
+    for k, p in enumerate(P):
+        if not math.isfinite(p):
+            continue
+        if p > best:
+            if i_best is not None and low < best - drop and area[k] > area[i_best] and lo <= best <= hi:
+                return float(best)
+            if best > hi:
+                break
+            best, i_best, low = float(p), k, math.inf
+        else:
+            low = min(low, float(p))
+    return math.nan
+
+
 def _grids_text(res) -> str:
     from tengsim.design.units import length_text
 
@@ -206,7 +239,11 @@ def summarize(res, plan) -> tuple[dict, dict, list]:
     st = states(res, plan)["approach"]
     notes = [physical_message(str(res.params["resolve_message"]), sc.lateral)] if res.params.get("resolve_message") \
         else []
-    jin = next((j for j in res.jumps if j.kind == "jump-in"), None)
+    from tengsim.run.area import CHARGED_COLUMN
+
+    a = res.branch("approach")
+    col = CHARGED_COLUMN if area_definition(plan) == "contact" and CHARGED_COLUMN in a else "contact_length"
+    jump_in = snap_in(k_p * np.asarray(a["F"], float), a[col], (plan.pressures[0], plan.pressures[-1]))
     full = _full_fraction(res, plan)
     full_P = math.nan
     if math.isfinite(full):
@@ -224,7 +261,7 @@ def summarize(res, plan) -> tuple[dict, dict, list]:
     summary = {
         "status": design_status(res, plan.pressures[-1]),
         "tabor": sc.mu,
-        "jump_in_Pa": k_p * jin.F_before if jin else math.nan,
+        "jump_in_Pa": jump_in,
         "pull_off_N": sc.force(pull) if pull < 0 else math.nan,
         "pull_off_Pa": k_p * pull if pull < 0 else math.nan,
         "full_contact_Pa": full_P,
@@ -241,17 +278,20 @@ def summarize(res, plan) -> tuple[dict, dict, list]:
         "charged_area_definition": definition(res, plan),
         "seconds": float(res.params.get("resolve_seconds", res.seconds)),
     }
-    summary["reasons"] = na_reasons(summary, numbers, plan, full)
+    summary["reasons"] = na_reasons(summary, numbers, plan, full, drawn_in=bool(len(a["F"]) and a["F"][0] < 0))
     conv = convergence(res)
     return summary, conv, notes
 
 
-def na_reasons(summary: dict, numbers, plan, full: float) -> dict:
-    """{number: why it is n/a} for the per-design numbers that are NaN (the sensor's from its own reasons)."""
+def na_reasons(summary: dict, numbers, plan, full: float, drawn_in: bool = False) -> dict:
+    """{number: why it is n/a} for the per-design numbers that are NaN (the sensor's from its own reasons);
+    ``drawn_in``: the approach starts attracted (an adhesive apex drawn into contact at zero load)."""
     from tengsim.design.units import pressure_text
 
     top = pressure_text(plan.pressures[-1])
-    why = {"jump_in_Pa": "no jump into contact on the approach: the contact grows without a snap",
+    start = "the apex is drawn in at zero load, then " if drawn_in else ""
+    why = {"jump_in_Pa": f"no jump into contact on the approach between {pressure_text(plan.pressures[0])} and "
+                         f"{top}: {start}the contact grows under the load without a snap",
            "full_contact_Pa": (f"A/S does not reach {FULL_CONTACT_FRACTION:g} of the footprint's by {top}"
                                if math.isfinite(full) else "the shape has no known full-contact area"),
            "pull_off_N": "no tensile load on the retraction", "pull_off_Pa": "no tensile load on the retraction",

@@ -7,7 +7,8 @@ from tengsim.design.plan import BOUNDARY_WHY
 from tengsim.design.units import length_text, pressure_text
 
 ROWS = (
-    ("jump_in_Pa", "jump-in pressure (approach, just before the first jump into contact; < 0 tensile)", "kPa"),
+    ("jump_in_Pa", "jump-in pressure (approach under load, just before the first snap into contact in the asked "
+                   "range)", "kPa"),
     ("pull_off_N", "pull-off force per cell (most tensile load on the retraction)", "N"),
     ("pull_off_Pa", "pull-off pressure", "kPa"),
     ("full_contact_Pa", "full-contact pressure (A/S reaches 95 % of the footprint's; interpolated)", "kPa"),
