@@ -141,4 +141,6 @@ def test_no_second_definition_of_sensitivity_in_the_sources():
     root = Path(tengsim.__file__).parent
     hits = [str(f.relative_to(root)) for f in root.rglob("*.py")
             if "polyfit" in f.read_text() and f.name != "sensor.py"]
-    assert set(hits) <= {"analysis.py"}, hits  # analysis.py fits the contact's own profile, not V_OC(P)
+    # analysis.py fits the contact's own profile, calibrate/fit.py the log-log trade-off between two fitted
+    # parameters along the region that fits: neither is a line through V_OC(P)
+    assert set(hits) <= {"analysis.py", "calibrate/fit.py"}, hits

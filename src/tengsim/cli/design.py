@@ -254,10 +254,10 @@ def run(args) -> int:
         except TengsimError as exc:
             raise TengsimError(f"{where}{exc}") from None
     with folder_lock(out):
-        return _run_locked(args, plans, folders, out)
+        return _run_locked(args, plans, folders, out, material)
 
 
-def _run_locked(args, plans, folders, out) -> int:
+def _run_locked(args, plans, folders, out, material=None) -> int:
     from tengsim.design import run_design, write_comparison, write_design
 
     say = _Say(args.quiet)
