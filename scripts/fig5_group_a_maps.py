@@ -74,7 +74,7 @@ def main(out):
     ax.set_xlabel("x along the row through the apex (µm)")
     ax.set_ylabel("pressure (kPa)")
     ax.legend(fontsize=7)
-    fig.suptitle("black: charged area's edge g = 3^{1/6} (the whole cell is inside); orange: ±Λc/2, the paper's "
+    fig.suptitle("black: charged area's edge g = 3$^{1/6}$ ε (the whole cell is inside); orange: ±Λc/2, the paper's "
                  "innermost tensile minimum; green dotted: the pyramid's base", fontsize=9)
     fig.savefig(out, dpi=110)
 
