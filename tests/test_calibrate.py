@@ -108,7 +108,9 @@ def test_unidentifiable_W_is_said_with_the_range_that_fits(tmp_path):
     from tengsim.calibrate import calibrate, plan_calibration
     from tengsim.calibrate.data import Curve
 
-    g = {**G1, "pitch": "0.5um", "base": "0.25um", "height": "0.1um", "eps": "40nm"}
+    # the isolated cell under the paper's definition, whose A/S (0.215) stays flat over 2-20 kPa whatever W
+    g = {**G1, "pitch": "0.5um", "base": "0.25um", "height": "0.1um", "eps": "40nm", "boundary": "free",
+         "area": "paper"}
     P = np.linspace(2e3, 20e3, 10)
     V = 8e-6 * 0.215 * 400e-6 / (2.4 * 8.8541878128e-12) * (1 + 0.02 * np.random.default_rng(3).standard_normal(10))
     prob = plan_calibration([g], [Curve("flat", P, V, ("approach",) * 10)], "sigma,W", "W=15mJ/m2:40mJ/m2")
