@@ -223,3 +223,16 @@ def test_film_kernels_against_penalty_wall(kind):
     f = FastSolver(1e-6, max_iter=20000).solve(Problem(g0, Repulsive(exponent=36.0), K), State.zero(g0.shape))
     assert f.converged, f.message
     assert f.P.mean() == pytest.approx(hard.P.mean(), rel=5e-3)
+
+
+def test_design_refuses_pk_for_a_smooth_law_before_anything_runs(tmp_path, capsys, monkeypatch):
+    """`design ... --solver pk` with LJ 9-3: the solver's own one line, exit 2, from the preflight (no solve, no
+    progress line, nothing written)."""
+    from tengsim.cli.main import main
+
+    monkeypatch.chdir(tmp_path)
+    rc = main(["design", "pyramid", "--pitch", "1um", "--base", "0.5um", "--height", "0.2um", "--E-star", "5MPa",
+               "--W", "20mJ/m2", "--eps", "50nm", "--p-max", "20kPa", "--solver", "pk", "--out", "o"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert rc == 2 and len(err) == 1 and "smooth repulsion" in err[0] and "'fast'" in err[0]
+    assert list(tmp_path.iterdir()) == []

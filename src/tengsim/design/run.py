@@ -285,7 +285,14 @@ def preflight(plan) -> None:
     from tengsim.solvers import make_solver
 
     cplan = as_plan(plan.contact_table if plan.contact_plan is None else plan.contact_plan)
-    make_solver(cplan.solver, tol=solver_tol(plan))  # a solver this machine lacks (gpu): refused now, one line
+    cplan = choose_solver(plan, cplan)  # the solver the run will use (a cohesive law: pk)
+    solver = make_solver(cplan.solver, tol=solver_tol(plan))  # a solver this machine lacks (gpu): refused now
+    if hasattr(solver, "solves") and not solver.solves(cplan.law):  # a law it cannot solve: refused now
+        from tengsim.solvers.pk import PKSolver, wall_model
+
+        if isinstance(solver, PKSolver):
+            wall_model(cplan.law)  # raises the solver's own line, naming the solvers that can
+        raise TengsimError(f"solver {cplan.solver!r} cannot solve law {type(cplan.law).__name__}")
     lateral = cplan.scaling.lateral
     try:
         dx = start_dx(plan, cplan)
