@@ -72,3 +72,22 @@ def test_no_snap_in_the_range_is_na_with_its_reason(tiny):
     assert math.isnan(s["jump_in_Pa"])
     why = s["reasons"]["jump_in_Pa"]
     assert "no jump into contact" in why and "600 Pa" in why and "drawn in at zero load" in why
+
+
+def test_a_second_pass_walks_every_grid_to_the_extended_path():
+    """The false "reached only … kPa, give a lower p_max": a finer grid walks only to where the grid before it
+    reached p_max (plus a margin) and may fall short; the run's second pass must not cut the finer grids' paths
+    again at the same D, or it fails the same way and blames p_max."""
+    from tengsim.design import plan_design, run_design
+    from tengsim.design.run import _reach, grid_path
+
+    plan = plan_design({"shape": "pyramid", "pitch": "1um", "base": "0.5um", "height": "0.2um", "E_star": "5MPa",
+                        "W": "20mJ/m2", "eps": "50nm", "p_max": "20kPa", "p_step": "10kPa", "tol": 0.05,
+                        "maps": False})
+    prev = run_design(plan).finest
+    ok, D_hit, _, _ = _reach(prev, plan.pressures[-1])
+    assert ok
+    d_max = D_hit + 50.0
+    cut = grid_path(plan, d_max)(prev)
+    full = grid_path(plan, d_max, cut=False)(prev)
+    assert cut.d_max < d_max - 10 and full.d_max == pytest.approx(d_max)

@@ -437,14 +437,15 @@ D_MARGIN = 0.03
 (at least 2 d_step): a finer grid is softer, and between the issue's grids that D moved by less than 0.1 ε."""
 
 
-def grid_path(plan, d_max):
+def grid_path(plan, d_max, cut: bool = True):
     """``path_for`` of the refinement (:func:`tengsim.run.resolve.resolve_contact`): the first grid walks to
     ``d_max`` (found on the coarse grid, :func:`find_d_max`); each finer grid to the D at which the grid before
     it reached p_max, plus :data:`D_MARGIN` (on the path's lattice, never beyond ``d_max``): about 10 % of the
     rows were past p_max.  Each finer grid's path also keeps the pressure and gap maps at the map depths of the
     grid before it (:func:`map_depths` of its curve), so the finest grid's maps are recorded during its own walk
     (an extra row at each such D, solved from the rows around it: the walk's other rows are unchanged);
-    ``plan.maps`` false: no maps."""
+    ``plan.maps`` false: no maps.  ``cut`` false: every grid walks to ``d_max`` (a second pass, after a finer
+    grid fell short of p_max at the D the grid before it reached p_max)."""
     from tengsim.continuation import PathSpec
 
     def on_lattice(D):
@@ -454,7 +455,7 @@ def grid_path(plan, d_max):
         depths, top = (), d_max
         if prev is not None and prev.scaling is not None:
             ok, D_hit, _, _ = _reach(prev, plan.pressures[-1])
-            if ok:
+            if ok and cut:
                 top = min(d_max, on_lattice(D_hit + max(D_MARGIN * abs(D_hit), 2 * D_STEP)))
             if plan.maps:
                 last = D_MIN + math.floor((top - D_MIN) / D_STEP + 1e-9) * D_STEP
@@ -591,13 +592,14 @@ def run_design(plan, progress=None, keep=None) -> DesignResult:
     check_budget(plan, est, max_pixels)
     _say(progress, cap_line(plan, cplan, dx, d_max, max_pixels, coarse))
     res = None
-    for _ in range(2):
+    for attempt in range(2):
         from tengsim.continuation import PathSpec
 
         path = PathSpec(D_MIN, d_max, D_STEP, adaptive=True)
         ck, found = _checkpoint(keep, base, d_max, progress) or (None, None)
         res = resolve_plan(dataclasses.replace(cplan, path=path, resolve=ResolveSettings(plan.tol, max_pixels, dx)),
-                           observe=_observer(plan), watch=_watcher(plan), path_for=grid_path(plan, d_max),
+                           observe=_observer(plan), watch=_watcher(plan),
+                           path_for=grid_path(plan, d_max, cut=attempt == 0),
                            progress=_deadline(progress, plan, keep, started),
                            checkpoint=None if ck is None else ck.save, start=found)
         if res.scaling is None:  # every grid taken back from the checkpoint file, which keeps the columns only
@@ -608,7 +610,8 @@ def run_design(plan, progress=None, keep=None) -> DesignResult:
         d_max = 1.2 * d_max + 2.0
     else:
         raise TengsimError(f"the approach reached only {top / 1e3:.4g} kPa of p_max = {plan.pressures[-1] / 1e3:.4g} "
-                           f"kPa on the finest grid: give a lower p_max")
+                           f"kPa on the finest grid, walked to D = {d_max:.4g} ε "
+                           f"({d_max * cplan.scaling.eps * 1e6:.3g} µm) on every grid: give a lower p_max")
     summary, conv, notes = summarize(res, plan)
     maps, depths = (res, maps_asked(res, plan)) if plan.maps and res.maps else (None, {})
     summary["map_pressures_asked"] = tuple(depths.items())
