@@ -44,6 +44,24 @@ def test_a_curve_that_saturates_at_2p5_kPa_reports_no_large_sensitivity_above_it
     assert sensor_numbers(P, V).flat()["saturation_Pa"] == pytest.approx(p_sat, abs=0.5e3)
 
 
+def test_a_snap_is_a_knee_of_its_own_with_a_line_each_side():
+    """A contact snapping in (V_OC jumps between two states: the land of a pyramid array adhering) splits the
+    curve at the snap, not at a least-squares knee inside the jump: each side keeps its own line (R² 1)."""
+    P = np.array([0, 10, 20, 30, 40, 45, 60, 70, 80, 90, 100]) * 1e3  # states; the snap from 45 to 60 kPa
+    V = np.where(P <= 45e3, 1.0 + 0.3e-3 * P, 90.0 + 0.1e-3 * (P - 60e3))  # 0.3 V/kPa, then 0.1 V/kPa
+    s = sensor_numbers(P, V)
+    f = s.flat()
+    assert [r.name for r in s.regions][:3] == ["below the snap", "the snap", "above the snap"]
+    assert f["knee_Pa"] == pytest.approx(45e3)
+    assert f["sensitivity_V_per_Pa"] == pytest.approx(0.3e-3, rel=1e-6) and s.regions[0].r2 == pytest.approx(1.0)
+    assert f["sensitivity_above_knee_V_per_Pa"] == pytest.approx(0.1e-3, rel=1e-6)
+    assert s.regions[1].sensitivity_V_per_Pa == pytest.approx((90.0 - 14.5) / 15e3, rel=1e-6)
+    assert f["linear_range_Pa"] == pytest.approx(45e3, abs=0.3e3)
+    # a steep but smooth rise (no two states farther apart than the rest) is no snap
+    Q = np.linspace(0, 100e3, 401)
+    assert "the snap" not in [r.name for r in sensor_numbers(Q, 1.0 + 0.3e-3 * Q + 50 * np.tanh(Q / 5e3)).regions]
+
+
 def test_a_knee_splits_the_curve_into_two_regions_with_their_slopes():
     V = np.where(P < 10e3, 1.0 + 2e-3 * P, 21.0 + 0.5e-3 * (P - 10e3))  # 2 V/kPa, then 0.5 V/kPa above 10 kPa
     s = sensor_numbers(P, V)

@@ -14,6 +14,10 @@ resampled at :data:`SAMPLES` even pressures, so the numbers depend on the curve,
   the region "saturated".  Each region has its sensitivity dV_OC/dP (V/Pa, the least-squares slope), its
   relative sensitivity (dV_OC/dP)/V₀ (1/Pa; V₀ = V_OC at p_lo, the unloaded baseline; n/a when V₀ = 0) and
   the R² of its line.  The sensor's **sensitivity** is that of its lowest region, stated with the region's top.
+  A **snap** (the contact jumping in: between two states of the curve V_OC rises by at least
+  :data:`SNAP_FRACTION` of its full-scale change at a slope at least :data:`SNAP_STEEPNESS` times the range's
+  mean) is a knee of its own: the curve is split at its first snap below P_sat into "below the snap", "the snap"
+  (the jump's two states) and "above the snap", each with its own line, and the knee is the pressure before it.
 * **Linear range**: from p_lo up to the highest pressure p, at most the top of the lowest region, such that the
   least-squares line over [p_lo, p] fits with R² >= :data:`R2_LINEAR`; its R² is stated.
 * **Hysteresis**: the largest |V_OC(retraction) − V_OC(approach)| at a pressure both branches reach in the
@@ -34,6 +38,10 @@ SATURATION_BAND = 0.02
 """V_OC within this fraction of its full-scale change of its top value counts as saturated."""
 SATURATION_MIN_WIDTH = 0.1
 """The flat tail must cover at least this fraction of the pressure range to be a saturation."""
+SNAP_FRACTION = 0.2
+"""A rise of V_OC between two states of at least this fraction of its full-scale change may be a snap ..."""
+SNAP_STEEPNESS = 3.0
+"""... when its slope is at least this many times the range's mean slope (full-scale change over the range)."""
 SAMPLES = 401
 """Even pressures the piecewise-linear curve is read at over the range."""
 
@@ -43,7 +51,8 @@ NUMBERS = {
     "sensitivity_rel_per_Pa": ("1/Pa", "relative sensitivity (dV_OC/dP)/V0 of the lowest region, V0 = V_OC at "
                                        "the lowest pressure"),
     "sensitivity_to_Pa": ("Pa", "top of the lowest region (the knee, the saturation pressure or the range's top)"),
-    "knee_Pa": ("Pa", "knee: where V_OC(P) changes slope (two lines fit better than one)"),
+    "knee_Pa": ("Pa", "knee: where V_OC(P) changes slope (two lines fit better than one), or the pressure "
+                       "just before a snap"),
     "sensitivity_above_knee_V_per_Pa": ("V/Pa", "sensitivity dV_OC/dP above the knee"),
     "saturation_Pa": ("Pa", f"saturation pressure: V_OC within {100 * SATURATION_BAND:g} % of its full-scale "
                             "change of its top value from there on"),
@@ -88,7 +97,7 @@ class SensorNumbers:
         """{name of :data:`NUMBERS`: value (SI)}."""
         nan = math.nan
         low = self.regions[0] if self.regions else None
-        above = next((r for r in self.regions if r.name == "above the knee"), None)
+        above = next((r for r in self.regions if r.name in ("above the knee", "above the snap")), None)
         return {"sensitivity_V_per_Pa": low.sensitivity_V_per_Pa if low else nan,
                 "sensitivity_rel_per_Pa": low.relative_per_Pa if low else nan,
                 "sensitivity_to_Pa": low.p_hi_Pa if low else nan,
@@ -170,6 +179,19 @@ def _region(name, x, y, v0, lo=None, hi=None):
     return Region(name, float(x[0] if lo is None else lo), float(x[-1] if hi is None else hi), slope, rel, r2)
 
 
+def _snap(P, V, lo, hi, span):
+    """(P before, P after) of the first snap of the states (P, V) inside [lo, hi] (module doc), or None."""
+    mean = span / (hi - lo)
+    for i in range(P.size - 1):
+        a, b = float(P[i]), float(P[i + 1])
+        if a < lo or b > hi:
+            continue
+        dv = float(V[i + 1] - V[i])
+        if dv >= SNAP_FRACTION * span and dv / (b - a) >= SNAP_STEEPNESS * mean:
+            return a, b
+    return None
+
+
 def _split(x, y):
     """The knee index: two lines (one each side, sharing the knee) with the least total squared error."""
     n = len(x)
@@ -219,7 +241,15 @@ def sensor_numbers(pressure_Pa, voc_V, retraction=None, p_range=None) -> SensorN
     top = "up to saturation" if math.isfinite(p_sat) else "whole range"
     knee = nan
     single = _fit(xr, yr)[2] if xr.size >= 3 else 1.0
-    if not (single >= R2_LINEAR or math.isnan(single)) and xr.size >= 8:
+    snap = _snap(P, V, lo, float(xr[-1]), span)
+    below = xr <= (snap[0] if snap else -math.inf)
+    above = xr >= (snap[1] if snap else math.inf)
+    if snap and np.count_nonzero(below) >= 2 and np.count_nonzero(above) >= 2:
+        knee = snap[0]
+        regions = [_region("below the snap", xr[below], yr[below], v0),
+                   _region("the snap", np.array(snap), np.interp(snap, P, V), v0),
+                   _region("above the snap", xr[above], yr[above], v0, hi=p_sat if math.isfinite(p_sat) else None)]
+    elif not (single >= R2_LINEAR or math.isnan(single)) and xr.size >= 8:
         k = _split(xr, yr)
         knee = float(xr[k])
         regions = [_region("below the knee", xr[:k + 1], yr[:k + 1], v0),
@@ -303,5 +333,6 @@ def describe(numbers: SensorNumbers) -> list:
     return lines
 
 
-__all__ = ["NUMBERS", "R2_LINEAR", "SATURATION_BAND", "SATURATION_MIN_WIDTH", "Region", "SensorNumbers",
+__all__ = ["NUMBERS", "R2_LINEAR", "SATURATION_BAND", "SATURATION_MIN_WIDTH", "SNAP_FRACTION", "SNAP_STEEPNESS",
+           "Region", "SensorNumbers",
            "describe", "sensor_numbers"]
