@@ -57,6 +57,9 @@ def test_a_snap_is_a_knee_of_its_own_with_a_line_each_side():
     assert f["sensitivity_above_knee_V_per_Pa"] == pytest.approx(0.1e-3, rel=1e-6)
     assert s.regions[1].sensitivity_V_per_Pa == pytest.approx((90.0 - 14.5) / 15e3, rel=1e-6)
     assert f["linear_range_Pa"] == pytest.approx(45e3, abs=0.3e3)
+    # saturated from the lowest pressure on (a flat top in contact at once): no snap, no division by a zero range
+    flat = sensor_numbers([0.0, 1.0, 40e3], [0.0, 20.0, 20.0])
+    assert "the snap" not in [r.name for r in flat.regions]
     # a steep but smooth rise (no two states farther apart than the rest) is no snap
     Q = np.linspace(0, 100e3, 401)
     assert "the snap" not in [r.name for r in sensor_numbers(Q, 1.0 + 0.3e-3 * Q + 50 * np.tanh(Q / 5e3)).regions]

@@ -181,6 +181,8 @@ def _region(name, x, y, v0, lo=None, hi=None):
 
 def _snap(P, V, lo, hi, span):
     """(P before, P after) of the first snap of the states (P, V) inside [lo, hi] (module doc), or None."""
+    if not hi > lo:  # saturated from the lowest pressure on: no rise to snap in
+        return None
     mean = span / (hi - lo)
     for i in range(P.size - 1):
         a, b = float(P[i]), float(P[i + 1])
