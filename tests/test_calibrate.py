@@ -62,6 +62,7 @@ def test_recovery_two_geometries_intervals_contain_truth(fitted):
         i = names.index(k)
         lo, hi, best = float(ds["lower_95"][i]), float(ds["upper_95"][i]), float(ds["best"][i])
         assert lo <= TRUE[k] <= hi, (k, lo, best, hi)
+        assert lo <= best <= hi, (k, lo, best, hi)  # the best value inside its own interval
         assert abs(best / TRUE[k] - 1) < 0.05, (k, best)  # the best values recover the truth
         assert hi / lo < 10  # an interval, not every value between the bounds
     assert ds.attrs["Conventions"] == "CF-1.10"

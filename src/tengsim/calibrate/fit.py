@@ -229,6 +229,12 @@ def fit(model: Model, box=None, polish: bool = True, model_error: float = 0.0) -
         profile["sigma"] = (svals, np.maximum(prof, 0.0))
         interval["sigma"] = (math.exp(lo), math.exp(hi), olo and svals[0] <= slo * (1 + 1e-9),
                              ohi and svals[-1] >= shi * (1 - 1e-9))
+    extended = []
+    for name, (lo, hi, olo, ohi) in list(interval.items()):  # the best value always inside its own interval
+        v = best[name]
+        if not lo <= v <= hi:
+            extended.append(name)
+            interval[name] = (min(lo, v), max(hi, v), olo, ohi)
     region = pts[dev <= dmin + thr] if d else pts
     cnames, corr = _correlation(model, pts, dev, dmin, b, c, scale)
     fitres = Fit(best, interval, profile, cnames, corr, thr, dmin, scale, (), region, box, theta, pts, dev, sig)
@@ -238,6 +244,10 @@ def fit(model: Model, box=None, polish: bool = True, model_error: float = 0.0) -
         words += (f"These intervals are widened ×{math.sqrt(grow):.2g} for the interpolation's own error "
                   f"({model_error:.3g} against the noise {scale:.3g}): with more designs (--nodes, --zooms, tighter "
                   "--bounds) they narrow to what the data alone allow.",)
+    if extended:
+        words += (f"The best fit lay outside the grid's profile interval of {', '.join(extended)}: the interval "
+                  "was extended to hold it. The interpolation between designs is not smooth enough here to trust "
+                  "these intervals: give more designs (--nodes, --zooms) or tighter --bounds.",)
     return Fit(best, interval, profile, cnames, corr, thr, dmin, scale, words, region, box, theta, pts, dev, sig)
 
 
