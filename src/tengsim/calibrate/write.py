@@ -217,15 +217,20 @@ def figures(cal, out: Path) -> list:
     save(fig, out / "residuals.png")
     paths.append(out / "residuals.png")
     ks = list(f.profile)
+    from matplotlib.ticker import FuncFormatter, ScalarFormatter
+
     fig, axes = plt.subplots(1, len(ks), figsize=(3.2 * len(ks), 3.0), squeeze=False)
     for ax, k in zip(axes[0], ks):
         vals, d = f.profile[k]
         ax.plot(vals / UNITS[k][1], d, color="k")
-        ax.axhline(f.threshold, color="r", ls="--", lw=0.8)
+        ax.axhline(f.threshold, color="r", ls="--", lw=0.8, label="95 % threshold")
         ax.set_xscale("log")
-        ax.set_xlabel(f"{label(k)} ({UNITS[k][0]})")
+        ax.xaxis.set_major_formatter(ScalarFormatter())  # plain numbers in the axis unit, not 2×10¹
+        ax.xaxis.set_minor_formatter(FuncFormatter(lambda v, _: f"{v:g}" if f"{v:g}"[0] in "25" else ""))
+        ax.set_xlabel(f"{label(k)} ({UNITS[k][0]}, log scale)")
         ax.set_ylim(0, max(3 * f.threshold, 1))
     axes[0][0].set_ylabel("profile deviance rise")
+    axes[0][0].legend(fontsize=7, loc="upper left")
     save(fig, out / "profiles.png")
     paths.append(out / "profiles.png")
     return paths
