@@ -130,7 +130,7 @@ def charged_area(H: np.ndarray, grid: Grid, g_c: float, opening: float = 1.0, pe
     return float(0.5 * (ax + ay) * grid.area)
 
 
-_LINES = 32
+_LINES = 4
 """Lines measured at a time by :func:`charged_area`."""
 
 

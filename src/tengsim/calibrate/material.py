@@ -141,7 +141,8 @@ def write_bands(bands: dict, out_dir, name: str = "") -> list:
     fig, axes = plt.subplots(1, 2, figsize=(9, 3.4))
     P = bands["pressure"] / 1e3
     for ax, k, lab in ((axes[0], "area", "charged area A/S"), (axes[1], "voc", "V_OC, Eq. 12 (V)")):
-        ax.fill_between(P, bands[f"{k}_lower"], bands[f"{k}_upper"], alpha=0.3, lw=0)
+        ax.fill_between(P, bands[f"{k}_lower"], bands[f"{k}_upper"], where=np.ones(np.shape(P), bool), alpha=0.3,
+                        lw=0)  # ``where`` given: matplotlib 3.6.0 with numpy 1.24 (the floors) fails on its default
         ax.plot(P, bands[k], color="C0")
         ax.set_xlabel("nominal pressure (kPa)")
         ax.set_ylabel(lab)

@@ -196,7 +196,8 @@ def figures(cal, out: Path) -> list:
         col = f"C{i}"
         best, lo, hi = cal.bands[i]
         P = cal.plot_pressures[i] / 1e3
-        ax.fill_between(P, lo, hi, color=col, alpha=0.25, lw=0)
+        # ``where`` given: matplotlib 3.6.0 with numpy 1.24 (the floors) fails on its default
+        ax.fill_between(P, lo, hi, where=np.ones(np.shape(P), bool), color=col, alpha=0.25, lw=0)
         ax.plot(P, best, color=col, label=f"fit: {Path(str(prob.names[i])).stem}")
         ax.errorbar(c.pressure / 1e3, c.voc, yerr=c.err, fmt="o", ms=4, color=col, mfc="none")
     ax.set_xlabel("nominal pressure (kPa)")
