@@ -219,3 +219,20 @@ def test_material_file_refused_when_not_one(tmp_path, capsys):
     rc = main(["design", str(d), "--material", str(tmp_path / "m.toml"), "--out", str(tmp_path / "o")])
     err = capsys.readouterr().err.strip()
     assert rc == 2 and "not a material key" in err and not (tmp_path / "o").exists()
+
+
+def test_data_and_design_files_read_as_utf8_under_a_c_locale(tmp_path):
+    """A µ in a comment of the measured CSV and of the design TOML, read under LC_ALL=C: the files are UTF-8
+    whatever the locale (the data's own check answers, not a decoding error)."""
+    import os
+    import subprocess
+    import sys
+
+    (tmp_path / "d.toml").write_text("# µ-structured PDMS\n[design]\n" + "".join(
+        f'{k} = "{v}"\n' if isinstance(v, str) else f"{k} = {v}\n" for k, v in G1.items()), encoding="utf-8")
+    (tmp_path / "m.csv").write_text("# µ-pyramids\npressure_kPa,voc_V\n2,6.1\n4,6.4\n", encoding="utf-8")
+    env = {**os.environ, "LC_ALL": "C", "LANG": "C", "PYTHONUTF8": "0", "PYTHONIOENCODING": ""}
+    r = subprocess.run([sys.executable, "-m", "tengsim.cli.main", "calibrate", "d.toml", "--data", "m.csv",
+                        "--free", "sigma,W,eps", "--out", "f"], cwd=tmp_path, env=env, capture_output=True)
+    assert r.returncode == 2 and b"measured points for 3 free parameters" in r.stderr, r.stderr
+    assert not (tmp_path / "f").exists()

@@ -52,7 +52,7 @@ def read_curve(path) -> Curve:
     if not p.is_file():
         raise TengsimError(f"--data {path}: no such file")
     try:
-        lines = [ln for ln in p.read_text().splitlines() if ln.strip() and not ln.lstrip().startswith("#")]
+        lines = [ln for ln in p.read_text(encoding="utf-8").splitlines() if ln.strip() and not ln.lstrip().startswith("#")]
     except UnicodeDecodeError:
         raise TengsimError(f"--data {path}: not a text (CSV) file") from None
     if not lines:

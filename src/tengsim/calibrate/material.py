@@ -55,7 +55,7 @@ def read_material(path) -> dict:
     if not p.is_file():
         raise TengsimError(f"--material {path}: no such file")
     try:
-        data = tomllib.loads(p.read_text())
+        data = tomllib.loads(p.read_text(encoding="utf-8"))
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise TengsimError(f"--material {path}: not a TOML file: {str(exc).splitlines()[0]}") from None
     vals = data.get("design", data.get("material"))

@@ -61,7 +61,7 @@ def _read_design_file(path) -> dict:
     if not p.is_file():
         raise TengsimError(f"{path}: no such file (give a design TOML that tengsim design accepts)")
     try:
-        data = tomllib.loads(p.read_text())
+        data = tomllib.loads(p.read_text(encoding="utf-8"))
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise TengsimError(f"{path}: not a TOML file: {str(exc).splitlines()[0]}") from None
     t = data.get("design", data)

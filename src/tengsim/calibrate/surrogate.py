@@ -83,7 +83,7 @@ def solve_node(table: dict, folder: Path, u: float, v: float, progress=None) -> 
         P, A, status, secs = _load(nc)
         return Node(u, v, status == "ok", P, A, "" if status == "ok" else f"status {status}", secs, True)
     if bad.is_file():
-        return Node(u, v, False, message=bad.read_text().strip(), cached=True)
+        return Node(u, v, False, message=bad.read_text(encoding="utf-8").strip(), cached=True)
     folder.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
     try:
