@@ -47,17 +47,9 @@ def band_points(cal) -> list:
 def read_material(path) -> dict:
     """{'values': {key: text}, 'points': [{key: text}], 'intervals': {...}} of a material.toml; a file that is not
     one: one line."""
-    try:
-        import tomllib
-    except ModuleNotFoundError:  # pragma: no cover
-        import tomli as tomllib
-    p = Path(path)
-    if not p.is_file():
-        raise TengsimError(f"--material {path}: no such file")
-    try:
-        data = tomllib.loads(p.read_text(encoding="utf-8"))
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-        raise TengsimError(f"--material {path}: not a TOML file: {str(exc).splitlines()[0]}") from None
+    from tengsim.calibrate.data import read_toml
+
+    data = read_toml(path, f"--material {path}")
     vals = data.get("design", data.get("material"))
     if not isinstance(vals, dict) or not any(k in vals for k in MATERIAL_KEYS):
         raise TengsimError(f"--material {path}: no [design] table with E_star, W, eps or sigma (a material.toml "

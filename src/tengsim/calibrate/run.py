@@ -53,17 +53,9 @@ def _say(progress, text):
 
 
 def _read_design_file(path) -> dict:
-    try:
-        import tomllib
-    except ModuleNotFoundError:  # pragma: no cover
-        import tomli as tomllib
-    p = Path(path)
-    if not p.is_file():
-        raise TengsimError(f"{path}: no such file (give a design TOML that tengsim design accepts)")
-    try:
-        data = tomllib.loads(p.read_text(encoding="utf-8"))
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-        raise TengsimError(f"{path}: not a TOML file: {str(exc).splitlines()[0]}") from None
+    from tengsim.calibrate.data import read_toml
+
+    data = read_toml(path, str(path), "no such file (give a design TOML that tengsim design accepts)")
     t = data.get("design", data)
     if not isinstance(t, dict) or "shape" not in t:
         raise TengsimError(f"{path}: not a design (no shape key in [design] or at the top level)")
