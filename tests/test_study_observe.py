@@ -136,3 +136,21 @@ def test_physical_scale_of_any_shape_from_its_columns():
     assert k_p == pytest.approx(3 * math.pi * 54e-3 * (1e-7) ** 2 / 1e-7 / (2e-6) ** 2, rel=1e-9)
     del res.table["pressure_Pa"]
     assert physical_scale(res)[0] == pytest.approx(k_p, rel=1e-9)  # from F_N and cell_area_m2
+
+
+def test_study_reader_gives_the_observables_of_the_full_result(tmp_path):
+    """The study table reads point files with a light reader; it must hand observe every column the
+    full reader does (a missing charged_fraction made the study's V_sat the paper's Λc² one)."""
+    from tengsim.results import load_result
+    from tengsim.study.dataset import _light_result
+
+    P = np.linspace(0.0, 60e3, 7)
+    area = 0.05 + 0.3 * P / P[-1]
+    synthetic(P, area).save(tmp_path / "p.nc")
+    settings = parse_observables({})
+    full = observe(load_result(tmp_path / "p.nc")[1], DEVICE, settings)
+    light = observe(_light_result(tmp_path / "p.nc")[0], DEVICE, settings)
+    assert light["notes"] == full["notes"]
+    for k, v in full["scalars"].items():
+        assert light["scalars"][k] == pytest.approx(v, nan_ok=True), k
+    assert light["scalars"]["V_sat"] == pytest.approx(K_V * area[-1], rel=1e-9)

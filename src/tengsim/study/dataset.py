@@ -56,7 +56,7 @@ def _read_point(sd, pid):
 
 
 _COLUMNS = ("branch", "D", "F", "contact_length", "jump", "converged", "pressure_Pa", "F_N", "contact_length_m",
-            "status", "area_fraction_greenwood")
+            "status", "area_fraction_greenwood", "charged_fraction")
 
 
 def _light_result(nc):

@@ -114,8 +114,9 @@ def observe(res, device: dict, settings: dict) -> dict:
     """Scalars (dict name → float) and curves ('V_OC', 'area_fraction' on the common pressure grid,
     'V_OC_at' at the named pressures) of one contact result.
 
-    A/S is :func:`area_fraction` of Λc, or, for a run with the ``array_area`` observer, its
-    ``area_fraction_greenwood`` column (Σ over the array's cells).  A value that cannot be had is NaN:
+    A/S is :func:`tengsim.run.area.loaded_area`'s: the result's ``charged_fraction`` column (the 2-D
+    charged area), or, for a run with the ``array_area`` observer, its ``area_fraction_greenwood`` column
+    (Σ over the array's cells).  A value that cannot be had is NaN:
     every pressure observable of a dimensionless run (no scaling); transition_D and
     adhesive_full_contact of a shape without a known full-contact length (:func:`full_length`); the
     V_OC observables of a run with fewer than two loaded states or no known cell (:func:`cell_side`).
