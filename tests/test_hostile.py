@@ -459,6 +459,60 @@ def test_c12_a_second_sweep_on_a_held_folder_is_refused(tmp_path, study_client):
     assert s["ok"] + s.get("under_resolved", 0) == 1
 
 
+def test_c12_a_child_forked_while_the_folder_is_held_does_not_keep_it(tmp_path):
+    """A process forked while a sweep holds its folder (a worker a Dask nanny restarts) does not hold the
+    folder after the sweep ends (a flock kept by the child's copy made the next sweep refuse, by chance);
+    another live process that holds it is still refused, with its pid."""
+    import signal
+    import subprocess
+    import sys
+
+    from tengsim.errors import TengsimError
+    from tengsim.study.layout import StudyDir
+
+    sd = StudyDir(tmp_path / "out")
+    children, truncate = [], os.ftruncate
+
+    def fork_meanwhile(fd, n):  # another thread's fork lands while the lock is being taken
+        truncate(fd, n)
+        if not children:
+            pid = os.fork()
+            if pid == 0:  # the child: outlives the sweep's lock, as a restarted worker does
+                time.sleep(30)
+                os._exit(0)
+            children.append(pid)
+
+    os.ftruncate = fork_meanwhile
+    try:
+        with sd.lock():
+            os.ftruncate = truncate
+            with pytest.raises(TengsimError, match="in use by another sweep"):  # the same process, again
+                with sd.lock():
+                    pass
+    finally:
+        os.ftruncate = truncate
+    (pid,) = children
+    try:
+        with sd.lock():  # the child still lives and the folder is free
+            pass
+    finally:
+        os.kill(pid, signal.SIGKILL)
+        os.waitpid(pid, 0)
+    code = ("import sys, time; from pathlib import Path; from tengsim.study.layout import StudyDir\n"
+            "with StudyDir(Path(sys.argv[1])).lock():\n    print('held', flush=True); time.sleep(30)\n")
+    p = subprocess.Popen([sys.executable, "-c", code, str(sd.root)], stdout=subprocess.PIPE, text=True)
+    try:
+        assert p.stdout.readline().strip() == "held"
+        with pytest.raises(TengsimError, match=rf"in use by another sweep or optimisation \(pid {p.pid}\)"):
+            with sd.lock():
+                pass
+    finally:
+        p.kill()
+        p.wait()
+    with sd.lock():  # its holder is gone: free again
+        pass
+
+
 # ---- 13: messages that keep the cause ------------------------------------------------------------
 def test_c13_negative_quantity_is_a_value_not_a_missing_argument(tmp_path, capsys):
     argv = ["contact", "pyramid", "--pitch", "2um", "--base", "1um", "--height", "0.7um", "--E-star", "-0.59MPa",

@@ -12,7 +12,7 @@
     DIR/log.jsonl             one line per finished or failed point, in completion order
     DIR/study.nc, study.csv   the assembled dataset (tengsim.study.dataset), rebuilt at the end
     DIR/optimum.json          the best point found by ``tengsim optimize``
-    DIR/.lock                 held (flock) by the one sweep or optimisation running in DIR
+    DIR/.lock                 held (a POSIX record lock) by the one sweep or optimisation running in DIR
 
 Both the runner (:mod:`tengsim.study.runner`, :mod:`tengsim.study.optimize`) and the assembler
 (:mod:`tengsim.study.dataset`) read the directory through :class:`StudyDir`; neither imports the other
@@ -25,23 +25,8 @@ import os
 from dataclasses import dataclass
 from pathlib import Path
 
-_HELD: set = set()
-"""The study-folder lock descriptors this process holds (:meth:`StudyDir.lock`)."""
-
-
-def _drop_held_in_child() -> None:
-    """In a child forked while a lock is held (a worker a Dask nanny restarts by fork), close its copies of
-    the lock descriptors: the flock belongs to the open file, so a child that kept a copy would hold the
-    folder after the sweep ended.  Closing a copy (never unlocking it) leaves the parent's lock as it is."""
-    for fd in list(_HELD):
-        try:
-            os.close(fd)
-        except OSError:
-            pass
-    _HELD.clear()
-
-
-os.register_at_fork(after_in_child=_drop_held_in_child)
+_HELD: dict = {}
+"""The study folders this process holds (:meth:`StudyDir.lock`): resolved lock path → descriptor."""
 
 
 @dataclass
@@ -73,29 +58,43 @@ class StudyDir:
 
     @contextlib.contextmanager
     def lock(self, who: str = "sweep"):
-        """Hold ``DIR/.lock`` (an exclusive flock, released by the OS if the process dies) while the block
-        runs; a second sweep or optimisation on the same folder is refused with one TengsimError naming
-        the folder and the holder's pid, instead of computing every point twice."""
+        """Hold ``DIR/.lock`` while the block runs; a second sweep or optimisation on the same folder is
+        refused with one TengsimError naming the folder and the holder's pid, instead of computing every
+        point twice.
+
+        The lock is a POSIX record lock (``lockf``): it belongs to this process, is released by the OS
+        when the process ends, and is *not* inherited by a child forked meanwhile (a worker a Dask nanny
+        restarts) — a flock belongs to the open file and a forked copy kept the folder held after the
+        sweep ended.  Record locks do not exclude the same process, so the folders this process holds are
+        kept in ``_HELD`` and a second lock from within it is refused too."""
         import fcntl
 
         from tengsim.errors import TengsimError
 
         self.root.mkdir(parents=True, exist_ok=True)
         path = self.root / ".lock"
+        key = os.path.realpath(path)
+
+        def refuse(holder):
+            return TengsimError(f"--out {self.root} is in use by another sweep or optimisation (pid {holder}); "
+                                "wait for it to finish, or use another --out")
+
+        if key in _HELD:
+            raise refuse(os.getpid())
         fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o644)
         try:
             try:
-                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+                fcntl.lockf(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
             except OSError:
-                holder = os.pread(fd, 32, 0).decode(errors="replace").strip() or "unknown"
-                raise TengsimError(f"--out {self.root} is in use by another sweep or optimisation (pid {holder}); "
-                                   "wait for it to finish, or use another --out") from None
+                raise refuse(os.pread(fd, 32, 0).decode(errors="replace").strip() or "unknown") from None
             os.ftruncate(fd, 0)
             os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
-            _HELD.add(fd)
-            yield path
+            _HELD[key] = fd
+            try:
+                yield path
+            finally:
+                _HELD.pop(key, None)
         finally:
-            _HELD.discard(fd)
             os.close(fd)  # closing releases the lock
 
     @property
