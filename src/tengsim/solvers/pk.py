@@ -158,6 +158,16 @@ class PKSolver:
                 raise TengsimError(f"{key} must be an integer >= 1, got {v!r}")
 
     @staticmethod
+    def _convolution(kernel, shape):
+        """The convolution the solve calls (the JAX variant's: on its device)."""
+        return Convolution(kernel, shape)
+
+    @staticmethod
+    def _core(*args, **kw):
+        """The contact solve (tengsim.solvers._pk_core.constrained_cg; the JAX variant's: compiled)."""
+        return constrained_cg(*args, **kw)
+
+    @staticmethod
     def solves(law) -> bool:
         """Can this solver solve ``law`` (its hard-wall limit; module doc)?"""
         return supports(law)
@@ -196,7 +206,7 @@ class PKSolver:
                                "use solver 'fast' for a mirror-symmetric cell")
         model = wall_model(problem.law)
         shape = np.shape(problem.g0)
-        conv = Convolution(problem.kernel, shape)
+        conv = self._convolution(problem.kernel, shape)
         pre = preconditioner(problem.kernel, shape) if self.precondition else None
         if model.kind == "md" and self.md_zone == "ramp":
             model = replace(model, ramp=self._ramp(problem.law, conv, shape))
@@ -216,7 +226,7 @@ class PKSolver:
         mon = None if self.monitor is None else (
             lambda it, res: self.monitor(it, res, math.nan) if it % every == 0 else None)
         if model.kind == "wall":
-            core = constrained_cg(conv, h0, np.maximum(q0, 0.0), self.tol, self.max_iter, load, mon, pre)
+            core = self._core(conv, h0, np.maximum(q0, 0.0), self.tol, self.max_iter, load, mon, pre)
             p, Kp, u, c = core.p, core.Kp, core.u, core.c
             its, ok, res, zones = core.iterations, core.converged, core.residual, 0
             msg = "converged" if ok else f"not converged in {self.max_iter} iterations (residual {res:.3g} ε)"
@@ -282,7 +292,7 @@ class PKSolver:
                                    f"is below the cohesive zone's tension {float(pa.mean()):.6g} W/ε")
             # the contact solve to a tolerance the zone's last move allows (inexact early updates)
             tol_in = tol if model.sharp else max(tol, min(1e-2 * last_move, 1e-2))
-            core = constrained_cg(conv, hh, pc, tol_in, self.max_iter, core_load, mon, pre,
+            core = self._core(conv, hh, pc, tol_in, self.max_iter, core_load, mon, pre,
                                   None if core is None else core.Kp)   # K p_c: the last solve's
             its += core.iterations
             pc, u, c = core.p, core.u, core.c
@@ -354,4 +364,35 @@ class _Anderson:
         x += f - (np.stack(self.X, axis=1) + Fm) @ gamma
 
 
+@dataclass(frozen=True)
+class PKJaxSolver(PKSolver):
+    """:class:`PKSolver` with its contact solve (the active set and the CG) compiled with JAX as one loop
+    (tengsim.solvers._pk_jax), float64, on ``device`` ('auto': JAX's default, 'cpu' or 'gpu'); the cohesive
+    zone's updates stay on the host.  The same states as 'pk' to round-off (tests/test_pk_jax.py)."""
+
+    device: str = "auto"
+    name: str = "pk-jax"
+    compiles: ClassVar[bool] = True
+
+    def __post_init__(self):
+        super().__post_init__()
+        from tengsim.solvers.jax_fast import DEVICES, find_device
+
+        if self.device not in DEVICES:
+            raise TengsimError(f"device must be one of {', '.join(DEVICES)}, got {self.device!r}")
+        find_device(self.device)          # the one-line error (no JAX, no GPU) before a run writes anything
+
+    def _convolution(self, kernel, shape):
+        from tengsim.solvers._pk_jax import JaxConvolution
+
+        return JaxConvolution(kernel, shape, self.device)
+
+    @staticmethod
+    def _core(*args, **kw):
+        from tengsim.solvers._pk_jax import constrained_cg as jax_cg
+
+        return jax_cg(*args, **kw)
+
+
+SOLVERS.register("pk-jax", PKJaxSolver, summary="the 'pk' solver's contact solve compiled with JAX (float64)")
 SOLVERS.register("pk", PKSolver, summary="Polonsky–Keer constrained CG: hard wall, Maugis–Dugdale, exponential")
