@@ -34,7 +34,9 @@ solve's K p_c), and one per zone update (K p_a); ``Equilibrium.n_conv`` counts t
 the contact solves' iterations.  The Maugis–Dugdale ramp: the sharp zone's solve first (loosely, to
 ``SHARP_TOL``: it jumps in few updates), then the ramp from it (Anderson-mixed, ``anderson`` differences).
 The returned state is q = P = p, w = K p, H = g0 + w − 1 (load control: g0 moved by the approach's
-correction, :meth:`PKSolver.solve_load`); ``residual`` is the hard-wall residual in ε (the largest
+correction, :meth:`PKSolver.solve_load`), H = 0 exactly where the contact pressure p_c > 0 (the hard wall's gap
+there; g0 + w − 1 is within the residual of it, of either sign, and a measure that asks g <= 1, the charged area
+of a law whose peak tension starts at the wall, must not see that noise); ``residual`` is the hard-wall residual in ε (the largest
 gap over the contact, overlap of the wall, or move of the last zone update).
 """
 from __future__ import annotations
@@ -228,6 +230,7 @@ class PKSolver:
         if model.kind == "wall":
             core = self._core(conv, h0, np.maximum(q0, 0.0), self.tol, self.max_iter, load, mon, pre)
             p, Kp, u, c = core.p, core.Kp, core.u, core.c
+            touching = p > 0
             its, ok, res, zones = core.iterations, core.converged, core.residual, 0
             msg = "converged" if ok else f"not converged in {self.max_iter} iterations (residual {res:.3g} ε)"
         else:
@@ -240,10 +243,11 @@ class PKSolver:
                 spent = (0, 0)
             if out is None:
                 out = self._ramp_after_sharp(model, conv, h0, q0, w0, load, mon, pre)
-            p, Kp, u, c, its, ok, res, zones, msg = out
+            p, Kp, u, c, its, ok, res, zones, msg, touching = out
             its, zones = its + spent[0], zones + spent[1]
         w = Kp
         H = (g0 + c) + w - 1.0
+        H[touching] = 0.0          # on the wall where it presses (the hard wall's u = 0; off by <= tol before)
         E = problem.dA * (0.5 * float(np.dot(p, w)) + model.energy(u))
         eq = Equilibrium(State(p.reshape(shape), w.reshape(shape)), H.reshape(shape), p.reshape(shape).copy(),
                          float(res), bool(ok), int(its), int(conv.count), E, time.perf_counter() - t0,
@@ -266,7 +270,7 @@ class PKSolver:
             out = self._cohesive(replace(model, ramp=0.0), conv, h0, sharp[0], sharp[1], load, mon, pre,
                                  self.max_zone)
             its, zones = its + out[4], zones + out[7]
-            out = out[:8] + (f"{out[8]} (sharp Dugdale zone: the ramp did not settle in {RAMP_UPDATES} updates)",)
+            out = out[:8] + (f"{out[8]} (sharp Dugdale zone: the ramp did not settle in {RAMP_UPDATES} updates)",) + out[9:]
         return out[:4] + (its,) + out[5:7] + (zones,) + out[8:]
 
     def _cohesive(self, model: WallModel, conv, h0, q0, w0, load, mon, pre, limit, tol=None):
@@ -327,7 +331,7 @@ class PKSolver:
             msg = f"contact solve not converged in {self.max_iter} iterations (residual {res:.3g} ε)"
         else:
             msg = f"cohesive zone not settled in {limit} updates (last move {res:.3g} ε)"
-        return p, Kp, u, c, its, ok, res, zones, msg
+        return p, Kp, u, c, its, ok, res, zones, msg, pc > 0
 
 
 class _Anderson:
