@@ -398,5 +398,5 @@ class PKJaxSolver(PKSolver):
         return jax_cg(*args, **kw)
 
 
-SOLVERS.register("pk-jax", PKJaxSolver, summary="the 'pk' solver's contact solve compiled with JAX (float64)")
 SOLVERS.register("pk", PKSolver, summary="Polonsky–Keer constrained CG: hard wall, Maugis–Dugdale, exponential")
+SOLVERS.register("pk-jax", PKJaxSolver, summary="the 'pk' solver's contact solve compiled with JAX (float64)")
