@@ -38,6 +38,7 @@ def main(argv=None):
     ap.add_argument("--mu", type=float, default=1.0)
     ap.add_argument("--cell", type=float, default=16.0)
     ap.add_argument("--solvers", nargs="+", default=["pk", "homotopy"])
+    ap.add_argument("--tol", type=float, default=1e-6, help="every solver's tolerance (ε; default 1e-6)")
     ap.add_argument("--dx-of", nargs="*", default=[], metavar="SOLVER=DX",
                     help="another grid for a solver (compare at equal pull-off accuracy: e.g. homotopy=0.1)")
     args = ap.parse_args(argv)
@@ -51,7 +52,7 @@ def main(argv=None):
     for name in args.solvers:
         grid = shape.grid(dx_of.get(name, args.dx))
         kernel = FreeKernel(grid, args.mu ** 1.5)
-        solver = make_solver(name, tol=1e-6, **({"max_iter": 20000} if not name.startswith("pk") else {}))
+        solver = make_solver(name, tol=args.tol, **({"max_iter": 20000} if not name.startswith("pk") else {}))
         t = time.perf_counter()
         res = run_path(shape.gap(grid), law, kernel, solver, spec)
         dt = time.perf_counter() - t
