@@ -153,7 +153,13 @@ class JaxConvolution:
         self.shape, self.padded, self.periodic = tuple(shape), padded, periodic
         self.dev = find_device(device)
         self.spec = jax.device_put(np.asarray(spec), self.dev)
-        self._conv = jax.jit(lambda x, s: _jax_fft.convolution(self.shape, padded, periodic, jnp.dtype("float64"))(x, s))
+        key = ("conv", self.shape, padded, periodic, str(self.dev))
+        with _LOCK:
+            self._conv = _CACHE.get(key)
+        if self._conv is None:                        # compiled once per grid and device, as the solve
+            self._conv = jax.jit(_jax_fft.convolution(self.shape, padded, periodic, jnp.dtype("float64")))
+            with _LOCK:
+                _CACHE[key] = self._conv
         self.count = 0
 
     def __call__(self, x, out):

@@ -36,8 +36,8 @@ the contact solves' iterations.  The Maugis–Dugdale ramp: the sharp zone's sol
 The returned state is q = P = p, w = K p, H = g0 + w − 1 (load control: g0 moved by the approach's
 correction, :meth:`PKSolver.solve_load`), H = 0 exactly where the contact pressure p_c > 0 (the hard wall's gap
 there; g0 + w − 1 is within the residual of it, of either sign, and a measure that asks g <= 1, the charged area
-of a law whose peak tension starts at the wall, must not see that noise); ``residual`` is the hard-wall residual in ε (the largest
-gap over the contact, overlap of the wall, or move of the last zone update).
+of a law whose peak tension starts at the wall, must not see that noise); ``residual`` is the hard-wall
+residual in ε (the largest gap over the contact, overlap of the wall, or move of the last zone update).
 """
 from __future__ import annotations
 
@@ -270,7 +270,8 @@ class PKSolver:
             out = self._cohesive(replace(model, ramp=0.0), conv, h0, sharp[0], sharp[1], load, mon, pre,
                                  self.max_zone)
             its, zones = its + out[4], zones + out[7]
-            out = out[:8] + (f"{out[8]} (sharp Dugdale zone: the ramp did not settle in {RAMP_UPDATES} updates)",) + out[9:]
+            why = f"{out[8]} (sharp Dugdale zone: the ramp did not settle in {RAMP_UPDATES} updates)"
+            out = out[:8] + (why,) + out[9:]
         return out[:4] + (its,) + out[5:7] + (zones,) + out[8:]
 
     def _cohesive(self, model: WallModel, conv, h0, q0, w0, load, mon, pre, limit, tol=None):
