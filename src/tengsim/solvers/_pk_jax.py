@@ -24,6 +24,7 @@ import threading
 
 import numpy as np
 
+from tengsim import backend
 from tengsim.solvers._pk_core import STALL, CoreResult, Preconditioner
 from tengsim.solvers.jax_fast import _jax, _kernel_form, find_device
 
@@ -180,9 +181,9 @@ class JaxConvolution:
                 _CACHE[key] = fn
         put = lambda a: jax.device_put(np.ascontiguousarray(a, dtype=float), self.dev)  # noqa: E731
         n = h.size
-        mult = precond.mult if precond is not None else np.zeros((1, 1))
+        mult = precond.mult if precond is not None else backend.zeros((1, 1))
         diag = precond.diag if precond is not None else 0.0
-        out = jax.device_get(fn(put(h), put(p), put(Kp0 if Kp0 is not None else np.zeros(n)), Kp0 is not None,
+        out = jax.device_get(fn(put(h), put(p), put(Kp0 if Kp0 is not None else backend.zeros(n)), Kp0 is not None,
                                 self.spec, jax.device_put(np.asarray(mult), self.dev), float(diag), float(tol),
                                 int(max_iter), float(0.0 if load is None else load)))
         self.count += int(out["nc"])
