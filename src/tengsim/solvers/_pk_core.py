@@ -39,6 +39,9 @@ from tengsim.solvers._kernelcall import takes_out
 #: preconditioner (from its best pressure): the |q| preconditioner's steps can cycle on a contact set that
 #: a displacement-controlled cold start has yet to find
 STALL = 40
+#: steps after which K p, carried by the CG's recurrence K p ← K p − τ K t while no pixel is clipped or enters,
+#: is convolved afresh (as it is before any residual is judged)
+RESYNC = 20
 
 
 @dataclass
@@ -128,6 +131,21 @@ def _residual(u, S, work):
     return max(float(work.max()), 0.0) if work.size else 0.0
 
 
+def _gap(h, Kp, p, u, load, c, work):
+    """u = h + K p (+ c under load control) into ``u``; (the direction's set S, its size, c, the residual)."""
+    np.add(h, Kp, out=u)
+    S = p > 0
+    nS = int(np.count_nonzero(S))
+    if load is not None and nS:
+        c = -float(np.sum(u, where=S)) / nS           # the rigid approach's correction
+        u += c
+    res = _residual(u, S, work)
+    if nS == 0:
+        S = u < 0                                     # nothing in contact yet: the overlap enters
+        nS = int(np.count_nonzero(S))
+    return S, nS, c, res
+
+
 def constrained_cg(conv: Convolution, h, p, tol: float, max_iter: int, load: float | None = None,
                    monitor=None, precond=None, Kp0=None) -> CoreResult:
     """Polonsky–Keer's constrained CG (module doc) from the start pressure ``p`` (>= 0, a flat array; the
@@ -147,21 +165,17 @@ def constrained_cg(conv: Convolution, h, p, tol: float, max_iter: int, load: flo
     delta, G_old, c = 0.0, 1.0, 0.0
     res = best = math.inf
     p_best, it_best, stalled = (backend.empty(n) if precond is not None else None), 0, False
+    inc = 0                                           # steps since K p was last convolved (0: K p exact)
     for it in range(max_iter + 1):
         if it == 0 and Kp0 is not None and load is None:
             Kp[:] = Kp0
-        else:
+        elif inc == 0:
             conv(p, Kp)
-        np.add(h, Kp, out=u)
-        S = p > 0
-        nS = int(np.count_nonzero(S))
-        if load is not None and nS:
-            c = -float(np.sum(u, where=S)) / nS       # the rigid approach's correction
-            u += c
-        elif nS == 0:
-            S = u < 0                                 # nothing in contact yet: the overlap enters
-            nS = int(np.count_nonzero(S))
-        res = _residual(u, p > 0, work)
+        S, nS, c, res = _gap(h, Kp, p, u, load, c, work)
+        if inc and (res <= tol or nS == 0 or it == max_iter or inc >= RESYNC):
+            conv(p, Kp)                               # judged on an exact K p only
+            inc = 0
+            S, nS, c, res = _gap(h, Kp, p, u, load, c, work)
         if monitor is not None:
             monitor(it, res)
         if res <= tol or nS == 0 or it == max_iter:
@@ -193,6 +207,7 @@ def constrained_cg(conv: Convolution, h, p, tol: float, max_iter: int, load: flo
             break
         tau = float(np.dot(work, t)) / rt
         p -= tau * t
+        exact = load is None and not bool((p < 0).any())   # no pixel clipped: K p moved by −τ K t exactly
         np.maximum(p, 0.0, out=p)
         left = nS - int(np.count_nonzero(p)) if precond is not None else 0   # pixels the step released
         np.less(u, 0.0, out=S)                        # overlaps out of contact enter (S reused)
@@ -200,7 +215,7 @@ def constrained_cg(conv: Convolution, h, p, tol: float, max_iter: int, load: flo
         if S.any():
             np.multiply(u, S, out=work)
             p -= (tau if precond is None else tau * precond.diag) * work
-            delta = 0.0
+            delta, exact = 0.0, False
         else:                                         # preconditioned: restart where the set shrank too
             delta = 0.0 if left > 0 else 1.0
         if load is not None:
@@ -208,6 +223,11 @@ def constrained_cg(conv: Convolution, h, p, tol: float, max_iter: int, load: flo
             if not m > 0:
                 break
             p *= load / m
+        if exact:                                     # K p by the CG's own recurrence: no convolution
+            Kp -= tau * r
+            inc += 1
+        else:
+            inc = 0
     if stalled:  # no progress in STALL iterations: on from the best pressure without the preconditioner
         p[:] = p_best
         rest = constrained_cg(conv, h, p, tol, max_iter - it, load, monitor, None)

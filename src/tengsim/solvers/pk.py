@@ -34,8 +34,10 @@ solve's K p_c), and one per zone update (K p_a); ``Equilibrium.n_conv`` counts t
 the contact solves' iterations.  The Maugis–Dugdale ramp: the sharp zone's solve first (loosely, to
 ``SHARP_TOL``: it jumps in few updates), then the ramp from it (Anderson-mixed, ``anderson`` differences).
 The returned state is q = P = p, w = K p, H = g0 + w − 1 (load control: g0 moved by the approach's
-correction, :meth:`PKSolver.solve_load`); ``residual`` is the hard-wall residual in ε (the largest
-gap over the contact, overlap of the wall, or move of the last zone update).
+correction, :meth:`PKSolver.solve_load`), H = 0 exactly where the contact pressure p_c > 0 (the hard wall's gap
+there; g0 + w − 1 is within the residual of it, of either sign, and a measure that asks g <= 1, the charged area
+of a law whose peak tension starts at the wall, must not see that noise); ``residual`` is the hard-wall
+residual in ε (the largest gap over the contact, overlap of the wall, or move of the last zone update).
 """
 from __future__ import annotations
 
@@ -158,6 +160,16 @@ class PKSolver:
                 raise TengsimError(f"{key} must be an integer >= 1, got {v!r}")
 
     @staticmethod
+    def _convolution(kernel, shape):
+        """The convolution the solve calls (the JAX variant's: on its device)."""
+        return Convolution(kernel, shape)
+
+    @staticmethod
+    def _core(*args, **kw):
+        """The contact solve (tengsim.solvers._pk_core.constrained_cg; the JAX variant's: compiled)."""
+        return constrained_cg(*args, **kw)
+
+    @staticmethod
     def solves(law) -> bool:
         """Can this solver solve ``law`` (its hard-wall limit; module doc)?"""
         return supports(law)
@@ -196,7 +208,7 @@ class PKSolver:
                                "use solver 'fast' for a mirror-symmetric cell")
         model = wall_model(problem.law)
         shape = np.shape(problem.g0)
-        conv = Convolution(problem.kernel, shape)
+        conv = self._convolution(problem.kernel, shape)
         pre = preconditioner(problem.kernel, shape) if self.precondition else None
         if model.kind == "md" and self.md_zone == "ramp":
             model = replace(model, ramp=self._ramp(problem.law, conv, shape))
@@ -216,8 +228,9 @@ class PKSolver:
         mon = None if self.monitor is None else (
             lambda it, res: self.monitor(it, res, math.nan) if it % every == 0 else None)
         if model.kind == "wall":
-            core = constrained_cg(conv, h0, np.maximum(q0, 0.0), self.tol, self.max_iter, load, mon, pre)
+            core = self._core(conv, h0, np.maximum(q0, 0.0), self.tol, self.max_iter, load, mon, pre)
             p, Kp, u, c = core.p, core.Kp, core.u, core.c
+            touching = p > 0
             its, ok, res, zones = core.iterations, core.converged, core.residual, 0
             msg = "converged" if ok else f"not converged in {self.max_iter} iterations (residual {res:.3g} ε)"
         else:
@@ -230,10 +243,11 @@ class PKSolver:
                 spent = (0, 0)
             if out is None:
                 out = self._ramp_after_sharp(model, conv, h0, q0, w0, load, mon, pre)
-            p, Kp, u, c, its, ok, res, zones, msg = out
+            p, Kp, u, c, its, ok, res, zones, msg, touching = out
             its, zones = its + spent[0], zones + spent[1]
         w = Kp
         H = (g0 + c) + w - 1.0
+        H[touching] = 0.0          # on the wall where it presses (the hard wall's u = 0; off by <= tol before)
         E = problem.dA * (0.5 * float(np.dot(p, w)) + model.energy(u))
         eq = Equilibrium(State(p.reshape(shape), w.reshape(shape)), H.reshape(shape), p.reshape(shape).copy(),
                          float(res), bool(ok), int(its), int(conv.count), E, time.perf_counter() - t0,
@@ -256,7 +270,8 @@ class PKSolver:
             out = self._cohesive(replace(model, ramp=0.0), conv, h0, sharp[0], sharp[1], load, mon, pre,
                                  self.max_zone)
             its, zones = its + out[4], zones + out[7]
-            out = out[:8] + (f"{out[8]} (sharp Dugdale zone: the ramp did not settle in {RAMP_UPDATES} updates)",)
+            why = f"{out[8]} (sharp Dugdale zone: the ramp did not settle in {RAMP_UPDATES} updates)"
+            out = out[:8] + (why,) + out[9:]
         return out[:4] + (its,) + out[5:7] + (zones,) + out[8:]
 
     def _cohesive(self, model: WallModel, conv, h0, q0, w0, load, mon, pre, limit, tol=None):
@@ -282,7 +297,7 @@ class PKSolver:
                                    f"is below the cohesive zone's tension {float(pa.mean()):.6g} W/ε")
             # the contact solve to a tolerance the zone's last move allows (inexact early updates)
             tol_in = tol if model.sharp else max(tol, min(1e-2 * last_move, 1e-2))
-            core = constrained_cg(conv, hh, pc, tol_in, self.max_iter, core_load, mon, pre,
+            core = self._core(conv, hh, pc, tol_in, self.max_iter, core_load, mon, pre,
                                   None if core is None else core.Kp)   # K p_c: the last solve's
             its += core.iterations
             pc, u, c = core.p, core.u, core.c
@@ -317,7 +332,7 @@ class PKSolver:
             msg = f"contact solve not converged in {self.max_iter} iterations (residual {res:.3g} ε)"
         else:
             msg = f"cohesive zone not settled in {limit} updates (last move {res:.3g} ε)"
-        return p, Kp, u, c, its, ok, res, zones, msg
+        return p, Kp, u, c, its, ok, res, zones, msg, pc > 0
 
 
 class _Anderson:
@@ -354,4 +369,35 @@ class _Anderson:
         x += f - (np.stack(self.X, axis=1) + Fm) @ gamma
 
 
+@dataclass(frozen=True)
+class PKJaxSolver(PKSolver):
+    """:class:`PKSolver` with its contact solve (the active set and the CG) compiled with JAX as one loop
+    (tengsim.solvers._pk_jax), float64, on ``device`` ('auto': JAX's default, 'cpu' or 'gpu'); the cohesive
+    zone's updates stay on the host.  The same states as 'pk' to round-off (tests/test_pk_jax.py)."""
+
+    device: str = "auto"
+    name: str = "pk-jax"
+    compiles: ClassVar[bool] = True
+
+    def __post_init__(self):
+        super().__post_init__()
+        from tengsim.solvers.jax_fast import DEVICES, find_device
+
+        if self.device not in DEVICES:
+            raise TengsimError(f"device must be one of {', '.join(DEVICES)}, got {self.device!r}")
+        find_device(self.device)          # the one-line error (no JAX, no GPU) before a run writes anything
+
+    def _convolution(self, kernel, shape):
+        from tengsim.solvers._pk_jax import JaxConvolution
+
+        return JaxConvolution(kernel, shape, self.device)
+
+    @staticmethod
+    def _core(*args, **kw):
+        from tengsim.solvers._pk_jax import constrained_cg as jax_cg
+
+        return jax_cg(*args, **kw)
+
+
 SOLVERS.register("pk", PKSolver, summary="Polonsky–Keer constrained CG: hard wall, Maugis–Dugdale, exponential")
+SOLVERS.register("pk-jax", PKJaxSolver, summary="the 'pk' solver's contact solve compiled with JAX (float64)")

@@ -1,0 +1,86 @@
+"""The 'pk' solver's contact solve compiled with JAX ('pk-jax', tengsim.solvers._pk_jax) against the NumPy one
+('pk'), on JAX's CPU backend in float64: the same pressures, forces and gaps to round-off (never iteration
+counts), for the hard wall (displacement and load control, free and periodic kernels) and a Maugis–Dugdale
+sphere (the cohesive zone's updates on the host around the compiled solve)."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+pytest.importorskip("jax")
+
+from tengsim.errors import TengsimError  # noqa: E402
+from tengsim.grid import Grid  # noqa: E402
+from tengsim.kernels import FreeKernel, PeriodicKernel  # noqa: E402
+from tengsim.laws import MaugisDugdale, Repulsive  # noqa: E402
+from tengsim.shapes import Paraboloid  # noqa: E402
+from tengsim.solvers import Problem, State, make_solver  # noqa: E402
+from tengsim.solvers.pk import PKJaxSolver, PKSolver  # noqa: E402
+
+import tengsim.plugins  # noqa: E402,F401  (registers 'pk-jax')
+
+
+def _sphere(dx=0.3):
+    shape = Paraboloid(1.0, 9.0)
+    grid = shape.grid(dx)
+    return grid, shape.gap(grid)
+
+
+def _rough(n=32):
+    rng = np.random.default_rng(5)
+    k = np.fft.fftfreq(n, 1.0 / n)
+    kk = np.hypot(*np.meshgrid(k, k, indexing="ij"))
+    c = np.where((kk >= 2) & (kk <= n / 4), np.maximum(kk, 1e-9) ** -1.8, 0.0) * np.exp(2j * np.pi * rng.random((n, n)))
+    h = np.real(np.fft.ifft2(c))
+    h *= 30.0 / h.std()
+    grid = Grid(n, n, 1.0, 1.0)
+    return grid, h.max() - h - 70.0 + 1.0, PeriodicKernel(grid, 3.0)
+
+
+def _same(a, b, rel=1e-9):
+    """Pressures to ``rel`` of the peak, the force and the gap over the cell to ``rel``."""
+    assert a.converged and b.converged, (a.message, b.message)
+    scale = np.abs(a.P).max()
+    assert np.abs(a.P - b.P).max() <= rel * scale
+    assert b.P.sum() == pytest.approx(a.P.sum(), rel=rel)
+    assert np.abs(a.H - b.H).max() <= rel * max(1.0, np.abs(a.H).max())
+
+
+def test_registered_and_refuses_a_bad_device():
+    assert isinstance(make_solver("pk-jax", tol=1e-6, device="cpu"), PKJaxSolver)
+    with pytest.raises(TengsimError, match="device"):
+        PKJaxSolver(device="tpu")
+
+
+@pytest.mark.parametrize("load", [None, 0.05])
+def test_hertz_equals_numpy(load):
+    grid, U0 = _sphere()
+    pr = Problem(U0 - 3.0 + 1.0, Repulsive(), FreeKernel(grid, 1.0))
+    if load is None:
+        a = PKSolver(1e-9).solve(pr, State.zero(U0.shape))
+        b = PKJaxSolver(1e-9, device="cpu").solve(pr, State.zero(U0.shape))
+    else:
+        (a, da), (b, db) = (s.solve_load(pr, load) for s in (PKSolver(1e-9), PKJaxSolver(1e-9, device="cpu")))
+        assert db == pytest.approx(da, abs=1e-9)
+        assert b.P.mean() == pytest.approx(load, rel=1e-12)
+    _same(a, b)
+    assert (b.P > 0).sum() > 10           # a contact of many pixels, not a trivial case
+
+
+def test_rough_hard_wall_equals_numpy():
+    grid, g0, K = _rough()
+    pr = Problem(g0, Repulsive(), K)
+    a = PKSolver(1e-9).solve(pr, State.zero(g0.shape))
+    b = PKJaxSolver(1e-9, device="cpu").solve(pr, State.zero(g0.shape))
+    _same(a, b, rel=1e-8)
+    assert 0.01 < np.mean(b.P > 0) < 0.5
+    assert b.H.min() > -1e-8
+
+
+def test_maugis_dugdale_sphere_equals_numpy():
+    grid, U0 = _sphere()
+    pr = Problem(U0, MaugisDugdale(), FreeKernel(grid, 1.0))
+    a = PKSolver(1e-8).solve(pr, State.zero(U0.shape))
+    b = PKJaxSolver(1e-8, device="cpu").solve(pr, State.zero(U0.shape))
+    _same(a, b, rel=1e-8)
+    assert b.P.min() < 0 < b.P.max()      # tension in the zone, compression in the contact
