@@ -1,6 +1,8 @@
 """Fixtures shared by test modules."""
 import pytest
 
+import tengsim.plugins  # noqa: F401,E402  (the built-ins registered in their own order before any test imports one alone)
+
 
 def solver_or_skip(name: str, **kw):
     """The registered solver ``name`` (tengsim.registry.SOLVERS) made with ``kw``, or the test skipped with

@@ -9,6 +9,7 @@ import pytest
 
 pytest.importorskip("jax")
 
+import tengsim.plugins  # noqa: E402,F401  (every built-in, in the registry's order, before pk is imported alone)
 from tengsim.errors import TengsimError  # noqa: E402
 from tengsim.grid import Grid  # noqa: E402
 from tengsim.kernels import FreeKernel, PeriodicKernel  # noqa: E402
@@ -17,7 +18,6 @@ from tengsim.shapes import Paraboloid  # noqa: E402
 from tengsim.solvers import Problem, State, make_solver  # noqa: E402
 from tengsim.solvers.pk import PKJaxSolver, PKSolver  # noqa: E402
 
-import tengsim.plugins  # noqa: E402,F401  (registers 'pk-jax')
 
 
 def _sphere(dx=0.3):
