@@ -192,8 +192,8 @@ def test_first_grid_is_the_default_refinements_first_fine_enough_one():
     for the issue's pyramid)."""
     from tengsim import status
     from tengsim.run.plan import plan_contact
-    from tengsim.design.run import START_ZONE_PIXELS, refinement_grids, start_dx
-    from tengsim.run.resolve import default_dx
+    from tengsim.design.walk import START_ZONE_PIXELS, start_dx
+    from tengsim.run.grids import default_dx, refinement_grids
 
     from tengsim.cli.design import _read_toml
     from pathlib import Path
@@ -217,7 +217,7 @@ def test_maps_kept_during_the_finest_walk(small):
     asked pressures: each map's nominal pressure is the one the finest grid's own depth for that pressure gives
     (what a second walk kept, :func:`tengsim.design.run.map_depths`; after a snap, the state the load reaches)
     to within 2 % of p_max."""
-    from tengsim.design.run import map_depths
+    from tengsim.design.walk import map_depths
 
     res = small.finest
     assert small.maps is res
@@ -325,7 +325,8 @@ def test_budget_cap_lies_between_plain_grids():
 
     from tengsim.cli.design import _read_toml
     from tengsim.run.plan import plan_contact
-    from tengsim.design.run import budget_pixels, height_eps, run_cost, start_dx
+    from tengsim.design.estimate import budget_pixels, run_cost
+    from tengsim.design.walk import height_eps, start_dx
 
     plan = plan_design(_read_toml(str(Path(__file__).parent.parent / "examples" / "own_design" / "pyramid.toml")))
     cp = plan_contact(plan.contact_table)

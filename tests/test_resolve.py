@@ -333,7 +333,7 @@ def test_finer_grids_keep_a_shapes_edges_where_they_fell_in_the_first_grids_pixe
     45², 65², 105², 165², 245², the edge a quarter pixel past a pixel centre on each.  A shape without edges
     (paraboloid), an edge no grid in reach can keep, and the pixel cap get the plain grid."""
     from tengsim.grid import Grid
-    from tengsim.run.resolve import FACTOR, PHASE_TOL, _aligned, edge_phases
+    from tengsim.run.grids import FACTOR, PHASE_TOL, aligned, edge_phases
     from tengsim.shapes import Cone, Cube, Hemisphere, Paraboloid, Pyramid
 
     pyr = Pyramid(N=10.0, cell=40.0)
@@ -345,7 +345,7 @@ def test_finer_grids_keep_a_shapes_edges_where_they_fell_in_the_first_grids_pixe
     for _ in range(4):
         gp = pyr.grid(gp.dx / FACTOR)
         plain.append(gp.nx)
-        gk = _aligned(pyr, pyr.grid(gk.dx / FACTOR), phases, 10**8)
+        gk = aligned(pyr, pyr.grid(gk.dx / FACTOR), phases, 10**8)
         kept.append(gk.nx)
         assert isinstance(gk, Grid) and gk.nx * gk.dx == pytest.approx(40.0, rel=1e-12)
         assert min(abs(edge_phases(pyr, gk)[0] - 0.25), 1 - abs(edge_phases(pyr, gk)[0] - 0.25)) <= PHASE_TOL
@@ -358,9 +358,9 @@ def test_finer_grids_keep_a_shapes_edges_where_they_fell_in_the_first_grids_pixe
     assert Cube(half_width=1.5, height=5.0, cell=6.0).edge_offsets() == (1.5,)
     sph = Paraboloid(1.0, 16.0)
     g1 = sph.grid(16.0 / 45)
-    assert edge_phases(sph, g1) == () and _aligned(sph, sph.grid(g1.dx / FACTOR), (), 10**8).nx == 65
+    assert edge_phases(sph, g1) == () and aligned(sph, sph.grid(g1.dx / FACTOR), (), 10**8).nx == 65
     # the cap: no kept grid above max_pixels, so the plain one
-    assert _aligned(pyr, pyr.grid(40.0 / 99), phases, 100 * 100).nx == 99
+    assert aligned(pyr, pyr.grid(40.0 / 99), phases, 100 * 100).nx == 99
 
 
 def test_a_refinement_records_its_edge_phases():
