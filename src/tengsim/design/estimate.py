@@ -26,10 +26,12 @@ each finer one to a little past where the grid before reached p_max; docs/benchm
 ITERATIONS_PER_COARSE = 4.0
 """A refinement grid's solver iterations per path row over the coarse pre-run's mean (:func:`find_d_max`;
 docs/benchmarks.md, "Design estimates")."""
-THIRD_GRID_SHARE = 0.5
-"""The expected run counts the third grid at this weight: some designs converge on two grids, others need a third
-(docs/benchmarks.md, "Design estimates")."""
-LEVELS_ESTIMATED = 3
+LEVELS_ESTIMATED = 4
+"""Grids of the refinement the expected run counts: most designs converge on their fourth grid, some on their
+second (docs/benchmarks.md, "Design estimates")."""
+LAST_GRID_SHARE = 0.5
+"""The weight of the last grid counted (:data:`LEVELS_ESTIMATED`) in the expected run: designs that converge
+earlier do not walk it (docs/benchmarks.md, "Design estimates")."""
 
 
 def _blocks(shape, grid) -> int:
@@ -82,6 +84,8 @@ class Estimate:
     d_max: float
     backend: str = ""
     cost: Cost | None = None
+    least: float = 0.0
+    """Seconds of the first two grids alone (a design that converges on its second grid)."""
 
     def lines(self) -> list:
         from tengsim.design.units import bytes_text, length_text, time_text
@@ -91,25 +95,40 @@ class Estimate:
                 if self.cost else "")
         return [f"grids: {g} (refined by √2 until converged; the last two are used only if needed)",
                 f"memory: {bytes_text(self.memory_bytes)} on the finest; expected time: {time_text(self.seconds)} "
-                f"(the first two grids and half the third, D path to about {self.d_max:.0f} ε{rows}) on "
-                f"{self.backend}"]
+                f"(the first three grids and half the fourth; {time_text(self.least)} if it converges on the "
+                f"second; D path to about {self.d_max:.0f} ε{rows}) on {self.backend}"]
 
 def estimate(plan, cplan, dx: float, d_max: float, coarse=None) -> Estimate:
-    """Grids, memory and expected time of the refinement (module doc): the first two grids and
-    :data:`THIRD_GRID_SHARE` of the third, at the cost :func:`run_cost` of the backend the plan solves on."""
+    """Grids, memory and expected time of the refinement (module doc): the first :data:`LEVELS_ESTIMATED` grids,
+    the last at :data:`LAST_GRID_SHARE`, at the cost :func:`run_cost` of the backend the plan solves on."""
     from tengsim.resources import estimate_bytes
     from tengsim.run.grids import refinement_grids
 
     cost = run_cost(cplan, d_max, coarse)
-    grids, secs = [], 0.0
+    grids, secs, least = [], 0.0, 0.0
     for k, g in enumerate(refinement_grids(cplan.shape, dx, LEVELS_ESTIMATED)):  # the grids the refinement walks
         if plan.max_pixels is not None and g.nx * g.ny > plan.max_pixels and grids:
             break
         grids.append((g.nx, g.ny, g.dx * cplan.scaling.lateral))
-        secs += cost.grid_seconds(cplan.shape, g) * (THIRD_GRID_SHARE if k >= 2 else 1.0)
+        step = cost.grid_seconds(cplan.shape, g)
+        secs += step * (LAST_GRID_SHARE if k == LEVELS_ESTIMATED - 1 else 1.0)
+        least += step if k < 2 else 0.0
     nx, ny, _ = grids[-1]
     return Estimate(tuple(grids), estimate_bytes(nx, ny, cplan.boundary, cplan.solver), secs, d_max,
-                    cost.model.backend, cost)
+                    cost.model.backend, cost, least)
+
+
+def next_grid_line(shape, grids, seconds: float, lateral: float) -> str:
+    """The progress line after a finished grid (the last of ``grids``, the refinement's sequence so far plus the
+    next): its measured time and the next grid's, scaled from it by the pixels (a grid's time goes as its pixels),
+    which the refinement walks if the last two grids have not converged."""
+    from tengsim.design.units import length_text, time_text
+
+    done, nxt = grids[-2], grids[-1]
+    scale = (nxt.nx * nxt.ny) / (done.nx * done.ny)
+    return (f"grid {len(grids) - 1} ({done.nx}×{done.ny}, dx {length_text(done.dx * lateral)}) took "
+            f"{time_text(seconds)}; the next ({nxt.nx}×{nxt.ny}), if not converged yet: about "
+            f"{time_text(seconds * scale)}")
 
 
 def budget_pixels(plan, cplan, dx: float, d_max: float, coarse=None) -> int:

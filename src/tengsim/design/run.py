@@ -28,15 +28,12 @@ from dataclasses import dataclass, field
 
 from tengsim.design.estimate import (BudgetSpent, budget_pixels, cap_line, check_budget, deadline,  # noqa: F401
                                      estimate, run_cost)
+from tengsim.design.plan import PK_LAWS, SOLVER_TOL_PER_TOL, solver_tol  # noqa: F401
 from tengsim.design.keep import checkpoint, identity, kept_path
 from tengsim.design.walk import (D_MIN, D_STEP, _observer, _reach, _say, _simulate, _watcher,  # noqa: F401
                                  find_d_max, grid_path, height_eps, maps_asked, start_dx)
 from tengsim.errors import TengsimError
-from tengsim.run.grids import refinement_grids  # noqa: F401
-
-SOLVER_TOL_PER_TOL = 0.01
-"""Each equilibrium of a design is solved to max|r| <= this × the design's tol (ε; 1e-4 at the default 1 %): the
-solver's share of a reported number is then far below tol (docs/validation.md, "A design's solver tolerance")."""
+from tengsim.run.grids import refinement_grids
 
 
 @dataclass(frozen=True)
@@ -59,7 +56,7 @@ class DesignResult:
     def status(self) -> str:
         return str(self.summary["status"])
 
-def preflight(plan) -> None:
+def preflight(plan, progress=None):
     """Every bound of a design checked from its sizes alone, before any array is allocated or anything is
     written: the first grid fits the cell (in the user's units), is within ``max_pixels`` and the memory, and
     its shortest path (D to 2 ε: no structure at all) fits the budget.  The full estimate, with the structure's
@@ -68,12 +65,11 @@ def preflight(plan) -> None:
     from tengsim.design.units import length_text, time_text
     from tengsim.errors import GeometryError
     from tengsim.resources import check_memory
-    from tengsim.run.plan import _metres, as_plan
+    from tengsim.run.plan import _metres
     from tengsim.solvers import make_solver
 
-    cplan = as_plan(plan.contact_table if plan.contact_plan is None else plan.contact_plan)
-    cplan = choose_solver(plan, cplan)  # the solver the run will use (a cohesive law: pk)
-    solver = make_solver(cplan.solver, tol=solver_tol(plan))  # a solver this machine lacks (gpu): refused now
+    cplan = choose_solver(plan, plan.contact_plan, progress)  # the plan the run will use
+    solver = make_solver(cplan.solver, tol=cplan.tol)  # a solver this machine lacks (gpu): refused now
     if hasattr(solver, "solves") and not solver.solves(cplan.law):  # a law it cannot solve: refused now
         from tengsim.solvers.pk import PKSolver, wall_model
 
@@ -100,32 +96,39 @@ def preflight(plan) -> None:
         raise TengsimError(f"{plan.name[:80]}: {first} alone is estimated at {time_text(secs)}, over the budget "
                            f"of {time_text(plan.budget_s)}: give a coarser --dx, a coarser --tol (now "
                            f"{plan.tol:g}) or a larger --budget")
-
-#: laws a design runs on the constrained solver 'pk' (their hard-wall limit) unless it names its solver
-PK_LAWS = ("MaugisDugdale", "Exponential")
+    return cplan
 
 
 def choose_solver(plan, cplan, progress=None):
-    """The contact plan a design runs: a cohesive law with a wall (``md``, ``exp``) on the constrained solver
-    'pk' (tengsim.solvers.pk) unless the design's table names a solver; said in one line."""
-    table = plan.contact_table if isinstance(plan.contact_table, dict) else {}
-    if table.get("solver") in (None, "", "auto") and type(cplan.law).__name__ in PK_LAWS:
-        cplan = dataclasses.replace(cplan, solver="pk", solver_note="")
+    """The contact plan a design runs: :func:`tengsim.design.plan.plan_design` put a cohesive law with a wall
+    (``md``, ``exp``) on the constrained solver 'pk' (tengsim.solvers.pk) unless the design names its solver;
+    said here in one line."""
+    if not plan.solver_given and type(cplan.law).__name__ in PK_LAWS and cplan.solver == "pk":
         _say(progress, "solver: pk (Polonsky–Keer constrained CG with a cohesive zone: the law's hard-wall "
                        "limit; give solver = 'fast' or 'homotopy' for the penalty wall)")
     return cplan
 
 
-def solver_tol(plan) -> float:
-    """The solver's tolerance of a design (:data:`SOLVER_TOL_PER_TOL`)."""
-    return SOLVER_TOL_PER_TOL * plan.tol
+def _grid_done(progress, cplan, dx, save):
+    """The refinement's call after each finished grid: the grid kept (``save``, or None) and a line with its
+    measured time and the next grid's expected one (:func:`tengsim.design.estimate.next_grid_line`)."""
+    from tengsim.design.estimate import next_grid_line
+
+    def done(levels, phases, res):
+        if save is not None:
+            save(levels, phases, res)
+        grids = refinement_grids(cplan.shape, dx, len(levels) + 1)
+        _say(progress, next_grid_line(cplan.shape, grids, levels[-1]["seconds"], cplan.scaling.lateral))
+
+    return done
+
 
 def run_design(plan, progress=None, keep=None) -> DesignResult:
     """Run one design (module doc).  ``progress``: a :class:`tengsim.progress.Progress`-like callable (the
     path's progress) and/or an object with ``say(text)``, which gets the lines said before and during the run
     (the Tabor number, the solver, the grids, memory and expected time).  ``keep`` (a file path, or None): where each
     finished grid is kept (:func:`tengsim.design.keep.checkpoint`), so a killed run of the same design resumes from it."""
-    from tengsim.run.plan import ResolveSettings, as_plan
+    from tengsim.run.plan import ResolveSettings
     from tengsim.design.curves import summarize
     from tengsim.design.write import to_dataset
     from tengsim.continuation import PathSpec
@@ -134,10 +137,7 @@ def run_design(plan, progress=None, keep=None) -> DesignResult:
     import time
 
     started = time.monotonic()
-    preflight(plan)
-    cplan = dataclasses.replace(as_plan(plan.contact_table if plan.contact_plan is None else plan.contact_plan),
-                                tol=solver_tol(plan))  # the plan plan_design built (planned once)
-    cplan = choose_solver(plan, cplan, progress)
+    cplan = preflight(plan, progress)  # the plan plan_design built, with the design's solver and tolerance
     dx = start_dx(plan, cplan)
     _say(progress, f"{plan.name}: Tabor number {cplan.tabor:.3g} (from eps = {plan.eps * 1e9:.3g} nm), "
                    f"lateral unit {cplan.scaling.lateral * 1e9:.3g} nm")
@@ -157,13 +157,13 @@ def run_design(plan, progress=None, keep=None) -> DesignResult:
     _say(progress, cap_line(plan, cplan, dx, d_max, max_pixels, coarse))
     res = None
     for attempt in range(2):
-        path = PathSpec(D_MIN, d_max, D_STEP, adaptive=True)
         ck, found = checkpoint(keep, base, d_max, progress) or (None, None)
+        path = PathSpec(D_MIN, d_max, D_STEP, adaptive=True)
         res = resolve_plan(dataclasses.replace(cplan, path=path, resolve=ResolveSettings(plan.tol, max_pixels, dx)),
                            observe=_observer(plan), watch=_watcher(plan),
                            path_for=grid_path(plan, d_max, cut=attempt == 0),
                            progress=deadline(progress, plan, keep, started),
-                           checkpoint=None if ck is None else ck.save, start=found)
+                           checkpoint=_grid_done(progress, cplan, dx, None if ck is None else ck.save), start=found)
         if res.scaling is None:  # every grid taken back from the checkpoint file, which keeps the columns only
             res = dataclasses.replace(res, scaling=cplan.scaling)
         ok, D_hit, top, slope = _reach(res, plan.pressures[-1])

@@ -50,13 +50,14 @@ def height_eps(cplan, dx) -> float:
     return float(np.nanmax(U0) - np.nanmin(U0))
 
 def _simulate(cplan, dx, d_max, **kw):
-    from tengsim.run.simulate import simulate
+    """``cplan`` on the grid of spacing ``dx``, walked from D_MIN to ``d_max``."""
+    import dataclasses
+
     from tengsim.continuation import PathSpec
+    from tengsim.run.simulate import simulate_plan
 
     path = PathSpec(D_MIN, d_max, D_STEP, adaptive=True)
-    return simulate(cplan.shape, cplan.tabor, dx, path, boundary=cplan.boundary, solver=cplan.solver,
-                    tol=cplan.tol, law=cplan.law, extra_params=cplan.extra, scaling=cplan.scaling,
-                    kernel_params=cplan.kernel_params, symmetry=cplan.symmetry, **kw)
+    return simulate_plan(dataclasses.replace(cplan, dx=dx, grid=None, path=path), **kw)
 
 
 def _reach(res, p_max):
