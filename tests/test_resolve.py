@@ -78,7 +78,7 @@ def test_cheap_refinement_reaches_ok(refined):
         r = p["richardson"][name]
         assert r["rel_error"] <= 0.01 and r["change"] <= 0.01, name
     # the curves are exactly those of a plain run on the finest grid
-    from tengsim.run.simulate import run_contact
+    from tengsim.run.simulate import run_grid as run_contact
 
     plain = run_contact({k: v for k, v in PYR_CFG.items() if k != "resolve"} | {"dx": grids[-1]})
     np.testing.assert_allclose(res.table["F"], plain.table["F"], rtol=0, atol=1e-9)
@@ -167,8 +167,8 @@ BASE = ["contact", "pyramid", "--N", "0.946", "--cell", "3.78", "--d-min", "-1",
 @pytest.mark.parametrize("extra, words", [
     (["--resolve-tol", "0.02"], "resolve_tol applies only with resolve = 'auto'"),
     (["--max-pixels", "100"], "max_pixels applies only with resolve = 'auto'"),
-    (["--resolve", "auto", "--resolve-tol", "0"], "resolve_tol must be > 0 and < 1, got 0"),
-    (["--resolve", "auto", "--resolve-tol", "1"], "resolve_tol must be > 0 and < 1, got 1"),
+    (["--resolve", "auto", "--resolve-tol", "0"], "resolve_tol must be > 0 and < 0.5, got 0"),
+    (["--resolve", "auto", "--resolve-tol", "1"], "resolve_tol must be > 0 and < 0.5, got 1"),
     (["--resolve", "auto", "--resolve-tol", "x"], "resolve_tol"),
     (["--resolve", "auto", "--max-pixels", "4"], "max_pixels must be >= 9"),
     (["--resolve", "auto", "--max-pixels", "10.5"], "max_pixels must be an integer"),
@@ -184,7 +184,7 @@ def test_bad_values_are_refused_with_one_line(tmp_path, capsys, extra, words):
 
 
 def test_one_grid_run_contact_refuses_resolve_auto():
-    from tengsim.run.simulate import run_contact
+    from tengsim.run.simulate import run_grid as run_contact
 
     with pytest.raises(TengsimError, match="tengsim.run.resolve.run_contact"):
         run_contact({**PYR_CFG, "d_max": 0.0})

@@ -11,7 +11,7 @@ a run past its budget is stopped between two rows (:func:`deadline`, :class:`Bud
 """
 from __future__ import annotations
 
-import math
+import itertools
 from dataclasses import dataclass
 
 import numpy as np
@@ -132,38 +132,34 @@ def next_grid_line(shape, grids, seconds: float, lateral: float) -> str:
 
 
 def budget_pixels(plan, cplan, dx: float, d_max: float, coarse=None) -> int:
-    """The largest grid (nx·ny) the refinement may reach within the plan's time budget (the cost summed
-    over the grids dx, dx/√2, ... up to it): the default max_pixels, so no default run runs past its budget."""
+    """The largest grid (nx·ny) the refinement may reach within the plan's time budget: the last of the grids it
+    walks (:func:`tengsim.run.grids.refinement_grids`) whose cost summed with the grids before it fits the budget
+    (at least the first grid); the default max_pixels, so no default run runs past its budget."""
+    from tengsim.run.grids import grid_sequence
+
     cost = run_cost(cplan, d_max, coarse)
-    secs, top = 0.0, 9
-    for k in range(12):
-        g = cplan.shape.grid(dx / math.sqrt(2.0) ** k)
-        step = cost.grid_seconds(cplan.shape, g)
-        if secs + step > plan.budget_s and k > 0:  # the grid between the last that fits and this one that the
-            # budget still pays for (a grid's time goes as its pixels): the refinement's grids keep a shape's
-            # edges in place and so are up to resolve.PHASE_SPAN larger than the plain √2 sequence
-            return max(top, int(g.nx * g.ny * (plan.budget_s - secs) / step))
-        secs += step
+    secs, top = 0.0, None
+    for g in itertools.islice(grid_sequence(cplan.shape, dx), 12):
+        secs += cost.grid_seconds(cplan.shape, g)
+        if secs > plan.budget_s and top is not None:
+            break
         top = g.nx * g.ny
     return top
 
 
 def cap_line(plan, cplan, dx: float, d_max: float, cap: int, coarse=None) -> str:
-    """The worst case: the grids dx, dx/√2, ... up to ``cap`` pixels, and their summed cost."""
+    """The worst case: the refinement's grids up to ``cap`` pixels, and their summed cost."""
     from tengsim.design.units import time_text
+    from tengsim.run.grids import grid_sequence
 
     cost = run_cost(cplan, d_max, coarse)
     secs, last = 0.0, None
-    for k in range(16):
-        g = cplan.shape.grid(dx / math.sqrt(2.0) ** k)
+    for g in itertools.islice(grid_sequence(cplan.shape, dx), 12):
         if g.nx * g.ny > cap and last is not None:
             break
         secs += cost.grid_seconds(cplan.shape, g)
         last = g
-    side = max(last.nx, math.isqrt(int(cap)))
-    if side > last.nx:  # one more grid, beyond the plain sequence's last (budget_pixels): its time as its pixels
-        secs += cost.grid_seconds(cplan.shape, last) * side * side / (last.nx * last.ny)
-    return (f"at most: refinement up to {side}×{side} (the budget's largest grid; --max-pixels sets it), "
+    return (f"at most: refinement up to {last.nx}×{last.ny} (the budget's largest grid; --max-pixels sets it), "
             f"about {time_text(secs)} in all")
 
 

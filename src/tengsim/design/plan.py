@@ -58,6 +58,7 @@ CONTROLLED = ("tabor", "dx", "d_min", "d_max", "d_step", "refine_levels", "maps_
 
 def design_fields() -> list:
     """The design's own keys (besides the [contact] keys of its shape)."""
+    from tengsim.run.tolerance import DEFAULT_TOL
     from tengsim.schema import Field
 
     return [
@@ -76,7 +77,7 @@ def design_fields() -> list:
               "paper's 400 µm)"),
         Field("gap", default=PAPER_DEVICE["gap"], dim="length",
               help="the device's rest gap d0 for Eq. (17) (default the paper's 0.1 mm)"),
-        Field("tol", default=0.01, help="relative tolerance the reported numbers are converged to (default "
+        Field("tol", default=DEFAULT_TOL, help="relative tolerance the reported numbers are converged to (default "
               "0.01 = 1 %)"),
         Field("dx", default=None, dim="length", help="first grid spacing, a length such as '50nm' (default: "
               "from the shape's features and the law's process zone)"),
@@ -243,9 +244,12 @@ def plan_design(table: dict, where: str = "") -> DesignPlan:
         lo_k, hi_k, text = DEVICE_BOUNDS[k]
         if not lo_k <= own[k] <= hi_k:
             raise ConfigValueError(f"{where}{k} = {shown(table.get(k))} is outside {text}")
+    from tengsim.run.tolerance import MAX_TOL
+
     tol = own["tol"]
-    if not 0 < tol < 0.5:
-        raise ConfigValueError(f"{where}tol must be a fraction > 0 and < 0.5 (0.01 = 1 %), got {table.get('tol')!r}")
+    if isinstance(tol, bool) or not 0 < tol < MAX_TOL:
+        raise ConfigValueError(f"{where}tol must be a fraction > 0 and < {MAX_TOL:g} (0.01 = 1 %), got "
+                               f"{table.get('tol')!r}")
     if tol < TOL_FLOOR:
         raise ConfigValueError(f"{where}tol = {tol:g} is below {TOL_FLOOR:g}: the grids' discretisation error "
                                f"cannot be driven that low within any budget (give tol >= {TOL_FLOOR:g})")

@@ -4,12 +4,13 @@
 fine enough for a process zone of a given number of pixels (a design's start).  :func:`next_grid` is the grid
 after a spacing ``dx``: the plain grid of the cell at ``dx`` moved, for a shape with kinks, to the first
 FFT-friendly grid whose edges fall where the first grid's did (:func:`aligned`; why: :mod:`tengsim.run.resolve`,
-"Edges kept in place"), skipping a pixel count already walked.  :func:`refinement_grids` lists the sequence, so
+"Edges kept in place"), skipping a pixel count already walked.  :func:`grid_sequence` gives the sequence (:func:`refinement_grids` its first grids), so
 whoever plans a refinement (its cost, its budget) plans on the grids :func:`tengsim.run.resolve.resolve_plan`
 walks.
 """
 from __future__ import annotations
 
+import itertools
 import math
 
 from tengsim import backend
@@ -106,17 +107,22 @@ def next_grid(shape, dx: float, phases: tuple, seen, max_pixels: int = 2**40):
         dx /= FACTOR
 
 
-def refinement_grids(shape, dx: float, count: int = 12, max_pixels: int = 2**40) -> list:
-    """The first ``count`` grids the refinement walks from a first grid of spacing ``dx`` (:func:`next_grid`)."""
-    out, seen, phases = [], set(), None
-    while len(out) < count:
+def grid_sequence(shape, dx: float, max_pixels: int = 2**40):
+    """The grids the refinement walks from a first grid of spacing ``dx`` (:func:`next_grid`), one at a time and
+    without end: a caller stops when it has what it needs (a grid past the cell's pixel limit raises)."""
+    seen, phases = set(), None
+    while True:
         g = next_grid(shape, dx, phases, seen, max_pixels)
         if phases is None:
             phases = edge_phases(shape, g)
         seen.add((g.nx, g.ny))
-        out.append(g)
+        yield g
         dx = g.dx / FACTOR
-    return out
+
+
+def refinement_grids(shape, dx: float, count: int = 12, max_pixels: int = 2**40) -> list:
+    """The first ``count`` grids of :func:`grid_sequence`."""
+    return list(itertools.islice(grid_sequence(shape, dx, max_pixels), count))
 
 
 def start_dx(shape, law, coupling: float, boundary: str = "free", zone_pixels: float | None = None) -> float:

@@ -58,11 +58,9 @@ from tengsim.errors import TengsimError
 from tengsim.run.checkpoint import Checkpoint
 from tengsim.run.grids import (FACTOR, MIN_SIDE, PHASE_SPAN, PHASE_TOL, aligned, default_dx,  # noqa: F401
                                 default_max_pixels, edge_phases, next_grid)
+from tengsim.run.tolerance import DEFAULT_TOL
 from tengsim.run.judge import (FLOORS, NEED_FLOOR, P_MAX, P_MIN, _dx_needed, _judge, _levels_table,  # noqa: F401
                                _why, contact_observables, floor_of, relative, richardson)
-
-DEFAULT_TOL = 0.01
-
 
 def resolve_plan(plan, observe=None, full_length: float | None = None, progress=None, checkpoint=None, start=None,
                  watch=None, path_for=None):
@@ -209,7 +207,7 @@ def resolve_contact(shape, tabor: float, path, dx: float | None = None, law=None
 
 def run_contact(plan, progress=None, sink=None, observe=None):
     """Run a :class:`tengsim.run.plan.ContactPlan` (or a [contact] table, planned here once): one grid
-    (:func:`tengsim.run.simulate.run_contact`), or refined automatically when its ``resolve`` settings say so
+    (:func:`tengsim.run.simulate.run_grid`), or refined automatically when its ``resolve`` settings say so
     (:func:`resolve_plan`, transition_D judged with the shape's own full-contact length).
 
     The refinement's grids each stream their rows to ``sink`` would mix grids in one file, so a sink is not
@@ -221,7 +219,7 @@ def run_contact(plan, progress=None, sink=None, observe=None):
     plan = as_plan(plan)
     if plan.resolve is None:  # one grid
         kw = {k: v for k, v in (("progress", progress), ("sink", sink)) if v is not None}
-        return contact.run_contact(plan, **kw)
+        return contact.run_grid(plan, **kw)
     ck = Checkpoint.of(sink, plan.config)
     full = getattr(plan.shape, "full_contact_length", None)
     res = resolve_plan(plan, observe=observe, full_length=None if full is None else full(), progress=progress,
