@@ -8,7 +8,7 @@ import tengsim
 from tengsim.shapes.arrays import Array
 from tengsim.cli.main import main
 from tengsim.run.plan import plan_contact
-from tengsim.run.simulate import run_contact
+from tengsim.run.simulate import run_grid as run_contact
 from tengsim.errors import TengsimError
 
 A = dict(N=0.946, cell=3.78)

@@ -192,8 +192,8 @@ def test_first_grid_is_the_default_refinements_first_fine_enough_one():
     for the issue's pyramid)."""
     from tengsim import status
     from tengsim.run.plan import plan_contact
-    from tengsim.design.run import START_ZONE_PIXELS, refinement_grids, start_dx
-    from tengsim.run.resolve import default_dx
+    from tengsim.design.walk import START_ZONE_PIXELS, start_dx
+    from tengsim.run.grids import default_dx, refinement_grids
 
     from tengsim.cli.design import _read_toml
     from pathlib import Path
@@ -217,7 +217,7 @@ def test_maps_kept_during_the_finest_walk(small):
     asked pressures: each map's nominal pressure is the one the finest grid's own depth for that pressure gives
     (what a second walk kept, :func:`tengsim.design.run.map_depths`; after a snap, the state the load reaches)
     to within 2 % of p_max."""
-    from tengsim.design.run import map_depths
+    from tengsim.design.walk import map_depths
 
     res = small.finest
     assert small.maps is res
@@ -317,29 +317,31 @@ def test_cli_removes_the_kept_grids_once_written(tmp_path):
     assert (out / "design.nc").is_file() and not list(out.glob(".design-*.resolve.nc"))
 
 
-def test_budget_cap_lies_between_plain_grids():
-    """The default max_pixels is the largest grid the budget pays for, also between two grids of the plain √2
-    sequence (the refinement's grids keep a shape's edges in place and are larger than the plain ones): the issue's
-    pyramid refines to 585² from its 245² first grid within the default 10 min."""
+def test_budget_cap_is_the_last_refinement_grid_the_budget_pays_for():
+    """The default max_pixels is the largest grid of the refinement's own sequence whose cost, with the grids before
+    it, fits the budget: the next grid of that sequence does not; the example pyramid refines to 585² from its 245²
+    first grid within the default 10 min."""
     from pathlib import Path
 
     from tengsim.cli.design import _read_toml
-    from tengsim.run.plan import plan_contact
-    from tengsim.design.run import budget_pixels, height_eps, run_cost, start_dx
+    from tengsim.design.estimate import budget_pixels, run_cost
+    from tengsim.design.walk import height_eps, start_dx
+    from tengsim.run.grids import refinement_grids
 
     plan = plan_design(_read_toml(str(Path(__file__).parent.parent / "examples" / "own_design" / "pyramid.toml")))
-    cp = plan_contact(plan.contact_table)
+    cp = plan.contact_plan
     dx = start_dx(plan, cp)
     d_max = 1.2 * height_eps(cp, dx) + 2.0
     cap = budget_pixels(plan, cp, dx, d_max)
     assert cap >= 585 * 585
     cost = run_cost(cp, d_max)
-    plain = [cp.shape.grid(dx / math.sqrt(2.0) ** k) for k in range(8)]
-    below = [g for g in plain if g.nx * g.ny <= cap]
-    nxt = plain[len(below)]
-    assert nxt.nx * nxt.ny > cap  # the cap lies before the next plain grid, which the budget does not pay for
+    seq = refinement_grids(cp.shape, dx, 12)
+    below = [g for g in seq if g.nx * g.ny <= cap]
+    assert below[-1].nx * below[-1].ny == cap  # the cap is a grid of the sequence
     secs = sum(cost.grid_seconds(cp.shape, g) for g in below)
-    assert secs <= plan.budget_s  # the plain grids up to the cap fit the budget
+    assert secs <= plan.budget_s  # the grids up to the cap fit the budget
+    nxt = seq[len(below)]
+    assert secs + cost.grid_seconds(cp.shape, nxt) > plan.budget_s  # and the next one does not
 
 
 def test_estimate_uses_the_backends_cost_and_names_it(monkeypatch):

@@ -239,14 +239,14 @@ def test_tol_has_a_floor_and_the_budget_stops_a_run_cleanly(here, capsys):
     refused(capsys, ["design", *S, "--tol", "1e-14", "--budget", "10", "--out", "o"], here, contains="tol")
     from types import SimpleNamespace
 
-    from tengsim.design.run import BudgetSpent, _deadline
+    from tengsim.design.estimate import BudgetSpent, deadline
 
     plan = SimpleNamespace(budget_s=1.0, name="d")
     seen = []
-    call = _deadline(lambda *a: seen.append(a), plan, None, time.monotonic())
+    call = deadline(lambda *a: seen.append(a), plan, None, time.monotonic())
     call("approach", 0.0, 1, 2)
     assert seen
-    late = _deadline(None, plan, None, time.monotonic() - 5.0)
+    late = deadline(None, plan, None, time.monotonic() - 5.0)
     with pytest.raises(BudgetSpent, match="stopped at the budget.*larger --budget"):
         late("approach", 0.0, 1, 2)
 
@@ -271,7 +271,7 @@ def test_device_inputs_of_a_design_have_physical_bounds(here, capsys, key, value
 
 def test_a_design_checkpoint_belongs_to_the_input_files_content(here):
     from tengsim.design import plan_design
-    from tengsim.design.run import identity
+    from tengsim.design.keep import identity
 
     h = np.outer(np.hanning(16), np.hanning(16)) * 0.2
     np.savetxt(here / "h.txt", h)
@@ -285,20 +285,20 @@ def test_a_design_checkpoint_belongs_to_the_input_files_content(here):
 
 
 def test_a_design_resumes_on_its_second_pass_path(here):
-    from tengsim.design.run import _checkpoint, _kept_path
+    from tengsim.design.keep import checkpoint, kept_path
     from tengsim.run.checkpoint import Checkpoint
 
     keep = here / ".design-0.resolve.nc"
     said = []
     progress = type("P", (), {"say": lambda self, t: said.append(t)})()
-    ck, found = _checkpoint(keep, "abc", 7.5, progress)
+    ck, found = checkpoint(keep, "abc", 7.5, progress)
     assert found is None and not said
-    assert _kept_path(keep, "abc") is None  # nothing kept yet
+    assert kept_path(keep, "abc") is None  # nothing kept yet
     # a kept grid of the same design on a longer path (its second pass): found, and no "another design" line
     orig = Checkpoint.stored_digest
     try:
         Checkpoint.stored_digest = lambda self: "abc@11.0"
-        assert _kept_path(keep, "abc") == 11.0 and _kept_path(keep, "xyz") is None
+        assert kept_path(keep, "abc") == 11.0 and kept_path(keep, "xyz") is None
     finally:
         Checkpoint.stored_digest = orig
 

@@ -75,8 +75,8 @@ def test_the_plan_is_frozen_and_its_resolve_settings_typed():
 
 
 @pytest.mark.parametrize("kw, words", [
-    ({"tol": 0.0}, "resolve_tol must be > 0 and < 1, got 0.0"),
-    ({"tol": True}, "resolve_tol must be > 0 and < 1, got True"),
+    ({"tol": 0.0}, "resolve_tol must be > 0 and < 0.5, got 0.0"),
+    ({"tol": True}, "resolve_tol must be > 0 and < 0.5, got True"),
     ({"max_pixels": 8}, "max_pixels must be >= 9"),
     ({"max_pixels": 10.5}, "max_pixels must be >= 9"),
     ({"dx": -1.0}, "dx must be finite and > 0, got -1.0"),
@@ -214,3 +214,26 @@ def test_a_design_plans_once_and_refines_that_plan(counted, spied):
     assert len(counted) == 1, counted
     _refined_by_the_plan(spied, res.finest, 0.05)
     assert spied["resolve"][-1].path.d_max == res.finest.params["d_max"]
+
+
+def test_a_design_builds_a_contact_plan_once_per_grid_and_per_refinement_pass(monkeypatch):
+    """A design runs the ContactPlan plan_design built (with the design's solver and its tolerance): it builds one
+    more per refinement pass (its path and settings) and one per grid it solves (the coarse pre-run and each grid of
+    each pass), no other."""
+    from tengsim.design import plan_design, run_design
+    from tengsim.design.plan import solver_tol
+    from tengsim.run import resolve
+    from tengsim.run import simulate as sim
+
+    plan = plan_design({"shape": "pyramid", "pitch": "1um", "base": "0.5um", "height": "0.2um", "E_star": "5MPa",
+                        "W": "20mJ/m2", "eps": "50nm", "p_max": "20kPa", "p_step": "10kPa", "tol": 0.05,
+                        "maps": False})
+    assert isinstance(plan.contact_plan, ContactPlan) and plan.contact_plan.tol == solver_tol(plan)
+    built, grids, passes = [], [], []
+    real_post, real_run, real_resolve = ContactPlan.__post_init__, sim.simulate_plan, resolve.resolve_plan
+    monkeypatch.setattr(ContactPlan, "__post_init__", lambda self: (built.append(1), real_post(self))[1])
+    monkeypatch.setattr(sim, "simulate_plan", lambda p, **kw: (grids.append(p.grid.nx), real_run(p, **kw))[1])
+    monkeypatch.setattr(resolve, "resolve_plan", lambda p, **kw: (passes.append(1), real_resolve(p, **kw))[1])
+    res = run_design(plan)
+    assert res.status == "ok" and len(grids) >= 3 and passes
+    assert len(built) <= len(grids) + len(passes), (len(built), grids, len(passes))

@@ -54,7 +54,7 @@ def test_more_grids_study_is_the_periodic_one_for_the_smooth_sided_patterns():
     changed but max_pixels, which admits the refinement 45², 65², 105², 165², 245² (each base edge a quarter
     pixel past a pixel centre on every grid: tengsim.run.resolve keeps it there) and no finer grid."""
     from tengsim.run.plan import plan_contact
-    from tengsim.run.resolve import FACTOR, _aligned, edge_phases
+    from tengsim.run.grids import FACTOR, aligned, edge_phases
     from tengsim.study.validate import validate
     from tengsim.study.spec import load_study
 
@@ -72,7 +72,7 @@ def test_more_grids_study_is_the_periodic_one_for_the_smooth_sided_patterns():
         phases, sides = edge_phases(plan.shape, g), [g.nx]
         assert phases == pytest.approx((0.25,), abs=1e-9)
         while True:
-            g = _aligned(plan.shape, plan.shape.grid(g.dx / FACTOR), phases, cap)
+            g = aligned(plan.shape, plan.shape.grid(g.dx / FACTOR), phases, cap)
             if g.nx * g.ny > cap:
                 break
             sides.append(g.nx)

@@ -78,7 +78,7 @@ def test_cheap_refinement_reaches_ok(refined):
         r = p["richardson"][name]
         assert r["rel_error"] <= 0.01 and r["change"] <= 0.01, name
     # the curves are exactly those of a plain run on the finest grid
-    from tengsim.run.simulate import run_contact
+    from tengsim.run.simulate import run_grid as run_contact
 
     plain = run_contact({k: v for k, v in PYR_CFG.items() if k != "resolve"} | {"dx": grids[-1]})
     np.testing.assert_allclose(res.table["F"], plain.table["F"], rtol=0, atol=1e-9)
@@ -167,8 +167,8 @@ BASE = ["contact", "pyramid", "--N", "0.946", "--cell", "3.78", "--d-min", "-1",
 @pytest.mark.parametrize("extra, words", [
     (["--resolve-tol", "0.02"], "resolve_tol applies only with resolve = 'auto'"),
     (["--max-pixels", "100"], "max_pixels applies only with resolve = 'auto'"),
-    (["--resolve", "auto", "--resolve-tol", "0"], "resolve_tol must be > 0 and < 1, got 0"),
-    (["--resolve", "auto", "--resolve-tol", "1"], "resolve_tol must be > 0 and < 1, got 1"),
+    (["--resolve", "auto", "--resolve-tol", "0"], "resolve_tol must be > 0 and < 0.5, got 0"),
+    (["--resolve", "auto", "--resolve-tol", "1"], "resolve_tol must be > 0 and < 0.5, got 1"),
     (["--resolve", "auto", "--resolve-tol", "x"], "resolve_tol"),
     (["--resolve", "auto", "--max-pixels", "4"], "max_pixels must be >= 9"),
     (["--resolve", "auto", "--max-pixels", "10.5"], "max_pixels must be an integer"),
@@ -184,7 +184,7 @@ def test_bad_values_are_refused_with_one_line(tmp_path, capsys, extra, words):
 
 
 def test_one_grid_run_contact_refuses_resolve_auto():
-    from tengsim.run.simulate import run_contact
+    from tengsim.run.simulate import run_grid as run_contact
 
     with pytest.raises(TengsimError, match="tengsim.run.resolve.run_contact"):
         run_contact({**PYR_CFG, "d_max": 0.0})
@@ -333,7 +333,7 @@ def test_finer_grids_keep_a_shapes_edges_where_they_fell_in_the_first_grids_pixe
     45², 65², 105², 165², 245², the edge a quarter pixel past a pixel centre on each.  A shape without edges
     (paraboloid), an edge no grid in reach can keep, and the pixel cap get the plain grid."""
     from tengsim.grid import Grid
-    from tengsim.run.resolve import FACTOR, PHASE_TOL, _aligned, edge_phases
+    from tengsim.run.grids import FACTOR, PHASE_TOL, aligned, edge_phases
     from tengsim.shapes import Cone, Cube, Hemisphere, Paraboloid, Pyramid
 
     pyr = Pyramid(N=10.0, cell=40.0)
@@ -345,7 +345,7 @@ def test_finer_grids_keep_a_shapes_edges_where_they_fell_in_the_first_grids_pixe
     for _ in range(4):
         gp = pyr.grid(gp.dx / FACTOR)
         plain.append(gp.nx)
-        gk = _aligned(pyr, pyr.grid(gk.dx / FACTOR), phases, 10**8)
+        gk = aligned(pyr, pyr.grid(gk.dx / FACTOR), phases, 10**8)
         kept.append(gk.nx)
         assert isinstance(gk, Grid) and gk.nx * gk.dx == pytest.approx(40.0, rel=1e-12)
         assert min(abs(edge_phases(pyr, gk)[0] - 0.25), 1 - abs(edge_phases(pyr, gk)[0] - 0.25)) <= PHASE_TOL
@@ -358,9 +358,9 @@ def test_finer_grids_keep_a_shapes_edges_where_they_fell_in_the_first_grids_pixe
     assert Cube(half_width=1.5, height=5.0, cell=6.0).edge_offsets() == (1.5,)
     sph = Paraboloid(1.0, 16.0)
     g1 = sph.grid(16.0 / 45)
-    assert edge_phases(sph, g1) == () and _aligned(sph, sph.grid(g1.dx / FACTOR), (), 10**8).nx == 65
+    assert edge_phases(sph, g1) == () and aligned(sph, sph.grid(g1.dx / FACTOR), (), 10**8).nx == 65
     # the cap: no kept grid above max_pixels, so the plain one
-    assert _aligned(pyr, pyr.grid(40.0 / 99), phases, 100 * 100).nx == 99
+    assert aligned(pyr, pyr.grid(40.0 / 99), phases, 100 * 100).nx == 99
 
 
 def test_a_refinement_records_its_edge_phases():

@@ -34,6 +34,7 @@ _WHERE = {  # public name -> the module defining it, imported on first use (PEP 
     "SHAPES": "tengsim.plugins",
     "SOLVERS": "tengsim.plugins",
     "resolve_contact": "tengsim.run.resolve",
+    "run_contact": "tengsim.run.resolve",
     "ContactPlan": "tengsim.run.plan",
     "plan_contact": "tengsim.run.plan",
     "simulate_plan": "tengsim.run.simulate",
@@ -76,14 +77,6 @@ def __getattr__(name):
 def __dir__():
     return sorted(set(globals()) | set(_WHERE))
 
-
-def run_contact(cfg, progress=None, sink=None, observe=None):
-    """One run of a [contact] table (the keys of ``tengsim contact``) or of its plan
-    (:func:`tengsim.run.plan.plan_contact`), as ``tengsim contact`` runs it: ``resolve = "auto"`` refined until
-    converged (:func:`tengsim.run.resolve.run_contact`).  Returns a ContactResult."""
-    from tengsim.run.resolve import run_contact as run
-
-    return run(cfg, progress=progress, sink=sink, observe=observe)
 
 __all__ = [
     "KERNELS", "LAWS", "OBSERVERS", "SHAPES", "SOLVERS", "Scaling", "Summary", "ContactPlan", "plan_contact",

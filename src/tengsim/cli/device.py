@@ -12,6 +12,7 @@ import json
 import sys
 from pathlib import Path
 
+from tengsim.cli import device_inputs as given
 from tengsim.errors import TengsimError, require
 
 SUMMARY = 'dynamic TENG output (paper Section 5)'  # its line in `tengsim --help`
@@ -32,14 +33,6 @@ DEFAULT_CYCLES = {"fig7": 5, "run": 5, "sweep": 3, "design": 5}
 MAX_SWEEP_POINTS = 10_000
 """The most loads one sweep may hold (each is a multi-cycle device run)."""
 
-# CLI option -> (table, key)
-_OPTIONS = {"out": ("run", "out"), "cycles": ("run", "cycles"), "t_end": ("run", "t_end"), "dt": ("run", "dt_out"),
-            "quick": ("run", "quick"), "load_ohm": ("device", "load_ohm"), "damping": ("device", "damping_ratio"),
-            "force_model": ("device", "force_model"), "initial_charge": ("device", "initial_charge"),
-            "r_min": ("sweep", "r_min_ohm"), "r_max": ("sweep", "r_max_ohm"), "points": ("sweep", "points"),
-            "area_from": ("device", "area"), "mass": ("device", "mass_kg"),
-            "stiffness": ("device", "stiffness_N_per_m"), "electrode_area": ("device", "area_m2"),
-            "pressure": ("waveform", "amplitude_Pa"), "frequency": ("waveform", "frequency_Hz")}
 DESIGN_HELP = ("The device a design describes, in one step: `tengsim device design --area-from d1/design.nc "
                "--out dev.csv`. From the design it takes σ, ε_r, T, the rest gap d0 and A/S(P) (approach); what the "
                "design does not know (mass, stiffness, electrode area, load, waveform) comes from the options, the "
@@ -78,23 +71,23 @@ def register(subparsers) -> None:
     f7 = sub.add_parser("fig7", help="flat device, 10 N 5 Hz square wave (Fig. 7)", description=CONFIG_HELP)
     common(f7, 5)
     f7.add_argument("--t-end", help="run length in s or with a unit (overrides [run] t_end; default cycles x period)")
-    f7.set_defaults(func=lambda a: execute("fig7", _read(a.config), _cli(a), a.quiet, a.config))
+    f7.set_defaults(func=lambda a: execute("fig7", given.read(a.config), given.options(a), a.quiet, a.config))
     f8 = sub.add_parser("fig8", help="group-A device, 10-150 kPa staircase at 2 Hz (Fig. 8)", description=CONFIG_HELP)
     common(f8, "all 15 steps")
     f8.add_argument("--quick", action="store_true", default=None,
                     help="quick (coarse) contact-engine area table (overrides [run] quick)")
-    f8.set_defaults(func=lambda a: execute("fig8", _read(a.config), _cli(a), a.quiet, a.config))
+    f8.set_defaults(func=lambda a: execute("fig8", given.read(a.config), given.options(a), a.quiet, a.config))
     rn = sub.add_parser("run", help="any device and waveform from --config", description=CONFIG_HELP)
     common(rn, 5)
     rn.add_argument("--t-end", help="run length in s or with a unit (overrides [run] t_end; default cycles x period)")
-    rn.set_defaults(func=lambda a: execute("run", _read(a.config), _cli(a), a.quiet, a.config))
+    rn.set_defaults(func=lambda a: execute("run", given.read(a.config), given.options(a), a.quiet, a.config))
     sw = sub.add_parser("sweep", help="load-resistance sweep of the Fig. 7 device (or --config)",
                         description=CONFIG_HELP)
     common(sw, 3, sweep=True)
     sw.add_argument("--r-min", help="smallest load in ohm or with a unit (overrides [sweep] r_min_ohm; default 1e3)")
     sw.add_argument("--r-max", help="largest load in ohm or with a unit (overrides [sweep] r_max_ohm; default 1e10)")
     sw.add_argument("--points", help="loads, log-spaced (overrides [sweep] points; default 15)")
-    sw.set_defaults(func=lambda a: execute("sweep", _read(a.config), _cli(a), a.quiet, a.config))
+    sw.set_defaults(func=lambda a: execute("sweep", given.read(a.config), given.options(a), a.quiet, a.config))
     dz = sub.add_parser("design", help="the device a design describes (σ, ε_r, T, rest gap, A/S(P) from "
                         "--area-from DIR/design.nc)", description=DESIGN_HELP)
     common(dz, 5)
@@ -105,112 +98,9 @@ def register(subparsers) -> None:
     dz.add_argument("--mass", help="moving plate mass, e.g. 13.45g (default: the paper's Fig. 8 device, 13.45 g)")
     dz.add_argument("--stiffness", help="spring stiffness, e.g. 5.12kN/m (default 5.12 kN/m, Fig. 8)")
     dz.add_argument("--electrode-area", help="electrode area S in m2, plain number (default 4e-4, Fig. 8's 4 cm²)")
-    dz.set_defaults(func=lambda a: execute("design", _read(a.config), _cli(a), a.quiet, a.config))
+    dz.set_defaults(func=lambda a: execute("design", given.read(a.config), given.options(a), a.quiet, a.config))
     fl = sub.add_parser("fields", help="list every config table and key (from the dataclasses)")
     fl.set_defaults(func=_cmd_fields)
-
-
-# --- config and options ---
-
-def _read(path) -> dict:
-    if path is None:
-        return {}
-    from tengsim.schema import read_config
-
-    return read_config(path)
-
-
-def _cli(args) -> dict:
-    """Options given on the command line, as {table: {key: raw value}}."""
-    out = {}
-    for opt, (table, key) in _OPTIONS.items():
-        v = getattr(args, opt, None)
-        if v is not None and v != "":
-            out.setdefault(table, {})[key] = v
-    return out
-
-
-def _typed_cli(table, values: dict) -> dict:
-    """CLI values typed by the table's own fields; an error names the option (--load-ohm, not load_ohm)."""
-    names = {key: "--" + opt.replace("_", "-") for opt, (_, key) in _OPTIONS.items()}
-    if table is None:  # --pressure, --frequency: the square wave's fields
-        from tengsim.device.config import waveform_table
-
-        table = waveform_table("square")
-    out = {}
-    for key, raw in values.items():
-        if key == "area":  # --area-from: always a file (a design or contact result), never a number
-            from tengsim.device.areas import area_table_from_file
-
-            out[key] = area_table_from_file(raw)
-            continue
-        f = dataclasses.replace(table.fields[key], name=names[key])
-        out[key] = f.parse(raw)
-    return out
-
-
-def _area_beside(cfg: dict, source) -> dict:
-    """A [device] area given as a relative path that is not in the working folder but beside the config
-    file (``area = "d1/design.nc"`` next to the TOML) is read from there."""
-    dev = cfg.get("device")
-    area = dev.get("area") if isinstance(dev, dict) else None
-    if not source or not isinstance(area, str) or Path(area).is_absolute() or Path(area).exists():
-        return cfg
-    beside = Path(source).parent / area
-    return {**cfg, "device": {**dev, "area": str(beside)}} if beside.exists() else cfg
-
-
-def _out_path(run: dict, case: str) -> Path:
-    """The output path (checked by suffix only: nothing is created before every input has been checked)."""
-    out = run.get("out")
-    require(out, "give --out FILE (or [run] out = 'FILE' in the config)")
-    out = Path(out)
-    allowed = (".csv",) if case == "sweep" else (".csv", ".nc")
-    require(out.suffix.lower() in allowed, f"out must end in {' or '.join(allowed)}, got {str(out)!r}")
-    return out
-
-
-def _inputs(cfg: dict, cli: dict, source) -> list:
-    """Every file a device run reads: the config file, the area result (a file, or a design folder's
-    design.nc) from --area-from or [device] area."""
-    out = [source] if source else []
-    for area in (cli.get("device", {}).get("area"), (cfg.get("device") or {}).get("area")):
-        if isinstance(area, (str, Path)) and len(str(area)) < 4096:
-            out.append(str(area))
-            if Path(area).is_dir():
-                from tengsim.device.areas import DESIGN_FILE
-
-                out.append(str(Path(area) / DESIGN_FILE))
-    return out
-
-
-def _guard(out: Path, cfg: dict, cli: dict, source) -> None:
-    """The output and its .json sidecar (a .csv output), checked before anything runs: neither may be an input
-    (:func:`tengsim.io.check_outputs`), both must be writable."""
-    from tengsim.io import check_output
-
-    inputs = _inputs(cfg, cli, source)
-    check_output(out, inputs)
-    if out.suffix.lower() == ".csv":
-        check_output(out.with_suffix(".json"), inputs, what=f"the sidecar of --out {out.name}:")
-
-
-def _warn_unconverged(cfg: dict, cli: dict, quiet: bool) -> None:
-    """A warning line when the area comes from a design whose status is not ok (under-resolved, not
-    converged): the device then inherits that design's error."""
-    for path in _inputs(cfg, cli, None):
-        p = Path(path)
-        if p.suffix.lower() != ".nc" or not p.is_file():
-            continue
-        try:
-            from tengsim.io import read_dataset
-
-            status = str(read_dataset(p).attrs.get("status", "ok"))
-        except Exception:  # noqa: BLE001 - the area reader has said what is wrong with it already
-            continue
-        if status != "ok":
-            print(f"tengsim: warning: the area comes from {p}, a design of status {status!r} (not converged to "
-                  "its tolerance): the device's numbers carry its error (see its report.md)", file=sys.stderr)
 
 
 # --- the one path every device run takes ---
@@ -221,13 +111,13 @@ def execute(case: str, cfg: dict, cli: dict | None = None, quiet: bool = False, 
 
     cli = cli or {}
     dc.check_device_tables(cfg, source or "config")
-    cfg = _area_beside(cfg, source)
+    cfg = given.area_beside(cfg, source)
     ignored = []  # keys of the other command (run <-> sweep) in a config that serves both
     if "sweep" in cfg and case != "sweep":
         if case != "run":
             raise TengsimError(f"[sweep] is used only by the sweep case, not {case}")
         ignored.append("[sweep]")
-    run = {**dc.parse_run(cfg.get("run", {}), case, ignored), **_typed_cli(dc.RUN_TABLE, cli.get("run", {}))}
+    run = {**dc.parse_run(cfg.get("run", {}), case, ignored), **given.typed(dc.RUN_TABLE, cli.get("run", {}))}
     if case == "sweep" and "load_ohm" in cfg.get("device", {}):
         ignored.append("[device] load_ohm")
         cfg = {**cfg, "device": {k: v for k, v in cfg["device"].items() if k != "load_ohm"}}
@@ -235,11 +125,11 @@ def execute(case: str, cfg: dict, cli: dict | None = None, quiet: bool = False, 
         other = "run" if case == "sweep" else "sweep"
         print(f"tengsim: note: the {case} does not use {', '.join(ignored)} (used by `tengsim device {other}`)",
               file=sys.stderr)
-    dev_cli = _typed_cli(dc.DEVICE_TABLE, cli.get("device", {}))
+    dev_cli = given.typed(dc.DEVICE_TABLE, cli.get("device", {}))
     solver = dc.parse_solver(cfg.get("solver", {}))
-    out = _out_path(run, case)
-    _guard(out, cfg, cli, source)
-    _warn_unconverged(cfg, cli, quiet)
+    out = given.out_path(run, case)
+    given.guard(out, cfg, cli, source)
+    given.warn_unconverged(cfg, cli, quiet)
     if case == "sweep":
         return _sweep(cfg, cli, run, dev_cli, solver, out, quiet, source)
     designed = None
@@ -343,10 +233,10 @@ def _designed(cfg, cli, dev_cli):
     dev = {**dc.DEVICE_TABLE.parse({k: v for k, v in (cfg.get("device") or {}).items() if k != "area"},
                                    defaults=False), **{k: v for k, v in dev_cli.items() if k != "area"}}
     for opt in ("mass", "stiffness", "electrode_area"):
-        key = _OPTIONS[opt][1]
+        key = given.OPTIONS[opt][1]
         if key in dev_cli and not dev_cli[key] > 0:
             raise TengsimError(f"--{opt.replace('_', '-')} must be > 0, got {cli['device'][key]!r}")
-    wcli = _typed_cli(None, cli.get("waveform", {}))
+    wcli = given.typed(None, cli.get("waveform", {}))
     return designed_device(raw, dev, cfg.get("waveform"), wcli.get("amplitude_Pa"), wcli.get("frequency_Hz"))
 
 
@@ -402,7 +292,7 @@ def _sweep(cfg, cli, run, dev_cli, solver, out, quiet, source) -> int:
     from tengsim.device import resistance_sweep
     from tengsim.io import write_csv, write_json
 
-    sw_cfg = {**dc.SWEEP_TABLE.parse(cfg.get("sweep", {})), **_typed_cli(dc.SWEEP_TABLE, cli.get("sweep", {}))}
+    sw_cfg = {**dc.SWEEP_TABLE.parse(cfg.get("sweep", {})), **given.typed(dc.SWEEP_TABLE, cli.get("sweep", {}))}
     r_min, r_max, points = sw_cfg["r_min_ohm"], sw_cfg["r_max_ohm"], sw_cfg["points"]
     require(0 < r_min < r_max, f"need 0 < r_min < r_max, got {r_min!r}, {r_max!r}")
     require(points >= 2, f"points must be >= 2, got {points!r}")

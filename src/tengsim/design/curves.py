@@ -330,7 +330,7 @@ HYSTERESIS = "hysteresis energy (recorded, not judged)"
 def convergence(res) -> dict:
     """{number: relative change between the last two grids}: the judged numbers, A/S on the approach (the
     largest over the asked pressures), pull-off force, jump-in and jump-out D; then the retraction's numbers the
-    refinement records but does not judge (:func:`tengsim.design.run._watcher`): A/S on the retraction (the
+    refinement records but does not judge (:func:`tengsim.design.walk._watcher`): A/S on the retraction (the
     largest over the pressures it reaches on both grids) and the hysteresis energy; NaN with one grid."""
     rich = res.params.get("richardson") or {}
     watched = res.params.get("watched") or {}

@@ -20,11 +20,16 @@ reached.
 """
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 from tengsim.errors import ConfigValueError, TengsimError, listed, shown
+
+if TYPE_CHECKING:
+    from tengsim.run.plan import ContactPlan
 
 PAPER_DEVICE = {"sigma": 5.84e-6, "eps_r": 2.40, "T": 400e-6, "gap": 0.1e-3}
 """The paper's device (Section 5, Fig. 8): σ = 5.84 µC/m², ε_r = 2.40, T = 400 µm, rest gap d0 = 0.1 mm."""
@@ -34,6 +39,11 @@ DEVICE_BOUNDS = {"sigma": (1e-9, 1e-2, "1 nC/m2 ... 10 mC/m2 (air breaks down fa
                  "T": (1e-9, 1.0, "1 nm ... 1 m"),
                  "gap": (1e-9, 1.0, "1 nm ... 1 m")}
 """Physical bounds of the device inputs of Eq. (12) and Eq. (17): a value outside is a typo, not a device."""
+SOLVER_TOL_PER_TOL = 0.01
+"""Each equilibrium of a design is solved to max|r| <= this × the design's tol (ε; 1e-4 at the default 1 %): the
+solver's share of a reported number is then far below tol (docs/validation.md, "A design's solver tolerance")."""
+PK_LAWS = ("MaugisDugdale", "Exponential")
+"""Laws a design runs on the constrained solver 'pk' (their hard-wall limit) unless it names its solver."""
 TOL_FLOOR = 1e-4
 """The smallest design tolerance (0.01 %): each equilibrium is solved to 0.01 × tol, and a grid refinement to
 1e-4 is already far beyond what a design's budget pays for."""
@@ -48,6 +58,7 @@ CONTROLLED = ("tabor", "dx", "d_min", "d_max", "d_step", "refine_levels", "maps_
 
 def design_fields() -> list:
     """The design's own keys (besides the [contact] keys of its shape)."""
+    from tengsim.run.tolerance import DEFAULT_TOL
     from tengsim.schema import Field
 
     return [
@@ -66,7 +77,7 @@ def design_fields() -> list:
               "paper's 400 µm)"),
         Field("gap", default=PAPER_DEVICE["gap"], dim="length",
               help="the device's rest gap d0 for Eq. (17) (default the paper's 0.1 mm)"),
-        Field("tol", default=0.01, help="relative tolerance the reported numbers are converged to (default "
+        Field("tol", default=DEFAULT_TOL, help="relative tolerance the reported numbers are converged to (default "
               "0.01 = 1 %)"),
         Field("dx", default=None, dim="length", help="first grid spacing, a length such as '50nm' (default: "
               "from the shape's features and the law's process zone)"),
@@ -119,7 +130,11 @@ class DesignPlan:
     boundary: str = "periodic"
     boundary_given: bool = False
     extra: dict = field(default_factory=dict)
-    contact_plan: object = field(default=None, compare=False, repr=False)
+    solver_given: bool = False
+    """Whether the design's table names its solver (else a cohesive law runs on 'pk')."""
+    contact_plan: ContactPlan | None = field(default=None, compare=False, repr=False)
+    """The plan of ``contact_table`` the design runs (with its solver tolerance, :func:`solver_tol`, and its
+    solver): always set by :func:`plan_design`, the one place a design is planned."""
 
     def shape_params_json(self) -> str:
         return json.dumps(self.shape_params, sort_keys=True)
@@ -205,6 +220,7 @@ def plan_design(table: dict, where: str = "") -> DesignPlan:
     cfg = {k: v for k, v in table.items() if k in contact_keys and k not in own_names and v not in (None, "")}
     cfg["shape"] = shape
     boundary_given = "boundary" in cfg
+    solver_given = cfg.get("solver") not in (None, "", "auto")
     cfg.setdefault("boundary", "periodic")  # a pattern's design is the array it describes
     from tengsim.run.area import check_definition
 
@@ -228,9 +244,12 @@ def plan_design(table: dict, where: str = "") -> DesignPlan:
         lo_k, hi_k, text = DEVICE_BOUNDS[k]
         if not lo_k <= own[k] <= hi_k:
             raise ConfigValueError(f"{where}{k} = {shown(table.get(k))} is outside {text}")
+    from tengsim.run.tolerance import MAX_TOL
+
     tol = own["tol"]
-    if not 0 < tol < 0.5:
-        raise ConfigValueError(f"{where}tol must be a fraction > 0 and < 0.5 (0.01 = 1 %), got {table.get('tol')!r}")
+    if isinstance(tol, bool) or not 0 < tol < MAX_TOL:
+        raise ConfigValueError(f"{where}tol must be a fraction > 0 and < {MAX_TOL:g} (0.01 = 1 %), got "
+                               f"{table.get('tol')!r}")
     if tol < TOL_FLOOR:
         raise ConfigValueError(f"{where}tol = {tol:g} is below {TOL_FLOOR:g}: the grids' discretisation error "
                                f"cannot be driven that low within any budget (give tol >= {TOL_FLOOR:g})")
@@ -246,11 +265,14 @@ def plan_design(table: dict, where: str = "") -> DesignPlan:
     sc = plan.scaling
     draft = DesignPlan("", shape, {}, sp, (), 0, 0, 0, 0, 0, None, None, 0, 0, 0, 0, 0)
     name = own["name"] or f"{shape} {draft.shape_text()}"
+    pk = {"solver": "pk", "solver_note": ""} if not solver_given and type(plan.law).__name__ in PK_LAWS else {}
+    plan = dataclasses.replace(plan, tol=SOLVER_TOL_PER_TOL * tol, **pk)  # the plan the design runs
     return DesignPlan(name=name, shape=shape, contact_table=cfg, shape_params=sp, pressures=pressures,
                       sigma=own["sigma"], eps_r=own["eps_r"], T=own["T"], gap=own["gap"], tol=tol, dx=own["dx"],
                       max_pixels=own["max_pixels"], budget_s=own["budget"], E_star=sc.E_star,
                       W=sc.W, eps=sc.eps, tabor=sc.mu, maps=bool(own["maps"]), area=area,
-                      boundary=str(plan.boundary), boundary_given=boundary_given, contact_plan=plan)
+                      boundary=str(plan.boundary), boundary_given=boundary_given, solver_given=solver_given,
+                      contact_plan=plan)
 
 
 def _pressures(own: dict, where: str) -> tuple:
@@ -272,3 +294,8 @@ def _pressures(own: dict, where: str) -> tuple:
     if hi - ps[-1] > 1e-9 * hi:
         ps.append(hi)
     return tuple(float(p) for p in ps)
+
+
+def solver_tol(plan) -> float:
+    """The solver's tolerance of a design (:data:`SOLVER_TOL_PER_TOL`)."""
+    return SOLVER_TOL_PER_TOL * plan.tol

@@ -148,7 +148,7 @@ def common_fields() -> list:
               help="auto: refine the grid (dx/√2 per level, from dx or a coarse default) until every equilibrium "
               "is ok and the observables changed by at most resolve_tol (tengsim.run.resolve); off: the one grid dx"),
         Field("resolve_tol", "float", None, help="resolve = auto: relative tolerance of the observables, "
-              "> 0 and < 1 (default 0.01)"),
+              "> 0 and < 0.5 (default 0.01)"),
         Field("max_pixels", "int", None, help="resolve = auto: largest grid nx·ny, >= 9 (default: what the "
               "free memory holds)"),
         Field("resolve_pressures", "floats", None, dim="pressure",

@@ -14,6 +14,7 @@ from tengsim.errors import ConfigValueError, GeometryError, TengsimError, finite
 from tengsim.laws import LJ93, make_law
 from tengsim.continuation import PathSpec
 from tengsim.plugins import KERNELS
+from tengsim.run.tolerance import DEFAULT_TOL, check_tol  # noqa: F401
 from tengsim.run.keys import (ADAPTIVE_KEYS, LOAD_KEYS, common_fields, common_names, contact_keys,
                               contact_table, law_fields, law_keys, physical_triggers, shape_class)
 from tengsim.shapes.base import dimensionless_fields, physical_fields
@@ -142,13 +143,6 @@ def coupling(tabor) -> float:
     return positive("tabor", tabor) ** 1.5
 
 
-def check_tol(v) -> float:
-    """resolve_tol: a number > 0 and < 1 (a ConfigValueError naming it otherwise)."""
-    if isinstance(v, bool) or not isinstance(v, (int, float)) or not 0 < float(v) < 1:
-        raise ConfigValueError(f"resolve_tol must be > 0 and < 1, got {v!r}")
-    return float(v)
-
-
 def check_max_pixels(v) -> int:
     """max_pixels: a whole number of pixels nx·ny >= 9 (a ConfigValueError naming it otherwise)."""
     if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or int(v) < 9:
@@ -156,8 +150,8 @@ def check_max_pixels(v) -> int:
     return int(v)
 
 
-DEFAULT_RESOLVE_TOL = 0.01
-"""resolve_tol when a table does not give one."""
+DEFAULT_RESOLVE_TOL = DEFAULT_TOL
+"""resolve_tol when a table does not give one (:data:`tengsim.run.tolerance.DEFAULT_TOL`)."""
 
 
 @dataclass(frozen=True)

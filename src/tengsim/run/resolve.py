@@ -54,91 +54,13 @@ import time
 
 import numpy as np
 
-from tengsim import backend
 from tengsim.errors import TengsimError
-from tengsim.grid import Grid
 from tengsim.run.checkpoint import Checkpoint
+from tengsim.run.grids import (FACTOR, MIN_SIDE, PHASE_SPAN, PHASE_TOL, aligned, default_dx,  # noqa: F401
+                                default_max_pixels, edge_phases, next_grid)
+from tengsim.run.tolerance import DEFAULT_TOL
 from tengsim.run.judge import (FLOORS, NEED_FLOOR, P_MAX, P_MIN, _dx_needed, _judge, _levels_table,  # noqa: F401
                                _why, contact_observables, floor_of, relative, richardson)
-
-FACTOR = math.sqrt(2.0)
-"""Refinement factor in dx between two grids (twice the pixels)."""
-DEFAULT_TOL = 0.01
-MIN_SIDE = 9
-"""Fewest pixels across the cell of a default starting grid."""
-PHASE_TOL = 0.1
-"""How far (in pixels) a shape's edge may sit from its place in the first grid's pixel on a finer grid."""
-PHASE_SPAN = 1.3
-"""Largest pixel count, relative to the plain next grid's, searched for a grid that keeps the edges' places."""
-
-
-def default_max_pixels(boundary: str = "free", solver: str = "fast") -> int:
-    """The largest n² whose run fits in the machine's free memory (:mod:`tengsim.resources`); 4096² if that
-    cannot be read."""
-    from tengsim.resources import available_bytes, estimate_bytes
-
-    avail = available_bytes()
-    if avail is None:
-        return 4096**2
-    lo, hi = 3, 3
-    while estimate_bytes(hi, hi, boundary, solver) <= avail and hi < 2**17:
-        lo, hi = hi, hi * 2
-    while hi - lo > 1:
-        mid = (lo + hi) // 2
-        if estimate_bytes(mid, mid, boundary, solver) <= avail:
-            lo = mid
-        else:
-            hi = mid
-    return max(9, lo * lo)
-
-
-def default_dx(shape, law, coupling: float, boundary: str = "free") -> float:
-    """Starting dx when none is given: the a-priori Dugdale zone ℓ_D (:func:`tengsim.status.process_zone_estimate`)
-    over ``status.RESOLUTION`` (the zone spans the pixels the grid status asks for) and the dx at which the pixel
-    snap number s ∝ dx (:func:`tengsim.status.pixel_snap_number`, measured on a grid of the cell) falls to
-    ``status.SNAP_LIMIT``, whichever is
-    smaller, and at most cell/MIN_SIDE.  Coarser grids are under-resolved by those criteria whatever their
-    observables do, so they would only be spent."""
-    from tengsim import status
-    from tengsim.kernels import make_kernel
-
-    cell = float(getattr(shape, "cell"))
-    dx = cell / MIN_SIDE
-    lD = status.process_zone_estimate(law, coupling)
-    if math.isfinite(lD) and lD > 0:
-        dx = min(dx, lD / status.RESOLUTION)  # the zone spans the pixels the status asks for
-    g = shape.grid(dx)
-    from tengsim.resources import check_memory
-
-    check_memory(g.nx, g.ny, boundary)  # the kernel below is the grid's: one line, not an allocation that fails
-    s = status.pixel_snap_number(law, make_kernel(boundary, g, coupling))
-    if s > status.SNAP_LIMIT:
-        dx = g.dx * status.SNAP_LIMIT / s
-    return dx
-
-
-def edge_phases(shape, grid) -> tuple:
-    """Where each of the shape's edges (``Shape.edge_offsets``, from the centre pixel along X) falls in its
-    pixel on ``grid``: the fractional part of offset/dx, in [0, 1)."""
-    offsets = getattr(shape, "edge_offsets", lambda: ())()
-    return tuple(float((e / grid.dx) % 1.0) for e in offsets)
-
-
-def _aligned(shape, grid, phases, max_pixels: int):
-    """``grid`` or, for a shape with edges, the first plain square grid of the same cell with FFT-friendly odd
-    pixel count between grid.nx and PHASE_SPAN × grid.nx (and within ``max_pixels``) whose edges fall where the
-    first grid's did (``phases``, to PHASE_TOL of a pixel); ``grid`` itself if none does."""
-    if not phases or type(grid) is not Grid or grid.nx != grid.ny:
-        return grid
-    L = grid.nx * grid.dx
-    n, top = grid.nx, min(int(PHASE_SPAN * grid.nx), int(math.isqrt(int(max_pixels))))
-    while n <= top:
-        g = Grid(n, n, L / n, L / n)
-        if all(min(abs(a - b), 1.0 - abs(a - b)) <= PHASE_TOL for a, b in zip(edge_phases(shape, g), phases)):
-            return g
-        n = backend.fast_odd_len(n + 2)
-    return grid
-
 
 def resolve_plan(plan, observe=None, full_length: float | None = None, progress=None, checkpoint=None, start=None,
                  watch=None, path_for=None):
@@ -188,14 +110,10 @@ def resolve_plan(plan, observe=None, full_length: float | None = None, progress=
         done = _judge(levels, [n for n in names if n not in watched], tol)[0]
         dx = levels[-1]["dx"] / FACTOR
     while not done:
-        grid = shape.grid(dx)
-        if levels:  # keep the shape's edges where they fell in the first grid's pixels (module doc)
-            grid = _aligned(shape, grid, phases, max_pixels)
-        else:
+        # keep the shape's edges where they fell in the first grid's pixels (module doc)
+        grid = next_grid(shape, dx, phases if levels else None, seen, max_pixels)
+        if not levels:
             phases = edge_phases(shape, grid)
-        if (grid.nx, grid.ny) in seen:  # the FFT-friendly pixel count did not change: one more step
-            dx /= FACTOR
-            continue
         if grid.nx * grid.ny > max_pixels:
             if not levels:
                 raise TengsimError(f"max_pixels = {max_pixels} is below the first grid's {grid.nx}×{grid.ny} "
@@ -289,7 +207,7 @@ def resolve_contact(shape, tabor: float, path, dx: float | None = None, law=None
 
 def run_contact(plan, progress=None, sink=None, observe=None):
     """Run a :class:`tengsim.run.plan.ContactPlan` (or a [contact] table, planned here once): one grid
-    (:func:`tengsim.run.simulate.run_contact`), or refined automatically when its ``resolve`` settings say so
+    (:func:`tengsim.run.simulate.run_grid`), or refined automatically when its ``resolve`` settings say so
     (:func:`resolve_plan`, transition_D judged with the shape's own full-contact length).
 
     The refinement's grids each stream their rows to ``sink`` would mix grids in one file, so a sink is not
@@ -301,7 +219,7 @@ def run_contact(plan, progress=None, sink=None, observe=None):
     plan = as_plan(plan)
     if plan.resolve is None:  # one grid
         kw = {k: v for k, v in (("progress", progress), ("sink", sink)) if v is not None}
-        return contact.run_contact(plan, **kw)
+        return contact.run_grid(plan, **kw)
     ck = Checkpoint.of(sink, plan.config)
     full = getattr(plan.shape, "full_contact_length", None)
     res = resolve_plan(plan, observe=observe, full_length=None if full is None else full(), progress=progress,

@@ -87,7 +87,7 @@ def simulate(shape: Shape, tabor: float, dx: float, path: PathSpec, boundary: st
     not_converged / out_of_law_range / under_resolved (:mod:`tengsim.status`); with ``throw=True``
     a status other than 'ok' raises :class:`tengsim.status.ResultStatusError`, which carries the
     result.  The grid's memory is checked once, before anything is built (``check_memory_first=False``:
-    the caller has checked it, as :func:`run_contact` does through :func:`tengsim.run.plan.plan_contact`).
+    the caller has checked it, as :func:`run_grid` does through :func:`tengsim.run.plan.plan_contact`).
     ``grid``: the grid to solve on (then ``dx`` is the grid's); None: the shape's grid of spacing ``dx``.
 
     ``sink`` (a callable or None) receives each equilibrium as it is recorded, ``sink(row, maps)``
@@ -196,7 +196,7 @@ def simulate_pyramid(N: float, cell: float, tabor: float = 0.5, dx: float = 0.05
                     symmetry=symmetry)
 
 
-def run_contact(plan, progress=None, sink=None):
+def run_grid(plan, progress=None, sink=None):
     """Run a :class:`tengsim.run.plan.ContactPlan` (or a [contact] table, planned here) on one grid; returns a
     ContactResult with the table in ``params['config']``.  ``sink``: as for :func:`simulate` (the config is not
     among the parameters it is given: a CLI run and a TOML run of the same settings spell it differently, and
@@ -204,6 +204,6 @@ def run_contact(plan, progress=None, sink=None):
     plan = as_plan(plan)
     if plan.resolve is not None:  # refinement is the layer above's: never run one grid silently instead
         raise TengsimError("resolve = 'auto' runs through tengsim.run.resolve.run_contact (tengsim.run_contact), "
-                           "not tengsim.run.simulate.run_contact")
+                           "not tengsim.run.simulate.run_grid")
     res = simulate_plan(plan, progress=progress, sink=sink, check_memory_first=False)  # plan_contact checked it
     return replace(res, params={**res.params, "config": dict(plan.config)})

@@ -1,0 +1,202 @@
+"""What a design costs: the expected time of its refinement, the worst case up to its budget, the budget's checks.
+
+After the coarse pre-run (:func:`tengsim.design.walk.find_d_max`: the path's range and the solver's iterations per
+row, on a cheap grid) and before the refinement, :func:`estimate` gives the grids (the refinement's first ones,
+:func:`tengsim.run.grids.refinement_grids`), the memory of the finest, the solver ``auto`` chose and the expected
+time, each grid rows × iterations × the backend's cost per iteration (:class:`Cost`, :mod:`tengsim.resources`: the
+CPU's or the GPU's model, named in the line); :func:`cap_line` the worst case up to the budget's largest grid
+(:func:`budget_pixels`).  An expected time above the plan's budget is refused (:func:`check_budget`, a
+:class:`tengsim.errors.TengsimError` naming max_pixels and tol) before the refinement is solved or anything written;
+a run past its budget is stopped between two rows (:func:`deadline`, :class:`BudgetSpent`).
+"""
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass
+
+import numpy as np
+
+from tengsim.design.walk import D_MIN, D_STEP
+from tengsim.errors import TengsimError
+from tengsim.resources import CostModel, cost_model
+
+ROWS_PER_STEP = 2.0
+"""Path rows per d_step of D range on each grid, approach and retraction together (the first grid walks to d_max,
+each finer one to a little past where the grid before reached p_max; docs/benchmarks.md, "Design estimates")."""
+ITERATIONS_PER_COARSE = 4.0
+"""A refinement grid's solver iterations per path row over the coarse pre-run's mean (:func:`find_d_max`;
+docs/benchmarks.md, "Design estimates")."""
+LEVELS_ESTIMATED = 4
+"""Grids of the refinement the expected run counts: most designs converge on their fourth grid, some on their
+second (docs/benchmarks.md, "Design estimates")."""
+LAST_GRID_SHARE = 0.5
+"""The weight of the last grid counted (:data:`LEVELS_ESTIMATED`) in the expected run: designs that converge
+earlier do not walk it (docs/benchmarks.md, "Design estimates")."""
+
+
+def _blocks(shape, grid) -> int:
+    """Pixels of the solved block (a quarter of the grid for a shape mirrored in x and y on an odd grid)."""
+    axes = [a for a in getattr(shape, "mirror_axes", ()) or () if grid.shape[a] % 2 == 1]
+    n = grid.nx * grid.ny
+    return n // (2 ** len(axes)) if axes else n
+
+@dataclass(frozen=True)
+class Cost:
+    """What a design's run costs per grid, known after the coarse pre-run (:func:`find_d_max`): the backend's
+    :class:`tengsim.resources.CostModel`, the path rows per grid and the solver iterations per row."""
+
+    model: CostModel
+    rows: float
+    iterations: float
+    gpu: bool = False
+
+    def grid_seconds(self, shape, grid) -> float:
+        """Seconds of one grid's walk (the GPU solves the whole grid: the JAX solver has no mirror symmetry)."""
+        points = grid.nx * grid.ny if self.gpu else _blocks(shape, grid)
+        return self.rows * self.iterations * self.model.iteration_seconds(points)
+
+
+def on_gpu(cplan) -> bool:
+    """Whether the plan's solver runs on a GPU ('gpu', or 'jax' where JAX sees one)."""
+    from tengsim.solvers.choice import gpu_visible
+
+    name = cplan.solver if isinstance(cplan.solver, str) else getattr(cplan.solver, "name", "")
+    return name == "gpu" or (name == "jax" and gpu_visible()) or getattr(cplan.solver, "device", "") == "gpu"
+
+
+def run_cost(cplan, d_max: float, coarse=None) -> Cost:
+    """The :class:`Cost` of a design's grids: rows from the path's D range (:data:`ROWS_PER_STEP`), iterations per
+    row from the coarse pre-run ``coarse`` (× :data:`ITERATIONS_PER_COARSE`; 20 per row without one)."""
+    its = 20.0
+    if coarse is not None:
+        it = np.asarray(coarse.table.get("iterations", ()), dtype=float)
+        if it.size and np.isfinite(it).all():
+            its = float(np.mean(it))
+    gpu = on_gpu(cplan)
+    return Cost(cost_model(gpu), ROWS_PER_STEP * (d_max - D_MIN) / D_STEP, ITERATIONS_PER_COARSE * its, gpu)
+
+
+@dataclass(frozen=True)
+class Estimate:
+    grids: tuple  # ((nx, ny, dx_m), ...)
+    memory_bytes: int
+    seconds: float
+    d_max: float
+    backend: str = ""
+    cost: Cost | None = None
+    least: float = 0.0
+    """Seconds of the first two grids alone (a design that converges on its second grid)."""
+
+    def lines(self) -> list:
+        from tengsim.design.units import bytes_text, length_text, time_text
+
+        g = ", ".join(f"{nx}×{ny} (dx {length_text(d)})" for nx, ny, d in self.grids)
+        rows = (f", {self.cost.rows:.0f} rows of about {self.cost.iterations:.0f} iterations per grid"
+                if self.cost else "")
+        return [f"grids: {g} (refined by √2 until converged; the last two are used only if needed)",
+                f"memory: {bytes_text(self.memory_bytes)} on the finest; expected time: {time_text(self.seconds)} "
+                f"(the first three grids and half the fourth; {time_text(self.least)} if it converges on the "
+                f"second; D path to about {self.d_max:.0f} ε{rows}) on {self.backend}"]
+
+def estimate(plan, cplan, dx: float, d_max: float, coarse=None) -> Estimate:
+    """Grids, memory and expected time of the refinement (module doc): the first :data:`LEVELS_ESTIMATED` grids,
+    the last at :data:`LAST_GRID_SHARE`, at the cost :func:`run_cost` of the backend the plan solves on."""
+    from tengsim.resources import estimate_bytes
+    from tengsim.run.grids import refinement_grids
+
+    cost = run_cost(cplan, d_max, coarse)
+    grids, secs, least = [], 0.0, 0.0
+    for k, g in enumerate(refinement_grids(cplan.shape, dx, LEVELS_ESTIMATED)):  # the grids the refinement walks
+        if plan.max_pixels is not None and g.nx * g.ny > plan.max_pixels and grids:
+            break
+        grids.append((g.nx, g.ny, g.dx * cplan.scaling.lateral))
+        step = cost.grid_seconds(cplan.shape, g)
+        secs += step * (LAST_GRID_SHARE if k == LEVELS_ESTIMATED - 1 else 1.0)
+        least += step if k < 2 else 0.0
+    nx, ny, _ = grids[-1]
+    return Estimate(tuple(grids), estimate_bytes(nx, ny, cplan.boundary, cplan.solver), secs, d_max,
+                    cost.model.backend, cost, least)
+
+
+def next_grid_line(shape, grids, seconds: float, lateral: float) -> str:
+    """The progress line after a finished grid (the last of ``grids``, the refinement's sequence so far plus the
+    next): its measured time and the next grid's, scaled from it by the pixels (a grid's time goes as its pixels),
+    which the refinement walks if the last two grids have not converged."""
+    from tengsim.design.units import length_text, time_text
+
+    done, nxt = grids[-2], grids[-1]
+    scale = (nxt.nx * nxt.ny) / (done.nx * done.ny)
+    return (f"grid {len(grids) - 1} ({done.nx}×{done.ny}, dx {length_text(done.dx * lateral)}) took "
+            f"{time_text(seconds)}; the next ({nxt.nx}×{nxt.ny}), if not converged yet: about "
+            f"{time_text(seconds * scale)}")
+
+
+def budget_pixels(plan, cplan, dx: float, d_max: float, coarse=None) -> int:
+    """The largest grid (nx·ny) the refinement may reach within the plan's time budget: the last of the grids it
+    walks (:func:`tengsim.run.grids.refinement_grids`) whose cost summed with the grids before it fits the budget
+    (at least the first grid); the default max_pixels, so no default run runs past its budget."""
+    from tengsim.run.grids import grid_sequence
+
+    cost = run_cost(cplan, d_max, coarse)
+    secs, top = 0.0, None
+    for g in itertools.islice(grid_sequence(cplan.shape, dx), 12):
+        secs += cost.grid_seconds(cplan.shape, g)
+        if secs > plan.budget_s and top is not None:
+            break
+        top = g.nx * g.ny
+    return top
+
+
+def cap_line(plan, cplan, dx: float, d_max: float, cap: int, coarse=None) -> str:
+    """The worst case: the refinement's grids up to ``cap`` pixels, and their summed cost."""
+    from tengsim.design.units import time_text
+    from tengsim.run.grids import grid_sequence
+
+    cost = run_cost(cplan, d_max, coarse)
+    secs, last = 0.0, None
+    for g in itertools.islice(grid_sequence(cplan.shape, dx), 12):
+        if g.nx * g.ny > cap and last is not None:
+            break
+        secs += cost.grid_seconds(cplan.shape, g)
+        last = g
+    return (f"at most: refinement up to {last.nx}×{last.ny} (the budget's largest grid; --max-pixels sets it), "
+            f"about {time_text(secs)} in all")
+
+
+def check_budget(plan, est: Estimate, fit_pixels: int | None = None) -> None:
+    """Refuse an expected time over the plan's budget, naming what to change: a max_pixels that fits (when the
+    first two grids do) or a coarser dx."""
+    from tengsim.design.units import length_text, time_text
+
+    if est.seconds <= plan.budget_s:
+        return
+    two = est.grids[1][0] * est.grids[1][1] if len(est.grids) > 1 else None
+    what = f"a coarser --dx (the first grid's is {length_text(est.grids[0][2])})"
+    if fit_pixels and two and fit_pixels >= two:
+        what = f"--max-pixels {fit_pixels} (the grids that fit the budget), {what}"
+    raise TengsimError(f"this design is expected to take {time_text(est.seconds)} on {est.backend.split(' (')[0]}, "
+                       f"over the budget of {time_text(plan.budget_s)}: give {what}, a coarser --tol (now "
+                       f"{plan.tol:g}) or a larger --budget")
+
+class BudgetSpent(TengsimError):
+    """A design stopped at its time budget (what finished is kept; the message says how to go on)."""
+
+
+def deadline(progress, plan, keep, started):
+    """``progress`` (called per path row) that also stops the run, cleanly, once ``plan.budget_s`` seconds
+    have passed since ``started``: the finished grids stay in ``keep`` and the message says how to go on."""
+    import time
+
+    def call(*a, **k):
+        if time.monotonic() - started > plan.budget_s:
+            from tengsim.design.units import time_text
+
+            where = (f"the finished grids are kept in {keep}: run the same command with a larger --budget to go "
+                     "on from them") if keep is not None and keep.exists() else \
+                "no grid had finished: give a larger --budget, a coarser --dx or a coarser --tol"
+            raise BudgetSpent(f"{plan.name[:80]}: stopped at the budget of {time_text(plan.budget_s)}; {where}")
+        if callable(progress):
+            return progress(*a, **k)
+        return None
+
+    return call
