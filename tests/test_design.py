@@ -432,3 +432,21 @@ def test_the_designs_solver_tolerance_moves_its_numbers_far_less_than_tol():
     (a, f, h), (a0, f0, h0) = out
     assert np.max(np.abs(a - a0) / np.maximum(np.abs(a0), 0.01)) < plan.tol / 20
     assert abs(f - f0) < plan.tol / 20 * abs(f0) and abs(h - h0) <= plan.tol / 20 * abs(h0) + 1e-12
+
+
+def test_estimate_on_a_busy_machine_says_the_longer_time(monkeypatch):
+    """On a machine busier than its cores (load / cores >= 1.25) the estimate's line adds the time at that
+    load, the idle estimate × load / cores; an idle machine's line says nothing of it; the GPU's never."""
+    import os
+
+    from tengsim.design import estimate as de
+
+    monkeypatch.setattr(os, "getloadavg", lambda: (5.0, 4.0, 3.0))
+    monkeypatch.setattr(os, "sched_getaffinity", lambda pid: {0, 1})
+    assert de.machine_busy() == (2.5, 5.0, 2)
+    est = de.Estimate(((64, 64, 1e-7),), 1000, 120.0, 10.0, "CPU", None, 60.0, de.machine_busy())
+    assert "busy (load 5.0 on 2 cores): expect about 5.0 min" in est.lines()[1]
+    monkeypatch.setattr(os, "getloadavg", lambda: (1.5, 1.0, 1.0))
+    assert de.machine_busy() == (1.0, 1.5, 2)
+    assert "busy" not in de.Estimate(((64, 64, 1e-7),), 1000, 120.0, 10.0, "CPU", None, 60.0,
+                                     de.machine_busy()).lines()[1]

@@ -86,6 +86,8 @@ class Estimate:
     cost: Cost | None = None
     least: float = 0.0
     """Seconds of the first two grids alone (a design that converges on its second grid)."""
+    busy: tuple = (1.0, 0.0, 1)
+    """(factor, 1-minute load, cores) of the machine when the estimate was made (:func:`machine_busy`)."""
 
     def lines(self) -> list:
         from tengsim.design.units import bytes_text, length_text, time_text
@@ -96,7 +98,38 @@ class Estimate:
         return [f"grids: {g} (refined by √2 until converged; the last two are used only if needed)",
                 f"memory: {bytes_text(self.memory_bytes)} on the finest; expected time: {time_text(self.seconds)} "
                 f"(the first three grids and half the fourth; {time_text(self.least)} if it converges on the "
-                f"second; D path to about {self.d_max:.0f} ε{rows}) on {self.backend}"]
+                f"second; D path to about {self.d_max:.0f} ε{rows}) on {self.backend}" + self.busy_text()]
+
+    def busy_text(self) -> str:
+        """The expected time on this machine as busy as it is now (nothing on a machine that is not)."""
+        from tengsim.design.units import time_text
+
+        factor, load, cores = self.busy
+        if factor < BUSY_SAID:
+            return ""
+        return (f"; this machine is busy (load {load:.1f} on {cores} core{'s' if cores > 1 else ''}): expect about "
+                f"{time_text(self.seconds * factor)}")
+
+
+BUSY_SAID = 1.25
+"""The busy factor (:func:`machine_busy`) from which the estimate's line gives the time on the busy machine too."""
+
+
+def machine_busy() -> tuple:
+    """(factor, 1-minute load average, cores this process may use): how much longer a CPU-bound run takes now
+    than on an idle machine, ``max(1, load / cores)`` (every runnable process gets an equal share of the cores;
+    the design's own pre-run is part of the load).  (1, 0, cores) where the OS gives no load average."""
+    import os
+
+    try:
+        cores = len(os.sched_getaffinity(0))
+    except (AttributeError, OSError):
+        cores = os.cpu_count() or 1
+    try:
+        load = os.getloadavg()[0]
+    except (AttributeError, OSError):
+        return 1.0, 0.0, cores
+    return max(1.0, load / cores), load, cores
 
 def estimate(plan, cplan, dx: float, d_max: float, coarse=None) -> Estimate:
     """Grids, memory and expected time of the refinement (module doc): the first :data:`LEVELS_ESTIMATED` grids,
@@ -115,7 +148,7 @@ def estimate(plan, cplan, dx: float, d_max: float, coarse=None) -> Estimate:
         least += step if k < 2 else 0.0
     nx, ny, _ = grids[-1]
     return Estimate(tuple(grids), estimate_bytes(nx, ny, cplan.boundary, cplan.solver), secs, d_max,
-                    cost.model.backend, cost, least)
+                    cost.model.backend, cost, least, (1.0, 0.0, 1) if cost.gpu else machine_busy())
 
 
 def next_grid_line(shape, grids, seconds: float, lateral: float) -> str:
