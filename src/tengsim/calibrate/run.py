@@ -149,8 +149,9 @@ def _p_max(prob, key, geo):
     from tengsim.calibrate.surrogate import nice_up
 
     top = max(float(c.pressure.max()) for c, g in zip(prob.curves, geo) if g == key)
-    lam_min = prob.bounds["E_star"][0] / prob.E_ref if "E_star" in prob.free else 1.0
-    return nice_up(1.05 * top / lam_min)
+    if "E_star" not in prob.free:  # λ = 1: the nodes' pressures can be the data's own (a step of p_max/20)
+        return nice_up(top)
+    return nice_up(1.05 * top * prob.E_ref / prob.bounds["E_star"][0])
 
 
 def calibrate(prob, out_dir, n_nodes: int = 4, zooms: int = 2, progress=None) -> Calibration:
