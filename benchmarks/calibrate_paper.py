@@ -38,6 +38,8 @@ def main(argv=None):
     ap.add_argument("--nodes", type=int, default=3)
     ap.add_argument("--seed", type=int, default=5)
     ap.add_argument("--zooms", type=int, default=2)
+    ap.add_argument("--free", default="sigma,W,eps", help="sigma,W with ε fixed at the truth")
+    ap.add_argument("--name", default="calibrate_paper", help="the output's name under --out")
     ap.add_argument("--W-lo", default="30mJ/m2")
     ap.add_argument("--W-hi", default="100mJ/m2")
     ap.add_argument("--eps-lo", default="250nm")
@@ -61,15 +63,18 @@ def main(argv=None):
         curves.append(Curve(f"group {g}", P[keep], V[keep] * (1 + a.noise * rng.standard_normal(keep.sum())),
                             ("approach",) * int(keep.sum())))
         tables.append(t)
-    prob = plan_calibration(tables, curves, "sigma,W,eps", {"W": (a.W_lo, a.W_hi), "eps": (a.eps_lo, a.eps_hi)})
-    cal = calibrate(prob, out / "calibrate_paper", n_nodes=a.nodes, zooms=a.zooms,
+    bounds = {"W": (a.W_lo, a.W_hi), "eps": (a.eps_lo, a.eps_hi)}
+    prob = plan_calibration(tables, curves, a.free, {k: v for k, v in bounds.items() if k in a.free})
+    cal = calibrate(prob, out / a.name, n_nodes=a.nodes, zooms=a.zooms,
                     progress=lambda s: print(f"  {s}", file=sys.stderr, flush=True))
-    write_calibration(cal, out / "calibrate_paper")
+    write_calibration(cal, out / a.name)
     f = cal.fit
-    res = {"truth": TRUE, "seed": a.seed, "noise": a.noise, "tol": a.tol, "nodes": a.nodes, "zooms": a.zooms, "bounds": {"W": [a.W_lo, a.W_hi], "eps": [a.eps_lo, a.eps_hi]}, "best": f.best, "interval": f.interval, "words": f.words, "seconds": cal.seconds,
+    res = {"truth": TRUE, "seed": a.seed, "noise": a.noise, "tol": a.tol, "nodes": a.nodes, "zooms": a.zooms,
+           "free": a.free, "bounds": {"W": [a.W_lo, a.W_hi], "eps": [a.eps_lo, a.eps_hi]}, "best": f.best,
+           "interval": f.interval, "words": f.words, "seconds": cal.seconds,
            "designs_solved": cal.nodes_solved, "surrogate_error": cal.surrogate_error, "noise_scale": f.scale,
            "W_rel_error": f.best["W"] / TRUE["W"] - 1, "sigma_rel_error": f.best["sigma"] / TRUE["sigma"] - 1}
-    (out / "calibrate_paper.json").write_text(json.dumps(res, indent=1, default=float))
+    (out / f"{a.name}.json").write_text(json.dumps(res, indent=1, default=float))
     print(json.dumps(res, indent=1, default=float))
 
 
