@@ -13,7 +13,7 @@ TRUE = {"sigma": 8e-6, "W": 25e-3}
 G1 = {"shape": "pyramid", "pitch": "1um", "base": "0.5um", "height": "0.2um", "E_star": "10MPa", "eps": "50nm",
       "tol": 0.05}
 G2 = {**G1, "pitch": "0.8um", "base": "0.4um"}
-P_MAX = 50e3  # what calibrate gives the nodes for data up to 30 kPa (nice_up(1.05 × 30 kPa))
+P_MAX = 50e3  # what calibrate gives the nodes for data up to 30 kPa (nice_up(30 kPa), E* fixed)
 
 
 def _toml(path, table):

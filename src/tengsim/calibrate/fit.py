@@ -261,7 +261,8 @@ def _correlation(model, pts, dev, dmin, b, c, scale):
     if "sigma" in prob.free:
         s = np.maximum(model.sigma_hat(b, c), 1e-300)
         cols.append(np.log(s))
-        extra_var = (scale ** 2 / np.maximum(c, 1e-300)) / s ** 2
+        with np.errstate(over="ignore", divide="ignore", invalid="ignore"):  # c = 0: no charged area, no σ
+            extra_var = (scale ** 2 / np.maximum(c, 1e-300)) / s ** 2
         names.append("sigma")
     for j, name in enumerate(prob.contact_free):
         cols.append(pts[:, j])
@@ -273,9 +274,14 @@ def _correlation(model, pts, dev, dmin, b, c, scale):
     Xc = X - mean
     cov = (Xc * wts[:, None]).T @ Xc
     if extra_var is not None:
-        cov[0, 0] += float(wts @ extra_var)
+        live = wts > 0  # points of no weight add nothing (an infinite variance at one of them included)
+        cov[0, 0] += float(wts[live] @ extra_var[live])
     sd = np.sqrt(np.maximum(np.diag(cov), 1e-300))
-    return tuple(names), cov / np.outer(sd, sd)
+    with np.errstate(invalid="ignore"):
+        corr = cov / np.outer(sd, sd)
+    corr[~np.isfinite(corr)] = 0.0  # an unbounded variance: no linear trade-off to report
+    np.fill_diagonal(corr, 1.0)
+    return tuple(names), corr
 
 
 def identifiability(f: Fit, prob) -> list:

@@ -149,8 +149,9 @@ def _p_max(prob, key, geo):
     from tengsim.calibrate.surrogate import nice_up
 
     top = max(float(c.pressure.max()) for c, g in zip(prob.curves, geo) if g == key)
-    lam_min = prob.bounds["E_star"][0] / prob.E_ref if "E_star" in prob.free else 1.0
-    return nice_up(1.05 * top / lam_min)
+    if "E_star" not in prob.free:  # λ = 1: the nodes' pressures can be the data's own (a step of p_max/20)
+        return nice_up(top)
+    return nice_up(1.05 * top * prob.E_ref / prob.bounds["E_star"][0])
 
 
 def calibrate(prob, out_dir, n_nodes: int = 4, zooms: int = 2, progress=None) -> Calibration:
@@ -204,9 +205,10 @@ def calibrate(prob, out_dir, n_nodes: int = 4, zooms: int = 2, progress=None) ->
                 failed.append(f"W {math.exp(u) * 1e3:.4g} mJ/m², ε {math.exp(v) * 1e9:.4g} nm: {node.message}")
         return out
 
-    def grid(box):
-        us = grid_points(*box[0], n_nodes if 0 in dims else 1)
-        vs = grid_points(*box[1], n_nodes if 1 in dims else 1)
+    def grid(box, n=n_nodes):
+        """Solve the n × n grid over ``box`` (nodes near one solved left out); the number of designs it added."""
+        us = grid_points(*box[0], n if 0 in dims else 1)
+        vs = grid_points(*box[1], n if 1 in dims else 1)
         du = (us[1] - us[0]) / span[0] if len(us) > 1 else 1.0
         dv = (vs[1] - vs[0]) / span[1] if len(vs) > 1 else 1.0
         todo = []
@@ -221,6 +223,7 @@ def calibrate(prob, out_dir, n_nodes: int = 4, zooms: int = 2, progress=None) ->
         for (k, *_), node in zip(todo, solve(todo, "the (W, ε) grid")):
             surr[k].nodes.append(node)
             surr[k]._rbf.clear()
+        return len(todo)
 
     box_uv = ((u0, u1), (v0, v1))
     grid(box_uv)
@@ -236,7 +239,9 @@ def calibrate(prob, out_dir, n_nodes: int = 4, zooms: int = 2, progress=None) ->
         box_uv = _region_box(model, result, ((u0, u1), (v0, v1)), box_uv)
         _say(progress, f"interpolation error {err:.3g} (noise {result.scale:.3g}): zooming on the "
                        "region that fits")
-        grid(box_uv)
+        n = n_nodes
+        while not grid(box_uv, n) and n < 4 * n_nodes:  # the region is the box already solved (a fit too poor
+            n = 2 * n - 1  # to narrow it): its grid at half the spacing, else the zoom would repeat the same fit
         model = Model(prob, surr, geo)
         result = _fit_in_box(model, fit)
     if math.isfinite(err) and err > 0:  # the intervals with room for the model's own error

@@ -1,0 +1,46 @@
+"""Parts of tengsim.calibrate checked on their own (no contact solve): the nodes' pressure range against the data's,
+and the correlation when σ is unbounded at grid points with no charged area."""
+import types
+
+import numpy as np
+import pytest
+
+
+def _prob(free, top, E_bounds=(0.1e6, 10e6), E_ref=1e6):
+    from tengsim.calibrate.data import Curve
+
+    c = Curve("c", np.linspace(top / 10, top, 10), np.ones(10), ("approach",) * 10)
+    return types.SimpleNamespace(curves=[c], free=free, bounds={"E_star": E_bounds}, E_ref=E_ref)
+
+
+def test_nodes_reach_the_datas_top_pressure_on_the_datas_own_steps_when_E_star_is_fixed():
+    """E* fixed (λ = 1): p_max is the data's top rounded up to 1, 2, 2.5, 5 × 10^k, so data every p_max/20 fall on
+    the nodes' own pressures (no interpolation across a jump in A/S between two node pressures)."""
+    from tengsim.calibrate.run import _p_max
+
+    assert _p_max(_prob(("sigma", "W", "eps"), 100e3), "g", ("g",)) == pytest.approx(100e3)
+    assert _p_max(_prob(("sigma", "W"), 30e3), "g", ("g",)) == pytest.approx(50e3)
+
+
+def test_nodes_reach_the_datas_top_pressure_at_the_softest_E_star_when_free():
+    """E* free: a node at E_ref is read at P·E_ref/E*, so it must reach top·E_ref/E*_min."""
+    from tengsim.calibrate.run import _p_max
+
+    p = _p_max(_prob(("sigma", "E_star"), 10e3, (0.5e6, 2e6), 1e6), "g", ("g",))
+    assert p >= 10e3 * 1e6 / 0.5e6 and p <= 2 * 1.05 * 10e3 * 1e6 / 0.5e6
+
+
+def test_correlation_stays_finite_where_a_grid_point_has_no_charged_area():
+    """A grid point whose A/S is 0 at every data pressure (c = 0) leaves σ unbounded there; with no likelihood
+    weight it must not turn the correlation matrix into NaN."""
+    from tengsim.calibrate.fit import _correlation
+
+    prob = types.SimpleNamespace(free=("sigma", "W"), contact_free=("W",), bounds={"sigma": (1e-8, 5e-4)})
+    model = types.SimpleNamespace(prob=prob, sigma_hat=lambda b, c: np.where(c > 0, b / np.maximum(c, 1e-300), 1e-8))
+    pts = np.log(np.array([[0.01], [0.02], [0.03], [0.04]]))
+    dev = np.array([2000.0, 1.0, 0.0, 1.5])  # the c = 0 point is far outside: exp(-1000) = 0 weight
+    b = np.array([0.0, 1.0, 1.1, 1.2])
+    c = np.array([0.0, 1e5, 1.1e5, 1.2e5])
+    names, corr = _correlation(model, pts, dev, 0.0, b, c, 0.01)
+    assert names == ("sigma", "W")
+    assert np.isfinite(corr).all() and np.allclose(np.diag(corr), 1.0) and abs(corr[0, 1]) <= 1.0
