@@ -44,3 +44,19 @@ def test_correlation_stays_finite_where_a_grid_point_has_no_charged_area():
     names, corr = _correlation(model, pts, dev, 0.0, b, c, 0.01)
     assert names == ("sigma", "W")
     assert np.isfinite(corr).all() and np.allclose(np.diag(corr), 1.0) and abs(corr[0, 1]) <= 1.0
+
+
+def test_a_bare_bound_read_as_SI_is_refused_where_implausible():
+    """--bounds W=10:60 (meant as mJ/m²) is 10–60 J/m²: refused naming --bounds and the value, as a design's
+    key is, instead of a later message that blamed the design file; bounds with units pass."""
+    import pytest
+
+    from tengsim.calibrate.problem import parse_bounds
+    from tengsim.errors import TengsimError
+
+    with pytest.raises(TengsimError, match=r"--bounds W: W = 60 is read as 60 J/m2.*'60mJ/m2'"):
+        parse_bounds("W=10:60")
+    with pytest.raises(TengsimError, match=r"--bounds eps: eps = 30 is read as 30 m"):
+        parse_bounds("eps=30:80")
+    assert parse_bounds("W=10mJ/m2:60mJ/m2,eps=3e-8:8e-8") == {"W": pytest.approx((0.01, 0.06)),
+                                                                "eps": pytest.approx((3e-8, 8e-8))}

@@ -56,6 +56,25 @@ def parse_free(spec) -> tuple:
     return tuple(k for k in PARAMS if k in out)
 
 
+PLAUSIBLE_AS = {"W": "energy/area", "eps": "length", "E_star": "modulus"}
+"""The quantity (:data:`tengsim.units.PLAUSIBLE`) a bare number given as a bound must be plausible for."""
+
+
+def _bound(text, name: str) -> float:
+    """One bound in SI: a quantity with its unit, or a bare number read as SI and refused where implausible
+    (``W=10:60`` is 10 to 60 J/m², not mJ/m²: one line naming it, as a design's keys are)."""
+    from tengsim.units import check_plausible, parse_quantity
+
+    value = parse_quantity(text, KINDS[name], name)
+    try:
+        float(str(text).strip())
+    except ValueError:
+        return value  # it carries its unit
+    if name in PLAUSIBLE_AS:
+        check_plausible(name, value, PLAUSIBLE_AS[name])
+    return value
+
+
 def parse_bounds(spec) -> dict:
     """'W=20mJ/m2:200mJ/m2,eps=30nm:300nm' (or a dict {name: (lo, hi)} of strings or SI numbers) → {name: (lo, hi)}."""
     from tengsim.units import parse_quantity
@@ -73,7 +92,7 @@ def parse_bounds(spec) -> dict:
             raise TengsimError(f"--bounds {k!r}: not a parameter (sigma, W, eps, E_star)")
         lo, hi = v.split(":", 1) if isinstance(v, str) else v
         try:
-            lo, hi = (parse_quantity(x, KINDS[name], name) for x in (lo, hi))
+            lo, hi = (_bound(x, name) for x in (lo, hi))
         except TengsimError as exc:
             raise TengsimError(f"--bounds {name}: {exc}") from None
         if not 0 < lo < hi:
