@@ -326,15 +326,15 @@ def test_budget_cap_is_the_last_refinement_grid_the_budget_pays_for():
     from tengsim.cli.design import _read_toml
     from tengsim.design.estimate import budget_pixels, run_cost
     from tengsim.design.walk import height_eps, start_dx
-    from tengsim.run.grids import refinement_grids
+    from tengsim.run.grids import GridSequence, refinement_grids
 
     plan = plan_design(_read_toml(str(Path(__file__).parent.parent / "examples" / "own_design" / "pyramid.toml")))
     cp = plan.contact_plan
     dx = start_dx(plan, cp)
     d_max = 1.2 * height_eps(cp, dx) + 2.0
-    cap = budget_pixels(plan, cp, dx, d_max)
-    assert cap >= 585 * 585
     cost = run_cost(cp, d_max)
+    cap = budget_pixels(plan, cp.shape, GridSequence(cp.shape, dx), cost)
+    assert cap >= 585 * 585
     seq = refinement_grids(cp.shape, dx, 12)
     below = [g for g in seq if g.nx * g.ny <= cap]
     assert below[-1].nx * below[-1].ny == cap  # the cap is a grid of the sequence
@@ -359,18 +359,23 @@ def test_estimate_uses_the_backends_cost_and_names_it(monkeypatch):
     plan = plan_design(_read_toml(str(Path(__file__).parent.parent / "examples" / "own_design" / "pyramid.toml")))
     cp = plan_contact(plan.contact_table)
     assert cp.solver == "fast" and "no GPU" in cp.solver_note  # auto, on this machine
+    from tengsim.run.grids import GridSequence
+
     dx = dr.start_dx(plan, cp)
-    cpu = dr.estimate(plan, cp, dx, 25.0)
+    seq = GridSequence(cp.shape, dx)
+    cpu = dr.estimate(plan, cp, seq, 25.0, dr.run_cost(cp, 25.0))
     assert cpu.backend == CPU_COST.backend and "CPU" in cpu.lines()[1]
     monkeypatch.setattr(choice, "gpu_visible", lambda: True)
-    gpu = dr.estimate(plan, dataclasses.replace(cp, solver="gpu"), dx, 25.0)
+    cp_gpu = dataclasses.replace(cp, solver="gpu")
+    gpu = dr.estimate(plan, cp_gpu, seq, 25.0, dr.run_cost(cp_gpu, 25.0))
     assert gpu.backend == GPU_COST.backend and "GPU" in gpu.lines()[1]
     g = cp.shape.grid(dx)
     rows_its = gpu.cost.rows * gpu.cost.iterations
     per_iteration = GPU_COST.floor + GPU_COST.per_point * g.nx * g.ny
     assert gpu.cost.grid_seconds(cp.shape, g) == pytest.approx(rows_its * per_iteration)
     assert gpu.seconds < cpu.seconds
-    assert dr.budget_pixels(plan, dataclasses.replace(cp, solver="gpu"), dx, 25.0) > dr.budget_pixels(plan, cp, dx, 25.0)
+    assert (dr.budget_pixels(plan, cp.shape, seq, dr.run_cost(cp_gpu, 25.0))
+            > dr.budget_pixels(plan, cp.shape, seq, dr.run_cost(cp, 25.0)))
 
 
 def test_auto_picks_the_gpu_where_jax_sees_one(monkeypatch):

@@ -193,13 +193,15 @@ def estimate_seconds(table: dict) -> float:
     import dataclasses
 
     from tengsim.design import plan_design
-    from tengsim.design.run import estimate, height_eps, solver_tol, start_dx
+    from tengsim.design.run import estimate, height_eps, run_cost, solver_tol, start_dx
+    from tengsim.run.grids import GridSequence
     from tengsim.run.plan import as_plan
 
     plan = plan_design(table)
     cplan = dataclasses.replace(as_plan(plan.contact_plan), tol=solver_tol(plan))
     dx = start_dx(plan, cplan)
-    return float(estimate(plan, cplan, dx, 1.2 * height_eps(cplan, dx) + 2.0).seconds)
+    d_max = 1.2 * height_eps(cplan, dx) + 2.0
+    return float(estimate(plan, cplan, GridSequence(cplan.shape, dx), d_max, run_cost(cplan, d_max)).seconds)
 
 
 def grid_points(lo, hi, n) -> np.ndarray:

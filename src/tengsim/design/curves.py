@@ -45,6 +45,11 @@ def _params(res, plan) -> dict:
     return {**res.params, "config": {"shape": plan.shape}}
 
 
+def _shape(plan):
+    """The plan's shape object (None for a plan without its contact plan): what A/S asks (:func:`tengsim.run.area.patch`)."""
+    return getattr(getattr(plan, "contact_plan", None), "shape", None)
+
+
 def area_definition(plan) -> str:
     """The plan's charged-area definition: 'contact' (default) or 'paper'."""
     return getattr(plan, "area", "contact") or "contact"
@@ -52,14 +57,14 @@ def area_definition(plan) -> str:
 
 def definition(res, plan) -> str:
     """The charged-area definition in words (the report's line)."""
-    from tengsim.run.area import CHARGED_COLUMN, family
+    from tengsim.run.area import CHARGED_COLUMN, patch
 
     if area_definition(plan) == "contact" and CHARGED_COLUMN in res.table:
         law = res.params.get("law") or "the law"
         return ("the 2-D contact area, A/S = area where the gap is below the separation of the law's peak tension "
                 f"({law}; Greenwood's contact edge; a law without tension: its wall's gap), measured on the "
                 "contact map, over the cell area S")
-    return DEFINITIONS[family(_params(res, plan))]
+    return DEFINITIONS[patch(_shape(plan), _params(res, plan))[1]]
 
 
 def _retraction_states(res, cols):
@@ -99,7 +104,7 @@ def states(res, plan) -> dict:
     col = CHARGED_COLUMN if contact else "contact_length"
 
     def area(v):
-        return np.clip(np.asarray(v, float), 0.0, 1.0) if contact else area_fraction(res, v, p)
+        return np.clip(np.asarray(v, float), 0.0, 1.0) if contact else area_fraction(res, v, p, _shape(plan))
 
     F, L = load_control(res, col)
     _, R = load_control(res, "area_repulsive")
@@ -132,10 +137,11 @@ def branch_curves(res, plan) -> dict:
 def _full_fraction(res, plan) -> float:
     from tengsim.run.area import area_fraction, full_length
 
-    full = full_length(_params(res, plan))
+    shape = _shape(plan)
+    full = full_length(_params(res, plan), shape)
     if not math.isfinite(full):
         return math.nan
-    return float(area_fraction(res, [full], _params(res, plan))[0])
+    return float(area_fraction(res, [full], _params(res, plan), shape)[0])
 
 
 def sensor(res, plan):

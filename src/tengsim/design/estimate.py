@@ -12,6 +12,7 @@ a run past its budget is stopped between two rows (:func:`deadline`, :class:`Bud
 from __future__ import annotations
 
 import itertools
+
 from dataclasses import dataclass
 
 import numpy as np
@@ -131,23 +132,23 @@ def machine_busy() -> tuple:
         return 1.0, 0.0, cores
     return max(1.0, load / cores), load, cores
 
-def estimate(plan, cplan, dx: float, d_max: float, coarse=None) -> Estimate:
-    """Grids, memory and expected time of the refinement (module doc): the first :data:`LEVELS_ESTIMATED` grids,
-    the last at :data:`LAST_GRID_SHARE`, at the cost :func:`run_cost` of the backend the plan solves on."""
+def estimate(plan, cplan, grids, d_max: float, cost: Cost) -> Estimate:
+    """Grids, memory and expected time of the refinement (module doc): the first :data:`LEVELS_ESTIMATED` of
+    ``grids`` (the refinement's sequence, :class:`tengsim.run.grids.GridSequence`), the last at
+    :data:`LAST_GRID_SHARE`, at ``cost`` (:func:`run_cost` of the backend the plan solves on, for the D range
+    ``d_max``)."""
     from tengsim.resources import estimate_bytes
-    from tengsim.run.grids import refinement_grids
 
-    cost = run_cost(cplan, d_max, coarse)
-    grids, secs, least = [], 0.0, 0.0
-    for k, g in enumerate(refinement_grids(cplan.shape, dx, LEVELS_ESTIMATED)):  # the grids the refinement walks
-        if plan.max_pixels is not None and g.nx * g.ny > plan.max_pixels and grids:
+    chosen, secs, least = [], 0.0, 0.0
+    for k, g in enumerate(itertools.islice(grids, LEVELS_ESTIMATED)):  # the grids the refinement walks
+        if plan.max_pixels is not None and g.nx * g.ny > plan.max_pixels and chosen:
             break
-        grids.append((g.nx, g.ny, g.dx * cplan.scaling.lateral))
+        chosen.append((g.nx, g.ny, g.dx * cplan.scaling.lateral))
         step = cost.grid_seconds(cplan.shape, g)
         secs += step * (LAST_GRID_SHARE if k == LEVELS_ESTIMATED - 1 else 1.0)
         least += step if k < 2 else 0.0
-    nx, ny, _ = grids[-1]
-    return Estimate(tuple(grids), estimate_bytes(nx, ny, cplan.boundary, cplan.solver), secs, d_max,
+    nx, ny, _ = chosen[-1]
+    return Estimate(tuple(chosen), estimate_bytes(nx, ny, cplan.boundary, cplan.solver), secs, d_max,
                     cost.model.backend, cost, least, (1.0, 0.0, 1) if cost.gpu else machine_busy())
 
 
@@ -164,33 +165,33 @@ def next_grid_line(shape, grids, seconds: float, lateral: float) -> str:
             f"{time_text(seconds * scale)}")
 
 
-def budget_pixels(plan, cplan, dx: float, d_max: float, coarse=None) -> int:
-    """The largest grid (nx·ny) the refinement may reach within the plan's time budget: the last of the grids it
-    walks (:func:`tengsim.run.grids.refinement_grids`) whose cost summed with the grids before it fits the budget
-    (at least the first grid); the default max_pixels, so no default run runs past its budget."""
-    from tengsim.run.grids import grid_sequence
+SEQUENCE_COUNTED = 12
+"""Grids of the refinement's sequence the budget and the worst case look at (the refinement never walks more)."""
 
-    cost = run_cost(cplan, d_max, coarse)
+
+def budget_pixels(plan, shape, grids, cost: Cost) -> int:
+    """The largest grid (nx·ny) the refinement may reach within the plan's time budget: the last of ``grids`` (the
+    refinement's sequence, :func:`tengsim.run.grids.refinement_grids`) whose cost (``cost``, :func:`run_cost`)
+    summed with the grids before it fits the budget (at least the first grid); the default max_pixels, so no
+    default run runs past its budget."""
     secs, top = 0.0, None
-    for g in itertools.islice(grid_sequence(cplan.shape, dx), 12):
-        secs += cost.grid_seconds(cplan.shape, g)
+    for g in itertools.islice(grids, SEQUENCE_COUNTED):
+        secs += cost.grid_seconds(shape, g)
         if secs > plan.budget_s and top is not None:
             break
         top = g.nx * g.ny
     return top
 
 
-def cap_line(plan, cplan, dx: float, d_max: float, cap: int, coarse=None) -> str:
-    """The worst case: the refinement's grids up to ``cap`` pixels, and their summed cost."""
+def cap_line(shape, grids, cost: Cost, cap: int) -> str:
+    """The worst case: the refinement's grids (``grids``) up to ``cap`` pixels, and their summed cost."""
     from tengsim.design.units import time_text
-    from tengsim.run.grids import grid_sequence
 
-    cost = run_cost(cplan, d_max, coarse)
     secs, last = 0.0, None
-    for g in itertools.islice(grid_sequence(cplan.shape, dx), 12):
+    for g in itertools.islice(grids, SEQUENCE_COUNTED):
         if g.nx * g.ny > cap and last is not None:
             break
-        secs += cost.grid_seconds(cplan.shape, g)
+        secs += cost.grid_seconds(shape, g)
         last = g
     return (f"at most: refinement up to {last.nx}×{last.ny} (the budget's largest grid; --max-pixels sets it), "
             f"about {time_text(secs)} in all")

@@ -47,23 +47,9 @@ def kept_path(keep, base: str) -> float | None:
 
 def checkpoint(keep, base, d_max, progress):
     """The refinement's checkpoint in the file ``keep`` for this design (``base``, :func:`identity`) and path
-    (None without ``keep``): each finished grid is kept there, and a run of the same design and path takes its
-    grids back instead of computing them again; grids of the same design on a shorter path (its first pass)
-    are replaced quietly, those of another design with a line saying so."""
+    (None without ``keep``): :func:`tengsim.run.checkpoint.open_checkpoint`, its lines said on ``progress``."""
     if keep is None:
         return None
-    from tengsim.errors import TengsimError as _Err
-    from tengsim.run.checkpoint import Checkpoint
+    from tengsim.run.checkpoint import open_checkpoint
 
-    ck = Checkpoint(keep, f"{base}@{d_max!r}")
-    try:
-        found = ck.load()
-    except _Err:
-        if not (ck.stored_digest() or "").startswith(base + "@"):
-            _say(progress, f"{keep} holds grids of another design or input: they are replaced")
-        keep.unlink()
-        found = None
-    if found is not None:
-        _say(progress, f"taking back {len(found[0])} finished grid(s) from {keep}")
-    keep.parent.mkdir(parents=True, exist_ok=True)
-    return ck, found
+    return open_checkpoint(keep, base, d_max, lambda text: _say(progress, text))

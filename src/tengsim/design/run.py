@@ -4,18 +4,20 @@
 
 1. **Checks.**  :func:`preflight` checks every bound from the sizes alone (the solver, the first grid, the memory,
    the budget) before any array is allocated; :func:`choose_solver` puts a cohesive law with a wall on 'pk'.
-2. **Path.**  The first grid (:func:`tengsim.design.walk.start_dx`) and the path's D range, found on a coarse grid
-   (:func:`tengsim.design.walk.find_d_max`).
+2. **Path.**  The first grid (:func:`tengsim.design.walk.start_dx`), the refinement's grids
+   (:class:`tengsim.run.grids.GridSequence`) and the path's D range, found on a coarse grid
+   (:func:`tengsim.run.reach.find_d_max`).
 3. **Estimate.**  The grids, the memory and the expected time (:func:`tengsim.design.estimate.estimate`), the worst
    case up to the budget's largest grid (:func:`tengsim.design.estimate.cap_line`); an expected time over the
    budget is refused before the refinement is solved or anything written.
-4. **Refinement.**  :func:`tengsim.run.resolve.resolve_plan` on dx, dx/√2, ... (:mod:`tengsim.run.grids`) until the
+4. **Refinement.**  :func:`tengsim.run.reach.resolve_to` on dx, dx/√2, ... (:mod:`tengsim.run.grids`) until the
    charged-area fraction A/S on the approach at every asked pressure, the pull-off force and the jump D values change
    by at most tol between the last two grids (and their Richardson error is within tol).  If the finest grid does
    not reach p_max (a finer grid is softer), d_max grows and the refinement runs again (once).  The retraction's
    numbers (A/S on the retraction, the hysteresis energy) are recorded per grid with their change and Richardson
    error but not judged (:func:`tengsim.design.walk._watcher`); the pull-off force is judged.  Each finished grid is
-   kept (:mod:`tengsim.design.keep`), so a killed run resumes.
+   kept (:func:`tengsim.run.checkpoint.open_checkpoint`, under :func:`tengsim.design.keep.identity`), so a killed
+   run resumes.
 5. **Maps.**  Each grid after the first keeps the pressure and gap maps at the D where the grid before it reached
    the asked pressures nearest 10 %, 50 % and 100 % of p_max (:func:`tengsim.design.walk.grid_path`): the finest
    grid's maps come from its own walk, at the coarser grid's prediction of those D (the figure titles say the
@@ -23,17 +25,16 @@
 """
 from __future__ import annotations
 
-import dataclasses
 from dataclasses import dataclass, field
 
 from tengsim.design.estimate import (BudgetSpent, budget_pixels, cap_line, check_budget, deadline,  # noqa: F401
                                      estimate, run_cost)
 from tengsim.design.plan import PK_LAWS, SOLVER_TOL_PER_TOL, solver_tol  # noqa: F401
-from tengsim.design.keep import checkpoint, identity, kept_path
+from tengsim.design.keep import checkpoint, identity, kept_path  # noqa: F401
 from tengsim.design.walk import (D_MIN, D_STEP, _observer, _reach, _say, _simulate, _watcher,  # noqa: F401
-                                 find_d_max, grid_path, height_eps, maps_asked, start_dx)
+                                 find_d_max, grid_path, height_eps, map_pressures, maps_asked, path_to, start_dx)
 from tengsim.errors import TengsimError
-from tengsim.run.grids import refinement_grids
+from tengsim.run.grids import refinement_grids  # noqa: F401
 
 
 @dataclass(frozen=True)
@@ -80,17 +81,17 @@ def preflight(plan, progress=None):
     try:
         dx = start_dx(plan, cplan)
         g = cplan.shape.grid(dx)
-    except GeometryError as exc:
-        raise exc.in_metres(lateral, _metres) from None
-    first = f"the first grid {g.nx}×{g.ny} (dx {length_text(g.dx * lateral)})"
-    if plan.max_pixels is not None and g.nx * g.ny > plan.max_pixels:
-        raise TengsimError(f"{plan.name[:80]}: {first} has {g.nx * g.ny} pixels, over max_pixels = "
-                           f"{plan.max_pixels}: give a larger --max-pixels or a coarser --dx")
-    check_memory(g.nx, g.ny, cplan.boundary, cplan.solver)
-    if (cplan.kernel_params or {}).get("thickness") is not None:
-        from tengsim.kernels.film import check_film_pixels
+        first = f"the first grid {g.nx}×{g.ny} (dx {length_text(g.dx * lateral)})"
+        if plan.max_pixels is not None and g.nx * g.ny > plan.max_pixels:
+            raise TengsimError(f"{plan.name[:80]}: {first} has {g.nx * g.ny} pixels, over max_pixels = "
+                               f"{plan.max_pixels}: give a larger --max-pixels or a coarser --dx")
+        if (cplan.kernel_params or {}).get("thickness") is not None:
+            from tengsim.kernels.film import check_film_pixels
 
-        check_film_pixels(cplan.kernel_params["thickness"], max(g.dx, g.dy), lateral)
+            check_film_pixels(cplan.kernel_params["thickness"], max(g.dx, g.dy), lateral)
+        check_memory(g.nx, g.ny, cplan.boundary, cplan.solver)
+    except GeometryError as exc:  # a size that does not fit, said in the user's units
+        raise exc.in_metres(lateral, _metres) from None
     secs = run_cost(cplan, 2.0).grid_seconds(cplan.shape, g)  # the shortest path, on the backend's cost model
     if secs > plan.budget_s:
         raise TengsimError(f"{plan.name[:80]}: {first} alone is estimated at {time_text(secs)}, over the budget "
@@ -109,16 +110,15 @@ def choose_solver(plan, cplan, progress=None):
     return cplan
 
 
-def _grid_done(progress, cplan, dx, save):
-    """The refinement's call after each finished grid: the grid kept (``save``, or None) and a line with its
-    measured time and the next grid's expected one (:func:`tengsim.design.estimate.next_grid_line`)."""
+def _grid_done(progress, cplan, grids):
+    """The refinement's call after each finished (and kept) grid: a line with its measured time and the next
+    grid's expected one (:func:`tengsim.design.estimate.next_grid_line`; ``grids`` the refinement's sequence,
+    :class:`tengsim.run.grids.GridSequence`)."""
     from tengsim.design.estimate import next_grid_line
 
-    def done(levels, phases, res):
-        if save is not None:
-            save(levels, phases, res)
-        grids = refinement_grids(cplan.shape, dx, len(levels) + 1)
-        _say(progress, next_grid_line(cplan.shape, grids, levels[-1]["seconds"], cplan.scaling.lateral))
+    def done(levels):
+        _say(progress, next_grid_line(cplan.shape, grids[:len(levels) + 1], levels[-1]["seconds"],
+                                      cplan.scaling.lateral))
 
     return done
 
@@ -131,50 +131,43 @@ def run_design(plan, progress=None, keep=None) -> DesignResult:
     from tengsim.run.plan import ResolveSettings
     from tengsim.design.curves import summarize
     from tengsim.design.write import to_dataset
-    from tengsim.continuation import PathSpec
-    from tengsim.run.resolve import resolve_plan
+    from tengsim.run.grids import GridSequence
+    from tengsim.run.reach import resolve_to
 
     import time
 
     started = time.monotonic()
+    # what lives on the design's own floor first: the kept grids' identity, the observers, the guards
+    base = identity(plan)
+    later = kept_path(keep, base)
+    observe, watch = _observer(plan), _watcher(plan)
+    coarse_guard, guard = deadline(None, plan, keep, started), deadline(progress, plan, keep, started)
+    maps_at = map_pressures(plan) if plan.maps else ()
+
+    def said(text):
+        _say(progress, text)
+
     cplan = preflight(plan, progress)  # the plan plan_design built, with the design's solver and tolerance
     dx = start_dx(plan, cplan)
     _say(progress, f"{plan.name}: Tabor number {cplan.tabor:.3g} (from eps = {plan.eps * 1e9:.3g} nm), "
                    f"lateral unit {cplan.scaling.lateral * 1e9:.3g} nm")
     if cplan.solver_note:
         _say(progress, cplan.solver_note)
-    d_max, coarse = find_d_max(plan, cplan, dx, progress,  # the path's range and iterations, on a cheap grid
-                               guard=deadline(None, plan, keep, started))
-    est = estimate(plan, cplan, dx, d_max, coarse)
+    grids = GridSequence(cplan.shape, dx)  # the refinement's grids: its estimate, its budget, its lines
+    done = _grid_done(progress, cplan, grids)
+    d_max, coarse = find_d_max(plan, cplan, dx, progress, guard=coarse_guard)  # the path's range, on a cheap grid
+    est = estimate(plan, cplan, grids, d_max, run_cost(cplan, d_max, coarse))
     for line in est.lines():
         _say(progress, line)
-    base = identity(plan)
-    later = kept_path(keep, base)
     if later is not None and later > d_max:  # killed in its second pass: go on on that pass's path
         d_max = later
-    max_pixels = plan.max_pixels or budget_pixels(plan, cplan, dx, d_max, coarse)
+    cost = run_cost(cplan, d_max, coarse)
+    max_pixels = plan.max_pixels or budget_pixels(plan, cplan.shape, grids, cost)
     check_budget(plan, est, max_pixels)
-    _say(progress, cap_line(plan, cplan, dx, d_max, max_pixels, coarse))
-    res = None
-    for attempt in range(2):
-        ck, found = checkpoint(keep, base, d_max, progress) or (None, None)
-        path = PathSpec(D_MIN, d_max, D_STEP, adaptive=True)
-        res = resolve_plan(dataclasses.replace(cplan, path=path, resolve=ResolveSettings(plan.tol, max_pixels, dx)),
-                           observe=_observer(plan), watch=_watcher(plan),
-                           path_for=grid_path(plan, d_max, cut=attempt == 0),
-                           progress=deadline(progress, plan, keep, started),
-                           checkpoint=_grid_done(progress, cplan, dx, None if ck is None else ck.save), start=found)
-        if res.scaling is None:  # every grid taken back from the checkpoint file, which keeps the columns only
-            res = dataclasses.replace(res, scaling=cplan.scaling)
-        ok, D_hit, top, slope = _reach(res, plan.pressures[-1])
-        if ok:
-            break
-        d_max = 1.2 * d_max + 2.0
-    else:
-        raise TengsimError(f"the approach reached only {top / 1e3:.4g} kPa of p_max = {plan.pressures[-1] / 1e3:.4g} "
-                           f"kPa on the finest grid, walked to D = {d_max:.4g} ε "
-                           f"({d_max * cplan.scaling.eps * 1e6:.3g} µm) on every grid: give a lower p_max")
-    summary, conv, notes = summarize(res, plan)
+    _say(progress, cap_line(cplan.shape, grids, cost, max_pixels))
+    res = resolve_to(cplan, plan.pressures[-1], d_max, ResolveSettings(plan.tol, max_pixels, dx), maps_at, observe,
+                     watch, guard, keep, base, done, said)
     maps, depths = (res, maps_asked(res, plan)) if plan.maps and res.maps else (None, {})
+    summary, conv, notes = summarize(res, plan)
     summary["map_pressures_asked"] = tuple(depths.items())
     return DesignResult(plan, to_dataset(res, plan, summary), summary, conv, res, tuple(notes), maps)

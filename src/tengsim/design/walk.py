@@ -2,12 +2,10 @@
 
 The first dx is the user's (a length) or :func:`start_dx`: the first grid of the refinement's sequence
 (:mod:`tengsim.run.grids`) whose dx is at most the law's process zone over :data:`START_ZONE_PIXELS`.
-The path is an adaptive D walk (:class:`tengsim.continuation.path.PathSpec`) from D = -1 ε to a d_max found on a grid
-twice as coarse as the default first grid (:func:`find_d_max`): from 1.2 × the structure's height (+2 ε), extended in
-chunks (the last rows' dP/dD, extrapolated to 1.3 × the pressure still missing) until the approach reaches p_max, at
-most :data:`EXTEND_TRIES` times; else an error naming the highest pressure reached, in kPa.  A finer grid's walk ends
-a little past the D at which the grid before it reached p_max (:func:`grid_path`), and keeps the pressure and gap maps
-at the D where the grid before it reached the asked pressures nearest 10 %, 50 % and 100 % of p_max.
+The path to p_max is the run layer's (:mod:`tengsim.run.reach`): an adaptive D walk from D = -1 ε to a d_max found on
+a grid twice as coarse as the default first grid (:func:`find_d_max`), each finer grid's walk ending a little past
+the D at which the grid before it reached p_max (:func:`grid_path`).  The design chooses where the pressure and gap
+maps are kept: at the asked pressures nearest 10 %, 50 % and 100 % of p_max (:func:`map_pressures`).
 """
 from __future__ import annotations
 
@@ -15,12 +13,9 @@ import math
 
 import numpy as np
 
-from tengsim.errors import TengsimError
-
-D_MIN = -1.0
-D_STEP = 0.4
-"""Largest D step (ε) of the adaptive walk (refine_levels 4: smallest 0.025 ε)."""
-EXTEND_TRIES = 6
+from tengsim.run.reach import D_MIN, D_STEP, EXTEND_TRIES, path_to, reach as _reach  # noqa: F401
+from tengsim.run.reach import D_MARGIN, find_d_max as reach_d_max, grid_path as reach_grid_path  # noqa: F401
+from tengsim.run.reach import map_depths as reach_depths
 
 
 def _say(progress, text):
@@ -49,112 +44,50 @@ def height_eps(cplan, dx) -> float:
     U0 = cplan.shape.gap(cplan.shape.grid(dx))
     return float(np.nanmax(U0) - np.nanmin(U0))
 
+
 def _simulate(cplan, dx, d_max, **kw):
     """``cplan`` on the grid of spacing ``dx``, walked from D_MIN to ``d_max``."""
     import dataclasses
 
-    from tengsim.continuation import PathSpec
     from tengsim.run.simulate import simulate_plan
 
-    path = PathSpec(D_MIN, d_max, D_STEP, adaptive=True)
-    return simulate_plan(dataclasses.replace(cplan, dx=dx, grid=None, path=path), **kw)
-
-
-def _reach(res, p_max):
-    """(reached, D where the approach first reaches p_max (NaN if not), highest approach pressure, slope dP/dD)."""
-    a = res.branch("approach")
-    D, P = np.asarray(a["D"], float), np.asarray(a["pressure_Pa"], float)
-    hit = np.flatnonzero(P >= p_max)
-    n = max(2, len(D) // 10)
-    slope = (P[-1] - P[-n]) / (D[-1] - D[-n]) if len(D) > n and D[-1] > D[-n] else math.nan
-    return bool(len(hit)), (float(D[hit[0]]) if len(hit) else math.nan), float(np.max(P)), slope
+    return simulate_plan(dataclasses.replace(cplan, dx=dx, grid=None, path=path_to(d_max)), **kw)
 
 
 def find_d_max(plan, cplan, dx, progress=None, guard=None):
     """(d_max, the coarse result): the D range that reaches p_max on a grid twice as coarse as the first
-    (module doc); ``guard`` (called per path row, e.g. :func:`tengsim.design.estimate.deadline`) may stop it."""
+    (:func:`tengsim.run.reach.find_d_max`; each extension said in one line); ``guard`` (called per path row,
+    e.g. :func:`tengsim.design.estimate.deadline`) may stop it."""
     from tengsim.design.units import pressure_text
 
-    from tengsim.run.grids import default_dx
-
-    p_max = plan.pressures[-1]
-
-    # the default grid's (the cell over 9 pixels at most): cheap, whatever the first grid (a --dx too)
-    coarse = 2 * max(dx, default_dx(cplan.shape, cplan.law, cplan.coupling, cplan.boundary))
-    d_max = 1.2 * height_eps(cplan, dx) + 2.0
-    for _ in range(EXTEND_TRIES):
-        res = _simulate(cplan, coarse, d_max, **({} if guard is None else {"progress": guard}))
-        ok, D_hit, top, slope = _reach(res, p_max)
-        if ok:
-            return 1.1 * D_hit + 1.0, res
-        grow = 1.3 * (p_max - top) / slope if math.isfinite(slope) and slope > 0 else 0.5 * d_max
+    def extending(top, d_max):
         _say(progress, f"path: {pressure_text(top)} reached at D = {d_max:.3g} ε, extending")
-        d_max += min(max(grow, 2.0), 2.0 * d_max)
-    raise TengsimError(f"the approach reached only {top / 1e3:.4g} kPa of p_max = {p_max / 1e3:.4g} kPa after "
-                       f"{EXTEND_TRIES} extensions of the path (to D = {d_max:.4g} ε = "
-                       f"{d_max * cplan.scaling.eps * 1e6:.3g} µm): give a lower p_max")
+
+    return reach_d_max(cplan, dx, plan.pressures[-1], height_eps(cplan, dx), extending, guard)
 
 
 MAP_FRACTIONS = (0.1, 0.5, 1.0)
 """Maps are kept at the asked pressures nearest these fractions of p_max."""
 
 
+def map_pressures(plan) -> tuple:
+    """The asked pressures (Pa) nearest :data:`MAP_FRACTIONS` of p_max (above 0), in that order: where the maps are
+    kept (none without a positive asked pressure)."""
+    asked = [p for p in plan.pressures if p > 0]
+    return tuple(min(asked, key=lambda x: abs(x - f * plan.pressures[-1])) for f in MAP_FRACTIONS) if asked else ()
+
+
 def map_depths(res, plan) -> dict:
     """{D (ε): asked pressure (Pa)}: for the asked pressures nearest :data:`MAP_FRACTIONS` of p_max (above 0),
-    the approach D at which ``res`` (the finest grid) reaches each on its load-controlled states, linear
-    between the two states around it."""
-    from tengsim.run.area import load_control
-
-    F, D = load_control(res, "D")
-    P = res.scaling.pressure(1.0) * F
-    asked = [p for p in plan.pressures if p > 0]
-    out = {}
-    for f in MAP_FRACTIONS:
-        if not asked or len(P) < 2:
-            break
-        p = min(asked, key=lambda x: abs(x - f * plan.pressures[-1]))
-        i = int(np.searchsorted(P, p))
-        if 0 < i < len(P) and D[i] - D[i - 1] <= D_STEP:
-            w = (p - P[i - 1]) / (P[i] - P[i - 1])
-            out[round(float(D[i - 1] + w * (D[i] - D[i - 1])), 9)] = p
-        elif 0 < i < len(P):  # states dropped between them (a snap): the state the load reaches
-            out[round(float(D[i]), 9)] = p
-        elif i == 0:
-            out[round(float(D[0]), 9)] = p
-    return out
-
-
-D_MARGIN = 0.03
-"""A finer grid's path ends at the D where the grid before it reached p_max, plus this fraction of that D
-(at least 2 d_step): a finer grid is softer, and between the issue's grids that D moved by less than 0.1 ε."""
+    the approach D at which ``res`` (the finest grid) reaches each (:func:`tengsim.run.reach.map_depths`)."""
+    return reach_depths(res, map_pressures(plan))
 
 
 def grid_path(plan, d_max, cut: bool = True):
-    """``path_for`` of the refinement (:func:`tengsim.run.resolve.resolve_contact`): the first grid walks to
-    ``d_max`` (found on the coarse grid, :func:`find_d_max`); each finer grid to the D at which the grid before
-    it reached p_max, plus :data:`D_MARGIN` (on the path's lattice, never beyond ``d_max``): about 10 % of the
-    rows were past p_max.  Each finer grid's path also keeps the pressure and gap maps at the map depths of the
-    grid before it (:func:`map_depths` of its curve), so the finest grid's maps are recorded during its own walk
-    (an extra row at each such D, solved from the rows around it: the walk's other rows are unchanged);
-    ``plan.maps`` false: no maps.  ``cut`` false: every grid walks to ``d_max`` (a second pass, after a finer
-    grid fell short of p_max at the D the grid before it reached p_max)."""
-    from tengsim.continuation import PathSpec
-
-    def on_lattice(D):
-        return D_MIN + math.ceil((D - D_MIN) / D_STEP - 1e-9) * D_STEP
-
-    def path_for(prev):
-        depths, top = (), d_max
-        if prev is not None and prev.scaling is not None:
-            ok, D_hit, _, _ = _reach(prev, plan.pressures[-1])
-            if ok and cut:
-                top = min(d_max, on_lattice(D_hit + max(D_MARGIN * abs(D_hit), 2 * D_STEP)))
-            if plan.maps:
-                last = D_MIN + math.floor((top - D_MIN) / D_STEP + 1e-9) * D_STEP
-                depths = tuple(sorted(D for D in map_depths(prev, plan) if D_MIN <= D <= last))
-        return PathSpec(D_MIN, top, D_STEP, adaptive=True, maps_at=depths)
-
-    return path_for
+    """``path_for`` of the design's refinement (:func:`tengsim.run.reach.grid_path`): each finer grid walks a little
+    past the D at which the grid before it reached p_max and keeps the maps at the asked pressures nearest
+    :data:`MAP_FRACTIONS` of p_max (``plan.maps`` false: no maps); ``cut`` false: every grid walks to ``d_max``."""
+    return reach_grid_path(plan.pressures[-1], d_max, map_pressures(plan) if plan.maps else (), cut)
 
 
 def maps_asked(res, plan) -> dict:

@@ -101,17 +101,28 @@ def family(params: dict) -> str:
         return "square"
 
 
-def area_fraction(res, contact_length, params: dict | None = None) -> np.ndarray:
+def patch(shape, params: dict) -> tuple[float, str]:
+    """(L̄, family) of the one pattern a result's Λc is measured on, asked of its ``shape`` object
+    (``charged_patch``: an array answers its pattern's); a result read back from a file carries no shape object
+    (None), nor does a shape that does not answer: then from the result's parameters ``params``
+    (:func:`cell_side`, :func:`family`)."""
+    ask = getattr(shape, "charged_patch", None)
+    if ask is not None:
+        return ask()
+    return cell_side(params), family(params)
+
+
+def area_fraction(res, contact_length, params: dict | None = None, shape=None) -> np.ndarray:
     """Charged-area fraction A/S of the cell (Eq. 12) from the contact length Λc:
     square patches (pyramid, cube) (Λc/L̄)², discs (cone, hemisphere, sphere, flat punch) π(Λc/2)²/L̄²,
     line gratings (line, sinusoid) Λc/L̄; clipped to [0, 1].  Λc/L̄ is the same ratio in ℓ or in metres.
     L̄ is :func:`cell_side` (an array: the pattern's cell, so A/S is that of K × K cells alike, each as
     the highest one; a run with the ``array_area`` observer has the sum over its cells, used instead by
-    :func:`observe`).  ``params``: the result's parameters to read (default ``res.params``)."""
+    :func:`observe`).  L̄ and the family are the ``shape`` object's where it is given (:func:`patch`), else from
+    ``params``: the result's parameters to read (default ``res.params``)."""
     p = res.params if params is None else params
-    cell = cell_side(p)
+    cell, fam = patch(shape, p)
     x = np.asarray(contact_length, float) / cell
-    fam = family(p)
     if fam == "line":
         return np.clip(x, 0.0, 1.0)
     if fam == "disc":
@@ -119,11 +130,15 @@ def area_fraction(res, contact_length, params: dict | None = None) -> np.ndarray
     return np.clip(x**2, 0.0, 1.0)
 
 
-def full_length(params: dict) -> float:
+def full_length(params: dict, shape=None) -> float:
     """Λc of full contact of a result's shape: its own :meth:`~tengsim.shapes.Shape.full_contact_length`
-    (the shape rebuilt from the result's parameters; an array: its pattern's); NaN if it has none or
-    cannot be rebuilt (a shape not registered here, a height map)."""
+    (asked of the ``shape`` object where it is given; else the shape rebuilt from the result's parameters, a
+    result read back from a file; an array: its pattern's); NaN if it has none or cannot be rebuilt (a shape
+    not registered here, a height map)."""
     import dataclasses
+
+    if shape is not None and hasattr(shape, "full_contact_length"):
+        return float(shape.full_contact_length())
 
     from tengsim.registry import SHAPES
 
@@ -182,13 +197,13 @@ def load_control(res, column: str = "contact_length"):
     return np.array(Fk), np.array(Lk)
 
 
-def loaded_area(res, params: dict | None = None, definition: str = "contact"
+def loaded_area(res, params: dict | None = None, definition: str = "contact", shape=None
                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, list]:
     """(F, Λc, A/S, notes) of the approach states a pressed device passes (:func:`load_control`).  A/S by
     ``definition`` (:data:`DEFINITIONS`): ``contact``, the result's ``charged_fraction`` column (a result
     written without it falls back to the paper's, with a note); ``paper``, :func:`area_fraction` of Λc, or,
     for a run with the ``array_area`` observer, its ``area_fraction_greenwood`` column (Σ over the array's
-    cells).  ``params`` as in :func:`area_fraction`."""
+    cells).  ``params`` and ``shape`` as in :func:`area_fraction`."""
     definition = check_definition(definition)
     p = res.params if params is None else params
     Fk, Lk = load_control(res)
@@ -201,7 +216,7 @@ def loaded_area(res, params: dict | None = None, definition: str = "contact"
     if "area_fraction_greenwood" in res.table:  # the array_area observer: the sum over the cells
         A = np.clip(load_control(res, "area_fraction_greenwood")[1], 0.0, 1.0)
     else:
-        A = area_fraction(res, Lk, p)
+        A = area_fraction(res, Lk, p, shape)
         if is_array(p) and len(Fk):
             notes.append("A/S of the array from its highest cell's contact length (K × K cells alike); "
                          "observers = ['array_area'] gives the sum over its cells")
@@ -213,13 +228,13 @@ def area_name(pressure_Pa: float) -> str:
     return f"A_S_at_{pressure_Pa:.6g}Pa".replace("+", "").replace(".", "p")
 
 
-def area_at(pressures, cfg: dict | None = None, definition: str = "contact"):
+def area_at(pressures, cfg: dict | None = None, definition: str = "contact", shape=None):
     """The observer ``res -> {area_name(P): A/S at P}`` that automatic refinement (``resolve_pressures``,
     :func:`tengsim.run.resolve.run_contact`) also converges: the charged-area fraction of Eq. (12) at each
     nominal pressure P (Pa) on the approach (linear in F between loaded states; NaN outside the states the
     run reaches or for a run without a physical scale).  V_OC (Eq. 12) is σT/(ε_r ε0) × A/S, so its relative
-    change is A/S's.  ``cfg``: the run's [contact] table (the shape's name for the patch family);
-    ``definition``: :data:`DEFINITIONS`."""
+    change is A/S's.  ``shape``: the run's shape object, which the paper's A/S asks (:func:`patch`); without it,
+    ``cfg``, the run's [contact] table (the shape's name for the patch family); ``definition``: :data:`DEFINITIONS`."""
     pressures = [float(p) for p in pressures]
 
     def observe_area(res) -> dict:
@@ -228,7 +243,7 @@ def area_at(pressures, cfg: dict | None = None, definition: str = "contact"):
         if scale is None:
             return out
         params = res.params if cfg is None else {**res.params, "config": cfg}
-        Fk, _, A, _ = loaded_area(res, params, definition)
+        Fk, _, A, _ = loaded_area(res, params, definition, shape)
         known = np.isfinite(A)
         if np.count_nonzero(known) < 2:
             return out

@@ -77,3 +77,22 @@ class Checkpoint:
         for lv in levels:  # strict JSON wrote NaN as null
             lv["obs"] = {k: (math.nan if v is None else v) for k, v in lv["obs"].items()}
         return levels, rec["phases"], res
+
+
+def open_checkpoint(keep, key: str, d_max: float, say=None):
+    """(the :class:`Checkpoint` in the file ``keep`` of the run ``key`` on the D range ``d_max``, what it holds or
+    None): each finished grid is kept there, and a run of the same key and path takes its grids back instead of
+    computing them again; grids of the same key on a shorter path (a first pass) are replaced quietly, those of
+    another key with a line (``say(text)``, if given)."""
+    ck = Checkpoint(keep, f"{key}@{d_max!r}")
+    try:
+        found = ck.load()
+    except TengsimError:
+        if not (ck.stored_digest() or "").startswith(key + "@") and say is not None:
+            say(f"{keep} holds grids of another design or input: they are replaced")
+        keep.unlink()
+        found = None
+    if found is not None and say is not None:
+        say(f"taking back {len(found[0])} finished grid(s) from {keep}")
+    keep.parent.mkdir(parents=True, exist_ok=True)
+    return ck, found

@@ -120,6 +120,36 @@ def grid_sequence(shape, dx: float, max_pixels: int = 2**40):
         dx = g.dx / FACTOR
 
 
+class GridSequence:
+    """The grids the refinement walks from a first grid of spacing ``dx`` (:func:`grid_sequence`), each computed
+    once, when first asked for (by index, slice or iteration), and kept: one sequence for whoever plans a
+    refinement (its cost, its budget, the next grid's line) and the refinement itself."""
+
+    def __init__(self, shape, dx: float, max_pixels: int = 2**40):
+        self.dx = dx
+        self._gen, self._grids = grid_sequence(shape, dx, max_pixels), []
+
+    def _upto(self, n: int) -> None:
+        while len(self._grids) < n:
+            self._grids.append(next(self._gen))
+
+    def __getitem__(self, k):
+        if isinstance(k, slice):
+            if k.stop is None or k.stop < 0 or (k.start or 0) < 0:
+                raise ValueError("a GridSequence (without end) is sliced with non-negative bounds")
+            self._upto(k.stop)
+        else:
+            self._upto(k + 1)
+        return self._grids[k]
+
+    def __iter__(self):
+        i = 0
+        while True:
+            self._upto(i + 1)
+            yield self._grids[i]
+            i += 1
+
+
 def refinement_grids(shape, dx: float, count: int = 12, max_pixels: int = 2**40) -> list:
     """The first ``count`` grids of :func:`grid_sequence`."""
     return list(itertools.islice(grid_sequence(shape, dx, max_pixels), count))

@@ -93,7 +93,7 @@ def resolve_plan(plan, observe=None, full_length: float | None = None, progress=
     if settings.pressures:
         from tengsim.run.area import area_at
 
-        extra = area_at(settings.pressures, plan.config)
+        extra = area_at(settings.pressures, shape=plan.shape)  # the paper's A/S asks the shape object
         observe = extra if observe is None else (lambda res, a=observe, b=extra: {**a(res), **b(res)})
     max_pixels = settings.max_pixels
     if max_pixels is None:

@@ -93,6 +93,11 @@ class Array:
             return ()
         return tuple(getattr(self.pattern, "mirror_axes", ()))
 
+    def charged_patch(self) -> tuple:
+        """The pattern's (L̄, family) (:meth:`tengsim.shapes.Shape.charged_patch`): Λc is measured on one pattern,
+        and its patch charged over one pattern's cell."""
+        return self.pattern.charged_patch()
+
     def full_contact_length(self) -> float:
         """The pattern's (Λc is measured on one pattern, through the highest apex)."""
         return float(getattr(self.pattern, "full_contact_length", lambda: float("nan"))())

@@ -69,6 +69,12 @@ class Shape:
         """A square grid over the shape's cell with spacing about ``dx``."""
         return Grid.square(self.cell, dx)
 
+    def charged_patch(self) -> tuple:
+        """(L̄, family): the side of the square cell over which one contact patch is charged and how the contact
+        length Λc maps to the patch's area (:attr:`contact_family`), what the paper's A/S asks of a shape
+        (:func:`tengsim.run.area.area_fraction`)."""
+        return float(self.cell), self.contact_family
+
     def full_contact_length(self) -> float:
         """Λc of full contact, in X units (what transition_D and the adhesive full-contact flag compare the
         contact length with): NaN where the shape has none (the default)."""
