@@ -152,8 +152,8 @@ def resolve_to(cplan, p_max: float, d_max: float, settings, map_pressures=(), ob
             if done is not None:
                 done(levels)
 
-        res = resolve_plan(dataclasses.replace(cplan, path=path_to(d_max), resolve=settings), observe=observe,
-                           watch=watch, path_for=grid_path(p_max, d_max, map_pressures, cut=attempt == 0),
+        res = resolve_plan(cplan, observe=observe, watch=watch, settings=settings,
+                           path_for=grid_path(p_max, d_max, map_pressures, cut=attempt == 0),
                            progress=progress, checkpoint=after, start=found)
         if res.scaling is None:  # every grid taken back from the checkpoint file, which keeps the columns only
             res = dataclasses.replace(res, scaling=cplan.scaling)

@@ -63,7 +63,7 @@ from tengsim.run.judge import (FLOORS, NEED_FLOOR, P_MAX, P_MIN, _dx_needed, _ju
                                _why, contact_observables, floor_of, relative, richardson)
 
 def resolve_plan(plan, observe=None, full_length: float | None = None, progress=None, checkpoint=None, start=None,
-                 watch=None, path_for=None):
+                 watch=None, path_for=None, settings=None):
     """Run the :class:`tengsim.run.plan.ContactPlan` ``plan`` on finer and finer grids until converged (module
     doc): each grid is :func:`tengsim.run.simulate.simulate_plan` of the plan with that grid and its path.
 
@@ -84,11 +84,14 @@ def resolve_plan(plan, observe=None, full_length: float | None = None, progress=
     ``watch(result) -> dict``: observables recorded per grid, with their change and Richardson error, but not
     judged (they do not decide when to stop: numbers a caller reports how converged they are, e.g. a design's
     hysteresis).  ``path_for(result) -> path``: the path of the next grid from the grid before it (None on the
-    first grid; e.g. the D at which its maps are kept, predicted from the coarser curve); default ``plan.path``."""
+    first grid; e.g. the D at which its maps are kept, predicted from the coarser curve); default ``plan.path``.
+    ``settings``: a :class:`tengsim.run.plan.ResolveSettings` used instead of ``plan.resolve`` (one plan serves
+    every refinement pass of a caller: a ContactPlan is built per grid only)."""
     from tengsim.run.plan import ResolveSettings
     from tengsim.run.simulate import simulate_plan
 
-    settings = plan.resolve if plan.resolve is not None else ResolveSettings()
+    if settings is None:  # a caller's settings for this refinement (no plan built for them), else the plan's
+        settings = plan.resolve if plan.resolve is not None else ResolveSettings()
     tol, shape = settings.tol, plan.shape
     if settings.pressures:
         from tengsim.run.area import area_at
