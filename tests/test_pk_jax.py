@@ -84,3 +84,16 @@ def test_maugis_dugdale_sphere_equals_numpy():
     b = PKJaxSolver(1e-8, device="cpu").solve(pr, State.zero(U0.shape))
     _same(a, b, rel=1e-8)
     assert b.P.min() < 0 < b.P.max()      # tension in the zone, compression in the contact
+
+
+def test_refuses_a_smooth_law_naming_itself(tmp_path, capsys, monkeypatch):
+    """`contact ... --solver pk-jax` with LJ 9-3: one line naming pk-jax (not pk) and the solver that can, exit 2,
+    nothing written."""
+    from tengsim.cli.main import main
+
+    monkeypatch.chdir(tmp_path)
+    rc = main(["contact", "pyramid", "--pitch", "2um", "--base", "1um", "--height", "0.7um", "--E-star", "0.59MPa",
+               "--W", "54mJ/m2", "--tabor", "0.5", "--solver", "pk-jax", "--out", "x.csv"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert rc == 2 and len(err) == 1 and "solver 'pk-jax' solves hard walls only" in err[0] and "'fast'" in err[0]
+    assert list(tmp_path.iterdir()) == []

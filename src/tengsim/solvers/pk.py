@@ -110,7 +110,7 @@ class WallModel:
         return float(-self.work * np.exp(-np.maximum(u, 0.0) / self.length).sum())
 
 
-def wall_model(law) -> WallModel:
+def wall_model(law, solver: str = "pk") -> WallModel:
     """The hard-wall limit of ``law`` (module doc), or one line naming the solvers that can solve it."""
     name = type(law).__name__
     if name == "Repulsive":
@@ -121,7 +121,7 @@ def wall_model(law) -> WallModel:
     if name == "Exponential":
         W, rho = float(law.work), float(law.range)
         return WallModel("exp", W / rho, rho, W)
-    raise TengsimError(f"solver 'pk' solves hard walls only (laws repulsive, md, exp); law {name} has a "
+    raise TengsimError(f"solver '{solver}' solves hard walls only (laws repulsive, md, exp); law {name} has a "
                        "smooth repulsion: use solver 'fast' (or 'homotopy' for a law stiff at the pixel scale)")
 
 
@@ -204,9 +204,9 @@ class PKSolver:
     def _solve(self, problem: Problem, start: State, load):
         t0 = time.perf_counter()
         if problem.weights is not None:
-            raise TengsimError("solver 'pk' does not solve weighted (mirror-block) problems; "
+            raise TengsimError(f"solver '{self.name}' does not solve weighted (mirror-block) problems; "
                                "use solver 'fast' for a mirror-symmetric cell")
-        model = wall_model(problem.law)
+        model = wall_model(problem.law, self.name)
         shape = np.shape(problem.g0)
         conv = self._convolution(problem.kernel, shape)
         pre = preconditioner(problem.kernel, shape) if self.precondition else None
