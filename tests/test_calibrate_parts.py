@@ -60,3 +60,15 @@ def test_a_bare_bound_read_as_SI_is_refused_where_implausible():
         parse_bounds("eps=30:80")
     assert parse_bounds("W=10mJ/m2:60mJ/m2,eps=3e-8:8e-8") == {"W": pytest.approx((0.01, 0.06)),
                                                                 "eps": pytest.approx((3e-8, 8e-8))}
+
+
+def test_residual_sizes_are_said_in_the_noise_models_unit():
+    """The interpolation's error and the noise are said as % of V_OC (relative noise), volts (absolute) or
+    multiples of voc_err_V (known errors), never as bare residual numbers."""
+    from types import SimpleNamespace
+
+    from tengsim.calibrate.fit import residual_text
+
+    assert residual_text(0.0233, SimpleNamespace(known_errors=False, noise="relative")) == "2.33 % of V_OC"
+    assert residual_text(0.5, SimpleNamespace(known_errors=False, noise="absolute")) == "0.5 V"
+    assert residual_text(1.2, SimpleNamespace(known_errors=True, noise="relative")) == "1.2 × voc_err_V"

@@ -242,7 +242,7 @@ def fit(model: Model, box=None, polish: bool = True, model_error: float = 0.0) -
     grow = inflation(n, model_error, scale)
     if grow > 1.5:
         words += (f"These intervals are widened ×{math.sqrt(grow):.2g} for the interpolation's own error "
-                  f"({model_error:.3g} against the noise {scale:.3g}): with more designs (--nodes, --zooms, tighter "
+                  f"({residual_text(model_error, prob)} against the noise {residual_text(scale, prob)}): with more designs (--nodes, --zooms, tighter "
                   "--bounds) they narrow to what the data alone allow.",)
     if extended:
         words += (f"The best fit lay outside the grid's profile interval of {', '.join(extended)}: the interval "
@@ -360,3 +360,13 @@ def band(model: Model, f: Fit, pressures, branches, level_threshold=None) -> tup
     for gi, gb in zip(G, Gb):
         out.append((f.best["sigma"] * gb[0], np.min(s_lo[:, None] * gi, axis=0), np.max(s_hi[:, None] * gi, axis=0)))
     return out
+
+
+def residual_text(x: float, prob) -> str:
+    """A size in the residual's units, said in the user's: % of V_OC (relative noise), volts (absolute), or
+    multiples of the data's own voc_err_V (known errors)."""
+    if prob.known_errors:
+        return f"{x:.3g} × voc_err_V"
+    if prob.noise == "relative":
+        return f"{100 * x:.3g} % of V_OC"
+    return f"{x:.3g} V"

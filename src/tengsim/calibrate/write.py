@@ -144,7 +144,7 @@ def material_text(cal) -> str:
 
 
 def report_text(cal, figures) -> str:
-    from tengsim.calibrate.fit import inflation
+    from tengsim.calibrate.fit import inflation, residual_text
 
     f, prob = cal.fit, cal.problem
     out = ["# Calibration", "", f"Fitted: {', '.join(label(k) for k in prob.free)} to {prob.n_points} points of "
@@ -172,7 +172,8 @@ def report_text(cal, figures) -> str:
             f"* Designs: {cal.nodes_solved} solved, {cal.nodes_cached} taken back from designs/ "
             f"({len(cal.nodes_failed)} not converged and left out), {cal.zooms} zoom(s); {cal.seconds:.0f} s.",
             f"* Interpolation error (designs solved at the best fit and at both ends of each interval against the "
-            f"interpolation there, the largest rms over the data points, residual units): {cal.surrogate_error:.3g} against the noise {f.scale:.3g}: "
+            f"interpolation there, the largest rms over the data points): {residual_text(cal.surrogate_error, prob)} "
+            f"against the noise {residual_text(f.scale, prob)}: "
             + ("within half the noise." if cal.surrogate_ok else "**above half the noise: the intervals are widened "
                "for it; narrow --bounds, add --nodes or --zooms for tighter ones**.")
             + f" The intervals make room for it (threshold × {inflation(prob.n_points, cal.surrogate_error, f.scale):.3g})."]
