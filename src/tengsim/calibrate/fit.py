@@ -242,7 +242,8 @@ def fit(model: Model, box=None, polish: bool = True, model_error: float = 0.0) -
     grow = inflation(n, model_error, scale)
     if grow > 1.5:
         words += (f"These intervals are widened ×{math.sqrt(grow):.2g} for the interpolation's own error "
-                  f"({residual_text(model_error, prob)} against the noise {residual_text(scale, prob)}): with more designs (--nodes, --zooms, tighter "
+                  f"({residual_text(model_error, prob)} against the noise {residual_text(scale, prob)}): "
+                  "with more designs (--nodes, --zooms, tighter "
                   "--bounds) they narrow to what the data alone allow.",)
     if extended:
         words += (f"The best fit lay outside the grid's profile interval of {', '.join(extended)}: the interval "
