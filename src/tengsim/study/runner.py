@@ -114,13 +114,16 @@ def connect(workers=None, scheduler=None, timeout: float | None = None):
 
     n = workers or os.cpu_count() or 1
     # the worker processes start with SIGINT ignored: a terminal's Ctrl-C reaches the whole process
-    # group, and the client alone answers it (one line, the cluster closed), not a traceback per worker
+    # group, and the client alone answers it (one line, the cluster closed), not a traceback per worker;
+    # their logs are silenced below CRITICAL: a worker that loses the closing scheduler mid-heartbeat logs an
+    # ERROR with a traceback, and what a sweep's user must know of a point (its failure, a dead worker) the
+    # client records and says itself
     old = signal.signal(signal.SIGINT, signal.SIG_IGN) if threading.current_thread() is threading.main_thread() \
         else None
     try:
         with dask.config.set(LOCAL_CLUSTER_CONFIG):
             cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, env=dict(WORKER_ENV),
-                                   dashboard_address=":0", silence_logs=logging.ERROR)
+                                   dashboard_address=":0", silence_logs=logging.CRITICAL)
     finally:
         if old is not None:
             signal.signal(signal.SIGINT, old)
