@@ -324,7 +324,7 @@ def test_budget_cap_is_the_last_refinement_grid_the_budget_pays_for():
     from pathlib import Path
 
     from tengsim.cli.design import _read_toml
-    from tengsim.design.estimate import budget_pixels, run_cost
+    from tengsim.run.budget import budget_pixels, run_cost
     from tengsim.design.walk import height_eps, start_dx
     from tengsim.run.grids import GridSequence, refinement_grids
 
@@ -444,7 +444,7 @@ def test_estimate_on_a_busy_machine_says_the_longer_time(monkeypatch):
     load, the idle estimate × load / cores; an idle machine's line says nothing of it; the GPU's never."""
     import os
 
-    from tengsim.design import estimate as de
+    from tengsim.run import budget as de
 
     monkeypatch.setattr(os, "getloadavg", lambda: (5.0, 4.0, 3.0))
     monkeypatch.setattr(os, "sched_getaffinity", lambda pid: {0, 1})

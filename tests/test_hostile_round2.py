@@ -239,7 +239,7 @@ def test_tol_has_a_floor_and_the_budget_stops_a_run_cleanly(here, capsys):
     refused(capsys, ["design", *S, "--tol", "1e-14", "--budget", "10", "--out", "o"], here, contains="tol")
     from types import SimpleNamespace
 
-    from tengsim.design.estimate import BudgetSpent, deadline
+    from tengsim.run.budget import BudgetSpent, deadline
 
     plan = SimpleNamespace(budget_s=1.0, name="d")
     seen = []

@@ -67,69 +67,30 @@ def definition(res, plan) -> str:
     return DEFINITIONS[patch(_shape(plan), _params(res, plan))[1]]
 
 
-def _retraction_states(res, cols):
-    """Retraction states under decreasing load (each F below every earlier F), as arrays in increasing F."""
-    r = res.branch("retraction")
-    F = np.asarray(r["F"], float)
-    keep, best = [], math.inf
-    for i, f in enumerate(F):
-        if f < best:
-            keep.append(i)
-            best = f
-    keep = keep[::-1]
-    return F[keep], [np.asarray(r[c], float)[keep] for c in cols]
-
-
-def _at(P, y, ps):
-    P, y = np.asarray(P, float), np.asarray(y, float)
-    out = np.full(len(ps), np.nan)
-    if len(P) < 2:
-        return out
-    ps = np.asarray(ps, float)
-    inside = (ps >= P[0]) & (ps <= P[-1])
-    out[inside] = np.interp(ps[inside], P, y)
-    return out
-
-
 def states(res, plan) -> dict:
     """{'approach'|'retraction': {'P' (Pa, increasing), 'area' (A/S), 'repulsive' (fraction)}} of the
-    load-controlled states (module doc), A/S by the plan's definition."""
-    from tengsim.run.area import CHARGED_COLUMN, area_fraction, load_control
+    load-controlled states (module doc, :func:`tengsim.run.area.branch_states`), A/S by the plan's definition."""
+    from tengsim.run.area import branch_states
 
-    sc = res.scaling
-    k_p = sc.pressure(1.0)
-    cell = sc.cell_area
-    p = _params(res, plan)
-    contact = area_definition(plan) == "contact" and CHARGED_COLUMN in res.table
-    col = CHARGED_COLUMN if contact else "contact_length"
-
-    def area(v):
-        return np.clip(np.asarray(v, float), 0.0, 1.0) if contact else area_fraction(res, v, p, _shape(plan))
-
-    F, L = load_control(res, col)
-    _, R = load_control(res, "area_repulsive")
-    out = {"approach": {"P": k_p * F, "area": area(L), "repulsive": R * sc.lateral**2 / cell}}
-    Fr, (Lr, Rr) = _retraction_states(res, (col, "area_repulsive"))
-    out["retraction"] = {"P": k_p * Fr, "area": area(Lr), "repulsive": Rr * sc.lateral**2 / cell}
-    return out
+    return branch_states(res, area_definition(plan), _params(res, plan), _shape(plan))
 
 
 def branch_curves(res, plan) -> dict:
     """Per branch, at the asked pressures: 'area' (A/S), 'repulsive', 'voc_eq12', 'voc_eq17' (V), 'dvoc_dp' (V/Pa)."""
     from tengsim.device.formulas import voc_apart, voc_polymer
+    from tengsim.run.area import at_pressures
 
     ps = np.asarray(plan.pressures, float)
     out = {}
     for b, s in states(res, plan).items():
-        A = np.clip(_at(s["P"], s["area"], ps), 0.0, 1.0)
-        A = np.where(np.isfinite(_at(s["P"], s["area"], ps)), A, np.nan)
+        A = np.clip(at_pressures(s["P"], s["area"], ps), 0.0, 1.0)
         V12 = voc_polymer(A, plan.sigma, plan.eps_r, plan.T)
         V17 = voc_apart(plan.sigma, A, plan.gap, 1.0)
         dV = np.full(len(ps), np.nan)
         ok = np.flatnonzero(np.isfinite(V12))
         if len(ok) >= 2:
             dV[ok] = np.gradient(V12[ok], ps[ok])
-        out[b] = {"area": A, "repulsive": _at(s["P"], s["repulsive"], ps), "voc_eq12": V12, "voc_eq17": V17,
+        out[b] = {"area": A, "repulsive": at_pressures(s["P"], s["repulsive"], ps), "voc_eq12": V12, "voc_eq17": V17,
                   "dvoc_dp": dV}
     return out
 
@@ -336,7 +297,7 @@ HYSTERESIS = "hysteresis energy (recorded, not judged)"
 def convergence(res) -> dict:
     """{number: relative change between the last two grids}: the judged numbers, A/S on the approach (the
     largest over the asked pressures), pull-off force, jump-in and jump-out D; then the retraction's numbers the
-    refinement records but does not judge (:func:`tengsim.design.walk._watcher`): A/S on the retraction (the
+    refinement records but does not judge (:func:`tengsim.design.walk.observers`): A/S on the retraction (the
     largest over the pressures it reaches on both grids) and the hysteresis energy; NaN with one grid."""
     rich = res.params.get("richardson") or {}
     watched = res.params.get("watched") or {}

@@ -9,40 +9,20 @@ maps are kept: at the asked pressures nearest 10 %, 50 % and 100 % of p_max (:fu
 """
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from tengsim.run.reach import D_MIN, D_STEP, EXTEND_TRIES, path_to, reach as _reach  # noqa: F401
-from tengsim.run.reach import D_MARGIN, find_d_max as reach_d_max, grid_path as reach_grid_path  # noqa: F401
+from tengsim.run.reach import D_MARGIN, find_d_max as reach_d_max, grid_path as reach_grid_path, height_eps  # noqa: F401
 from tengsim.run.reach import map_depths as reach_depths
+from tengsim.run.refine import START_ZONE_PIXELS, say_to as _say  # noqa: F401
 
-
-def _say(progress, text):
-    if progress is not None and hasattr(progress, "say"):
-        progress.say(text)
-
-START_ZONE_PIXELS = 12.0
-"""Pixels across the law's a-priori process zone ℓ_D on a design's first grid (by default).  The grid status asks
-for :data:`tengsim.status.RESOLUTION` (1.2); a design's numbers (A/S at the smallest contact of the curve, the
-pull-off) ask for far more, and the refinement judges from the last three grids only, so coarser first grids are
-walked and thrown away (the measurements behind the 12: docs/benchmarks.md, "A design's walk").  A design that
-would converge on a coarser grid pays for one or two grids finer than it needs."""
 
 def start_dx(plan, cplan) -> float:
-    """The first grid's dx in X units: the plan's (a length), or the refinement's first grid whose dx is at most
-    the law's process zone over :data:`START_ZONE_PIXELS` (:func:`tengsim.run.grids.start_dx`)."""
-    from tengsim.run.grids import start_dx as first_dx
+    """The design's first dx in X units (:func:`tengsim.run.refine.first_dx`: the plan's, or the refinement's first
+    grid whose dx is at most the law's process zone over :data:`START_ZONE_PIXELS`)."""
+    from tengsim.run.refine import first_dx
 
-    if plan.dx is not None:
-        return plan.dx / cplan.scaling.lateral
-    return first_dx(cplan.shape, cplan.law, cplan.coupling, cplan.boundary, START_ZONE_PIXELS)
-
-
-def height_eps(cplan, dx) -> float:
-    """The structure's height in ε (the range of its gap U0 on the grid)."""
-    U0 = cplan.shape.gap(cplan.shape.grid(dx))
-    return float(np.nanmax(U0) - np.nanmin(U0))
+    return first_dx(cplan, plan)
 
 
 def _simulate(cplan, dx, d_max, **kw):
@@ -55,15 +35,10 @@ def _simulate(cplan, dx, d_max, **kw):
 
 
 def find_d_max(plan, cplan, dx, progress=None, guard=None):
-    """(d_max, the coarse result): the D range that reaches p_max on a grid twice as coarse as the first
-    (:func:`tengsim.run.reach.find_d_max`; each extension said in one line); ``guard`` (called per path row,
-    e.g. :func:`tengsim.design.estimate.deadline`) may stop it."""
-    from tengsim.design.units import pressure_text
+    """(d_max, the coarse result): the design's path range (:func:`tengsim.run.refine.find_range`)."""
+    from tengsim.run.refine import find_range
 
-    def extending(top, d_max):
-        _say(progress, f"path: {pressure_text(top)} reached at D = {d_max:.3g} ε, extending")
-
-    return reach_d_max(cplan, dx, plan.pressures[-1], height_eps(cplan, dx), extending, guard)
+    return find_range(cplan, plan, dx, progress, guard)
 
 
 MAP_FRACTIONS = (0.1, 0.5, 1.0)
@@ -98,25 +73,25 @@ def maps_asked(res, plan) -> dict:
     Ds = sorted(float(m["D"]) for m in (res.maps or []) if str(m["branch"]) == "approach")
     return {round(D, 9): p for D, p in zip(Ds, want)} if len(Ds) == len(want) else {}
 
-def _observer(plan):
-    from tengsim.design.curves import area_name, branch_curves
+def observers(plan):
+    """(observe, watch): the refinement's observers of a design.  ``observe`` (judged): A/S on the approach at the
+    asked pressures; ``watch`` (recorded per grid with its convergence, not judged; the pull-off force is judged by
+    the refinement itself): A/S on the retraction at the asked pressures and the hysteresis energy.  A/S by the
+    plan's definition on the load-controlled branches (:func:`tengsim.run.area.areas_at`)."""
+    from tengsim.design.curves import _params, _shape, area_definition, area_name
+    from tengsim.run.area import areas_at
+
+    names = {b: [area_name(b, p) for p in plan.pressures] for b in ("approach", "retraction")}
+
+    def areas(res):
+        return areas_at(res, plan.pressures, area_definition(plan), _params(res, plan), _shape(plan))
 
     def observe(res) -> dict:
-        c = branch_curves(res, plan)
-        return {area_name("approach", p): float(a) for p, a in zip(plan.pressures, c["approach"]["area"])}
-
-    return observe
-
-
-def _watcher(plan):
-    """The retraction's numbers, recorded per grid with their convergence but not judged (the pull-off force
-    is judged by the refinement itself): A/S on the retraction at the asked pressures and the hysteresis."""
-    from tengsim.design.curves import area_name, branch_curves
+        return {n: float(a) for n, a in zip(names["approach"], areas(res)["approach"])}
 
     def watch(res) -> dict:
-        c = branch_curves(res, plan)
-        out = {area_name("retraction", p): float(a) for p, a in zip(plan.pressures, c["retraction"]["area"])}
+        out = {n: float(a) for n, a in zip(names["retraction"], areas(res)["retraction"])}
         out["hysteresis_W"] = float(res.hysteresis)
         return out
 
-    return watch
+    return observe, watch

@@ -197,6 +197,62 @@ def load_control(res, column: str = "contact_length"):
     return np.array(Fk), np.array(Lk)
 
 
+def retraction_control(res, columns):
+    """Retraction states a device passes under decreasing load (each F below every earlier F), as arrays in
+    increasing F: (F, [each of ``columns``])."""
+    r = res.branch("retraction")
+    F = np.asarray(r["F"], float)
+    keep, best = [], math.inf
+    for i, f in enumerate(F):
+        if f < best:
+            keep.append(i)
+            best = f
+    keep = keep[::-1]
+    return F[keep], [np.asarray(r[c], float)[keep] for c in columns]
+
+
+def at_pressures(P, y, ps) -> np.ndarray:
+    """``y`` of the states at pressures ``P`` (increasing) at the pressures ``ps``: linear between the two states
+    around each; NaN outside the states' range (or with fewer than two)."""
+    P, y = np.asarray(P, float), np.asarray(y, float)
+    out = np.full(len(ps), np.nan)
+    if len(P) < 2:
+        return out
+    ps = np.asarray(ps, float)
+    inside = (ps >= P[0]) & (ps <= P[-1])
+    out[inside] = np.interp(ps[inside], P, y)
+    return out
+
+
+def branch_states(res, definition: str, params: dict, shape=None) -> dict:
+    """{'approach'|'retraction': {'P' (Pa, increasing), 'area' (A/S), 'repulsive' (fraction)}} of the states a
+    pressed device passes on each branch (:func:`load_control`, :func:`retraction_control`); A/S by ``definition``
+    (:data:`DEFINITIONS`; ``contact`` where the result has its column, else the paper's from Λc with ``params``
+    and ``shape`` as in :func:`area_fraction`)."""
+    sc = res.scaling
+    k_p = sc.pressure(1.0)
+    cell = sc.cell_area
+    contact = definition == "contact" and CHARGED_COLUMN in res.table
+    col = CHARGED_COLUMN if contact else "contact_length"
+
+    def area(v):
+        return np.clip(np.asarray(v, float), 0.0, 1.0) if contact else area_fraction(res, v, params, shape)
+
+    F, L = load_control(res, col)
+    _, R = load_control(res, "area_repulsive")
+    out = {"approach": {"P": k_p * F, "area": area(L), "repulsive": R * sc.lateral**2 / cell}}
+    Fr, (Lr, Rr) = retraction_control(res, (col, "area_repulsive"))
+    out["retraction"] = {"P": k_p * Fr, "area": area(Lr), "repulsive": Rr * sc.lateral**2 / cell}
+    return out
+
+
+def areas_at(res, pressures, definition: str, params: dict, shape=None) -> dict:
+    """{branch: A/S at each of ``pressures`` (Pa)} on the branches of :func:`branch_states`, clipped to [0, 1]
+    (NaN outside the pressures a branch reaches)."""
+    return {b: np.clip(at_pressures(s["P"], s["area"], pressures), 0.0, 1.0)
+            for b, s in branch_states(res, definition, params, shape).items()}
+
+
 def loaded_area(res, params: dict | None = None, definition: str = "contact", shape=None
                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, list]:
     """(F, Λc, A/S, notes) of the approach states a pressed device passes (:func:`load_control`).  A/S by

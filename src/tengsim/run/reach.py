@@ -29,6 +29,12 @@ def path_to(d_max: float, maps_at=()):
     return PathSpec(D_MIN, d_max, D_STEP, adaptive=True, maps_at=tuple(maps_at))
 
 
+def height_eps(cplan, dx) -> float:
+    """The structure's height in ε (the range of its gap U0 on the grid of spacing ``dx``)."""
+    U0 = cplan.shape.gap(cplan.shape.grid(dx))
+    return float(np.nanmax(U0) - np.nanmin(U0))
+
+
 def reach(res, p_max):
     """(reached, D where the approach first reaches p_max (NaN if not), highest approach pressure, slope dP/dD)."""
     a = res.branch("approach")

@@ -1,11 +1,13 @@
-"""What a design costs: the expected time of its refinement, the worst case up to its budget, the budget's checks.
+"""What a refinement costs: its expected time, the worst case up to its budget, the budget's checks.
 
-After the coarse pre-run (:func:`tengsim.design.walk.find_d_max`: the path's range and the solver's iterations per
+``ask`` (below) is what was asked of the refinement: any object with ``name``, ``budget_s`` (s), ``tol`` and
+``max_pixels`` (a :class:`tengsim.design.plan.DesignPlan`).  After the coarse pre-run
+(:func:`tengsim.run.reach.find_d_max`: the path's range and the solver's iterations per
 row, on a cheap grid) and before the refinement, :func:`estimate` gives the grids (the refinement's first ones,
 :func:`tengsim.run.grids.refinement_grids`), the memory of the finest, the solver ``auto`` chose and the expected
 time, each grid rows × iterations × the backend's cost per iteration (:class:`Cost`, :mod:`tengsim.resources`: the
 CPU's or the GPU's model, named in the line); :func:`cap_line` the worst case up to the budget's largest grid
-(:func:`budget_pixels`).  An expected time above the plan's budget is refused (:func:`check_budget`, a
+(:func:`budget_pixels`).  An expected time above the budget asked is refused (:func:`check_budget`, a
 :class:`tengsim.errors.TengsimError` naming max_pixels and tol) before the refinement is solved or anything written;
 a run past its budget is stopped between two rows (:func:`deadline`, :class:`BudgetSpent`).
 """
@@ -17,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tengsim.design.walk import D_MIN, D_STEP
+from tengsim.run.reach import D_MIN, D_STEP
 from tengsim.errors import TengsimError
 from tengsim.resources import CostModel, cost_model
 
@@ -91,7 +93,7 @@ class Estimate:
     """(factor, 1-minute load, cores) of the machine when the estimate was made (:func:`machine_busy`)."""
 
     def lines(self) -> list:
-        from tengsim.design.units import bytes_text, length_text, time_text
+        from tengsim.units import bytes_text, length_text, time_text
 
         g = ", ".join(f"{nx}×{ny} (dx {length_text(d)})" for nx, ny, d in self.grids)
         rows = (f", {self.cost.rows:.0f} rows of about {self.cost.iterations:.0f} iterations per grid"
@@ -103,7 +105,7 @@ class Estimate:
 
     def busy_text(self) -> str:
         """The expected time on this machine as busy as it is now (nothing on a machine that is not)."""
-        from tengsim.design.units import time_text
+        from tengsim.units import time_text
 
         factor, load, cores = self.busy
         if factor < BUSY_SAID:
@@ -132,7 +134,7 @@ def machine_busy() -> tuple:
         return 1.0, 0.0, cores
     return max(1.0, load / cores), load, cores
 
-def estimate(plan, cplan, grids, d_max: float, cost: Cost) -> Estimate:
+def estimate(ask, cplan, grids, d_max: float, cost: Cost) -> Estimate:
     """Grids, memory and expected time of the refinement (module doc): the first :data:`LEVELS_ESTIMATED` of
     ``grids`` (the refinement's sequence, :class:`tengsim.run.grids.GridSequence`), the last at
     :data:`LAST_GRID_SHARE`, at ``cost`` (:func:`run_cost` of the backend the plan solves on, for the D range
@@ -141,7 +143,7 @@ def estimate(plan, cplan, grids, d_max: float, cost: Cost) -> Estimate:
 
     chosen, secs, least = [], 0.0, 0.0
     for k, g in enumerate(itertools.islice(grids, LEVELS_ESTIMATED)):  # the grids the refinement walks
-        if plan.max_pixels is not None and g.nx * g.ny > plan.max_pixels and chosen:
+        if ask.max_pixels is not None and g.nx * g.ny > ask.max_pixels and chosen:
             break
         chosen.append((g.nx, g.ny, g.dx * cplan.scaling.lateral))
         step = cost.grid_seconds(cplan.shape, g)
@@ -156,7 +158,7 @@ def next_grid_line(shape, grids, seconds: float, lateral: float) -> str:
     """The progress line after a finished grid (the last of ``grids``, the refinement's sequence so far plus the
     next): its measured time and the next grid's, scaled from it by the pixels (a grid's time goes as its pixels),
     which the refinement walks if the last two grids have not converged."""
-    from tengsim.design.units import length_text, time_text
+    from tengsim.units import length_text, time_text
 
     done, nxt = grids[-2], grids[-1]
     scale = (nxt.nx * nxt.ny) / (done.nx * done.ny)
@@ -169,15 +171,15 @@ SEQUENCE_COUNTED = 12
 """Grids of the refinement's sequence the budget and the worst case look at (the refinement never walks more)."""
 
 
-def budget_pixels(plan, shape, grids, cost: Cost) -> int:
-    """The largest grid (nx·ny) the refinement may reach within the plan's time budget: the last of ``grids`` (the
+def budget_pixels(ask, shape, grids, cost: Cost) -> int:
+    """The largest grid (nx·ny) the refinement may reach within the time budget asked: the last of ``grids`` (the
     refinement's sequence, :func:`tengsim.run.grids.refinement_grids`) whose cost (``cost``, :func:`run_cost`)
     summed with the grids before it fits the budget (at least the first grid); the default max_pixels, so no
     default run runs past its budget."""
     secs, top = 0.0, None
     for g in itertools.islice(grids, SEQUENCE_COUNTED):
         secs += cost.grid_seconds(shape, g)
-        if secs > plan.budget_s and top is not None:
+        if secs > ask.budget_s and top is not None:
             break
         top = g.nx * g.ny
     return top
@@ -185,7 +187,7 @@ def budget_pixels(plan, shape, grids, cost: Cost) -> int:
 
 def cap_line(shape, grids, cost: Cost, cap: int) -> str:
     """The worst case: the refinement's grids (``grids``) up to ``cap`` pixels, and their summed cost."""
-    from tengsim.design.units import time_text
+    from tengsim.units import time_text
 
     secs, last = 0.0, None
     for g in itertools.islice(grids, SEQUENCE_COUNTED):
@@ -197,38 +199,38 @@ def cap_line(shape, grids, cost: Cost, cap: int) -> str:
             f"about {time_text(secs)} in all")
 
 
-def check_budget(plan, est: Estimate, fit_pixels: int | None = None) -> None:
-    """Refuse an expected time over the plan's budget, naming what to change: a max_pixels that fits (when the
+def check_budget(ask, est: Estimate, fit_pixels: int | None = None) -> None:
+    """Refuse an expected time over the budget asked, naming what to change: a max_pixels that fits (when the
     first two grids do) or a coarser dx."""
-    from tengsim.design.units import length_text, time_text
+    from tengsim.units import length_text, time_text
 
-    if est.seconds <= plan.budget_s:
+    if est.seconds <= ask.budget_s:
         return
     two = est.grids[1][0] * est.grids[1][1] if len(est.grids) > 1 else None
     what = f"a coarser --dx (the first grid's is {length_text(est.grids[0][2])})"
     if fit_pixels and two and fit_pixels >= two:
         what = f"--max-pixels {fit_pixels} (the grids that fit the budget), {what}"
     raise TengsimError(f"this design is expected to take {time_text(est.seconds)} on {est.backend.split(' (')[0]}, "
-                       f"over the budget of {time_text(plan.budget_s)}: give {what}, a coarser --tol (now "
-                       f"{plan.tol:g}) or a larger --budget")
+                       f"over the budget of {time_text(ask.budget_s)}: give {what}, a coarser --tol (now "
+                       f"{ask.tol:g}) or a larger --budget")
 
 class BudgetSpent(TengsimError):
     """A design stopped at its time budget (what finished is kept; the message says how to go on)."""
 
 
-def deadline(progress, plan, keep, started):
-    """``progress`` (called per path row) that also stops the run, cleanly, once ``plan.budget_s`` seconds
+def deadline(progress, ask, keep, started):
+    """``progress`` (called per path row) that also stops the run, cleanly, once ``ask.budget_s`` seconds
     have passed since ``started``: the finished grids stay in ``keep`` and the message says how to go on."""
     import time
 
     def call(*a, **k):
-        if time.monotonic() - started > plan.budget_s:
-            from tengsim.design.units import time_text
+        if time.monotonic() - started > ask.budget_s:
+            from tengsim.units import time_text
 
             where = (f"the finished grids are kept in {keep}: run the same command with a larger --budget to go "
                      "on from them") if keep is not None and keep.exists() else \
                 "no grid had finished: give a larger --budget, a coarser --dx or a coarser --tol"
-            raise BudgetSpent(f"{plan.name[:80]}: stopped at the budget of {time_text(plan.budget_s)}; {where}")
+            raise BudgetSpent(f"{ask.name[:80]}: stopped at the budget of {time_text(ask.budget_s)}; {where}")
         if callable(progress):
             return progress(*a, **k)
         return None
