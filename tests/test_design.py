@@ -455,3 +455,33 @@ def test_estimate_on_a_busy_machine_says_the_longer_time(monkeypatch):
     assert de.machine_busy() == (1.0, 1.5, 2)
     assert "busy" not in de.Estimate(((64, 64, 1e-7),), 1000, 120.0, 10.0, "CPU", None, 60.0,
                                      de.machine_busy()).lines()[1]
+
+
+def test_approach_only_design_gives_the_full_designs_approach_and_says_the_rest_is_not_solved(small, tmp_path):
+    """``retraction = false``: the approach alone is walked on each grid (no retraction rows, half the estimated
+    rows); the approach's A/S equals the full design's on the same grids to 1e-12; every number of the retraction
+    (pull-off, hysteresis, A/S on the retraction, the sensor's hysteresis) is n/a with the reason, never a 0."""
+    from tengsim.design.curves import NOT_RETRACTED
+    from tengsim.run.budget import run_cost
+
+    plan = plan_design({**SMALL, "retraction": "false"})
+    assert plan.retraction is False and plan_design(SMALL).retraction is True
+    one = run_design(plan)
+    assert one.status == "ok"
+    assert set(np.asarray(one.finest.table["branch"]).astype(str)) == {"approach"}
+    if one.summary["grids"] == small.summary["grids"]:  # the same grids: the same approach, bit for bit
+        np.testing.assert_allclose(one.dataset["charged_area_fraction"].sel(branch="approach").values,
+                                   small.dataset["charged_area_fraction"].sel(branch="approach").values,
+                                   rtol=1e-12, equal_nan=True)
+    else:  # a refinement judging fewer numbers may stop a grid earlier: within the tolerance
+        np.testing.assert_allclose(one.summary["area_at_p_max"], small.summary["area_at_p_max"], rtol=2 * small.plan.tol)
+    assert np.all(np.isnan(one.dataset["charged_area_fraction"].sel(branch="retraction").values))
+    for k in ("pull_off_N", "pull_off_Pa", "hysteresis_J_m2", "area_hysteresis", "voc_hysteresis_V"):
+        assert math.isnan(one.summary[k]) and one.summary["reasons"][k] == NOT_RETRACTED, k
+    assert math.isfinite(small.summary["hysteresis_J_m2"])  # the full design has it
+    assert one.dataset.attrs["branches_solved"] == "approach"
+    cp = plan.contact_plan
+    assert run_cost(cp, 20.0, retract=False).rows == pytest.approx(0.5 * run_cost(cp, 20.0).rows)
+    write_design(one, tmp_path / "d", figures=False)
+    text = (tmp_path / "d" / "report.md").read_text()
+    assert "(the approach only)" in text and NOT_RETRACTED in text and "| 0 J/m² |" not in text

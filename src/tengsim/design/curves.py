@@ -116,8 +116,23 @@ def sensor(res, plan):
     def voc(b):
         return voc_polymer(np.clip(st[b]["area"], 0.0, 1.0), plan.sigma, plan.eps_r, plan.T)
 
-    return sensor_numbers(st["approach"]["P"], voc("approach"), (st["retraction"]["P"], voc("retraction")),
-                          (plan.pressures[0], plan.pressures[-1]))
+    back = (st["retraction"]["P"], voc("retraction")) if solved_back(plan) else None
+    numbers = sensor_numbers(st["approach"]["P"], voc("approach"), back, (plan.pressures[0], plan.pressures[-1]))
+    if back is None:
+        import dataclasses
+
+        why = {k: NOT_RETRACTED for k in ("voc_hysteresis_V", "voc_hysteresis_fraction")}
+        numbers = dataclasses.replace(numbers, reasons={**numbers.reasons, **why})
+    return numbers
+
+
+NOT_RETRACTED = "not solved: retraction = false, the approach only"
+"""Why a number of the retraction is n/a in a design that solved the approach only."""
+
+
+def solved_back(plan) -> bool:
+    """Whether the design solved the retraction (``retraction``, true by default)."""
+    return bool(getattr(plan, "retraction", True))
 
 
 def design_status(res, p_max: float) -> str:
@@ -225,6 +240,7 @@ def summarize(res, plan) -> tuple[dict, dict, list]:
     pull = float(res.pull_off_force)
     if pull >= 0:  # the retraction never pulls (a law without tension): no pull-off, not the least push
         notes.append("no pull-off: the retraction carries no tensile load")
+    back = solved_back(plan)
     summary = {
         "status": design_status(res, plan.pressures[-1]),
         "tabor": sc.mu,
@@ -234,8 +250,8 @@ def summarize(res, plan) -> tuple[dict, dict, list]:
         "full_contact_Pa": full_P,
         **numbers.flat(),
         "sensor": numbers,
-        "hysteresis_J_m2": sc.work(loop.value) / sc.cell_area,
-        "hysteresis_bound_J_m2": sc.work(loop.bound) / sc.cell_area,
+        "hysteresis_J_m2": sc.work(loop.value) / sc.cell_area if back else math.nan,
+        "hysteresis_bound_J_m2": sc.work(loop.bound) / sc.cell_area if back else math.nan,
         "area_hysteresis": float(np.nanmax(np.abs(diff))) if np.any(np.isfinite(diff)) else math.nan,
         "area_at_p_max": float(app["area"][-1]),
         "voc_eq12_at_p_max_V": float(app["voc_eq12"][-1]),
@@ -246,6 +262,9 @@ def summarize(res, plan) -> tuple[dict, dict, list]:
         "seconds": float(res.params.get("resolve_seconds", res.seconds)),
     }
     summary["reasons"] = na_reasons(summary, numbers, plan, full, drawn_in=bool(len(a["F"]) and a["F"][0] < 0))
+    if not back:
+        summary["reasons"].update({k: NOT_RETRACTED for k in ("pull_off_N", "pull_off_Pa", "hysteresis_J_m2",
+                                                              "hysteresis_bound_J_m2", "area_hysteresis")})
     conv = convergence(res)
     return summary, conv, notes
 

@@ -86,6 +86,9 @@ def design_fields() -> list:
               "in seconds or with a unit, e.g. 600 or '600s' (default 600 s)"),
         Field("maps", "bool", True, help="keep contact pressure maps near 10 %, 50 % and 100 % of p_max (kept "
               "during the finest grid's walk, at the depths the grid before it predicts); false: none"),
+        Field("retraction", "bool", True, help="solve the retraction too (the pull-off, the hysteresis, the "
+              "unloading curve); false: the approach only, about half the solving (all a fit to loading data "
+              "needs)"),
         Field("area", "str", "contact", help="charged-area definition: 'contact' (default: the 2-D area where "
               "the gap is below the law's peak-tension separation, any shape) or 'paper' (the paper's Λc², from "
               "the contact length through the apex; for its pyramids)"),
@@ -127,6 +130,8 @@ class DesignPlan:
     tabor: float
     maps: bool = True
     area: str = "contact"
+    retraction: bool = True
+    """Whether the retraction is solved (false: the approach only; no pull-off, hysteresis or unloading curve)."""
     boundary: str = "periodic"
     boundary_given: bool = False
     extra: dict = field(default_factory=dict)
@@ -271,7 +276,7 @@ def plan_design(table: dict, where: str = "") -> DesignPlan:
                       sigma=own["sigma"], eps_r=own["eps_r"], T=own["T"], gap=own["gap"], tol=tol, dx=own["dx"],
                       max_pixels=own["max_pixels"], budget_s=own["budget"], E_star=sc.E_star,
                       W=sc.W, eps=sc.eps, tabor=sc.mu, maps=bool(own["maps"]), area=area,
-                      boundary=str(plan.boundary), boundary_given=boundary_given, solver_given=solver_given,
+                      retraction=bool(own["retraction"]), boundary=str(plan.boundary), boundary_given=boundary_given, solver_given=solver_given,
                       contact_plan=plan)
 
 

@@ -37,8 +37,9 @@ def design_figure(result):
     ds = result.dataset
     P = ds["pressure"].values / 1e3
     fig, axes = plt.subplots(1, 3, figsize=(13, 4.2), constrained_layout=True)
+    branches = ("approach", "retraction") if getattr(result.plan, "retraction", True) else ("approach",)
     ax = axes[0]
-    for b in ("approach", "retraction"):
+    for b in branches:
         ax.plot(P, ds["charged_area_fraction"].sel(branch=b), BRANCH_STYLE[b], color="C0", marker="o", ms=3,
                 label=f"charged A/S, {b}")
         ax.plot(P, ds["repulsive_area_fraction"].sel(branch=b), BRANCH_STYLE[b], color="C7",
@@ -47,27 +48,28 @@ def design_figure(result):
     ax.set_ylabel("area over cell area A/S (1)")
     ax.legend(fontsize=7)
     ax = axes[1]
-    for b in ("approach", "retraction"):
+    for b in branches:
         ax.plot(P, ds["voc_eq12"].sel(branch=b), BRANCH_STYLE[b], color="C1", marker="o", ms=3,
                 label=f"Eq. 12 (polymer), {b}")
     ax.set_xlabel("nominal pressure (kPa)")
     ax.set_ylabel("open-circuit voltage, Eq. 12 (V)")
     tw = ax.twinx()
-    for b in ("approach", "retraction"):
+    for b in branches:
         tw.plot(P, ds["voc_eq17"].sel(branch=b), BRANCH_STYLE[b], color="C2", label=f"Eq. 17 (rest gap), {b}")
     tw.set_ylabel(f"open-circuit voltage at rest gap {ds.attrs['gap_m'] * 1e3:.3g} mm, Eq. 17 (V)", color="C2")
     h1, l1 = ax.get_legend_handles_labels()
     h2, l2 = tw.get_legend_handles_labels()
     ax.legend(h1 + h2, l1 + l2, fontsize=7)
     ax = axes[2]
-    for b in ("approach", "retraction"):
+    for b in branches:
         ax.plot(P, ds["dvoc_dp"].sel(branch=b) * 1e3, BRANCH_STYLE[b], color="C3", marker="o", ms=3, label=b)
     ax.set_xlabel("nominal pressure (kPa)")
     ax.set_ylabel("sensitivity dV_OC/dP, Eq. 12 (V/kPa)")
     ax.legend(fontsize=7)
     for a in (*axes, tw):
         a.ticklabel_format(axis="y", useOffset=False)
-    fig.suptitle(title(result.plan, result.status), fontsize=10)
+    only = "" if len(branches) == 2 else " — the approach only (retraction = false)"
+    fig.suptitle(title(result.plan, result.status) + only, fontsize=10)
     return fig
 
 

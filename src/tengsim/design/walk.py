@@ -90,6 +90,8 @@ def observers(plan):
         return {n: float(a) for n, a in zip(names["approach"], areas(res)["approach"])}
 
     def watch(res) -> dict:
+        if not plan.retraction:  # the approach only: nothing of the retraction to record
+            return {}
         out = {n: float(a) for n, a in zip(names["retraction"], areas(res)["retraction"])}
         out["hysteresis_W"] = float(res.hysteresis)
         return out

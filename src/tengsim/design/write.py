@@ -5,7 +5,8 @@ design.nc (CF-1.10, SI): coordinates ``pressure`` (Pa, the pressures asked for, 
 ``repulsive_area_fraction`` (1), ``voc_eq12``, ``voc_eq17`` (V), ``dvoc_dp`` (V Pa-1) on (branch, pressure), NaN
 where a branch does not reach a pressure; global attributes
 Conventions, title, shape, shape_params (JSON), E_star_Pa, W_J_m2, eps_m, tabor, sigma_C_m2, eps_r, thickness_m,
-gap_m, status, grids, tolerance, charged_area_definition, and the per-design numbers (:mod:`tengsim.design.curves`).
+gap_m, status, grids, tolerance, charged_area_definition, branches_solved (the retraction is all NaN where only
+the approach was solved), and the per-design numbers (:mod:`tengsim.design.curves`).
 ``tengsim.device.area_table_from_design`` reads it.
 """
 from __future__ import annotations
@@ -65,6 +66,7 @@ def to_dataset(res, plan, summary: dict):
         "tolerance": float(plan.tol), "solver_tolerance_eps": float(res.params.get("tol", math.nan)),
         "charged_area_definition": str(summary["charged_area_definition"]),
         "area_definition": str(getattr(plan, "area", "contact")), "boundary": str(getattr(plan, "boundary", "")),
+        "branches_solved": "approach and retraction" if getattr(plan, "retraction", True) else "approach",
         "contact_config": json.dumps({k: v for k, v in plan.contact_table.items()}, sort_keys=True, default=str),
     }
     sensor, reasons = summary.get("sensor"), summary.get("reasons") or {}

@@ -67,16 +67,18 @@ def on_gpu(cplan) -> bool:
     return name == "gpu" or (name == "jax" and gpu_visible()) or getattr(cplan.solver, "device", "") == "gpu"
 
 
-def run_cost(cplan, d_max: float, coarse=None) -> Cost:
-    """The :class:`Cost` of a design's grids: rows from the path's D range (:data:`ROWS_PER_STEP`), iterations per
-    row from the coarse pre-run ``coarse`` (× :data:`ITERATIONS_PER_COARSE`; 20 per row without one)."""
+def run_cost(cplan, d_max: float, coarse=None, retract: bool = True) -> Cost:
+    """The :class:`Cost` of a design's grids: rows from the path's D range (:data:`ROWS_PER_STEP`; half of them
+    without the retraction, ``retract`` false), iterations per row from the coarse pre-run ``coarse``
+    (× :data:`ITERATIONS_PER_COARSE`; 20 per row without one)."""
     its = 20.0
     if coarse is not None:
         it = np.asarray(coarse.table.get("iterations", ()), dtype=float)
         if it.size and np.isfinite(it).all():
             its = float(np.mean(it))
     gpu = on_gpu(cplan)
-    return Cost(cost_model(gpu), ROWS_PER_STEP * (d_max - D_MIN) / D_STEP, ITERATIONS_PER_COARSE * its, gpu)
+    rows = ROWS_PER_STEP * (d_max - D_MIN) / D_STEP * (1.0 if retract else 0.5)
+    return Cost(cost_model(gpu), rows, ITERATIONS_PER_COARSE * its, gpu)
 
 
 @dataclass(frozen=True)

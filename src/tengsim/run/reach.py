@@ -22,11 +22,12 @@ D_STEP = 0.4
 EXTEND_TRIES = 6
 
 
-def path_to(d_max: float, maps_at=()):
-    """The adaptive D walk from :data:`D_MIN` to ``d_max`` (maps kept at ``maps_at``)."""
+def path_to(d_max: float, maps_at=(), retract: bool = True):
+    """The adaptive D walk from :data:`D_MIN` to ``d_max`` (maps kept at ``maps_at``) and back (``retract`` false:
+    the approach only)."""
     from tengsim.continuation import PathSpec
 
-    return PathSpec(D_MIN, d_max, D_STEP, adaptive=True, maps_at=tuple(maps_at))
+    return PathSpec(D_MIN, d_max, D_STEP, adaptive=True, maps_at=tuple(maps_at), retract=retract)
 
 
 def height_eps(cplan, dx) -> float:
@@ -110,13 +111,14 @@ def map_depths(res, map_pressures) -> dict:
     return out
 
 
-def grid_path(p_max: float, d_max: float, map_pressures=(), cut: bool = True):
+def grid_path(p_max: float, d_max: float, map_pressures=(), cut: bool = True, retract: bool = True):
     """``path_for`` of the refinement (:func:`tengsim.run.resolve.resolve_plan`): the first grid walks to
     ``d_max`` (:func:`find_d_max`); each finer grid to the D at which the grid before it reached ``p_max``, plus
     :data:`D_MARGIN` (on the path's lattice, never beyond ``d_max``).  Each finer grid's path also keeps the
     pressure and gap maps at the D where the grid before it reached ``map_pressures`` (:func:`map_depths`), so the
     finest grid's maps are recorded during its own walk (an extra row at each such D, solved from the rows around
-    it: the walk's other rows are unchanged).  ``cut`` false: every grid walks to ``d_max``."""
+    it: the walk's other rows are unchanged).  ``cut`` false: every grid walks to ``d_max``; ``retract`` false: the
+    approach only."""
 
     def on_lattice(D):
         return D_MIN + math.ceil((D - D_MIN) / D_STEP - 1e-9) * D_STEP
@@ -130,13 +132,13 @@ def grid_path(p_max: float, d_max: float, map_pressures=(), cut: bool = True):
             if map_pressures:
                 last = D_MIN + math.floor((top - D_MIN) / D_STEP + 1e-9) * D_STEP
                 depths = tuple(sorted(D for D in map_depths(prev, map_pressures) if D_MIN <= D <= last))
-        return path_to(top, depths)
+        return path_to(top, depths, retract)
 
     return path_for
 
 
 def resolve_to(cplan, p_max: float, d_max: float, settings, map_pressures=(), observe=None, watch=None,
-               progress=None, keep=None, key: str = "", done=None, say=None):
+               progress=None, keep=None, key: str = "", done=None, say=None, retract: bool = True):
     """The refinement (:func:`tengsim.run.resolve.resolve_plan`, with ``settings``, a
     :class:`tengsim.run.plan.ResolveSettings`) of ``cplan`` on the path to ``d_max`` (:func:`grid_path`), whose
     finest grid must reach ``p_max``: if it does not (a finer grid is softer), d_max grows to 1.2 d_max + 2 ε and
@@ -144,7 +146,7 @@ def resolve_to(cplan, p_max: float, d_max: float, settings, map_pressures=(), ob
     ``keep`` (a file, or None): each finished grid is kept there for the run ``key`` and path
     (:func:`tengsim.run.checkpoint.open_checkpoint`, ``say`` told what it finds), and taken back by a run of the
     same key and path.  ``done(levels)`` is called after each finished grid is kept; ``observe``, ``watch`` and
-    ``progress`` as for resolve_plan."""
+    ``progress`` as for resolve_plan; ``retract`` false: each grid walks the approach only."""
     from tengsim.run.checkpoint import open_checkpoint
     from tengsim.run.resolve import resolve_plan
 
@@ -159,7 +161,7 @@ def resolve_to(cplan, p_max: float, d_max: float, settings, map_pressures=(), ob
                 done(levels)
 
         res = resolve_plan(cplan, observe=observe, watch=watch, settings=settings,
-                           path_for=grid_path(p_max, d_max, map_pressures, cut=attempt == 0),
+                           path_for=grid_path(p_max, d_max, map_pressures, attempt == 0, retract),
                            progress=progress, checkpoint=after, start=found)
         if res.scaling is None:  # every grid taken back from the checkpoint file, which keeps the columns only
             res = dataclasses.replace(res, scaling=cplan.scaling)

@@ -1,8 +1,8 @@
 """A refinement asked to reach a pressure: checked, estimated, budgeted and solved, on the run layer.
 
 ``ask`` is what was asked: any object with ``name``, ``pressures`` (Pa, increasing; the path must reach the last),
-``tol``, ``max_pixels`` (or None), ``budget_s`` (s) and ``dx`` (the first grid's spacing, m, or None: :func:`first_dx`)
-— a :class:`tengsim.design.plan.DesignPlan`.  ``cplan`` is the :class:`tengsim.run.plan.ContactPlan` it solves.
+``tol``, ``max_pixels`` (or None), ``budget_s`` (s), ``dx`` (the first grid's spacing, m, or None: :func:`first_dx`)
+and ``retraction`` (false: the approach only) — a :class:`tengsim.design.plan.DesignPlan`.  ``cplan`` is the :class:`tengsim.run.plan.ContactPlan` it solves.
 
 1. :func:`preflight` checks every bound from the sizes alone before any array is allocated: the solver (a machine
    without it, a law it cannot solve), the first grid (within ``max_pixels``, the film's pixels and the memory; in
@@ -81,7 +81,7 @@ def preflight(cplan, ask) -> float:
     lateral = cplan.scaling.lateral
     try:
         g = cplan.shape.grid(dx)
-        secs = run_cost(cplan, 2.0).grid_seconds(cplan.shape, g)  # the shortest path's time, on the backend's model
+        secs = run_cost(cplan, 2.0, None, ask.retraction).grid_seconds(cplan.shape, g)  # the shortest path
         solver = make_solver(cplan.solver, tol=cplan.tol)  # a solver this machine lacks (gpu): refused now
         if hasattr(solver, "solves") and not solver.solves(cplan.law):  # a law it cannot solve: refused now
             from tengsim.solvers.pk import PKSolver, wall_model
@@ -143,12 +143,12 @@ def refine(cplan, ask, hooks: Hooks = Hooks()):
     grids = GridSequence(cplan.shape, dx)  # the refinement's grids: its estimate, its budget, its lines
 
     d_max, coarse = find_range(cplan, ask, dx, hooks.progress, coarse_guard)  # the path's range, on a cheap grid
-    est = estimate(ask, cplan, grids, d_max, run_cost(cplan, d_max, coarse))
+    est = estimate(ask, cplan, grids, d_max, run_cost(cplan, d_max, coarse, ask.retraction))
     for line in est.lines():
         said(line)
     if hooks.later is not None and hooks.later > d_max:  # killed in its second pass: go on on that pass's path
         d_max = hooks.later
-    cost = run_cost(cplan, d_max, coarse)
+    cost = run_cost(cplan, d_max, coarse, ask.retraction)
     max_pixels = ask.max_pixels or budget_pixels(ask, cplan.shape, grids, cost)
     check_budget(ask, est, max_pixels)
     said(cap_line(cplan.shape, grids, cost, max_pixels))
@@ -157,4 +157,4 @@ def refine(cplan, ask, hooks: Hooks = Hooks()):
         said(next_grid_line(cplan.shape, grids[:len(levels) + 1], levels[-1]["seconds"], cplan.scaling.lateral))
 
     return resolve_to(cplan, p_max, d_max, ResolveSettings(ask.tol, max_pixels, dx), hooks.maps_at, hooks.observe,
-                      hooks.watch, guard, hooks.keep, hooks.base, done, said)
+                      hooks.watch, guard, hooks.keep, hooks.base, done, said, ask.retraction)
