@@ -312,7 +312,8 @@ def test_zone_inner_falls_back_and_says_so(monkeypatch):
     pr = Problem(U0 - 0.3 + 1.0, MaugisDugdale(), FreeKernel(grid, 1.0))
     outer = PKSolver(1e-7, zone="outer").solve(pr, State.zero(U0.shape))
     real = pkmod.zone_inner
-    monkeypatch.setattr(pkmod, "zone_inner", lambda conv, h, m, p, c, tol, max_iter, *a: real(conv, h, m, p, c, tol, 3, *a))
+    monkeypatch.setattr(pkmod, "zone_inner",
+                        lambda conv, h, m, p, c, tol, max_iter, *a: real(conv, h, m, p, c, tol, 3, *a))
     eq = PKSolver(1e-7).solve(pr, State.zero(U0.shape))
     assert eq.converged and "outer fixed point" in eq.message and "did not settle" in eq.message
     assert np.array_equal(eq.P, outer.P)
@@ -340,10 +341,11 @@ def test_outer_ramp_not_converged_on_a_zone_off_the_law():
 
 
 def test_md_path_jumps_out_at_maugis_displacement():
-    """The retraction of a displacement-controlled Maugis–Dugdale path (R = 1, μ = 1, dx 0.2, cell 16, D −2 → 0.5 →
-    −2 ε in 0.05 ε, tol 1e-6 ε) on pk's default inner zone loop leaves the contact at Maugis' smallest indentation,
-    D = −1.734 ε (the turning point of `references.maugis_dugdale_curve`): within 2 % (measured −1.744 ε, 0.6 %; the outer
-    loop, holding the sharp zone's pinned states where its ramp does not settle, leaves at −1.96 ε)."""
+    """The retraction of a displacement-controlled Maugis–Dugdale path (R = 1, μ = 1, dx 0.2, cell 16, D −2 → 0.5
+    → −2 ε in 0.05 ε, tol 1e-6 ε) on pk's default inner zone loop leaves the contact at Maugis' smallest
+    indentation, D = −1.734 ε (the turning point of `references.maugis_dugdale_curve`): within 2 % (measured
+    −1.744 ε, 0.6 %; the outer loop, holding the sharp zone's pinned states where its ramp does not settle, leaves
+    at −1.96 ε)."""
     from tengsim.continuation import PathSpec, run_path
 
     shape = Paraboloid(1.0, 16.0)

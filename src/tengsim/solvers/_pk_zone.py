@@ -18,7 +18,8 @@ iterate is Anderson-mixed with the last ``anderson`` ones (the mixing restarted 
 leaves the contact or crosses the zone's middle).  The conjugate directions of the hard-wall CG are not kept:
 the zone moves the problem at every iteration, and kept directions made the ramp's collective modes grow
 (as did a per-pixel Newton step of the zone); the mixing is what accelerates the loop, over the contact and
-the zone together.
+the zone together.  Like the outer loop's mixing it is not a descent: it finds an equilibrium (below), whose
+stability it does not check.
 
 Converged when every pixel's gap is within ``tol`` (ε) of the gaps its pressure allows: 0 on the contact,
 [0, h0 − ramp/2] at −σ0, [h0 + ramp/2, ∞) at 0, the smoothstep's inverse between (:func:`zone_residual`: the
@@ -37,8 +38,9 @@ import numpy as np
 from tengsim import backend
 
 #: the fraction of the preconditioned gradient a contact step takes (M⁻¹ ≈ K⁻¹: 1 would be Newton's step in
-#: full contact; 0.5–0.8 measured alike on the Maugis–Dugdale path of benchmarks/md_path_pk.py)
-STEP = 0.7
+#: full contact; 0.4–0.8 alike on the Maugis–Dugdale path of benchmarks/md_path_pk.py at dx 0.2; 0.7 cycled on
+#: the contact's edge at dx 0.05 from a cold start)
+STEP = 0.5
 
 
 @dataclass

@@ -70,7 +70,7 @@ RAMP_WARM = 0
 #: the gap residual (ε) of the sharp zone's solve when it is only the ramp's start
 SHARP_TOL = 1e-3
 #: iterations without a new lowest residual after which the zone in the contact's loop stops, mixed and unmixed
-ZONE_STALL = (30, 100)
+ZONE_STALL = (10, 100)
 
 #: the laws 'pk' solves, by class name (their hard-wall limits, module doc)
 SUPPORTED = ("Repulsive", "MaugisDugdale", "Exponential")
