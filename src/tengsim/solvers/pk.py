@@ -18,8 +18,7 @@ that can ('fast', or 'homotopy' where the law is stiff at the pixel scale).
 
 Cohesive laws (Rey et al. 2017: the adhesive tractions outside the contact are a load of the
 non-adhesive problem).  ``zone='inner'`` (the default of 'pk'; the Maugis–Dugdale ramp under displacement
-control):
-the zone's tensions are set from the gap at every iteration of the contact's constrained solve, the
+control): the zone's tensions are set from the gap at every iteration of the contact's constrained solve, the
 iterates Anderson-mixed (tengsim.solvers._pk_zone: its doc says how, and what it is converged to); where
 that loop stalls (a set update cycling near a jump), the same loop unmixed, then the outer fixed point
 below, and the message says so.  ``zone='outer'`` (and the sharp zone, the exponential law, load control: on
