@@ -120,9 +120,9 @@ class _Mix:
 
     def __init__(self, n, m):
         self.m = m
-        self.X, self.F = np.empty((n, m)), np.empty((n, m))
-        self.A = np.empty((m, m))
-        self.x_old, self.f_old = np.empty(n), np.empty(n)
+        self.X, self.F = backend.empty((n, m)), backend.empty((n, m))
+        self.A = backend.empty((m, m))
+        self.x_old, self.f_old = backend.empty(n), backend.empty(n)
         self.reset()
 
     def reset(self):
