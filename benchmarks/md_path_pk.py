@@ -11,8 +11,9 @@ the pull-off ∬P / π against Maugis' P̄(λ) and the jumps of each solver, and
     OPENBLAS_NUM_THREADS=1 python benchmarks/md_path_pk.py --dx 0.2 --dx-of homotopy=0.1   # at equal pull-off error
 
 Both solvers stop at the same residual in the same unit: 1e-6 ε (homotopy: of Eq. (9) with the penalty wall;
-pk: the hard wall's gap residual and the zone's last move).  'pk-jax' (the contact solve compiled with JAX)
-may be added to --solvers; its first solve on a grid compiles (seconds, counted).
+pk: the gap residual against the wall and the law).  'pk-jax' (the contact solve compiled with JAX)
+may be added to --solvers; its first solve on a grid compiles (seconds, counted; its zone loop is the outer one).
+``--pk-zone outer``: pk's zone by the outer fixed point (PKSolver(zone='outer')) instead of its contact's loop.
 """
 from __future__ import annotations
 
@@ -38,6 +39,8 @@ def main(argv=None):
     ap.add_argument("--mu", type=float, default=1.0)
     ap.add_argument("--cell", type=float, default=16.0)
     ap.add_argument("--solvers", nargs="+", default=["pk", "homotopy"])
+    ap.add_argument("--pk-zone", choices=("inner", "outer"), default="inner",
+                    help="pk's cohesive zone: in the contact's loop (default) or the outer fixed point")
     ap.add_argument("--tol", type=float, default=1e-6, help="every solver's tolerance (ε; default 1e-6)")
     ap.add_argument("--dx-of", nargs="*", default=[], metavar="SOLVER=DX",
                     help="another grid for a solver (compare at equal pull-off accuracy: e.g. homotopy=0.1)")
@@ -52,7 +55,8 @@ def main(argv=None):
     for name in args.solvers:
         grid = shape.grid(dx_of.get(name, args.dx))
         kernel = FreeKernel(grid, args.mu ** 1.5)
-        solver = make_solver(name, tol=args.tol, **({"max_iter": 20000} if not name.startswith("pk") else {}))
+        solver = make_solver(name, tol=args.tol, **({"zone": args.pk_zone} if name == "pk" else
+                                                    {} if name.startswith("pk") else {"max_iter": 20000}))
         t = time.perf_counter()
         res = run_path(shape.gap(grid), law, kernel, solver, spec)
         dt = time.perf_counter() - t

@@ -17,27 +17,32 @@ Any other law (LJ93's smooth repulsion, a plugin's law) is refused with one line
 that can ('fast', or 'homotopy' where the law is stiff at the pixel scale).
 
 Cohesive laws (Rey et al. 2017: the adhesive tractions outside the contact are a load of the
-non-adhesive problem).  The pressure is p = p_c + p_a: p_a the law's tension where the gap is within
-its range (the contact included: −σ0 there), p_c >= 0 the contact pressure, solved by the constrained
-CG (tengsim.solvers._pk_core) with the initial gap g0 − 1 + K p_a.  The cohesive zone is then updated
-from the new gap and the contact solve repeated from its last pressure until the zone no longer
-changes (Maugis–Dugdale: a set of pixels, so this ends exactly; every state it ends in is a stable
-equilibrium of the sharp Dugdale law) or, for the exponential law, until the gap moves by less than
-``tol`` (a damped fixed point, halving its step when the change grows; it converges where the law is
-softer than a pixel, pixel snap number < 1, and says so when it does not).  The start state's gap
-gives the first zone, so a path's warm starts keep its branch (approach and retraction differ, jumps
-are the walker's).
+non-adhesive problem).  ``zone='inner'`` (the default of 'pk'; the Maugis–Dugdale ramp under displacement
+control): the zone's tensions are set from the gap at every iteration of the contact's constrained solve, the
+iterates Anderson-mixed (tengsim.solvers._pk_zone: its doc says how, and what it is converged to); where
+that loop stalls (a set update cycling near a jump), the same loop unmixed, then the outer fixed point
+below, and the message says so.  ``zone='outer'`` (and the sharp zone, the exponential law, load control: on
+the sharp zone, whose pixels trap the contact's edge, the inner loop finds other metastable states): the
+pressure is p = p_c + p_a, p_a the law's tension where the gap is within its range (the contact included:
+−σ0 there), p_c >= 0 the contact pressure, solved by the constrained CG (tengsim.solvers._pk_core) with the
+initial gap g0 − 1 + K p_a; the zone is then updated from the new gap and the contact solve repeated until
+the zone no longer changes (the sharp Dugdale zone: a set of pixels), or, for a ramp, the gap moves by less
+than ``tol`` and every gap is within ``tol`` of the law's graph (tengsim.solvers._pk_zone.zone_residual);
+for the exponential law until the gap moves by less than ``tol`` (a damped fixed point; it converges where
+the law is softer than a pixel, pixel snap number < 1, and says so when it does not).  The start state's gap
+gives the first zone, so a path's warm starts keep its branch (jumps are the walker's).
 
 Cost: two kernel convolutions an iteration of the contact solve and one FFT pair of its preconditioner
 (tengsim.solvers._pk_core), one convolution to start it (none when a zone update goes on from the last
-solve's K p_c), and one per zone update (K p_a); ``Equilibrium.n_conv`` counts the kernel's, ``iterations``
-the contact solves' iterations.  The Maugis–Dugdale ramp: the sharp zone's solve first (loosely, to
+solve's K p_c), and one per zone update (K p_a); ``zone='inner'``: one convolution and one FFT pair an
+iteration.  ``Equilibrium.n_conv`` counts the kernel's, ``iterations`` the contact solves' (or the inner
+loop's) iterations.  The outer Maugis–Dugdale ramp: the sharp zone's solve first (loosely, to
 ``SHARP_TOL``: it jumps in few updates), then the ramp from it (Anderson-mixed, ``anderson`` differences).
 The returned state is q = P = p, w = K p, H = g0 + w − 1 (load control: g0 moved by the approach's
-correction, :meth:`PKSolver.solve_load`), H = 0 exactly where the contact pressure p_c > 0 (the hard wall's gap
-there; g0 + w − 1 is within the residual of it, of either sign, and a measure that asks g <= 1, the charged area
-of a law whose peak tension starts at the wall, must not see that noise); ``residual`` is the hard-wall
-residual in ε (the largest gap over the contact, overlap of the wall, or move of the last zone update).
+correction, :meth:`PKSolver.solve_load`), H = 0 exactly on the contact (the hard wall's gap there; g0 + w − 1
+is within the residual of it, of either sign, and a measure that asks g <= 1, the charged area of a law whose
+peak tension starts at the wall, must not see that noise); ``residual`` is the hard-wall residual in ε (the
+largest gap over the contact, overlap of the wall, move of the last zone update or distance from the law).
 """
 from __future__ import annotations
 
@@ -52,6 +57,7 @@ from tengsim import backend
 from tengsim.errors import TengsimError
 from tengsim.registry import SOLVERS
 from tengsim.solvers._pk_core import Convolution, constrained_cg, preconditioner
+from tengsim.solvers._pk_zone import Anderson as _Anderson, zone_inner, zone_residual
 from tengsim.solvers.types import Equilibrium, Problem, State
 
 #: the largest pixel snap number of a Maugis–Dugdale ramp (PKSolver._ramp)
@@ -62,6 +68,8 @@ RAMP_UPDATES = 60
 RAMP_WARM = 0
 #: the gap residual (ε) of the sharp zone's solve when it is only the ramp's start
 SHARP_TOL = 1e-3
+#: iterations without a new lowest residual after which the zone in the contact's loop stops, mixed and unmixed
+ZONE_STALL = (10, 100)
 
 #: the laws 'pk' solves, by class name (their hard-wall limits, module doc)
 SUPPORTED = ("Repulsive", "MaugisDugdale", "Exponential")
@@ -142,6 +150,7 @@ class PKSolver:
     precondition: bool = True
     md_zone: str = "ramp"
     anderson: int = 5
+    zone: str = "inner"
     name: str = "pk"
     monitor: object = None
     monitor_every: int = 50
@@ -154,6 +163,8 @@ class PKSolver:
             raise TengsimError(f"tol must be a finite number > 0, got {self.tol!r}")
         if self.md_zone not in ("ramp", "sharp"):
             raise TengsimError(f"md_zone must be 'ramp' or 'sharp', got {self.md_zone!r}")
+        if self.zone not in ("inner", "outer"):
+            raise TengsimError(f"zone must be 'inner' or 'outer', got {self.zone!r}")
         for key in ("max_iter", "max_zone", "monitor_every"):
             v = getattr(self, key)
             if isinstance(v, bool) or not isinstance(v, int) or v < 1:
@@ -191,14 +202,17 @@ class PKSolver:
 
     # ---- the solve ---------------------------------------------------------------------------
     @staticmethod
-    def _ramp(law, conv, shape) -> float:
-        """The zone's ramp (ε): the law's smoothing, widened where a pixel would be stiffer than it
-        (pixel snap number 1.5 σ0 K_ii / ramp above ``RAMP_SNAP``; K_ii, a pixel's own compliance, by one
-        convolution of a unit pixel)."""
+    def _kii(conv, shape) -> float:
+        """K_ii, a pixel's own compliance (ε per W/ε), by one convolution of a unit pixel at the cell's middle."""
         unit = backend.zeros(int(np.prod(shape)))
         i = np.ravel_multi_index(tuple(n // 2 for n in shape), shape)
         unit[i] = 1.0
-        kii = float(conv(unit, backend.empty(unit.size))[i])
+        return float(conv(unit, backend.empty(unit.size))[i])
+
+    @staticmethod
+    def _ramp(law, kii) -> float:
+        """The zone's ramp (ε): the law's smoothing, widened where a pixel would be stiffer than it
+        (pixel snap number 1.5 σ0 K_ii / ramp above ``RAMP_SNAP``)."""
         return max(float(law.smoothing), 1.5 * float(law.tension) * kii / RAMP_SNAP)
 
     def _solve(self, problem: Problem, start: State, load):
@@ -211,7 +225,7 @@ class PKSolver:
         conv = self._convolution(problem.kernel, shape)
         pre = preconditioner(problem.kernel, shape) if self.precondition else None
         if model.kind == "md" and self.md_zone == "ramp":
-            model = replace(model, ramp=self._ramp(problem.law, conv, shape))
+            model = replace(model, ramp=self._ramp(problem.law, self._kii(conv, shape)))
         g0 = backend.xp.ascontiguousarray(problem.g0, dtype=float).ravel()
         q0 = backend.xp.asarray(start.q, dtype=float).ravel()
         w0 = backend.xp.asarray(start.w, dtype=float).ravel()
@@ -233,6 +247,8 @@ class PKSolver:
             touching = p > 0
             its, ok, res, zones = core.iterations, core.converged, core.residual, 0
             msg = "converged" if ok else f"not converged in {self.max_iter} iterations (residual {res:.3g} ε)"
+        elif model.kind == "md" and model.ramp > 0 and self.zone == "inner" and load is None:
+            p, Kp, u, c, its, ok, res, zones, msg, touching = self._zone_inner(model, conv, h0, q0, w0, mon, pre)
         else:
             out = None
             if model.ramp > 0 and RAMP_WARM and bool(np.any(q0)):   # warm: the ramp from the start, if quick
@@ -253,6 +269,29 @@ class PKSolver:
                          float(res), bool(ok), int(its), int(conv.count), E, time.perf_counter() - t0,
                          msg if zones == 0 else f"{msg} ({zones} cohesive-zone updates)")
         return eq, float(c)
+
+    def _zone_inner(self, model, conv, h0, q0, w0, mon, pre):
+        """The Maugis–Dugdale zone in the contact's loop (tengsim.solvers._pk_zone), from the start state's gap:
+        mixed (``anderson``), then, where that stalls, unmixed from the same start, then the outer fixed point
+        (the message says which)."""
+        u0 = h0 + w0
+        p0 = model.adhesive(np.maximum(u0, 0.0), backend.empty(h0.size))
+        pc = np.maximum(q0 - p0, 0.0)
+        pc[u0 > self.tol] = 0.0
+        p0 += pc
+        its, tried = 0, []
+        for m, stall in ((self.anderson, ZONE_STALL[0]), (0, ZONE_STALL[1])):
+            z = zone_inner(conv, h0, model, p0.copy(), pc > 0, self.tol, self.max_iter, mon, pre, m, stall)
+            its += z.iterations
+            if z.converged:
+                how = "zone in the contact's loop" + (", unmixed" if tried else "")
+                return z.p, z.Kp, z.u, 0.0, its, True, z.residual, 0, f"converged ({how})", z.contact
+            tried.append(f"{z.iterations} iterations (residual {z.residual:.3g} ε, {z.changes} set changes)")
+            if not m:
+                break
+        out = self._ramp_after_sharp(model, conv, h0, q0, w0, None, mon, pre)
+        why = f"{out[8]} (outer fixed point: the zone in the contact's loop did not settle in {' + '.join(tried)})"
+        return out[:4] + (out[4] + its, out[5], out[6], out[7], why, out[9])
 
     def _ramp_after_sharp(self, model, conv, h0, q0, w0, load, mon, pre):
         """A cohesive solve; with a ramp (md), the sharp zone's solve first (it jumps in few updates) as its
@@ -318,8 +357,16 @@ class PKSolver:
                 u_prev[:] = u
                 res = max(core.residual, move if math.isfinite(move) else 0.0)
                 if zones > 1 and move <= tol and tol_in <= tol:
-                    ok = True
-                    break
+                    if model.kind != "md":
+                        ok = True
+                        break
+                    # two updates can agree on a zone that is not the law's (Anderson's clipped iterates): the
+                    # state is judged by its gaps against the law's graph (tengsim.solvers._pk_zone), as the CG's is
+                    law = zone_residual(model, u, pc + used, pc > 0, backend.empty(n))
+                    res = max(res, law)
+                    if law <= tol:
+                        ok = True
+                        break
                 last_move = move
                 mix.step(pa, pa_new)                  # pa <- the next zone (Anderson-mixed fixed point)
                 np.clip(pa, -s0, 0.0, out=pa)
@@ -335,40 +382,6 @@ class PKSolver:
         return p, Kp, u, c, its, ok, res, zones, msg, pc > 0
 
 
-class _Anderson:
-    """Anderson mixing (type II, memory ``m``) of the fixed point x = G(x) of a cohesive zone's tractions:
-    ``step(x, gx)`` moves x in place to x + f − (ΔX + ΔF) γ, γ the least-squares fit of f = G(x) − x
-    by the stored differences (m = 0: the plain update x = G(x)).  Memory is dropped when the residual
-    grows tenfold (a jump: the old differences describe another branch)."""
-
-    def __init__(self, n: int, m: int):
-        self.m, self.X, self.F = int(m), [], []
-        self.x_old = self.f_old = None
-        self.f_norm = math.inf
-
-    def step(self, x, gx):
-        f = gx - x
-        fn = float(np.dot(f, f))
-        if fn > 100.0 * self.f_norm:
-            self.X, self.F = [], []
-        self.f_norm = fn
-        if self.m and self.x_old is not None:
-            self.X.append(x - self.x_old)
-            self.F.append(f - self.f_old)
-            if len(self.X) > self.m:
-                self.X.pop(0)
-                self.F.pop(0)
-        self.x_old, self.f_old = x.copy(), f
-        if not self.F:
-            x += f
-            return
-        Fm = np.stack(self.F, axis=1)
-        A = Fm.T @ Fm                                  # the normal equations (m × m), scaled to unit diagonal
-        d = np.sqrt(np.maximum(np.diag(A), 1e-300))
-        gamma = np.linalg.lstsq(A / np.outer(d, d), (Fm.T @ f) / d, rcond=1e-10)[0] / d
-        x += f - (np.stack(self.X, axis=1) + Fm) @ gamma
-
-
 @dataclass(frozen=True)
 class PKJaxSolver(PKSolver):
     """:class:`PKSolver` with its contact solve (the active set and the CG) compiled with JAX as one loop
@@ -376,6 +389,7 @@ class PKJaxSolver(PKSolver):
     zone's updates stay on the host.  The same states as 'pk' to round-off (tests/test_pk_jax.py)."""
 
     device: str = "auto"
+    zone: str = "outer"
     name: str = "pk-jax"
     compiles: ClassVar[bool] = True
 
@@ -386,6 +400,9 @@ class PKJaxSolver(PKSolver):
         if self.device not in DEVICES:
             raise TengsimError(f"device must be one of {', '.join(DEVICES)}, got {self.device!r}")
         find_device(self.device)          # the one-line error (no JAX, no GPU) before a run writes anything
+        if self.zone != "outer":
+            raise TengsimError(f"solver '{self.name}' updates a cohesive zone by the outer fixed point only "
+                               f"(zone 'outer'), got zone {self.zone!r}; use solver 'pk' for zone 'inner'")
 
     def _convolution(self, kernel, shape):
         from tengsim.solvers._pk_jax import JaxConvolution
