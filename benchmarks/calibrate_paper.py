@@ -38,6 +38,7 @@ def main(argv=None):
     ap.add_argument("--nodes", type=int, default=3)
     ap.add_argument("--seed", type=int, default=5)
     ap.add_argument("--zooms", type=int, default=2)
+    ap.add_argument("--refine", type=int, default=3, help="rounds in which the checks become nodes")
     ap.add_argument("--free", default="sigma,W,eps", help="sigma,W with ε fixed at the truth")
     ap.add_argument("--name", default="calibrate_paper", help="the output's name under --out")
     ap.add_argument("--W-lo", default="30mJ/m2")
@@ -65,14 +66,14 @@ def main(argv=None):
         tables.append(t)
     bounds = {"W": (a.W_lo, a.W_hi), "eps": (a.eps_lo, a.eps_hi)}
     prob = plan_calibration(tables, curves, a.free, {k: v for k, v in bounds.items() if k in a.free})
-    cal = calibrate(prob, out / a.name, n_nodes=a.nodes, zooms=a.zooms,
+    cal = calibrate(prob, out / a.name, n_nodes=a.nodes, zooms=a.zooms, refine=a.refine, expected_noise=a.noise,
                     progress=lambda s: print(f"  {s}", file=sys.stderr, flush=True))
     write_calibration(cal, out / a.name)
     f = cal.fit
     res = {"truth": TRUE, "seed": a.seed, "noise": a.noise, "tol": a.tol, "nodes": a.nodes, "zooms": a.zooms,
            "free": a.free, "bounds": {"W": [a.W_lo, a.W_hi], "eps": [a.eps_lo, a.eps_hi]}, "best": f.best,
            "interval": f.interval, "words": f.words, "seconds": cal.seconds,
-           "designs_solved": cal.nodes_solved, "surrogate_error": cal.surrogate_error, "noise_scale": f.scale,
+           "designs_solved": cal.nodes_solved, "refinements": cal.refinements, "warnings": cal.warnings, "surrogate_error": cal.surrogate_error, "noise_scale": f.scale,
            "W_rel_error": f.best["W"] / TRUE["W"] - 1, "sigma_rel_error": f.best["sigma"] / TRUE["sigma"] - 1}
     (out / f"{a.name}.json").write_text(json.dumps(res, indent=1, default=float))
     print(json.dumps(res, indent=1, default=float))
