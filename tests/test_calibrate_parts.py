@@ -111,3 +111,22 @@ def test_level_interpolation_is_exact_at_its_nodes():
     for n in nodes:
         got = s.area([n.u], [0.0], [1.0], P, ["approach"] * len(P))[0]
         assert np.max(np.abs(got - n.area["approach"])) < 2e-3
+
+
+def test_warnings_say_when_the_fitted_noise_or_the_interpolations_error_is_too_large():
+    from types import SimpleNamespace
+
+    from tengsim.calibrate.run import warnings
+
+    rel = SimpleNamespace(known_errors=False, noise="relative", n_points=60, free=("sigma", "W"))
+    fit = SimpleNamespace(scale=0.02, dev_min=0.0)
+    assert warnings(rel, fit, 0.01, 0.02) == ()  # a fit within its noise, an interpolation within it
+    w = warnings(rel, SimpleNamespace(scale=0.08, dev_min=0.0), 0.01, 0.02)
+    assert len(w) == 1 and "8 % of V_OC is 4 × the expected 2 % of V_OC" in w[0]
+    w = warnings(rel, fit, 0.05, None)
+    assert len(w) == 1 and "interpolation's own error (5 % of V_OC" in w[0] and "exceeds the fitted noise" in w[0]
+    assert len(warnings(rel, SimpleNamespace(scale=0.15, dev_min=0.0), 0.01, None)) == 1  # large with none expected
+    known = SimpleNamespace(known_errors=True, noise="relative", n_points=60, free=("sigma", "W"))
+    assert warnings(known, SimpleNamespace(scale=1.0, dev_min=58 * 1.1), 0.1) == ()
+    w = warnings(known, SimpleNamespace(scale=1.0, dev_min=58 * 9.0), 0.1)
+    assert len(w) == 1 and "3 × the stated errors" in w[0]
