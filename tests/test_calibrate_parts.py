@@ -72,3 +72,61 @@ def test_residual_sizes_are_said_in_the_noise_models_unit():
     assert residual_text(0.0233, SimpleNamespace(known_errors=False, noise="relative")) == "2.33 % of V_OC"
     assert residual_text(0.5, SimpleNamespace(known_errors=False, noise="absolute")) == "0.5 V"
     assert residual_text(1.2, SimpleNamespace(known_errors=True, noise="relative")) == "1.2 × voc_err_V"
+
+
+def _jumping_nodes():
+    """Synthetic nodes: A/S jumps from about 0.06 to 0.9 at a pressure 20 kPa + 40 kPa × u, u = log W on [0, 1]."""
+    from tengsim.calibrate.surrogate import Node
+
+    P = np.linspace(0, 100e3, 21)
+
+    def curve(u):
+        return np.where(P < 20e3 + 40e3 * u, 0.05 + 0.05 * P / 100e3, 0.9 + 0.05 * P / 100e3)
+
+    return P, [Node(u, 0.0, True, P, {"approach": curve(u), "retraction": curve(u)}) for u in np.linspace(0, 1, 5)]
+
+
+def test_the_jump_is_interpolated_to_where_it_moves_between_nodes_not_blended_at_fixed_pressure():
+    from tengsim.calibrate.surrogate import Surrogate
+
+    P, nodes = _jumping_nodes()
+    u = 0.375  # between the nodes at 0.25 (jump at 30 kPa) and 0.5 (40 kPa): the truth jumps at 35 kPa
+    q = np.linspace(20e3, 50e3, 31)
+    # the truth as a node there would give it: its curve on the 5 kPa steps, linear between (the jump from 30 to 35)
+    truth = np.interp(q, P, np.where(P < 35e3, 0.05 + 0.05 * P / 100e3, 0.9 + 0.05 * P / 100e3))
+    new = Surrogate(P, nodes, (1.0, 1.0), (0,)).area([u], [0.0], [1.0], q, ["approach"] * len(q))[0]
+    old = Surrogate(P, nodes, (1.0, 1.0), (0,), "pressure").area([u], [0.0], [1.0], q, ["approach"] * len(q))[0]
+    assert np.max(np.abs(new - truth)) < 0.03, np.c_[q, new, truth]
+    assert new[q == 29e3] < 0.1 and new[q == 36e3] > 0.9
+    # the blend at a fixed pressure: half-jumped between the two nodes' jumps (a plateau no design has)
+    assert np.max(np.abs(old - truth)) > 0.3
+    assert np.any((old > 0.3) & (old < 0.7) & (q >= 36e3)), np.c_[q, old]
+
+
+def test_level_interpolation_is_exact_at_its_nodes():
+    from tengsim.calibrate.surrogate import Surrogate
+
+    P, nodes = _jumping_nodes()
+    s = Surrogate(P, nodes, (1.0, 1.0), (0,))
+    for n in nodes:
+        got = s.area([n.u], [0.0], [1.0], P, ["approach"] * len(P))[0]
+        assert np.max(np.abs(got - n.area["approach"])) < 2e-3
+
+
+def test_warnings_say_when_the_fitted_noise_or_the_interpolations_error_is_too_large():
+    from types import SimpleNamespace
+
+    from tengsim.calibrate.run import warnings
+
+    rel = SimpleNamespace(known_errors=False, noise="relative", n_points=60, free=("sigma", "W"))
+    fit = SimpleNamespace(scale=0.02, dev_min=0.0)
+    assert warnings(rel, fit, 0.01, 0.02) == ()  # a fit within its noise, an interpolation within it
+    w = warnings(rel, SimpleNamespace(scale=0.08, dev_min=0.0), 0.01, 0.02)
+    assert len(w) == 1 and "8 % of V_OC is 4 × the expected 2 % of V_OC" in w[0]
+    w = warnings(rel, fit, 0.05, None)
+    assert len(w) == 1 and "interpolation's own error (5 % of V_OC" in w[0] and "exceeds the fitted noise" in w[0]
+    assert len(warnings(rel, SimpleNamespace(scale=0.15, dev_min=0.0), 0.01, None)) == 1  # large with none expected
+    known = SimpleNamespace(known_errors=True, noise="relative", n_points=60, free=("sigma", "W"))
+    assert warnings(known, SimpleNamespace(scale=1.0, dev_min=58 * 1.1), 0.1) == ()
+    w = warnings(known, SimpleNamespace(scale=1.0, dev_min=58 * 9.0), 0.1)
+    assert len(w) == 1 and "3 × the stated errors" in w[0]

@@ -6,13 +6,19 @@ parameters and bounds, that the voltage can be reached).  :func:`calibrate` then
 1. lays an n × n grid of nodes (default 4 × 4) over the bounds of (W_eff, ε) (the axes that are free), prints how
    many designs it will solve and the designs' own time estimate, and solves each (kept in ``DIR/designs``);
 2. fits (:func:`tengsim.calibrate.fit.fit`) and measures the interpolation's error: designs solved at the best fit
-   and at both ends of each free contact parameter's interval (:func:`_check`), the largest; if it is above half the data's noise, lays a new n × n grid over the box of that region (15 % margin, at
-   least half the previous box) and fits again, at most ``zooms`` times; the intervals make room for the last
-   error measured (:func:`tengsim.calibrate.fit.inflation`);
-3. returns a frozen :class:`Calibration` (the fit, its bands, the surrogate's error, the nodes' account).
+   and at both ends of each free contact parameter's interval (:func:`_check`), the largest; if it is above half
+   the data's noise, lays a new n × n grid over the box of that region (15 % margin, at least half the previous
+   box) and fits again, at most ``zooms`` times;
+3. if the error is still above half the noise, makes the checks nodes and checks anew, at most :data:`REFINE`
+   times (a check where a node is is measured from the other nodes); the intervals make room for the last error
+   measured (:func:`tengsim.calibrate.fit.inflation`);
+4. warns in words (:func:`warnings`, among the fit's words) when the fitted noise is much larger than the stated or
+   expected one, or the interpolation's error exceeds the noise;
+5. returns a frozen :class:`Calibration` (the fit, its bands, the surrogate's error, the nodes' account).
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 import sys
 import time
@@ -29,6 +35,9 @@ residual's units) is at most this fraction of the data's noise; whatever it is, 
 (:func:`tengsim.calibrate.fit.inflation`).  It includes each node's own discretisation error (a design converged to
 its tol), which no interpolation removes: give the designs a tol below the data's relative noise."""
 MARGIN = 0.15
+REFINE = 3
+"""Rounds after the zooms in which the checks (converged designs at the best fit and the interval ends) become
+nodes and are checked anew, while the interpolation's error is above :data:`LOO_PER_NOISE` of the noise."""
 
 
 @dataclass(frozen=True)
@@ -45,6 +54,8 @@ class Calibration:
     nodes_failed: tuple = ()
     seconds: float = 0.0
     zooms: int = 0
+    refinements: int = 0
+    warnings: tuple = ()
 
 
 def _say(progress, text):
@@ -154,8 +165,11 @@ def _p_max(prob, key, geo):
     return nice_up(1.05 * top * prob.E_ref / prob.bounds["E_star"][0])
 
 
-def calibrate(prob, out_dir, n_nodes: int = 4, zooms: int = 2, progress=None) -> Calibration:
-    """Run the calibration of the checked problem ``prob`` (module doc); nodes kept in ``out_dir/designs``."""
+def calibrate(prob, out_dir, n_nodes: int = 4, zooms: int = 2, progress=None, refine: int = REFINE,
+              expected_noise=None) -> Calibration:
+    """Run the calibration of the checked problem ``prob`` (module doc); nodes kept in ``out_dir/designs``.
+    ``expected_noise``: the data's noise as known beforehand, in the noise model's unit (a fraction of V_OC for
+    the relative model, volts for the absolute), for the warning when the fit's is much larger."""
     from tengsim.calibrate.fit import Model, band, fit
     from tengsim.calibrate.surrogate import (POINTS_PER_CURVE, Surrogate, geometry_key, grid_points, node_table,
                                              solve_node,
@@ -229,11 +243,11 @@ def calibrate(prob, out_dir, n_nodes: int = 4, zooms: int = 2, progress=None) ->
     grid(box_uv)
     model = Model(prob, surr, geo)
     result = _fit_in_box(model, fit)
-    err, zoom = 0.0, 0
+    err, zoom, rounds = 0.0, 0, 0
     for zoom in range(zooms + 1):
         if not dims:
             break
-        err = _check(model, result, solve, base, pmax)
+        err, checks = _check(model, result, solve, base, pmax)
         if math.isfinite(err) and err <= LOO_PER_NOISE * result.scale or zoom == zooms:
             break
         box_uv = _region_box(model, result, ((u0, u1), (v0, v1)), box_uv)
@@ -244,16 +258,65 @@ def calibrate(prob, out_dir, n_nodes: int = 4, zooms: int = 2, progress=None) ->
             n = 2 * n - 1  # to narrow it): its grid at half the spacing, else the zoom would repeat the same fit
         model = Model(prob, surr, geo)
         result = _fit_in_box(model, fit)
+    while dims and rounds < refine and not (math.isfinite(err) and err <= LOO_PER_NOISE * result.scale):
+        rounds += 1  # the checks, converged designs where the fit lands, become nodes; checked anew
+        _say(progress, f"interpolation error {err:.3g} (noise {result.scale:.3g}) after the zooms: the checks made "
+                       f"nodes (refinement {rounds}/{refine})")
+        for k, node in checks:
+            sk = surr[k]
+            if node.ok and not any(all(abs((n.u, n.v)[d] - (node.u, node.v)[d]) <= 1e-3 * sk.span[d]
+                                       for d in sk.dims) for n in sk.nodes):
+                sk.nodes.append(node)
+                sk._rbf.clear()
+        model = Model(prob, surr, geo)
+        result = _fit_in_box(model, fit)
+        err, checks = _check(model, result, solve, base, pmax)
     if math.isfinite(err) and err > 0:  # the intervals with room for the model's own error
         result = _fit_in_box(model, lambda m, box=None: fit(m, box, model_error=err))
     loo = err
+    ok = bool(math.isfinite(loo) and loo <= LOO_PER_NOISE * result.scale)
+    warn = warnings(prob, result, loo, expected_noise)
+    result = dataclasses.replace(result, words=result.words + warn)
     solved, cached = count["solved"], count["cached"]
     P_plot = [np.linspace(0.0, float(c.pressure.max()), 61) for c in prob.curves]
     B_plot = [np.full(61, "approach" if "approach" in c.branch else c.branch[0]) for c in prob.curves]
     bands = band(model, result, P_plot, B_plot)
-    return Calibration(prob, result, model, tuple(bands), tuple(P_plot), loo,
-                       bool(math.isfinite(loo) and loo <= LOO_PER_NOISE * result.scale), solved, cached,
-                       tuple(dict.fromkeys(failed)), time.perf_counter() - t0, zoom)
+    return Calibration(prob, result, model, tuple(bands), tuple(P_plot), loo, ok, solved, cached,
+                       tuple(dict.fromkeys(failed)), time.perf_counter() - t0, zoom, rounds, warn)
+
+
+NOISE_LARGE = 0.10
+"""A fitted relative noise above this (10 % of V_OC) is warned of when no expected noise is given: larger than a
+TENG bench measurement's usual few per cent, it says the model misses the data's shape."""
+NOISE_RATIO = 2.0
+"""A fitted noise more than this times the expected (or the stated errors') is warned of."""
+
+
+def warnings(prob, f, err, expected=None) -> tuple:
+    """Plain-word warnings: the fitted noise much larger than the data's stated or expected noise, the
+    interpolation's error above the fitted noise."""
+    from tengsim.calibrate.fit import residual_text
+
+    out = []
+    n, p = prob.n_points, len(prob.free)
+    if prob.known_errors:
+        s = math.sqrt(max(f.dev_min, 0.0) / max(n - p, 1))
+        if s > NOISE_RATIO:
+            out.append(f"Warning: the residuals are {s:.2g} × the stated errors (voc_err_V): the model does not "
+                       "fit these data within their errors; the intervals assume it does.")
+    elif expected is not None and f.scale > NOISE_RATIO * expected:
+        out.append(f"Warning: the fitted noise {residual_text(f.scale, prob)} is {f.scale / expected:.2g} × the "
+                   f"expected {residual_text(expected, prob)}: the model misses the data's shape by more than their "
+                   "noise; the best values and intervals are those of a poor fit.")
+    elif expected is None and prob.noise == "relative" and f.scale > NOISE_LARGE:
+        out.append(f"Warning: the fitted noise {residual_text(f.scale, prob)} is large for a V_OC measurement: the "
+                   "model may miss the data's shape; the best values and intervals are those of a poor fit.")
+    if not math.isfinite(err) or err > f.scale:
+        out.append(f"Warning: the interpolation's own error ({residual_text(err, prob)}, measured against designs "
+                   f"solved where the fit lands) exceeds the fitted noise ({residual_text(f.scale, prob)}): the "
+                   "model between designs, not the data, limits this fit; give more designs (--nodes, --zooms) or "
+                   "tighter --bounds.")
+    return tuple(out)
 
 
 def _fit_in_box(model, fit):
@@ -330,11 +393,11 @@ def check_points(f, prob) -> list:
     return pts
 
 
-def _check(model, f, solve, base, pmax) -> float:
+def _check(model, f, solve, base, pmax):
     """The interpolation's error, measured: at each of :func:`check_points` each geometry's design is solved (a
     check, not a node: kept in designs/ but not interpolated), its A/S at the data pressures against the
-    interpolation's, as residuals (σ̂ × factor × ΔA / weight); the largest over the points of the rms over the
-    data points."""
+    interpolation's, as residuals (σ̂ × factor × ΔA / weight); (the largest over the points of the rms over the
+    data points, [(geometry key, check design)])."""
     from tengsim.calibrate.surrogate import _interp_rows, node_table
 
     keys = list(dict.fromkeys(model.geo))
@@ -357,13 +420,25 @@ def _check(model, f, solve, base, pmax) -> float:
             off += c.n
             if not node.ok:
                 continue
-            sur = model.surrogates[model.geo[i]].area(u, v, lam, c.pressure, c.branch)[0]
+            sur = _without_node_at(model.surrogates[model.geo[i]], u, v).area(u, v, lam, c.pressure, c.branch)[0]
             own = np.array([_interp_rows(node.pressures, np.nan_to_num(node.area[b])[None, :],
                                          np.array([[p / lam]]))[0, 0] for p, b in zip(c.pressure, c.branch)])
             errs.append(f.best["sigma"] * model.prob.factor(i) * (sur - own) / w)
         if errs:
             worst = max(worst, float(np.sqrt(np.mean(np.concatenate(errs) ** 2))))
-    return worst
+    checks = [(k, node) for m in range(len(where)) for k, node in zip(keys, nodes[m * len(keys):(m + 1) * len(keys)])]
+    return worst, checks
+
+
+def _without_node_at(s, u, v):
+    """The surrogate ``s`` less its nodes at (u, v) (a check where a node already is is measured from the others,
+    else it would be exact there however wrong the interpolation is between nodes)."""
+    from tengsim.calibrate.surrogate import Surrogate
+
+    near = [n for n in s.nodes if all(abs((n.u, n.v)[d] - (u, v)[d]) <= 1e-6 * s.span[d] for d in s.dims)]
+    if not near or len(near) == len(s.good()):
+        return s
+    return Surrogate(s.pressures, [n for n in s.nodes if not any(n is x for x in near)], s.span, s.dims, s.interp)
 
 
 def say_to_stderr(quiet=False):

@@ -11,10 +11,15 @@ tol) at (W_eff, ε), kept in ``DIR/designs/KEY.nc`` as soon as it is solved (KEY
 killed calibration loses at most the design in progress and a rerun takes every solved node back.  A node whose
 design is not ok (or fails) is recorded and left out: no model value comes from an unconverged design.
 
-**Interpolation.**  A/S at the design's pressures, per branch, is interpolated between the nodes by a thin-plate
-spline in (log W_eff, log ε) (each axis over its bound range), then linearly in pressure at P/λ.  Its error is
-measured by leave-one-out at the nodes of the region that fits (:meth:`Surrogate.loo`) and reported beside the
-data's noise.
+**Interpolation: along the curve, not at a fixed pressure.**  A branch's A/S jumps (snap-in on the approach) at a
+pressure that moves with W and ε; blending two nodes' A/S at a fixed pressure, one jumped and one not, makes a
+curve with a plateau half-way that no design has.  So each node's curve, made monotone in P, is read as pressure
+against the level t = A/S + α P/p_max (α = :data:`LEVEL_SLOPE`; strictly increasing; flat beyond 0 and p_max), and
+P(t) at fixed levels t is what is interpolated between the nodes by a thin-plate spline in (log W_eff, log ε) (each
+axis over its bound range): a jump is a run of t at one pressure, and that pressure moves continuously between the
+nodes ("displacement interpolation").  A/S at P/λ is then read back off the interpolated curve.  Its error is
+measured against designs solved where the fit lands (:func:`tengsim.calibrate.run.calibrate`) and reported beside
+the data's noise.
 """
 from __future__ import annotations
 
@@ -31,6 +36,11 @@ from tengsim.errors import TengsimError
 
 POINTS_PER_CURVE = 21
 """Pressures of a node's design, 0 to p_max (A/S is linear between them; more make the refinement judge more)."""
+LEVEL_SLOPE = 0.25
+"""α of the level t = A/S + α P/p_max along which nodes are interpolated (module doc): small, the levels are A/S
+itself and a jump moves as one; not zero, so that a flat stretch (full contact) still has one pressure per level."""
+LEVELS = np.unique(np.concatenate([np.linspace(0.0, 1.0 + LEVEL_SLOPE, 1001), np.linspace(0.0, 0.3, 301)]))
+"""The levels t (dense at small A/S, where a relative noise weighs most)."""
 
 
 def geometry_key(table: dict) -> str:
@@ -121,6 +131,7 @@ class Surrogate:
     nodes: list
     span: tuple
     dims: tuple
+    interp: str = "level"  # "pressure": A/S blended at fixed pressures (the jump-blind interpolation, for comparison)
     _rbf: dict = field(default_factory=dict, repr=False)
 
     def good(self) -> list:
@@ -130,15 +141,26 @@ class Surrogate:
         uv = np.array([[n.u, n.v] for n in nodes_or_uv]) if isinstance(nodes_or_uv, list) else np.asarray(nodes_or_uv)
         return np.stack([uv[:, d] / self.span[d] for d in self.dims], axis=1) if self.dims else np.zeros((len(uv), 1))
 
+    def _curves(self, nodes, branch):
+        """(len(nodes), m) A/S of ``nodes`` on ``branch`` at :attr:`pressures` (NaN filled, monotone in P)."""
+        return np.stack([np.maximum.accumulate(np.clip(_fill(n.area[branch]), 0.0, 1.0)) for n in nodes])
+
     def _build(self, nodes, branch):
+        """x (K, len(dims)) -> (K, L): the interpolated rows (P at :data:`LEVELS`, or A/S at the pressures for
+        ``interp == "pressure"``)."""
         from scipy.interpolate import RBFInterpolator
 
-        Y = np.stack([_fill(n.area[branch]) for n in nodes])
+        Y = self._curves(nodes, branch)
+        if self.interp == "level":
+            Y = to_levels(self.pressures, Y)
         if not self.dims or len(nodes) == 1:
             return lambda x: np.broadcast_to(Y.mean(axis=0), (len(x), Y.shape[1]))
         if len(nodes) > len(self.dims) + 1:
-            return RBFInterpolator(self._coords(nodes), Y, kernel="thin_plate_spline", degree=1)
-        return RBFInterpolator(self._coords(nodes), Y, kernel="linear", degree=0)  # too few nodes for a spline
+            f = RBFInterpolator(self._coords(nodes), Y, kernel="thin_plate_spline", degree=1)
+        else:
+            f = RBFInterpolator(self._coords(nodes), Y, kernel="linear", degree=0)  # too few nodes for a spline
+        return lambda x: np.concatenate([f(x[k:k + CHUNK]) for k in range(0, len(x), CHUNK)]) if len(x) else \
+            np.zeros((0, Y.shape[1]))
 
     def rbf(self, branch):
         if branch not in self._rbf:
@@ -148,6 +170,12 @@ class Surrogate:
             self._rbf[branch] = self._build(good, branch)
         return self._rbf[branch]
 
+    def _read(self, rows, x):
+        """A/S (K, n) at pressures x (K or 1, n) off interpolated rows (K, L)."""
+        if self.interp == "level":
+            return from_levels(self.pressures, rows, x)
+        return _interp_rows(self.pressures, rows, x)
+
     def area(self, u, v, lam, pressures, branches) -> np.ndarray:
         """A/S (K, n) at points (u, v, λ) (arrays of K) and the pressures (n, Pa) on their branches."""
         u, v, lam = (np.atleast_1d(np.asarray(x, float)) for x in (u, v, lam))
@@ -156,8 +184,10 @@ class Surrogate:
         out = np.empty((len(u), len(pressures)))
         for b in np.unique(branches):
             sel = np.flatnonzero(branches == b)
-            grid = self.rbf(str(b))(self._coords(uv))  # (K, m)
-            out[:, sel] = _interp_rows(self.pressures, grid, pressures[sel][None, :] / lam[:, None])
+            f, x = self.rbf(str(b)), self._coords(uv)
+            for k in range(0, len(u), CHUNK):
+                out[k:k + CHUNK, sel] = self._read(f(x[k:k + CHUNK]),
+                                                   pressures[sel][None, :] / lam[k:k + CHUNK, None])
         return np.clip(out, 0.0, 1.0)
 
     def loo(self, which, pressures, branches) -> np.ndarray:
@@ -170,12 +200,50 @@ class Surrogate:
             row = np.empty(len(pressures))
             for b in np.unique(branches):
                 sel = np.flatnonzero(np.asarray(branches) == b)
-                pred = self._build(rest, str(b))(self._coords([good[j]]))
+                pred = self._read(self._build(rest, str(b))(self._coords([good[j]])),
+                                  np.asarray(pressures)[sel][None, :])
                 own = _fill(good[j].area[str(b)])[None, :]
-                row[sel] = (_interp_rows(self.pressures, pred, np.asarray(pressures)[sel][None, :])
+                row[sel] = (np.clip(pred, 0.0, 1.0)
                             - _interp_rows(self.pressures, own, np.asarray(pressures)[sel][None, :]))[0]
             out.append(row)
         return np.array(out).reshape(len(which), len(pressures))
+
+
+CHUNK = 2048
+"""Query points evaluated at once (a (CHUNK, len(LEVELS)) array)."""
+
+
+def to_levels(P, A) -> np.ndarray:
+    """(K, L): the pressure at each of :data:`LEVELS` of curves A (K, m) (monotone in P, tabulated at P (m,)),
+    along t = A + α P/p_max, A held flat beyond 0 and p_max (module doc)."""
+    P = np.asarray(P, float)
+    pm, a = float(P[-1]), LEVEL_SLOPE
+    far = (1.0 + 1.0 / a) * pm
+    Pe = np.concatenate([[P[0] - far], P, [pm + far]])
+    out = np.empty((len(A), len(LEVELS)))
+    for k, row in enumerate(np.asarray(A, float)):
+        Ae = np.concatenate([[row[0]], row, [row[-1]]])
+        out[k] = np.interp(LEVELS, Ae + a * Pe / pm, Pe)
+    return out
+
+
+def from_levels(P, rows, x) -> np.ndarray:
+    """A/S (K, n) at pressures x (K or 1, n) off rows (K, L) of pressures at :data:`LEVELS` (made monotone first):
+    the level t where the row reaches x, less α x/p_max."""
+    pm = float(np.asarray(P, float)[-1])
+    rows = np.maximum.accumulate(np.asarray(rows, float), axis=1)
+    x = np.broadcast_to(np.asarray(x, float), (rows.shape[0], np.shape(x)[-1]))
+    out = np.empty(x.shape)
+    L = len(LEVELS)
+    for j in range(x.shape[1]):
+        xj = x[:, j:j + 1]
+        i = np.clip((rows <= xj).sum(axis=1) - 1, 0, L - 2)
+        r = np.arange(rows.shape[0])
+        p0, p1 = rows[r, i], rows[r, i + 1]
+        w = np.clip(np.where(p1 > p0, (x[:, j] - p0) / np.where(p1 > p0, p1 - p0, 1.0), 1.0), 0.0, 1.0)
+        t = LEVELS[i] * (1 - w) + LEVELS[i + 1] * w
+        out[:, j] = t - LEVEL_SLOPE * x[:, j] / pm
+    return out
 
 
 def _interp_rows(xp, Y, x):

@@ -168,9 +168,11 @@ def report_text(cal, figures) -> str:
             f"* Intervals: profile likelihood (few parameters; a likelihood that is not Gaussian: bounds reached, "
             f"ridges), each where its profile deviance rises by less than {f.threshold:.3g}.",
             "* σ is profiled out in closed form (V_OC is linear in σ); W, ε (and E*) from converged designs on a grid in "
-            "(log W, log ε), interpolated by a thin-plate spline (E* as a pressure scale: no solve of its own).",
+            "(log W, log ε), interpolated along each curve (the pressure at fixed levels of A/S) by a thin-plate "
+            "spline (E* as a pressure scale: no solve of its own).",
             f"* Designs: {cal.nodes_solved} solved, {cal.nodes_cached} taken back from designs/ "
-            f"({len(cal.nodes_failed)} not converged and left out), {cal.zooms} zoom(s); {cal.seconds:.0f} s.",
+            f"({len(cal.nodes_failed)} not converged and left out), {cal.zooms} zoom(s), {cal.refinements} "
+            f"refinement(s) (the checks made designs); {cal.seconds:.0f} s.",
             f"* Interpolation error (designs solved at the best fit and at both ends of each interval against the "
             f"interpolation there, the largest rms over the data points): {residual_text(cal.surrogate_error, prob)} "
             f"against the noise {residual_text(f.scale, prob)}: "

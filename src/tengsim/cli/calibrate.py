@@ -43,6 +43,9 @@ def register(sub):
                    help="the V_OC model the data are compared with (default eq12: σ (A/S) T/(ε_r ε0))")
     p.add_argument("--nodes", type=int, default=4, help="designs per free axis of each (W, ε) grid (default 4)")
     p.add_argument("--zooms", type=int, default=2, help="new grids on the region that fits, at most (default 2)")
+    p.add_argument("--refine", type=int, default=3, help="rounds after the zooms in which the checks (designs at the "
+                   "best fit and the interval ends) become designs of the interpolation, while its error is above "
+                   "half the noise (default 3)")
     p.add_argument("--out", required=True, help="output folder (created; not on bad input)")
     p.add_argument("--quiet", action="store_true", help="no progress lines")
     p.set_defaults(func=run)
@@ -57,11 +60,13 @@ def run(args) -> int:
         raise TengsimError(f"--nodes {args.nodes}: 2 to 9 designs per axis")
     if not 0 <= args.zooms <= 5:
         raise TengsimError(f"--zooms {args.zooms}: 0 to 5")
+    if not 0 <= args.refine <= 10:
+        raise TengsimError(f"--refine {args.refine}: 0 to 10")
     prob = plan_calibration(args.designs, args.data, args.free, args.bounds, args.noise, args.voc)
     out = Path(args.out)
     _check_out(out)
     say = say_to_stderr(args.quiet)
-    cal = calibrate(prob, out, n_nodes=args.nodes, zooms=args.zooms, progress=say)
+    cal = calibrate(prob, out, n_nodes=args.nodes, zooms=args.zooms, progress=say, refine=args.refine)
     paths = write_calibration(cal, out)
     if say:
         for w in cal.fit.words:
