@@ -116,7 +116,10 @@ def _kpa(p: float) -> str:
 
 
 def _curve(P, V):
-    """Finite (P, V) with P increasing; at a pressure met again (a snap) the first state reached kept."""
+    """Finite (P, V) with P increasing; at a pressure given twice (a snap: the state before it and the state the
+    device lands on at the same load, :func:`tengsim.run.area.load_control`) the landing state is kept, so the
+    jump lies between the fold and the state before it, not spread over the pressures after it; a pressure
+    lower than one kept is dropped."""
     P, V = np.asarray(P, float).ravel(), np.asarray(V, float).ravel()
     ok = np.isfinite(P) & np.isfinite(V)
     P, V = P[ok], V[ok]
@@ -126,6 +129,8 @@ def _curve(P, V):
     for i in range(1, P.size):
         if P[i] > P[keep[-1]]:
             keep.append(i)
+        elif P[i] == P[keep[-1]]:
+            keep[-1] = i
     return P[keep], V[keep]
 
 

@@ -176,39 +176,74 @@ def check_definition(definition: str) -> str:
 # ---- the observables ----------------------------------------------------------------------------
 
 def load_control(res, column: str = "contact_length"):
-    """Approach states a pressed device passes under increasing load: F above every earlier F, F > 0;
-    the zero-load state is put first, Λc (or ``column``) interpolated linearly in F between the last
-    F <= 0 and the first F > 0.  Returns (F, Λc) arrays (possibly empty)."""
+    """Approach states a pressed device passes under increasing load: F above every earlier F, F > 0; the
+    zero-load state is put first, Λc (or ``column``) interpolated linearly in F between the last F <= 0 and the
+    first F > 0; after a snap (the load fell back on the D path), the state the device lands on at the fold's load
+    (:func:`_passed`).  Returns (F, Λc) arrays (possibly empty)."""
     a = res.branch("approach")
     F, L = np.asarray(a["F"], float), np.asarray(a[column], float)
-    keep, best = [], 0.0
-    for i, f in enumerate(F):
-        if f > best:
-            keep.append(i)
-            best = f
-    if not keep:
+    Fk, Lk = _passed(F, L, 0.0, _jumps(a, len(F)))
+    if not len(Fk):
         return np.array([]), np.array([])
-    i0 = keep[0]
-    Fk, Lk = list(F[keep]), list(L[keep])
+    i0 = int(np.flatnonzero(F == Fk[0])[0])
     if i0 > 0 and F[i0 - 1] <= 0:
         w = -F[i0 - 1] / (F[i0] - F[i0 - 1])
-        Fk.insert(0, 0.0)
-        Lk.insert(0, L[i0 - 1] + w * (L[i0] - L[i0 - 1]))
-    return np.array(Fk), np.array(Lk)
+        Fk, Lk = np.insert(Fk, 0, 0.0), np.insert(Lk, 0, L[i0 - 1] + w * (L[i0] - L[i0 - 1]))
+    return Fk, Lk
 
 
 def retraction_control(res, columns):
     """Retraction states a device passes under decreasing load (each F below every earlier F), as arrays in
-    increasing F: (F, [each of ``columns``])."""
+    increasing F: (F, [each of ``columns``]); after a snap, the state the load lands on first (:func:`_passed`)."""
     r = res.branch("retraction")
     F = np.asarray(r["F"], float)
-    keep, best = [], math.inf
+    runs = [_passed(-F, np.asarray(r[c], float), -math.inf, _jumps(r, len(F))) for c in columns]
+    negF = runs[0][0] if runs else _passed(-F, F, -math.inf)[0]
+    return -negF[::-1], [y[::-1] for _, y in runs]
+
+
+LANDING_STEEPNESS = 10.0
+"""A path segment whose y changes this many times faster in F than on the segment after it is a jump of the D path
+(the walk may step across one without flagging it): a snap lands on the state after it, not on a blend."""
+
+
+def _steep(F, y, i: int) -> bool:
+    """Whether the segment (i-1, i) is a jump by :data:`LANDING_STEEPNESS` (False where no rising segment follows)."""
+    if i + 1 >= len(F) or not F[i + 1] > F[i]:
+        return False
+    here = abs(y[i] - y[i - 1]) / (F[i] - F[i - 1])
+    after = abs(y[i + 1] - y[i]) / (F[i + 1] - F[i])
+    return here > LANDING_STEEPNESS * after
+
+
+def _jumps(branch, n: int):
+    """The branch's ``jump`` column (row i follows a jump of the D path) as booleans, or None without one."""
+    j = branch.get("jump") if hasattr(branch, "get") else None
+    return None if j is None or len(j) != n else np.asarray(j, bool)
+
+
+def _passed(F, y, start, jumps=None):
+    """(F, y) of the states a device passes under increasing load F from ``start``: each F above every earlier one.
+    Where the load fell back between two kept states (a fold: the device snaps at the load it reached), the state
+    it lands on is put in at that load, so the value jumps at the fold's load instead of being blended from the
+    fold to the next kept state: y linear in F on the path's segment that first exceeds it, or, where that segment
+    is itself a jump of the D path (``jumps[i]``: row i follows one; or y rises along it :data:`LANDING_STEEPNESS`
+    times faster in F than on the next segment), the state after that jump (the branch it lands on is not solved
+    below that state's load)."""
+    Fk, yk = [], []
+    best, last = start, None
     for i, f in enumerate(F):
-        if f < best:
-            keep.append(i)
-            best = f
-    keep = keep[::-1]
-    return F[keep], [np.asarray(r[c], float)[keep] for c in columns]
+        if f > best:
+            if last is not None and last != i - 1 and F[i - 1] <= best < f:  # landed after a snap
+                w = (best - F[i - 1]) / (f - F[i - 1])
+                if (jumps is not None and jumps[i]) or _steep(F, y, i):
+                    w = 1.0
+                Fk.append(best)
+                yk.append(y[i - 1] + w * (y[i] - y[i - 1]))
+            Fk.append(f)
+            yk.append(y[i])
+            best, last = f, i
+    return np.array(Fk, float), np.array(yk, float)
 
 
 def at_pressures(P, y, ps) -> np.ndarray:
