@@ -170,7 +170,7 @@ def calibrate(prob, out_dir, n_nodes: int = 4, zooms: int = 2, progress=None, re
     """Run the calibration of the checked problem ``prob`` (module doc); nodes kept in ``out_dir/designs``.
     ``expected_noise``: the data's noise as known beforehand, in the noise model's unit (a fraction of V_OC for
     the relative model, volts for the absolute), for the warning when the fit's is much larger."""
-    from tengsim.calibrate.fit import Model, band, fit
+    from tengsim.calibrate.fit import Model, band, fit, residual_text
     from tengsim.calibrate.surrogate import (POINTS_PER_CURVE, Surrogate, geometry_key, grid_points, node_table,
                                              solve_node,
                                              estimate_seconds)
@@ -251,8 +251,8 @@ def calibrate(prob, out_dir, n_nodes: int = 4, zooms: int = 2, progress=None, re
         if math.isfinite(err) and err <= LOO_PER_NOISE * result.scale or zoom == zooms:
             break
         box_uv = _region_box(model, result, ((u0, u1), (v0, v1)), box_uv)
-        _say(progress, f"interpolation error {err:.3g} (noise {result.scale:.3g}): zooming on the "
-                       "region that fits")
+        _say(progress, f"interpolation error {residual_text(err, prob)} (noise {residual_text(result.scale, prob)}):"
+                       " zooming on the region that fits")
         n = n_nodes
         while not grid(box_uv, n) and n < 4 * n_nodes:  # the region is the box already solved (a fit too poor
             n = 2 * n - 1  # to narrow it): its grid at half the spacing, else the zoom would repeat the same fit
@@ -260,8 +260,8 @@ def calibrate(prob, out_dir, n_nodes: int = 4, zooms: int = 2, progress=None, re
         result = _fit_in_box(model, fit)
     while dims and rounds < refine and not (math.isfinite(err) and err <= LOO_PER_NOISE * result.scale):
         rounds += 1  # the checks, converged designs where the fit lands, become nodes; checked anew
-        _say(progress, f"interpolation error {err:.3g} (noise {result.scale:.3g}) after the zooms: the checks made "
-                       f"nodes (refinement {rounds}/{refine})")
+        _say(progress, f"interpolation error {residual_text(err, prob)} (noise {residual_text(result.scale, prob)}) "
+                       f"after the zooms: the checks made nodes (refinement {rounds}/{refine})")
         for k, node in checks:
             sk = surr[k]
             if node.ok and not any(all(abs((n.u, n.v)[d] - (node.u, node.v)[d]) <= 1e-3 * sk.span[d]
