@@ -48,3 +48,21 @@ def study_client():
             c.close()
         finally:
             cluster.close()
+
+
+def rough_cell(n: int, seed: int):
+    """A periodic self-affine rough cell (Hurst 0.8, wavenumbers 2..n/4, 30 ε rms) pressed onto a hard wall 70 ε
+    below its highest summit: (grid, gap g0, the periodic kernel at κ = 3), for the constrained solver's tests."""
+    import numpy as np
+
+    from tengsim.grid import Grid
+    from tengsim.kernels import PeriodicKernel
+
+    rng = np.random.default_rng(seed)
+    k = np.fft.fftfreq(n, 1.0 / n)
+    kk = np.hypot(*np.meshgrid(k, k, indexing="ij"))
+    c = np.where((kk >= 2) & (kk <= n / 4), np.maximum(kk, 1e-9) ** -1.8, 0.0) * np.exp(2j * np.pi * rng.random((n, n)))
+    h = np.real(np.fft.ifft2(c))
+    h *= 30.0 / h.std()
+    grid = Grid(n, n, 1.0, 1.0)
+    return grid, h.max() - h - 70.0 + 1.0, PeriodicKernel(grid, 3.0)

@@ -11,12 +11,12 @@ pytest.importorskip("jax")
 
 import tengsim.plugins  # noqa: E402,F401  (every built-in, in the registry's order, before pk is imported alone)
 from tengsim.errors import TengsimError  # noqa: E402
-from tengsim.grid import Grid  # noqa: E402
-from tengsim.kernels import FreeKernel, PeriodicKernel  # noqa: E402
+from tengsim.kernels import FreeKernel  # noqa: E402
 from tengsim.laws import MaugisDugdale, Repulsive  # noqa: E402
 from tengsim.shapes import Paraboloid  # noqa: E402
 from tengsim.solvers import Problem, State, make_solver  # noqa: E402
 from tengsim.solvers.pk import PKJaxSolver, PKSolver  # noqa: E402
+from conftest import rough_cell  # noqa: E402
 
 
 
@@ -27,14 +27,7 @@ def _sphere(dx=0.3):
 
 
 def _rough(n=32):
-    rng = np.random.default_rng(5)
-    k = np.fft.fftfreq(n, 1.0 / n)
-    kk = np.hypot(*np.meshgrid(k, k, indexing="ij"))
-    c = np.where((kk >= 2) & (kk <= n / 4), np.maximum(kk, 1e-9) ** -1.8, 0.0) * np.exp(2j * np.pi * rng.random((n, n)))
-    h = np.real(np.fft.ifft2(c))
-    h *= 30.0 / h.std()
-    grid = Grid(n, n, 1.0, 1.0)
-    return grid, h.max() - h - 70.0 + 1.0, PeriodicKernel(grid, 3.0)
+    return rough_cell(n, 5)
 
 
 def _same(a, b, rel=1e-9):

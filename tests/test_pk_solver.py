@@ -14,6 +14,7 @@ from tengsim.errors import TengsimError
 from tengsim.grid import Grid
 from tengsim.kernels import FreeKernel, PeriodicKernel
 from tengsim.laws import LJ93, Exponential, MaugisDugdale, Repulsive
+from conftest import rough_cell
 from tengsim.shapes import Paraboloid, Sinusoid1D
 from tengsim.solvers import FastSolver, Problem, State, make_solver
 from tengsim.solvers.pk import PKSolver
@@ -147,15 +148,7 @@ def test_exponential_sphere_matches_penalty_wall_solution():
 # ---- rough periodic cell: 'pk' against L-BFGS with a stiffening penalty wall ----------------------------
 @lru_cache(maxsize=None)
 def _rough():
-    n = 64
-    rng = np.random.default_rng(3)
-    k = np.fft.fftfreq(n, 1.0 / n)
-    kk = np.hypot(*np.meshgrid(k, k, indexing="ij"))
-    c = np.where((kk >= 2) & (kk <= n / 4), np.maximum(kk, 1e-9) ** -1.8, 0.0) * np.exp(2j * np.pi * rng.random((n, n)))
-    h = np.real(np.fft.ifft2(c))
-    h *= 30.0 / h.std()
-    grid = Grid(n, n, 1.0, 1.0)
-    return grid, h.max() - h - 70.0 + 1.0, PeriodicKernel(grid, 3.0)
+    return rough_cell(64, 3)
 
 
 def test_rough_cell_against_penalty_wall():

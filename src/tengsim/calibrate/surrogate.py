@@ -190,24 +190,6 @@ class Surrogate:
                                                    pressures[sel][None, :] / lam[k:k + CHUNK, None])
         return np.clip(out, 0.0, 1.0)
 
-    def loo(self, which, pressures, branches) -> np.ndarray:
-        """(len(which), n): A/S predicted at each node of ``which`` (indices into :meth:`good`) from the other
-        nodes, minus the node's own, at ``pressures`` (λ = 1)."""
-        good = self.good()
-        out = []
-        for j in which:
-            rest = [n for k, n in enumerate(good) if k != j]
-            row = np.empty(len(pressures))
-            for b in np.unique(branches):
-                sel = np.flatnonzero(np.asarray(branches) == b)
-                pred = self._read(self._build(rest, str(b))(self._coords([good[j]])),
-                                  np.asarray(pressures)[sel][None, :])
-                own = _fill(good[j].area[str(b)])[None, :]
-                row[sel] = (np.clip(pred, 0.0, 1.0)
-                            - _interp_rows(self.pressures, own, np.asarray(pressures)[sel][None, :]))[0]
-            out.append(row)
-        return np.array(out).reshape(len(which), len(pressures))
-
 
 CHUNK = 2048
 """Query points evaluated at once (a (CHUNK, len(LEVELS)) array)."""
