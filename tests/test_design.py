@@ -311,6 +311,30 @@ def test_a_killed_design_resumes_from_its_kept_grids(tmp_path, small):
     assert any("holds grids of another design" in ln for ln in lines), lines
 
 
+def test_a_design_killed_after_its_first_grid_resumes_to_the_same_numbers_and_maps(tmp_path, small):
+    """Killed between two grids, the rerun takes the first back and walks the next on the path the first gives (its
+    end and the maps' depths): the same numbers as the run never killed, to the bit, and its maps (a grid taken back
+    has no scaling: its path was walked to d_max and the maps were lost)."""
+
+    class Killed(Exception):
+        pass
+
+    class Kill:
+        def say(self, text):
+            if text.startswith("grid 1 ("):
+                raise Killed
+
+    keep = tmp_path / ".design-0.resolve.nc"
+    with pytest.raises(Killed):
+        run_design(plan_design(SMALL), progress=Kill(), keep=keep)
+    again = run_design(plan_design(SMALL), keep=keep)
+    assert again.summary["grids"] == small.summary["grids"]
+    a, b = small.dataset["charged_area_fraction"].values, again.dataset["charged_area_fraction"].values
+    assert np.array_equal(np.isnan(a), np.isnan(b)) and np.array_equal(a[~np.isnan(a)], b[~np.isnan(b)])
+    assert (small.maps is None) == (again.maps is None) and again.summary["map_pressures_asked"] == \
+        small.summary["map_pressures_asked"]
+
+
 def test_cli_removes_the_kept_grids_once_written(tmp_path):
     out = tmp_path / "d"
     assert main([*CLI_SMALL, "--out", str(out)]) == 0

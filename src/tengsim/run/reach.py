@@ -160,8 +160,14 @@ def resolve_to(cplan, p_max: float, d_max: float, settings, map_pressures=(), ob
             if done is not None:
                 done(levels)
 
-        res = resolve_plan(cplan, observe=observe, watch=watch, settings=settings,
-                           path_for=grid_path(p_max, d_max, map_pressures, attempt == 0, retract),
+        path_for = grid_path(p_max, d_max, map_pressures, attempt == 0, retract)
+
+        def scaled_path_for(prev, path_for=path_for):  # a grid taken back from the file keeps its columns only
+            if prev is not None and prev.scaling is None:
+                prev = dataclasses.replace(prev, scaling=cplan.scaling)
+            return path_for(prev)
+
+        res = resolve_plan(cplan, observe=observe, watch=watch, settings=settings, path_for=scaled_path_for,
                            progress=progress, checkpoint=after, start=found)
         if res.scaling is None:  # every grid taken back from the checkpoint file, which keeps the columns only
             res = dataclasses.replace(res, scaling=cplan.scaling)
