@@ -130,3 +130,35 @@ def test_warnings_say_when_the_fitted_noise_or_the_interpolations_error_is_too_l
     assert warnings(known, SimpleNamespace(scale=1.0, dev_min=58 * 1.1), 0.1) == ()
     w = warnings(known, SimpleNamespace(scale=1.0, dev_min=58 * 9.0), 0.1)
     assert len(w) == 1 and "3 × the stated errors" in w[0]
+
+
+def test_a_snap_between_two_asked_pressures_is_read_off_the_states_passed_not_off_a_ramp_one_step_wide():
+    """The paper's group C at W 50 and 58 mJ/m² snaps at 15.7 and 13.5 kPa, both inside a 5 kPa step of the nodes'
+    pressures: between them (W 54: 14.5 kPa) the point measured at 15 kPa is on the landed branch.  Read off the
+    nodes' states the interpolation puts the snap between the two; read off the asked pressures it is a ramp
+    from 10 to 20 kPa, and the point at 15 kPa half-way down it."""
+    from tengsim.calibrate.surrogate import Node, Surrogate
+
+    P = np.linspace(0, 100e3, 21)
+
+    def states(p_snap):
+        sp = np.r_[np.linspace(0, p_snap, 12), p_snap, np.linspace(p_snap, 100e3, 30)[1:]]
+        sa = np.r_[0.02 + 0.1 * sp[:12] / p_snap, 0.9 + 0.05 * sp[12:] / 100e3]
+        return sp, sa
+
+    def node(u, p_snap):
+        sp, sa = states(p_snap)
+        tab = np.interp(P, sp, sa)
+        return Node(u, 0.0, True, P, {"approach": tab, "retraction": tab}, states={"approach": (sp, sa),
+                                                                                "retraction": (sp, sa)})
+
+    nodes = [node(0.0, 15.7e3), node(1.0, 13.5e3)]
+    q = np.array([14e3, 14.4e3, 15e3, 15.5e3])
+    got = Surrogate(P, nodes, (1.0, 1.0), (0,)).area([0.5], [0.0], [1.0], q, ["approach"] * 4)[0]
+    truth = np.where(q < 14.6e3, 0.02 + 0.1 * q / 14.6e3, 0.9 + 0.05 * q / 100e3)  # the snap half-way: 14.6 kPa
+    assert np.max(np.abs(got - truth)) < 0.02, np.c_[q, got, truth]
+    before, after = nodes[0].area_at("approach", [15.0e3, 15.8e3])  # the node's own, on either side of its snap
+    assert before < 0.13 and after > 0.9
+    bare = [Node(n.u, n.v, True, P, n.area) for n in nodes]  # the asked pressures only
+    ramp = Surrogate(P, bare, (1.0, 1.0), (0,)).area([0.5], [0.0], [1.0], q, ["approach"] * 4)[0]
+    assert abs(ramp[2] - truth[2]) > 0.3, ramp

@@ -39,6 +39,24 @@ def test_jump_in_is_where_the_pressed_device_snaps(tiny):
     assert P[land] > 10e3 and A[land - 1] - 1e-9 <= Aq[1] <= A[land] + 1e-9
 
 
+def test_design_nc_keeps_the_states_passed_with_the_snap_at_its_own_pressure(tiny):
+    """design.nc's state_* variables: the states a pressed device passes, the asked pressures' A/S read off them,
+    and the snap a step at the jump-in pressure (two states at one pressure), not a ramp between asked pressures."""
+    from tengsim.run.area import at_pressures
+
+    ds = tiny.dataset
+    sp = ds["state_pressure"].sel(branch="approach").values
+    sa = ds["state_charged_area_fraction"].sel(branch="approach").values
+    ok = np.isfinite(sp)
+    sp, sa = sp[ok], sa[ok]
+    assert ds["state_pressure"].attrs["units"] == "Pa" and np.all(np.diff(sp) >= 0)
+    asked = ds["charged_area_fraction"].sel(branch="approach").values
+    P = ds["pressure"].values
+    np.testing.assert_allclose(np.clip(at_pressures(sp, sa, P), 0, 1), asked, atol=1e-12)
+    at = np.flatnonzero(sp == tiny.summary["jump_in_Pa"])
+    assert len(at) == 2 and sa[at[1]] > sa[at[0]] + 0.3  # the fold, and where the device lands at its load
+
+
 def test_a_jump_the_walk_records_past_p_max_is_not_the_jump_in(tiny):
     """A D-controlled jump recorded deep in the wall (past p_max, the contact length growing) was taken as the
     design's jump-in: a pressure above p_max."""

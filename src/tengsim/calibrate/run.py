@@ -398,7 +398,7 @@ def _check(model, f, solve, base, pmax):
     check, not a node: kept in designs/ but not interpolated), its A/S at the data pressures against the
     interpolation's, as residuals (σ̂ × factor × ΔA / weight); (the largest over the points of the rms over the
     data points, [(geometry key, check design)])."""
-    from tengsim.calibrate.surrogate import _interp_rows, node_table
+    from tengsim.calibrate.surrogate import node_table
 
     keys = list(dict.fromkeys(model.geo))
     pts = check_points(f, model.prob)
@@ -421,8 +421,7 @@ def _check(model, f, solve, base, pmax):
             if not node.ok:
                 continue
             sur = _without_node_at(model.surrogates[model.geo[i]], u, v).area(u, v, lam, c.pressure, c.branch)[0]
-            own = np.array([_interp_rows(node.pressures, np.nan_to_num(node.area[b])[None, :],
-                                         np.array([[p / lam]]))[0, 0] for p, b in zip(c.pressure, c.branch)])
+            own = np.array([node.area_at(b, [p / lam])[0] for p, b in zip(c.pressure, c.branch)])
             errs.append(f.best["sigma"] * model.prob.factor(i) * (sur - own) / w)
         if errs:
             worst = max(worst, float(np.sqrt(np.mean(np.concatenate(errs) ** 2))))

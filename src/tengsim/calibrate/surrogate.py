@@ -17,7 +17,10 @@ curve with a plateau half-way that no design has.  So each node's curve, made mo
 against the level t = A/S + α P/p_max (α = :data:`LEVEL_SLOPE`; strictly increasing; flat beyond 0 and p_max), and
 P(t) at fixed levels t is what is interpolated between the nodes by a thin-plate spline in (log W_eff, log ε) (each
 axis over its bound range): a jump is a run of t at one pressure, and that pressure moves continuously between the
-nodes ("displacement interpolation").  A/S at P/λ is then read back off the interpolated curve.  Its error is
+nodes ("displacement interpolation").  Each node's curve is the states its design's device passes (design.nc's
+``state_pressure``, ``state_charged_area_fraction``), not its A/S at the asked pressures: there a snap between two
+of them is a ramp one pressure step wide, and a measured point inside that step is read off the ramp, far from
+either branch.  A/S at P/λ is then read back off the interpolated curve.  Its error is
 measured against designs solved where the fit lands (:func:`tengsim.calibrate.run.calibrate`) and reported beside
 the data's noise.
 """
@@ -71,15 +74,47 @@ class Node:
     message: str = ""
     seconds: float = 0.0
     cached: bool = False
+    states: dict | None = None  # branch -> (P, A/S) of the states passed (Pa, increasing), where the file has them
+
+    def curve(self, branch: str, p_max: float):
+        """(P, A/S) of the branch from 0 to ``p_max`` (Pa): the states passed, A/S held flat before the first and
+        after the last, made monotone; the asked pressures (NaN filled) for a file without states."""
+        st = (self.states or {}).get(branch)
+        if st is None or len(st[0]) < 2:
+            P = np.asarray(self.pressures, float)
+            return P, np.maximum.accumulate(np.clip(_fill(self.area[branch]), 0.0, 1.0))
+        P, A = st
+        A = np.maximum.accumulate(np.clip(A, 0.0, 1.0))
+        inside = (P > 0.0) & (P < p_max)
+        ends = np.interp([0.0, p_max], P, A)
+        return np.concatenate([[0.0], P[inside], [p_max]]), np.concatenate([[ends[0]], A[inside], [ends[1]]])
+
+    def area_at(self, branch: str, pressures) -> np.ndarray:
+        """The node's own A/S at ``pressures`` (Pa) on ``branch``, off :meth:`curve`."""
+        P, A = self.curve(branch, float(np.max(np.r_[self.pressures, pressures])))
+        return np.interp(np.asarray(pressures, float), P, A)
+
+
+def _read(ds):
+    """(pressures, {branch: A/S}, {branch: (P, A/S) of the states passed} or None) of a design.nc Dataset."""
+    P = np.asarray(ds["pressure"].values, float)
+    A = {b: np.asarray(ds["charged_area_fraction"].sel(branch=b).values, float) for b in ("approach", "retraction")}
+    if "state_pressure" not in ds:
+        return P, A, None
+    st = {}
+    for b in ("approach", "retraction"):
+        sp = np.asarray(ds["state_pressure"].sel(branch=b).values, float)
+        sa = np.asarray(ds["state_charged_area_fraction"].sel(branch=b).values, float)
+        ok = np.isfinite(sp) & np.isfinite(sa)
+        st[b] = (sp[ok], sa[ok])
+    return P, A, st
 
 
 def _load(path: Path):
     from tengsim.io import read_dataset
 
     ds = read_dataset(path)
-    P = np.asarray(ds["pressure"].values, float)
-    A = {b: np.asarray(ds["charged_area_fraction"].sel(branch=b).values, float) for b in ("approach", "retraction")}
-    return P, A, str(ds.attrs.get("status")), float(ds.attrs.get("seconds", 0.0) or 0.0)
+    return (*_read(ds), str(ds.attrs.get("status")), float(ds.attrs.get("seconds", 0.0) or 0.0))
 
 
 def solve_node(table: dict, folder: Path, u: float, v: float, progress=None) -> Node:
@@ -90,8 +125,8 @@ def solve_node(table: dict, folder: Path, u: float, v: float, progress=None) -> 
     key = node_key(table)
     nc, bad = folder / f"{key}.nc", folder / f"{key}.failed.txt"
     if nc.is_file():
-        P, A, status, secs = _load(nc)
-        return Node(u, v, status == "ok", P, A, "" if status == "ok" else f"status {status}", secs, True)
+        P, A, st, status, secs = _load(nc)
+        return Node(u, v, status == "ok", P, A, "" if status == "ok" else f"status {status}", secs, True, st)
     if bad.is_file():
         return Node(u, v, False, message=bad.read_text(encoding="utf-8").strip(), cached=True)
     folder.mkdir(parents=True, exist_ok=True)
@@ -105,11 +140,9 @@ def solve_node(table: dict, folder: Path, u: float, v: float, progress=None) -> 
         return Node(u, v, False, message=str(exc), seconds=time.perf_counter() - t0)
     write_dataset(res.dataset, nc)
     (folder / f"{key}.resolve.nc").unlink(missing_ok=True)
-    P = np.asarray(res.dataset["pressure"].values, float)
-    A = {b: np.asarray(res.dataset["charged_area_fraction"].sel(branch=b).values, float)
-         for b in ("approach", "retraction")}
+    P, A, st = _read(res.dataset)
     ok = res.status == "ok"
-    return Node(u, v, ok, P, A, "" if ok else f"status {res.status}", time.perf_counter() - t0)
+    return Node(u, v, ok, P, A, "" if ok else f"status {res.status}", time.perf_counter() - t0, states=st)
 
 
 def _fill(y):
@@ -150,9 +183,11 @@ class Surrogate:
         ``interp == "pressure"``)."""
         from scipy.interpolate import RBFInterpolator
 
-        Y = self._curves(nodes, branch)
         if self.interp == "level":
-            Y = to_levels(self.pressures, Y)
+            pm = float(self.pressures[-1])
+            Y = np.concatenate([to_levels(P, A[None, :], p_max=pm) for P, A in (n.curve(branch, pm) for n in nodes)])
+        else:
+            Y = self._curves(nodes, branch)
         if not self.dims or len(nodes) == 1:
             return lambda x: np.broadcast_to(Y.mean(axis=0), (len(x), Y.shape[1]))
         if len(nodes) > len(self.dims) + 1:
@@ -195,11 +230,12 @@ CHUNK = 2048
 """Query points evaluated at once (a (CHUNK, len(LEVELS)) array)."""
 
 
-def to_levels(P, A) -> np.ndarray:
-    """(K, L): the pressure at each of :data:`LEVELS` of curves A (K, m) (monotone in P, tabulated at P (m,)),
-    along t = A + α P/p_max, A held flat beyond 0 and p_max (module doc)."""
+def to_levels(P, A, p_max=None) -> np.ndarray:
+    """(K, L): the pressure at each of :data:`LEVELS` of curves A (K, m) (monotone in P, tabulated at P (m,),
+    nondecreasing: a jump is two points at one pressure), along t = A + α P/p_max, A held flat beyond 0 and p_max
+    (``p_max`` defaults to P's last; module doc)."""
     P = np.asarray(P, float)
-    pm, a = float(P[-1]), LEVEL_SLOPE
+    pm, a = float(P[-1] if p_max is None else p_max), LEVEL_SLOPE
     far = (1.0 + 1.0 / a) * pm
     Pe = np.concatenate([[P[0] - far], P, [pm + far]])
     out = np.empty((len(A), len(LEVELS)))

@@ -3,7 +3,10 @@
 design.nc (CF-1.10, SI): coordinates ``pressure`` (Pa, the pressures asked for, increasing; along the dimension
 ``applied_pressure``, :data:`PRESSURE_DIM`) and ``branch`` (approach, retraction); ``charged_area_fraction``,
 ``repulsive_area_fraction`` (1), ``voc_eq12``, ``voc_eq17`` (V), ``dvoc_dp`` (V Pa-1) on (branch, pressure), NaN
-where a branch does not reach a pressure; global attributes
+where a branch does not reach a pressure; ``state_pressure`` (Pa) and ``state_charged_area_fraction`` (1) on
+(branch, ``path_state``, :data:`STATE_DIM`): every state a pressed device passes on the finest grid, in increasing
+load, NaN-padded (a snap is two states at one pressure: the fold and where it lands, so the jump's pressure is
+exact, not one of the asked pressures); global attributes
 Conventions, title, shape, shape_params (JSON), E_star_Pa, W_J_m2, eps_m, tabor, sigma_C_m2, eps_r, thickness_m,
 gap_m, status, grids, tolerance, charged_area_definition, branches_solved (the retraction is all NaN where only
 the approach was solved), and the per-design numbers (:mod:`tengsim.design.curves`).
@@ -22,6 +25,7 @@ from tengsim.device.sensor import NUMBERS
 
 BRANCHES = ("approach", "retraction")
 PRESSURE_DIM = "applied_pressure"
+STATE_DIM = "path_state"
 """The dimension the coordinate ``pressure`` runs along: CF takes a dimension named 'pressure' for air pressure
 (a vertical axis asking for standard_name air_pressure), so it is named as a study.nc names it; select with
 ``ds.swap_dims(applied_pressure="pressure").sel(pressure=...)`` or by position."""
@@ -46,10 +50,11 @@ def to_dataset(res, plan, summary: dict):
     """The design.nc Dataset of a finished design (module doc)."""
     import xarray as xr
 
-    from tengsim.design.curves import branch_curves
+    from tengsim.design.curves import branch_curves, states
     from tengsim.io import cf_conventions
 
     curves = branch_curves(res, plan)
+    passed = states(res, plan)
     P = np.asarray(plan.pressures, float)
     data = {}
     for name, (units, long) in VARIABLES.items():
@@ -57,6 +62,15 @@ def to_dataset(res, plan, summary: dict):
         data[name] = (("branch", PRESSURE_DIM), arr, {"units": units, "long_name": long})
     coords = {"pressure": (PRESSURE_DIM, P, {"units": "Pa", "long_name": "nominal pressure"}),
               "branch": ("branch", np.array(BRANCHES, dtype=object), {"long_name": "path branch"})}
+    n = max([1] + [len(passed[b]["P"]) for b in BRANCHES])
+    for name, key, units, long in (
+            ("state_pressure", "P", "Pa", "nominal pressure of each state a pressed device passes (finest grid)"),
+            ("state_charged_area_fraction", "area", "1", "charged area A/S of each state a pressed device passes")):
+        arr = np.full((len(BRANCHES), n), np.nan)
+        for i, b in enumerate(BRANCHES):
+            v = np.asarray(passed[b][key], float)
+            arr[i, :len(v)] = v
+        data[name] = (("branch", STATE_DIM), arr, {"units": units, "long_name": long})
     ds = xr.Dataset(data, coords=coords)
     attrs = {
         "shape": plan.shape, "shape_params": json.dumps(plan.shape_params, sort_keys=True),
