@@ -58,13 +58,19 @@ def test_recovery_two_geometries_intervals_contain_truth(fitted):
     _, out, _ = fitted
     ds = read_dataset(out / "fit.nc")
     names = [str(x) for x in ds["parameter_name"].values]
+    # the interpolation is measured within the noise (it was 2× the noise once, the intervals widened to the bounds)
+    assert ds.attrs["surrogate_within_noise"] == 1 and ds.attrs["surrogate_error_at_best"] < 0.5 * ds.attrs[
+        "noise_scale"]
     for k in ("sigma", "W"):
         i = names.index(k)
         lo, hi, best = float(ds["lower_95"][i]), float(ds["upper_95"][i]), float(ds["best"][i])
         assert lo <= TRUE[k] <= hi, (k, lo, best, hi)
         assert lo <= best <= hi, (k, lo, best, hi)  # the best value inside its own interval
-        assert abs(best / TRUE[k] - 1) < 0.05, (k, best)  # the best values recover the truth
-        assert hi / lo < 10  # an interval, not every value between the bounds
+        # the best values recover the truth within what 24 points at 2.5 % allow: σ and W trade off (V = σ A/S),
+        # each interval ± about 8 % (this seed: W +8.7 %, σ -8.7 %, both intervals holding the truth)
+        assert abs(best / TRUE[k] - 1) < 0.12, (k, best)
+        assert int(ds["open_at_bound"].values[i]) == 0  # determined: no end at a bound
+        assert hi / lo < 1.5, (k, lo, hi)  # an interval, not every value between the bounds
     assert ds.attrs["Conventions"] == "CF-1.10"
     assert ds["correlation"].shape == (2, 2) and abs(float(ds["correlation"][0, 1])) <= 1
     # the fitted curve goes through the data within a few noise widths; the band holds the fit
@@ -102,6 +108,10 @@ def test_rerun_takes_every_design_back(fitted):
     prob = plan_calibration(args, [d / "g1.csv", d / "g2.csv"], "sigma,W", "W=10mJ/m2:60mJ/m2")
     cal = calibrate(prob, out, n_nodes=3, zooms=1)
     assert cal.nodes_solved == 0 and cal.nodes_cached > 0
+    from tengsim.io import read_dataset
+
+    kept = sorted((out / "designs").glob("*.nc"))  # data on the approach only: the nodes solved the approach only
+    assert kept and {read_dataset(f).attrs["branches_solved"] for f in kept} == {"approach"}
 
 
 def test_unidentifiable_W_is_said_with_the_range_that_fits(tmp_path):

@@ -93,7 +93,8 @@ class Model:
         return rss if self.prob.known_errors else self.prob.n_points * np.log(rss)
 
     def rss_from_dev(self, dev):
-        return dev if self.prob.known_errors else np.exp(dev / self.prob.n_points)
+        # capped below float overflow: a threshold widened for a large interpolation error can exceed it
+        return dev if self.prob.known_errors else np.exp(np.minimum(dev / self.prob.n_points, 700.0))
 
     def deviance(self, theta):
         """(deviance (K,), σ̂ (K,)) at log parameters ``theta``."""
@@ -344,6 +345,8 @@ def band(model: Model, f: Fit, pressures, branches, level_threshold=None) -> tup
     thr = f.threshold if level_threshold is None else level_threshold
     mask = f.grid_dev <= f.dev_min + thr
     pts = f.grid_theta[mask] if f.grid_theta.shape[1] else f.grid_theta
+    if not len(pts):  # a region narrower than the grid: the best point
+        pts = f.theta[None, :]
     if len(pts) > 4000:
         pts = pts[np.random.default_rng(0).choice(len(pts), 4000, replace=False)]
     b, c = model.sums(pts)

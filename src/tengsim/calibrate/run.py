@@ -10,7 +10,8 @@ parameters and bounds, that the voltage can be reached).  :func:`calibrate` then
    the data's noise, lays a new n × n grid over the box of that region (15 % margin, at least half the previous
    box) and fits again, at most ``zooms`` times;
 3. if the error is still above half the noise, makes the checks nodes and checks anew, at most :data:`REFINE`
-   times (a check where a node is is measured from the other nodes); the intervals make room for the last error
+   times (a check at the best fit where a node is is measured from the other nodes; an interval's end on a node
+   is checked half-way to the next node beyond it, :func:`_outward`); the intervals make room for the last error
    measured (:func:`tengsim.calibrate.fit.inflation`);
 4. warns in words (:func:`warnings`, among the fit's words) when the fitted noise is much larger than the stated or
    expected one, or the interpolation's error exceeds the noise;
@@ -180,7 +181,8 @@ def calibrate(prob, out_dir, n_nodes: int = 4, zooms: int = 2, progress=None, re
     folder = Path(out_dir) / "designs"
     geo = tuple(geometry_key(t) for t in prob.tables)
     keys = list(dict.fromkeys(geo))
-    base = {k: prob.tables[geo.index(k)] for k in keys}
+    base = {k: _branches(prob.tables[geo.index(k)],
+                         any("retraction" in c.branch for c, g in zip(prob.curves, geo) if g == k)) for k in keys}
     pmax = {k: _p_max(prob, k, geo) for k in keys}
     (u0, u1), (v0, v1), dims = _node_ranges(prob)
     span = (max(u1 - u0, 1e-12), max(v1 - v0, 1e-12))
@@ -285,6 +287,13 @@ def calibrate(prob, out_dir, n_nodes: int = 4, zooms: int = 2, progress=None, re
                        tuple(dict.fromkeys(failed)), time.perf_counter() - t0, zoom, rounds, warn)
 
 
+def _branches(table: dict, retraction: bool) -> dict:
+    """The nodes' design table: the retraction solved only where a curve of the geometry was measured on it (the
+    approach alone costs half)."""
+    t = {k: v for k, v in table.items() if k != "retraction"}
+    return t if retraction else {**t, "retraction": False}
+
+
 NOISE_LARGE = 0.10
 """A fitted relative noise above this (10 % of V_OC) is warned of when no expected noise is given: larger than a
 TENG bench measurement's usual few per cent, it says the model misses the data's shape."""
@@ -330,6 +339,8 @@ def _fit_in_box(model, fit):
         return f
     for _ in range(4):
         reg = f.grid_theta[f.grid_dev <= f.dev_min + 2 * f.threshold]
+        if not len(reg):  # a region narrower than the grid (data the model fits exactly): its best point
+            reg = f.theta[None, :]
         lo, hi = reg.min(axis=0), reg.max(axis=0)
         pad = np.maximum(MARGIN * (hi - lo), (f.box[:, 1] - f.box[:, 0]) / 40)
         box = np.stack([np.maximum(lo - pad, lb[:, 0]), np.minimum(hi + pad, lb[:, 1])], axis=1)
@@ -403,13 +414,22 @@ def _check(model, f, solve, base, pmax):
     keys = list(dict.fromkeys(model.geo))
     pts = check_points(f, model.prob)
     todo, where = [], []
+    first = model.surrogates[keys[0]]
+    best = None
     for theta in pts:
         ph = model.physical(theta[None, :])
         u = float(np.log(ph["W"][0]) + math.log(model.prob.E_ref) - np.log(ph["E_star"][0]))
         v, lam = float(np.log(ph["eps"][0])), float(ph["E_star"][0] / model.prob.E_ref)
-        where.append((u, v, lam))
-        todo += [(k, u, v, node_table(base[k], math.exp(u), math.exp(v), model.prob.E_ref, pmax[k])) for k in keys]
-    nodes = solve(todo, f"checks at the best fit and the interval ends ({len(pts)} points)")
+        if best is None:
+            best = (u, v)
+            spots = [(u, v)]
+        else:
+            spots = _outward(first, (u, v), best)
+        for u, v in spots:
+            where.append((u, v, lam))
+            todo += [(k, u, v, node_table(base[k], math.exp(u), math.exp(v), model.prob.E_ref, pmax[k]))
+                     for k in keys]
+    nodes = solve(todo, f"checks at the best fit, the interval ends and beyond them ({len(where)} points)")
     worst = 0.0
     for m, (u, v, lam) in enumerate(where):
         got = dict(zip(keys, nodes[m * len(keys):(m + 1) * len(keys)]))
@@ -427,6 +447,31 @@ def _check(model, f, solve, base, pmax):
             worst = max(worst, float(np.sqrt(np.mean(np.concatenate(errs) ** 2))))
     checks = [(k, node) for m in range(len(where)) for k, node in zip(keys, nodes[m * len(keys):(m + 1) * len(keys)])]
     return worst, checks
+
+
+def _outward(s, uv, best) -> list:
+    """Where to check the interpolation at an interval's end ``uv`` (log W_eff, log ε): there (unless a node is
+    there already: its value is exact) and half-way from it to the nearest node beyond it, away from the ``best``
+    fit (none beyond: an end at a bound).  The interval's end is where the model starts to miss the data, often at the
+    edge of the nodes, and its error there comes from the gap beyond: checking only at the end, which then becomes a
+    node, moves the end a little further each round and never closes the gap; the half-way check does."""
+    if not s.dims:
+        return [uv]
+    at_node = any(all(abs((n.u, n.v)[k] - uv[k]) <= 1e-6 * s.span[k] for k in s.dims) for n in s.good())
+    out = [] if at_node else [uv]
+    d = np.array([(uv[k] - best[k]) / s.span[k] for k in s.dims])
+    if not np.any(d):
+        return out or [uv]
+    d /= np.linalg.norm(d)
+    beyond = []
+    for n in s.good():
+        step = np.array([((n.u, n.v)[k] - uv[k]) / s.span[k] for k in s.dims])
+        if step @ d > 1e-6:
+            beyond.append((float(np.linalg.norm(step)), n))
+    if beyond:
+        n = min(beyond, key=lambda x: x[0])[1]
+        out.append(tuple(0.5 * (uv[k] + (n.u, n.v)[k]) if k in s.dims else uv[k] for k in (0, 1)))
+    return out
 
 
 def _without_node_at(s, u, v):

@@ -201,12 +201,13 @@ def figures(cal, out: Path) -> list:
         P = cal.plot_pressures[i] / 1e3
         # ``where`` given: matplotlib 3.6.0 with numpy 1.24 (the floors) fails on its default
         ax.fill_between(P, lo, hi, where=np.ones(np.shape(P), bool), color=col, alpha=0.25, lw=0)
-        ax.plot(P, best, color=col, label=f"fit: {Path(str(prob.names[i])).stem}")
+        data, design = Path(str(c.source)).stem, Path(str(prob.names[i])).stem
+        ax.plot(P, best, color=col, label=data if data == design else f"{data} ({design})")
         ax.errorbar(c.pressure / 1e3, c.voc, yerr=c.err, fmt="o", ms=4, color=col, mfc="none")
     ax.set_xlabel("nominal pressure (kPa)")
     ax.set_ylabel("V_OC (V)")
     ax.set_title("measured (o), fitted (line) and its 95 % band")
-    ax.legend(fontsize=8)
+    ax.legend(fontsize=8, title="curve (design)" if len(prob.curves) > 1 else None, title_fontsize=8)
     save(fig, out / "fit.png")
     paths.append(out / "fit.png")
     fig, ax = plt.subplots(figsize=(6.4, 3.4))
@@ -221,18 +222,25 @@ def figures(cal, out: Path) -> list:
     save(fig, out / "residuals.png")
     paths.append(out / "residuals.png")
     ks = list(f.profile)
-    from matplotlib.ticker import FuncFormatter, ScalarFormatter
+    from matplotlib.ticker import MaxNLocator, NullFormatter, ScalarFormatter
 
     fig, axes = plt.subplots(1, len(ks), figsize=(3.2 * len(ks), 3.0), squeeze=False)
+    top = max(3 * f.threshold, 1)
     for ax, k in zip(axes[0], ks):
         vals, d = f.profile[k]
-        ax.plot(vals / UNITS[k][1], d, color="k")
+        x = vals / UNITS[k][1]
+        ax.plot(x, d, color="k")
         ax.axhline(f.threshold, color="r", ls="--", lw=0.8, label="95 % threshold")
         ax.set_xscale("log")
-        ax.xaxis.set_major_formatter(ScalarFormatter())  # plain numbers in the axis unit, not 2×10¹
-        ax.xaxis.set_minor_formatter(FuncFormatter(lambda v, _: f"{v:g}" if f"{v:g}"[0] in "25" else ""))
+        seen = x[d <= top]  # the x range where the profile is drawn inside the axes, a little wider
+        if len(seen) and seen.max() > seen.min():
+            pad = (seen.max() / seen.min()) ** 0.08
+            ax.set_xlim(max(x.min(), seen.min() / pad), min(x.max(), seen.max() * pad))
+        ax.xaxis.set_major_locator(MaxNLocator(4))  # plain numbers in the axis unit, several even on a narrow range
+        ax.xaxis.set_major_formatter(ScalarFormatter())
+        ax.xaxis.set_minor_formatter(NullFormatter())
         ax.set_xlabel(f"{label(k)} ({UNITS[k][0]}, log scale)")
-        ax.set_ylim(0, max(3 * f.threshold, 1))
+        ax.set_ylim(0, top)
     axes[0][0].set_ylabel("profile deviance rise")
     axes[0][0].legend(fontsize=7, loc="upper left")
     save(fig, out / "profiles.png")
