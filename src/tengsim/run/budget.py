@@ -4,12 +4,12 @@
 ``max_pixels`` (a :class:`tengsim.design.plan.DesignPlan`).  After the coarse pre-run
 (:func:`tengsim.run.reach.find_d_max`: the path's range and the solver's iterations per
 row, on a cheap grid) and before the refinement, :func:`estimate` gives the grids (the refinement's first ones,
-:func:`tengsim.run.grids.refinement_grids`), the memory of the finest, the solver ``auto`` chose and the expected
-time, each grid rows × iterations × the backend's cost per iteration (:class:`Cost`, :mod:`tengsim.resources`: the
-CPU's or the GPU's model, named in the line); :func:`cap_line` the worst case up to the budget's largest grid
-(:func:`budget_pixels`).  An expected time above the budget asked is refused (:func:`check_budget`, a
-:class:`tengsim.errors.TengsimError` naming max_pixels and tol) before the refinement is solved or anything written;
-a run past its budget is stopped between two rows (:func:`deadline`, :class:`BudgetSpent`).
+:func:`estimated_grids`), the memory of the finest (counted by :func:`tengsim.run.refine.preflight`), the solver
+``auto`` chose and the expected time, each grid rows × iterations × the backend's cost per iteration (:class:`Cost`,
+:mod:`tengsim.resources`: the CPU's or the GPU's model, named in the line); :func:`cap_line` the worst case up to
+the budget's largest grid (:func:`budget_pixels`).  An expected time above the budget asked is refused
+(:func:`check_budget`, a :class:`tengsim.errors.TengsimError` naming max_pixels and tol) before the refinement is
+solved or anything written; a run past its budget is stopped between two rows (:func:`deadline`, :class:`BudgetSpent`).
 """
 from __future__ import annotations
 

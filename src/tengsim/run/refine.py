@@ -4,9 +4,11 @@
 ``tol``, ``max_pixels`` (or None), ``budget_s`` (s), ``dx`` (the first grid's spacing, m, or None: :func:`first_dx`)
 and ``retraction`` (false: the approach only) — a :class:`tengsim.design.plan.DesignPlan`.  ``cplan`` is the :class:`tengsim.run.plan.ContactPlan` it solves.
 
-1. :func:`preflight` checks every bound from the sizes alone before any array is allocated: the solver (a machine
-   without it, a law it cannot solve), the first grid (within ``max_pixels``, the film's pixels and the memory; in
-   the user's units) and the shortest path's time against the budget.
+1. The refinement's own numbers come first (:func:`sizes`: the first grid's dx, the grid sequence, the shortest
+   path's time, the finest grid the estimate counts); then :func:`preflight` checks every bound from them, in one
+   place, before any array is allocated: the solver (a machine without it, a law it cannot solve), the first grid
+   (within ``max_pixels``, the film's pixels and the memory; in the user's units), the shortest path's time
+   against the budget, and counts the memory of the finest grid estimated.
 2. :func:`refine` then finds the path's D range on a coarse grid (:func:`tengsim.run.reach.find_d_max`), says the
    grids, the memory and the expected time (:func:`tengsim.run.budget.estimate`) and the worst case up to the
    budget's largest grid, refuses an expected time over the budget, and refines (:func:`tengsim.run.reach.resolve_to`)
@@ -77,7 +79,8 @@ class Hooks:
 class Sizes:
     """A refinement's sizes, known before anything is solved: the first grid's spacing ``dx`` (X units), the
     refinement's ``grids`` (:class:`tengsim.run.grids.GridSequence`), the shortest path's time on the first grid
-    (``shortest_s``, s) and the finest grid the estimate counts (``finest``, :func:`tengsim.run.budget.estimated_grids`)."""
+    (``shortest_s``, s) and the finest grid the estimate counts (``finest``,
+    :func:`tengsim.run.budget.estimated_grids`)."""
 
     dx: float
     grids: object
