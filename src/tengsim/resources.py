@@ -124,6 +124,24 @@ def cgroup_room(root: str = "/sys/fs/cgroup") -> int | None:
     return max(0, int(limit) - used + cache)
 
 
+def default_max_pixels(boundary: str = "free", solver: str = "fast") -> int:
+    """The largest n² whose run fits in the machine's free memory (:func:`available_bytes`, :func:`estimate_bytes`):
+    a refinement's default max_pixels; 4096² if the free memory cannot be read."""
+    avail = available_bytes()
+    if avail is None:
+        return 4096**2
+    lo, hi = 3, 3
+    while estimate_bytes(hi, hi, boundary, solver) <= avail and hi < 2**17:
+        lo, hi = hi, hi * 2
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        if estimate_bytes(mid, mid, boundary, solver) <= avail:
+            lo = mid
+        else:
+            hi = mid
+    return max(9, lo * lo)
+
+
 @dataclass(frozen=True)
 class CostModel:
     """Seconds of one solver iteration on a grid of ``points`` solved pixels: ``floor`` + ``per_point`` × points;

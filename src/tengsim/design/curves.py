@@ -26,6 +26,7 @@ pressure region, knee, saturation pressure, linear range with its R², hysteresi
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -55,16 +56,10 @@ def area_definition(plan) -> str:
     return getattr(plan, "area", "contact") or "contact"
 
 
-def definition(res, plan) -> str:
-    """The charged-area definition in words (the report's line)."""
-    from tengsim.run.area import CHARGED_COLUMN, patch
-
-    if area_definition(plan) == "contact" and CHARGED_COLUMN in res.table:
-        law = res.params.get("law") or "the law"
-        return ("the 2-D contact area, A/S = area where the gap is below the separation of the law's peak tension "
-                f"({law}; Greenwood's contact edge; a law without tension: its wall's gap), measured on the "
-                "contact map, over the cell area S")
-    return DEFINITIONS[patch(_shape(plan), _params(res, plan))[1]]
+CONTACT_DEFINITION = ("the 2-D contact area, A/S = area where the gap is below the separation of the law's peak "
+                      "tension ({law}; Greenwood's contact edge; a law without tension: its wall's gap), measured on "
+                      "the contact map, over the cell area S")
+"""The charged-area definition ``contact`` in words (the report's line), ``{law}`` the result's law."""
 
 
 def states(res, plan) -> dict:
@@ -105,25 +100,47 @@ def _full_fraction(res, plan) -> float:
     return float(area_fraction(res, [full], _params(res, plan), shape)[0])
 
 
-def sensor(res, plan):
-    """The sensor's numbers (:func:`tengsim.device.sensor.sensor_numbers`) of V_OC (Eq. 12) on the load-controlled
-    approach states over [p_min, p_max], the retraction's for the hysteresis."""
+@dataclass(frozen=True)
+class Reading:
+    """What a design reads of its refined result, asked of the layers below in one go (:func:`read`): ``curves``
+    (:func:`branch_curves`), the load-controlled ``states`` (:func:`states`), ``full`` (A/S in full contact, NaN
+    where the shape has no known full-contact area), ``definition`` (the charged-area definition in words) and
+    ``sensor`` (:func:`tengsim.device.sensor.sensor_numbers` of V_OC (Eq. 12) on the approach states over
+    [p_min, p_max], the retraction's for the hysteresis)."""
+
+    curves: dict
+    states: dict
+    full: float
+    definition: str
+    sensor: object
+
+
+def read(res, plan) -> Reading:
+    """The :class:`Reading` of ``res``: the design's own settings first, then the run layer's A/S
+    (:mod:`tengsim.run.area`) and the device model's sensor numbers (:mod:`tengsim.device.sensor`)."""
+    import dataclasses
+
     from tengsim.device.formulas import voc_polymer
     from tengsim.device.sensor import sensor_numbers
+    from tengsim.run.area import CHARGED_COLUMN, area_fraction, branch_states, full_length, patch
 
-    st = states(res, plan)
-
-    def voc(b):
-        return voc_polymer(np.clip(st[b]["area"], 0.0, 1.0), plan.sigma, plan.eps_r, plan.T)
-
-    back = (st["retraction"]["P"], voc("retraction")) if solved_back(plan) else None
-    numbers = sensor_numbers(st["approach"]["P"], voc("approach"), back, (plan.pressures[0], plan.pressures[-1]))
-    if back is None:
-        import dataclasses
-
-        why = {k: NOT_RETRACTED for k in ("voc_hysteresis_V", "voc_hysteresis_fraction")}
-        numbers = dataclasses.replace(numbers, reasons={**numbers.reasons, **why})
-    return numbers
+    params, shape, how, back = _params(res, plan), _shape(plan), area_definition(plan), solved_back(plan)
+    curves = branch_curves(res, plan)
+    st = branch_states(res, how, params, shape)
+    full = full_length(params, shape)
+    full = float(area_fraction(res, [full], params, shape)[0]) if math.isfinite(full) else math.nan
+    if how == "contact" and CHARGED_COLUMN in res.table:
+        words = CONTACT_DEFINITION.format(law=res.params.get("law") or "the law")
+    else:
+        words = DEFINITIONS[patch(shape, params)[1]]
+    V = voc_polymer(np.clip(st["approach"]["area"], 0.0, 1.0), plan.sigma, plan.eps_r, plan.T)
+    pulled = (st["retraction"]["P"], voc_polymer(np.clip(st["retraction"]["area"], 0.0, 1.0), plan.sigma, plan.eps_r,
+                                                 plan.T)) if back else None
+    numbers = sensor_numbers(st["approach"]["P"], V, pulled, (plan.pressures[0], plan.pressures[-1]))
+    if not back:
+        numbers = dataclasses.replace(numbers, reasons={**numbers.reasons, **{
+            k: NOT_RETRACTED for k in ("voc_hysteresis_V", "voc_hysteresis_fraction")}})
+    return Reading(curves, st, full, words, numbers)
 
 
 NOT_RETRACTED = "not solved: retraction = false, the approach only"
@@ -214,19 +231,19 @@ def summarize(res, plan) -> tuple[dict, dict, list]:
     """(summary {name: value}, convergence {number: relative change between the last two grids}, notes)."""
     from tengsim.design.units import pressure_text
 
-    sc = res.scaling
-    k_p = sc.pressure(1.0)
-    curves = branch_curves(res, plan)
-    app, ret = curves["approach"], curves["retraction"]
-    st = states(res, plan)["approach"]
-    notes = [physical_message(str(res.params["resolve_message"]), sc.lateral)] if res.params.get("resolve_message") \
-        else []
     from tengsim.run.area import CHARGED_COLUMN
 
+    sc = res.scaling
+    k_p = sc.pressure(1.0)
     a = res.branch("approach")
     col = CHARGED_COLUMN if area_definition(plan) == "contact" and CHARGED_COLUMN in a else "contact_length"
+    back = solved_back(plan)
+    r = read(res, plan)  # the layers below asked once
+    app, ret = r.curves["approach"], r.curves["retraction"]
+    st, full, numbers = r.states["approach"], r.full, r.sensor
+    notes = [physical_message(str(res.params["resolve_message"]), sc.lateral)] if res.params.get("resolve_message") \
+        else []
     jump_in = snap_in(k_p * np.asarray(a["F"], float), a[col], (plan.pressures[0], plan.pressures[-1]))
-    full = _full_fraction(res, plan)
     full_P = math.nan
     if math.isfinite(full):
         full_P = crossing(st["P"], st["area"], FULL_CONTACT_FRACTION * full)
@@ -234,13 +251,11 @@ def summarize(res, plan) -> tuple[dict, dict, list]:
             full_P = math.nan
             notes.append(f"full contact (A/S >= {FULL_CONTACT_FRACTION:g} × {full:.3g}) is not reached by "
                          f"{pressure_text(plan.pressures[-1])}")
-    numbers = sensor(res, plan)
     diff = ret["area"] - app["area"]
     loop = res.loop_energy  # 0 where within its uncertainty, never a negative energy of quadrature error
     pull = float(res.pull_off_force)
     if pull >= 0:  # the retraction never pulls (a law without tension): no pull-off, not the least push
         notes.append("no pull-off: the retraction carries no tensile load")
-    back = solved_back(plan)
     summary = {
         "status": design_status(res, plan.pressures[-1]),
         "tabor": sc.mu,
@@ -258,7 +273,7 @@ def summarize(res, plan) -> tuple[dict, dict, list]:
         "voc_eq17_at_p_max_V": float(app["voc_eq17"][-1]),
         "grids": _grids_text(res),
         "tolerance": plan.tol,
-        "charged_area_definition": definition(res, plan),
+        "charged_area_definition": r.definition,
         "seconds": float(res.params.get("resolve_seconds", res.seconds)),
     }
     summary["reasons"] = na_reasons(summary, numbers, plan, full, drawn_in=bool(len(a["F"]) and a["F"][0] < 0))

@@ -40,6 +40,19 @@ def slabs(n: int, size: int) -> list[tuple[int, int]]:
     return out
 
 
+def check_split(comm, boundary: str, solver, grid) -> None:
+    """An MPI run (``comm``) splits the periodic kernel's FFT across its processes: refuse what it cannot split
+    (another boundary, a ``solver`` that does not split over MPI, a ``grid`` too small for the processes)."""
+    n = comm.Get_size()
+    if boundary != "periodic":
+        raise TengsimError(f"an MPI run ({n} processes) splits the periodic kernel across them: give boundary = "
+                           f"'periodic' (got {boundary!r}), or run without mpiexec")
+    if not getattr(solver, "splits_over_mpi", False):
+        raise TengsimError(f"an MPI run ({n} processes) uses the fast solver, not {getattr(solver, 'name', solver)!r}")
+    if grid.nx < n or grid.ny // 2 + 1 < n:
+        raise TengsimError(f"the {grid.nx}×{grid.ny} grid is too small to split over {n} processes")
+
+
 class SlabPeriodicKernel(_Film):
     """The periodic half-space (or film) kernel on the rows ``rows`` of ``grid`` owned by this rank.
 

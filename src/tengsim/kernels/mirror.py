@@ -37,6 +37,38 @@ from tengsim.kernels.film import _Film, film_pixel_correction
 
 BOUNDARIES = ("free", "periodic")
 _FILM_KEYS = ("thickness", "substrate", "poisson")
+SYMMETRY_CHOICES = ("auto", "off")
+_AXIS_NAMES = ("x", "y")
+
+
+def choose_symmetry(shape, U0, grid, boundary: str, solver, symmetry: str = "auto"):
+    """(mirror axes, label) of a run: the mirrors the shape declares (``mirror_axes``) that its gap U0 has on
+    ``grid`` (odd pixel counts along them), when the kernel is the free or periodic one (half-space or
+    film) and the solver (an object or a registered name) solves on a weighted block (its ``weighted_block``
+    attribute: fast, vsr); else () and the reason.  ``symmetry='off'``: always ()."""
+    sym = str(symmetry).strip().lower()
+    if sym not in SYMMETRY_CHOICES:
+        raise TengsimError(f"symmetry = {symmetry!r} is not one of {', '.join(SYMMETRY_CHOICES)}")
+    if sym == "off":
+        return (), "off"
+    declared = tuple(getattr(shape, "mirror_axes", ()) or ())
+    if not declared:
+        return (), "none (shape has no mirror)"
+    if boundary not in BOUNDARIES:  # the kernels that have a symmetry-reduced form
+        return (), f"none (boundary {boundary})"
+    if isinstance(solver, str):
+        from tengsim.registry import SOLVERS
+
+        name, solver = solver, (SOLVERS.get(solver) if solver in SOLVERS.names() else None)
+    else:
+        name = getattr(solver, "name", None)
+    if not getattr(solver, "weighted_block", False):
+        return (), f"none (solver {name or '?'})"
+    axes = tuple(a for a in sorted(set(declared)) if grid.shape[a] % 2 == 1 and grid.shape[a] >= 5
+                 and Mirror(grid, (a,)).is_symmetric(U0))
+    if not axes:
+        return (), "none (gap not mirror symmetric on the grid)"
+    return axes, "+".join(_AXIS_NAMES[a] for a in axes)
 
 
 class ReducedKernel:

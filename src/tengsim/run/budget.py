@@ -4,12 +4,12 @@
 ``max_pixels`` (a :class:`tengsim.design.plan.DesignPlan`).  After the coarse pre-run
 (:func:`tengsim.run.reach.find_d_max`: the path's range and the solver's iterations per
 row, on a cheap grid) and before the refinement, :func:`estimate` gives the grids (the refinement's first ones,
-:func:`tengsim.run.grids.refinement_grids`), the memory of the finest, the solver ``auto`` chose and the expected
-time, each grid rows × iterations × the backend's cost per iteration (:class:`Cost`, :mod:`tengsim.resources`: the
-CPU's or the GPU's model, named in the line); :func:`cap_line` the worst case up to the budget's largest grid
-(:func:`budget_pixels`).  An expected time above the budget asked is refused (:func:`check_budget`, a
-:class:`tengsim.errors.TengsimError` naming max_pixels and tol) before the refinement is solved or anything written;
-a run past its budget is stopped between two rows (:func:`deadline`, :class:`BudgetSpent`).
+:func:`estimated_grids`), the memory of the finest (counted by :func:`tengsim.run.refine.preflight`), the solver
+``auto`` chose and the expected time, each grid rows × iterations × the backend's cost per iteration (:class:`Cost`,
+:mod:`tengsim.resources`: the CPU's or the GPU's model, named in the line); :func:`cap_line` the worst case up to
+the budget's largest grid (:func:`budget_pixels`).  An expected time above the budget asked is refused
+(:func:`check_budget`, a :class:`tengsim.errors.TengsimError` naming max_pixels and tol) before the refinement is
+solved or anything written; a run past its budget is stopped between two rows (:func:`deadline`, :class:`BudgetSpent`).
 """
 from __future__ import annotations
 
@@ -136,24 +136,30 @@ def machine_busy() -> tuple:
         return 1.0, 0.0, cores
     return max(1.0, load / cores), load, cores
 
-def estimate(ask, cplan, grids, d_max: float, cost: Cost) -> Estimate:
-    """Grids, memory and expected time of the refinement (module doc): the first :data:`LEVELS_ESTIMATED` of
-    ``grids`` (the refinement's sequence, :class:`tengsim.run.grids.GridSequence`), the last at
-    :data:`LAST_GRID_SHARE`, at ``cost`` (:func:`run_cost` of the backend the plan solves on, for the D range
-    ``d_max``)."""
-    from tengsim.resources import estimate_bytes
-
-    chosen, secs, least = [], 0.0, 0.0
-    for k, g in enumerate(itertools.islice(grids, LEVELS_ESTIMATED)):  # the grids the refinement walks
+def estimated_grids(ask, grids) -> list:
+    """The grids the expected run counts: the first :data:`LEVELS_ESTIMATED` of ``grids`` (the refinement's
+    sequence, :class:`tengsim.run.grids.GridSequence`) within ``ask.max_pixels`` (at least the first)."""
+    chosen = []
+    for g in itertools.islice(grids, LEVELS_ESTIMATED):  # the grids the refinement walks
         if ask.max_pixels is not None and g.nx * g.ny > ask.max_pixels and chosen:
             break
+        chosen.append(g)
+    return chosen
+
+
+def estimate(ask, cplan, grids, d_max: float, cost: Cost, memory_bytes: int = 0) -> Estimate:
+    """Grids, memory and expected time of the refinement (module doc): the grids counted (:func:`estimated_grids`),
+    the last at :data:`LAST_GRID_SHARE`, at ``cost`` (:func:`run_cost` of the backend the plan solves on, for the D
+    range ``d_max``); ``memory_bytes`` the finest's memory, counted with the refinement's other bounds before it
+    (:func:`tengsim.run.refine.preflight`)."""
+    chosen, secs, least = [], 0.0, 0.0
+    for k, g in enumerate(estimated_grids(ask, grids)):
         chosen.append((g.nx, g.ny, g.dx * cplan.scaling.lateral))
         step = cost.grid_seconds(cplan.shape, g)
         secs += step * (LAST_GRID_SHARE if k == LEVELS_ESTIMATED - 1 else 1.0)
         least += step if k < 2 else 0.0
-    nx, ny, _ = chosen[-1]
-    return Estimate(tuple(chosen), estimate_bytes(nx, ny, cplan.boundary, cplan.solver), secs, d_max,
-                    cost.model.backend, cost, least, (1.0, 0.0, 1) if cost.gpu else machine_busy())
+    return Estimate(tuple(chosen), int(memory_bytes), secs, d_max, cost.model.backend, cost, least,
+                    (1.0, 0.0, 1) if cost.gpu else machine_busy())
 
 
 def next_grid_line(shape, grids, seconds: float, lateral: float) -> str:

@@ -15,6 +15,7 @@ import math
 
 from tengsim import backend
 from tengsim.grid import Grid
+from tengsim.resources import default_max_pixels  # noqa: F401  (the refinement's default bound)
 
 FACTOR = math.sqrt(2.0)
 """Refinement factor in dx between two grids (twice the pixels)."""
@@ -24,26 +25,6 @@ PHASE_TOL = 0.1
 """How far (in pixels) a shape's edge may sit from its place in the first grid's pixel on a finer grid."""
 PHASE_SPAN = 1.3
 """Largest pixel count, relative to the plain next grid's, searched for a grid that keeps the edges' places."""
-
-
-def default_max_pixels(boundary: str = "free", solver: str = "fast") -> int:
-    """The largest n² whose run fits in the machine's free memory (:mod:`tengsim.resources`); 4096² if that
-    cannot be read."""
-    from tengsim.resources import available_bytes, estimate_bytes
-
-    avail = available_bytes()
-    if avail is None:
-        return 4096**2
-    lo, hi = 3, 3
-    while estimate_bytes(hi, hi, boundary, solver) <= avail and hi < 2**17:
-        lo, hi = hi, hi * 2
-    while hi - lo > 1:
-        mid = (lo + hi) // 2
-        if estimate_bytes(mid, mid, boundary, solver) <= avail:
-            lo = mid
-        else:
-            hi = mid
-    return max(9, lo * lo)
 
 
 def default_dx(shape, law, coupling: float, boundary: str = "free") -> float:

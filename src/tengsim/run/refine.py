@@ -4,9 +4,11 @@
 ``tol``, ``max_pixels`` (or None), ``budget_s`` (s), ``dx`` (the first grid's spacing, m, or None: :func:`first_dx`)
 and ``retraction`` (false: the approach only) — a :class:`tengsim.design.plan.DesignPlan`.  ``cplan`` is the :class:`tengsim.run.plan.ContactPlan` it solves.
 
-1. :func:`preflight` checks every bound from the sizes alone before any array is allocated: the solver (a machine
-   without it, a law it cannot solve), the first grid (within ``max_pixels``, the film's pixels and the memory; in
-   the user's units) and the shortest path's time against the budget.
+1. The refinement's own numbers come first (:func:`sizes`: the first grid's dx, the grid sequence, the shortest
+   path's time, the finest grid the estimate counts); then :func:`preflight` checks every bound from them, in one
+   place, before any array is allocated: the solver (a machine without it, a law it cannot solve), the first grid
+   (within ``max_pixels``, the film's pixels and the memory; in the user's units), the shortest path's time
+   against the budget, and counts the memory of the finest grid estimated.
 2. :func:`refine` then finds the path's D range on a coarse grid (:func:`tengsim.run.reach.find_d_max`), says the
    grids, the memory and the expected time (:func:`tengsim.run.budget.estimate`) and the worst case up to the
    budget's largest grid, refuses an expected time over the budget, and refines (:func:`tengsim.run.reach.resolve_to`)
@@ -32,15 +34,21 @@ def first_dx(cplan, ask) -> float:
     whose dx is at most the law's process zone over :data:`START_ZONE_PIXELS` (:func:`tengsim.run.grids.start_dx`);
     a size that does not fit the cell is said in the user's units."""
     from tengsim.errors import GeometryError
-    from tengsim.run.grids import start_dx
     from tengsim.run.plan import _metres
+
+    try:
+        return _first_dx(cplan, ask)
+    except GeometryError as exc:
+        raise exc.in_metres(cplan.scaling.lateral, _metres) from None
+
+
+def _first_dx(cplan, ask) -> float:
+    """:func:`first_dx` in X units, a size that does not fit the cell raised as it is (in X units)."""
+    from tengsim.run.grids import start_dx
 
     if ask.dx is not None:
         return ask.dx / cplan.scaling.lateral
-    try:
-        return start_dx(cplan.shape, cplan.law, cplan.coupling, cplan.boundary, START_ZONE_PIXELS)
-    except GeometryError as exc:
-        raise exc.in_metres(cplan.scaling.lateral, _metres) from None
+    return start_dx(cplan.shape, cplan.law, cplan.coupling, cplan.boundary, START_ZONE_PIXELS)
 
 
 def say_to(progress, text: str) -> None:
@@ -67,21 +75,44 @@ class Hooks:
     started: float = 0.0
 
 
-def preflight(cplan, ask) -> float:
-    """Every bound checked from the sizes alone (module doc, 1); a :class:`tengsim.errors.TengsimError` naming the
-    value to change; the first grid's dx (:func:`first_dx`)."""
+@dataclass(frozen=True)
+class Sizes:
+    """A refinement's sizes, known before anything is solved: the first grid's spacing ``dx`` (X units), the
+    refinement's ``grids`` (:class:`tengsim.run.grids.GridSequence`), the shortest path's time on the first grid
+    (``shortest_s``, s) and the finest grid the estimate counts (``finest``,
+    :func:`tengsim.run.budget.estimated_grids`)."""
+
+    dx: float
+    grids: object
+    shortest_s: float
+    finest: object
+
+
+def sizes(cplan, ask) -> Sizes:
+    """The refinement's :class:`Sizes` (in X units; a size that does not fit the cell raised in X units)."""
+    from tengsim.run.budget import estimated_grids, run_cost
+    from tengsim.run.grids import GridSequence
+
+    dx = _first_dx(cplan, ask)
+    grids = GridSequence(cplan.shape, dx)  # the refinement's grids: its estimate, its budget, its lines
+    shortest = run_cost(cplan, 2.0, None, ask.retraction).grid_seconds(cplan.shape, grids[0])
+    return Sizes(dx, grids, shortest, estimated_grids(ask, grids)[-1])
+
+
+def preflight(cplan, ask) -> tuple:
+    """Every bound checked from the sizes alone (module doc, 1), in one place: a :class:`tengsim.errors.TengsimError`
+    naming the value to change, a size that does not fit in the user's units; (the refinement's :class:`Sizes`
+    (:func:`sizes`), the memory of the finest grid its estimate counts, bytes)."""
     from tengsim.errors import GeometryError
-    from tengsim.resources import check_memory
-    from tengsim.run.budget import run_cost
+    from tengsim.resources import check_memory, estimate_bytes
     from tengsim.run.plan import _metres
     from tengsim.solvers import make_solver
     from tengsim.units import length_text, time_text
 
-    dx = first_dx(cplan, ask)
     lateral = cplan.scaling.lateral
     try:
-        g = cplan.shape.grid(dx)
-        secs = run_cost(cplan, 2.0, None, ask.retraction).grid_seconds(cplan.shape, g)  # the shortest path
+        size = sizes(cplan, ask)
+        g = size.grids[0]
         solver = make_solver(cplan.solver, tol=cplan.tol)  # a solver this machine lacks (gpu): refused now
         if hasattr(solver, "solves") and not solver.solves(cplan.law):  # a law it cannot solve: refused now
             from tengsim.solvers.pk import PKSolver, wall_model
@@ -98,13 +129,14 @@ def preflight(cplan, ask) -> float:
 
             check_film_pixels(cplan.kernel_params["thickness"], max(g.dx, g.dy), lateral)
         check_memory(g.nx, g.ny, cplan.boundary, cplan.solver)
-        if secs > ask.budget_s:
-            raise TengsimError(f"{ask.name[:80]}: {first} alone is estimated at {time_text(secs)}, over the budget "
-                               f"of {time_text(ask.budget_s)}: give a coarser --dx, a coarser --tol (now "
+        if size.shortest_s > ask.budget_s:
+            raise TengsimError(f"{ask.name[:80]}: {first} alone is estimated at {time_text(size.shortest_s)}, over "
+                               f"the budget of {time_text(ask.budget_s)}: give a coarser --dx, a coarser --tol (now "
                                f"{ask.tol:g}) or a larger --budget")
+        memory = estimate_bytes(size.finest.nx, size.finest.ny, cplan.boundary, cplan.solver)
     except GeometryError as exc:  # a size that does not fit, said in the user's units
         raise exc.in_metres(lateral, _metres) from None
-    return dx
+    return size, memory
 
 
 def find_range(cplan, ask, dx: float, progress=None, guard=None):
@@ -125,25 +157,25 @@ def refine(cplan, ask, hooks: Hooks = Hooks()):
     pressure (module doc); a :class:`tengsim.errors.TengsimError` before anything is solved where a bound or the
     budget is exceeded."""
     from tengsim.run.budget import budget_pixels, cap_line, check_budget, deadline, estimate, next_grid_line, run_cost
-    from tengsim.run.grids import GridSequence
     from tengsim.run.plan import ResolveSettings
     from tengsim.run.reach import resolve_to
 
     def said(text):
         say_to(hooks.progress, text)
 
-    dx = preflight(cplan, ask)
+    # the run layer's own numbers first (the sizes, the guards), then every bound checked in one place
+    p_max = ask.pressures[-1]
     coarse_guard = deadline(None, ask, hooks.keep, hooks.started)
     guard = deadline(hooks.progress, ask, hooks.keep, hooks.started)
+    size, memory = preflight(cplan, ask)
+    dx, grids = size.dx, size.grids
     said(f"{ask.name}: Tabor number {cplan.tabor:.3g} (from eps = {cplan.scaling.eps * 1e9:.3g} nm), "
          f"lateral unit {cplan.scaling.lateral * 1e9:.3g} nm")
     if cplan.solver_note:
         said(cplan.solver_note)
-    p_max = ask.pressures[-1]
-    grids = GridSequence(cplan.shape, dx)  # the refinement's grids: its estimate, its budget, its lines
 
     d_max, coarse = find_range(cplan, ask, dx, hooks.progress, coarse_guard)  # the path's range, on a cheap grid
-    est = estimate(ask, cplan, grids, d_max, run_cost(cplan, d_max, coarse, ask.retraction))
+    est = estimate(ask, cplan, grids, d_max, run_cost(cplan, d_max, coarse, ask.retraction), memory)
     for line in est.lines():
         said(line)
     if hooks.later is not None and hooks.later > d_max:  # killed in its second pass: go on on that pass's path

@@ -98,10 +98,10 @@ def resolve_plan(plan, observe=None, full_length: float | None = None, progress=
 
         extra = area_at(settings.pressures, shape=plan.shape)  # the paper's A/S asks the shape object
         observe = extra if observe is None else (lambda res, a=observe, b=extra: {**a(res), **b(res)})
-    max_pixels = settings.max_pixels
-    if max_pixels is None:
-        max_pixels = default_max_pixels(plan.boundary, plan.solver if isinstance(plan.solver, str) else "fast")
     dx = default_dx(shape, plan.law, plan.coupling, plan.boundary) if settings.dx is None else settings.dx
+    max_pixels = settings.max_pixels
+    if max_pixels is None:  # what the machine's memory holds (tengsim.resources)
+        max_pixels = default_max_pixels(plan.boundary, plan.solver if isinstance(plan.solver, str) else "fast")
     levels, names, res, seen, watched = [], [], None, set(), []
     stop, phases, done = None, (), False
     if start is not None:  # a refinement kept by its checkpoint: its grids are not computed again

@@ -11,62 +11,20 @@ from tengsim.grid import Mirror
 from tengsim.shapes import Pyramid, Shape
 from tengsim.laws import Law
 from tengsim.kernels import make_kernel
-from tengsim.kernels.distributed import SlabPeriodicKernel
-from tengsim.kernels.mirror import BOUNDARIES as MIRROR_BOUNDARIES, MirrorKernel
+from tengsim.kernels.distributed import SlabPeriodicKernel, check_split
+from tengsim.kernels.mirror import SYMMETRY_CHOICES, MirrorKernel, choose_symmetry  # noqa: F401
 from tengsim.continuation import LoadPathSpec, run_load_path
 from tengsim.continuation import PathSpec, run_path
 from tengsim.resources import MAP_WORK, check_memory
-from tengsim.solvers import SOLVERS, make_solver
+from tengsim.solvers import make_solver
 from tengsim.solvers.mirror import MirrorSolver
 from tengsim.solvers.distributed import SlabSolver
 from tengsim import parallel
 
 MONITOR_MIN_POINTS = 1024**2  # grids from this size on report progress inside each solve
-SYMMETRY_CHOICES = ("auto", "off")
 #: full-grid arrays a block run still holds beside the block's workspace (U0, g0, the unfolded H and P the
 #: path keeps, its zero start; measured ~10, docs/benchmarks.md "Symmetry-reduced kernels"), for the memory check
 MIRROR_FULL_ARRAYS = 12
-_AXIS_NAMES = ("x", "y")
-
-
-def choose_symmetry(shape, U0, grid, boundary: str, solver, symmetry: str = "auto"):
-    """(mirror axes, label) of a run: the mirrors the shape declares (``mirror_axes``) that its gap U0 has on
-    ``grid`` (odd pixel counts along them), when the kernel is the free or periodic one (half-space or
-    film) and the solver (an object or a registered name) solves on a weighted block (its ``weighted_block``
-    attribute: fast, vsr); else () and the reason.  ``symmetry='off'``: always ()."""
-    sym = str(symmetry).strip().lower()
-    if sym not in SYMMETRY_CHOICES:
-        raise TengsimError(f"symmetry = {symmetry!r} is not one of {', '.join(SYMMETRY_CHOICES)}")
-    if sym == "off":
-        return (), "off"
-    declared = tuple(getattr(shape, "mirror_axes", ()) or ())
-    if not declared:
-        return (), "none (shape has no mirror)"
-    if boundary not in MIRROR_BOUNDARIES:  # the kernels that have a symmetry-reduced form
-        return (), f"none (boundary {boundary})"
-    if isinstance(solver, str):
-        name, solver = solver, (SOLVERS.get(solver) if solver in SOLVERS.names() else None)
-    else:
-        name = getattr(solver, "name", None)
-    if not getattr(solver, "weighted_block", False):
-        return (), f"none (solver {name or '?'})"
-    axes = tuple(a for a in sorted(set(declared)) if grid.shape[a] % 2 == 1 and grid.shape[a] >= 5
-                 and Mirror(grid, (a,)).is_symmetric(U0))
-    if not axes:
-        return (), "none (gap not mirror symmetric on the grid)"
-    return axes, "+".join(_AXIS_NAMES[a] for a in axes)
-
-
-def _check_distributed(comm, boundary, solver, grid):
-    """An MPI run splits the periodic kernel's FFT across the processes: refuse what it cannot split."""
-    n = comm.Get_size()
-    if boundary != "periodic":
-        raise TengsimError(f"an MPI run ({n} processes) splits the periodic kernel across them: give boundary = "
-                           f"'periodic' (got {boundary!r}), or run without mpiexec")
-    if not getattr(solver, "splits_over_mpi", False):
-        raise TengsimError(f"an MPI run ({n} processes) uses the fast solver, not {getattr(solver, 'name', solver)!r}")
-    if grid.nx < n or grid.ny // 2 + 1 < n:
-        raise TengsimError(f"the {grid.nx}×{grid.ny} grid is too small to split over {n} processes")
 
 
 def simulate(shape: Shape, tabor: float, dx: float, path: PathSpec, boundary: str = "free",
@@ -118,7 +76,7 @@ def simulate_plan(plan: ContactPlan, progress=None, sink=None, throw: bool = Fal
     U0 = shape.gap(grid)
     comm = parallel.world()  # mpiexec -n N: the periodic kernel split in slabs over the N processes
     if comm is not None:
-        _check_distributed(comm, boundary, solver_obj, grid)
+        check_split(comm, boundary, solver_obj, grid)
         symmetry = "off"
     axes, sym_label = choose_symmetry(shape, U0, grid, boundary, solver_obj, symmetry)
     if comm is not None:
