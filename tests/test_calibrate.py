@@ -202,6 +202,41 @@ def test_not_a_design_refused(tmp_path, capsys):
     assert rc == 2 and "not a design" in err and not (tmp_path / "o").exists()
 
 
+@pytest.mark.parametrize("extra, says", [
+    (["--expected-noise", "2"], "--expected-noise 2: give it with its unit, e.g. 2%"),
+    (["--expected-noise", "0.5V"], "--expected-noise 0.5V: give it with its unit, e.g. 2%"),
+    (["--expected-noise=-1%"], "--expected-noise -1%: a positive noise below 100 %"),
+    (["--expected-noise", "150%"], "--expected-noise 150%: a positive noise below 100 %"),
+    (["--noise", "absolute", "--expected-noise", "3%"], "e.g. 0.5V (absolute noise)"),
+    (["--solver", "abacus"], "abacus"),
+])
+def test_bad_options_one_line_exit_2_nothing_written(tmp_path, capsys, extra, says):
+    (tmp_path / "m.csv").write_text("pressure_kPa,voc_V\n5,2\n10,3\n15,4\n20,4.5\n")
+    d = _toml(tmp_path / "d.toml", G1)
+    out = tmp_path / "out"
+    rc = main(["calibrate", str(d), "--data", str(tmp_path / "m.csv"), "--free", "sigma,W", "--out", str(out), *extra])
+    err = capsys.readouterr().err.strip()
+    assert rc == 2 and not out.exists()
+    assert says in err and len(err.splitlines()) == 1, err
+
+
+def test_expected_noise_with_stated_errors_is_refused_not_ignored(tmp_path, capsys):
+    (tmp_path / "m.csv").write_text("pressure_kPa,voc_V,voc_err_V\n5,2,0.1\n10,3,0.1\n15,4,0.1\n20,4.5,0.1\n")
+    d = _toml(tmp_path / "d.toml", G1)
+    rc = main(["calibrate", str(d), "--data", str(tmp_path / "m.csv"), "--free", "sigma,W", "--expected-noise", "2%",
+               "--out", str(tmp_path / "out")])
+    err = capsys.readouterr().err.strip()
+    assert rc == 2 and "voc_err_V" in err and not (tmp_path / "out").exists()
+
+
+def test_expected_noise_reaches_the_warning():
+    from tengsim.cli.calibrate import _expected_noise
+
+    assert _expected_noise("2%", "relative") == pytest.approx(0.02)
+    assert _expected_noise("0.5V", "absolute") == pytest.approx(0.5)
+    assert _expected_noise(None, "relative") is None
+
+
 @pytest.mark.slow
 def test_design_with_the_fitted_material_writes_bands(fitted, tmp_path):
     """tengsim design --material: the design at the fitted material, and a band from the material's uncertainty

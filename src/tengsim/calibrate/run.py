@@ -74,9 +74,10 @@ def _read_design_file(path) -> dict:
     return dict(t)
 
 
-def plan_calibration(designs, data, free=None, bounds=None, noise="relative", voc="eq12"):
+def plan_calibration(designs, data, free=None, bounds=None, noise="relative", voc="eq12", solver=None):
     """The checked :class:`tengsim.calibrate.problem.Problem`.  ``designs``: design TOML paths or [design] tables,
-    one per curve (or one for all); ``data``: CSV paths or :class:`Curve` s."""
+    one per curve (or one for all); ``data``: CSV paths or :class:`Curve` s; ``solver``: the designs' solver (a
+    design's ``solver`` key; None: as the design files say)."""
     from tengsim.calibrate.data import Curve, read_curve
     from tengsim.calibrate.problem import (DEFAULT_BOUNDS, NOISES, PARAMS, VOC_MODELS, Problem, check_reachable,
                                            count_check, parse_bounds, parse_free, text)
@@ -100,6 +101,8 @@ def plan_calibration(designs, data, free=None, bounds=None, noise="relative", vo
     tables, names = [], []
     for d in designs:
         t = _read_design_file(d) if not isinstance(d, dict) else dict(d)
+        if solver is not None:
+            t["solver"] = solver
         tables.append(t)
         names.append(str(d) if not isinstance(d, dict) else t.get("name", t.get("shape")))
     # the material: fixed values from the designs (one material), starting values for the free ones

@@ -46,6 +46,11 @@ def register(sub):
     p.add_argument("--refine", type=int, default=3, help="rounds after the zooms in which the checks (designs at the "
                    "best fit and the interval ends) become designs of the interpolation, while its error is above "
                    "half the noise (default 3)")
+    p.add_argument("--solver", default=None, help="the designs' solver, as a design's solver key (auto, numpy, "
+                   "gpu, ...; default: as the design files say)")
+    p.add_argument("--expected-noise", default=None, metavar="NOISE",
+                   help="the data's noise as known beforehand (relative noise: e.g. 2%%; absolute: e.g. 0.5V): "
+                        "the report warns when the fitted noise is more than twice it")
     p.add_argument("--out", required=True, help="output folder (created; not on bad input)")
     p.add_argument("--quiet", action="store_true", help="no progress lines")
     p.set_defaults(func=run)
@@ -62,17 +67,43 @@ def run(args) -> int:
         raise TengsimError(f"--zooms {args.zooms}: 0 to 5")
     if not 0 <= args.refine <= 10:
         raise TengsimError(f"--refine {args.refine}: 0 to 10")
-    prob = plan_calibration(args.designs, args.data, args.free, args.bounds, args.noise, args.voc)
+    expected = _expected_noise(args.expected_noise, args.noise)
+    prob = plan_calibration(args.designs, args.data, args.free, args.bounds, args.noise, args.voc, args.solver)
+    if expected is not None and prob.known_errors:
+        raise TengsimError(f"--expected-noise {args.expected_noise}: the data give voc_err_V, their stated errors are "
+                           "the noise; leave it out")
     out = Path(args.out)
     _check_out(out)
     say = say_to_stderr(args.quiet)
-    cal = calibrate(prob, out, n_nodes=args.nodes, zooms=args.zooms, progress=say, refine=args.refine)
+    cal = calibrate(prob, out, n_nodes=args.nodes, zooms=args.zooms, progress=say, refine=args.refine,
+                    expected_noise=expected)
     paths = write_calibration(cal, out)
     if say:
         for w in cal.fit.words:
             say(w)
         say(f"wrote {len(paths)} files in {out} (report: {out / 'report.md'})")
     if not cal.surrogate_ok:
-        print(f"tengsim: warning: the interpolation's error ({cal.surrogate_error:.3g}) is above half the noise "
-              f"({cal.fit.scale:.3g}): see {out / 'report.md'}", file=sys.stderr)
+        from tengsim.calibrate.fit import residual_text
+
+        print(f"tengsim: warning: the interpolation's error ({residual_text(cal.surrogate_error, prob)}) is above "
+              f"half the noise ({residual_text(cal.fit.scale, prob)}): see {out / 'report.md'}", file=sys.stderr)
     return 0
+
+
+def _expected_noise(text, noise):
+    """--expected-noise in the noise model's unit: a fraction of V_OC from "2%" (relative), volts from "0.5V"
+    (absolute); None when not given."""
+    if text is None:
+        return None
+    t = str(text).strip()
+    unit = "%" if noise == "relative" else "V"
+    try:
+        if not t.endswith(unit):
+            raise ValueError
+        value = float(t[:-len(unit)])
+    except ValueError:
+        raise TengsimError(f"--expected-noise {text}: give it with its unit, e.g. "
+                           f"{'2%' if unit == '%' else '0.5V'} ({noise} noise)") from None
+    if not (value > 0 and value < (100 if unit == "%" else float("inf"))):
+        raise TengsimError(f"--expected-noise {text}: a positive noise{' below 100 %' if unit == '%' else ''}")
+    return value / 100 if unit == "%" else value
