@@ -140,8 +140,9 @@ def plan_calibration(designs, data, free=None, bounds=None, noise="relative", vo
             probe["p_max"] = 1e3
         try:
             plans.append(plan_design(probe, f"{where}: "))
-        except TengsimError as exc:
-            raise TengsimError(f"{exc} (not a design tengsim design accepts)") from None
+        except TengsimError as exc:  # a solver this machine lacks is not the design's fault
+            raise TengsimError(str(exc) if "--solver" in str(exc) else f"{exc} (not a design tengsim design accepts)"
+                               ) from None
     curves = [c if isinstance(c, Curve) else read_curve(c) for c in data]
     prob = Problem(tuple(plans), tuple(tables), tuple(curves), free, bnds, fixed, noise, voc, E_ref, tuple(names))
     count_check(prob)
