@@ -29,9 +29,9 @@ def test_repulsive_cube_charges_its_top_and_has_no_pull_off(cube):
 
 
 def test_full_contact_interpolated_inside_the_asked_range(cube):
-    from tengsim.design.curves import FULL_CONTACT_FRACTION, _full_fraction, crossing, states
+    from tengsim.design.curves import FULL_CONTACT_FRACTION, _full_fraction, _params, _shape, crossing, states
     st = states(cube.finest, cube.plan)["approach"]
-    full = _full_fraction(cube.finest, cube.plan)
+    full = _full_fraction(cube.finest, _params(cube.finest, cube.plan), _shape(cube.plan))
     p = cube.summary["full_contact_Pa"]
     if math.isfinite(p):
         assert p <= cube.plan.pressures[-1]

@@ -90,14 +90,12 @@ def branch_curves(res, plan) -> dict:
     return out
 
 
-def _full_fraction(res, plan) -> float:
+def _full_fraction(res, params, shape) -> float:
+    """A/S in full contact (NaN where the shape has no known full-contact area)."""
     from tengsim.run.area import area_fraction, full_length
 
-    shape = _shape(plan)
-    full = full_length(_params(res, plan), shape)
-    if not math.isfinite(full):
-        return math.nan
-    return float(area_fraction(res, [full], _params(res, plan), shape)[0])
+    full = full_length(params, shape)
+    return float(area_fraction(res, [full], params, shape)[0]) if math.isfinite(full) else math.nan
 
 
 @dataclass(frozen=True)
@@ -122,13 +120,12 @@ def read(res, plan) -> Reading:
 
     from tengsim.device.formulas import voc_polymer
     from tengsim.device.sensor import sensor_numbers
-    from tengsim.run.area import CHARGED_COLUMN, area_fraction, branch_states, full_length, patch
+    from tengsim.run.area import CHARGED_COLUMN, branch_states, patch
 
     params, shape, how, back = _params(res, plan), _shape(plan), area_definition(plan), solved_back(plan)
     curves = branch_curves(res, plan)
     st = branch_states(res, how, params, shape)
-    full = full_length(params, shape)
-    full = float(area_fraction(res, [full], params, shape)[0]) if math.isfinite(full) else math.nan
+    full = _full_fraction(res, params, shape)
     if how == "contact" and CHARGED_COLUMN in res.table:
         words = CONTACT_DEFINITION.format(law=res.params.get("law") or "the law")
     else:
