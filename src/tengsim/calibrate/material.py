@@ -76,7 +76,7 @@ def predict_bands(plan, result, material: dict, progress=None) -> dict | None:
     statuses = [result.status]
     table = dict(plan.contact_table)
     own = {k: getattr(plan, k) for k in ("eps_r", "T", "gap", "tol")}
-    from tengsim.calibrate.problem import KINDS
+    from tengsim.calibrate.problem import KINDS, label, text
     from tengsim.units import parse_quantity
 
     def si(pt, k):
@@ -91,7 +91,8 @@ def predict_bands(plan, result, material: dict, progress=None) -> dict | None:
             todo.setdefault(key, pt)
     for i, (key, pt) in enumerate(todo.items()):  # σ enters linearly: one design per (E*, W, ε)
         if progress is not None:
-            progress(f"band: design {i + 1}/{len(todo)} at " + ", ".join(f"{k} {pt[k]}" for k in contact if k in pt))
+            progress(f"band: design {i + 1}/{len(todo)} at " + ", ".join(
+                f"{label(k)} {text(k, si(pt, k))}" for k in contact if k in pt))
         t = {**{k: v for k, v in table.items() if k not in MATERIAL_KEYS}, **own,
              **{k: pt[k] for k in contact if k in pt}, "p_min": plan.pressures[0], "p_max": plan.pressures[-1],
              "p_step": (plan.pressures[-1] - plan.pressures[0]) / max(len(plan.pressures) - 1, 1), "maps": False}
