@@ -328,8 +328,25 @@ def warnings(prob, f, err, expected=None) -> tuple:
         out.append(f"Warning: the interpolation's own error ({residual_text(err, prob)}, measured against designs "
                    f"solved where the fit lands) exceeds the fitted noise ({residual_text(f.scale, prob)}): the "
                    "model between designs, not the data, limits this fit; give more designs (--nodes, --zooms) or "
-                   "tighter --bounds.")
+                   "tighter --bounds." + _tol_hint(prob, f.scale))
     return tuple(out)
+
+
+def _tol_hint(prob, scale) -> str:
+    """Where the designs' tol (their A/S to about that fraction) exceeds a relative noise: neighbouring designs then
+    differ by their discretisation more than the data do, which no number of designs removes."""
+    tols = [float(getattr(pl, "tol", 0.0) or 0.0) for pl in getattr(prob, "plans", ())]
+    tol = max(tols) if tols else 0.0
+    if prob.known_errors or prob.noise != "relative" or not tol > scale:
+        return ""
+    return (f" The designs' tol {tol:g} (A/S to about {100 * tol:.3g} %) exceeds that noise: give the designs a tol "
+            f"below it (e.g. tol = {_below(scale):g}).")
+
+
+def _below(x: float) -> float:
+    """A round number below x (1, 2 or 5 × a power of ten)."""
+    e = 10 ** math.floor(math.log10(x))
+    return max(m * e for m in (1, 2, 5) if m * e < x) if x > e else e / 2
 
 
 def _fit_in_box(model, fit):
