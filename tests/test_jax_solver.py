@@ -350,3 +350,25 @@ def test_gpu_memory_fraction_and_a_solve_too_large_for_the_device(monkeypatch):
     with pytest.raises(TengsimError, match=r"over 4 or more devices"):
         jax_fast.check_device_memory(h200, 32768 ** 2, "float64")
     jax_fast.check_device_memory(h200, 32768 ** 2, "float64", shards=8)
+
+
+def test_cupy_replay_benchmark_records_the_solve_it_does_not_change():
+    """benchmarks/cupy_vs_jax.py (the CuPy-or-JAX decision, docs/benchmarks.md): the recording arrays leave the
+    NumPy solve as it is (same iterations, F to 1e-12), every convolution and host transfer is an event, and the
+    record replays on NumPy without a failed call."""
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[1] / "benchmarks" / "cupy_vs_jax.py"
+    spec = importlib.util.spec_from_file_location("_cupy_vs_jax", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    rec = mod.record(48, 5000)
+    assert rec["converged"] and rec["iterations"] == rec["numpy_iterations"] > 5
+    assert abs(rec["F"] - rec["numpy_F"]) <= 1e-12 * abs(rec["numpy_F"])
+    kinds = [e[0] for e in rec["events"]]
+    assert kinds.count("conv") == rec["n_conv"] and kinds.count("sync") >= rec["iterations"]
+    c = mod.census(rec)
+    assert 1.0 <= c["conv_per_iter"] <= 1.2 and c["launches_per_iter"] > 20 and "vdot" in c["top"]
+    _, calls, failed = mod.replay(rec, 32, np, repeat=1)
+    assert calls == len(rec["events"]) and not failed

@@ -100,7 +100,9 @@ def check_device_memory(dev, points: int, dtype: str, shards: int = 1, padded: i
         more = -(-int(need * max(int(shards), 1)) // int(limit))
         raise TengsimError(f"{points:.3g} points in {dtype} need about {need / 2**30:.0f} GiB per device, "
                            f"{dev.platform.upper()} {dev.id} allows {limit / 2**30:.0f} GiB: split the grid "
-                           f"over {more} or more devices (JaxSolver(shards=...)), use a coarser grid or float32")
+                           f"over {more} or more devices (JaxSolver(shards=...)) or use a coarser grid"
+                           + (" (float32 halves the memory but may stop short of the tolerance on large grids)"
+                              if dtype == "float64" else ""))
 
 
 def _jax():
