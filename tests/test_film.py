@@ -326,3 +326,37 @@ def test_incompressible_periodic_film_warns_like_the_half_space():
     assert not bool(np.all(res.table["in_law_range"]))
     assert "incompressible (poisson = 0.5)" in res.params["warning"]
     assert "warning" not in run_contact({**base, "poisson": 0.49}).params
+
+
+def _kernels(coupling, **film):
+    """Each kernel class built with ``coupling`` and the film ``film`` (the slab kernel with a stand-in comm: it is
+    validated before the comm is asked anything)."""
+    from tengsim.grid import Grid, Mirror
+    from tengsim.kernels import FreeKernel, MirrorKernel, PeriodicKernel
+    from tengsim.kernels.distributed import SlabPeriodicKernel
+
+    g = Grid(9, 9, 0.5, 0.5)
+    return [lambda: FreeKernel(g, coupling, **film), lambda: PeriodicKernel(g, coupling, **film),
+            lambda: MirrorKernel("free", g, coupling, Mirror(g, (0, 1)), **film),
+            lambda: SlabPeriodicKernel(g, coupling, object(), **film)]
+
+
+@pytest.mark.parametrize("coupling, film, message", [
+    (-1.0, {}, "coupling must be finite and > 0, got -1.0"),
+    ("x", {}, "coupling must be a number, got 'x'"),
+    (float("nan"), {"thickness": -1.0}, "coupling must be finite and > 0, got nan"),  # the coupling first
+    (1.0, {"thickness": -1.0}, "thickness must be finite and > 0, got -1.0"),
+    (1.0, {"thickness": 1.0, "poisson": 0.7}, "poisson must be in (-1, 0.5], got 0.7"),
+])
+def test_every_kernel_validates_its_body_in_one_place(coupling, film, message):
+    for build in _kernels(coupling, **film):
+        with pytest.raises(TengsimError) as err:
+            build()
+        assert str(err.value) == message
+
+
+def test_kernels_keep_the_coupling_as_before():
+    """FreeKernel and PeriodicKernel keep the coupling as given; the mirror kernel holds it as a float."""
+    free, periodic, mirror, _ = _kernels(1)
+    assert type(free().coupling) is int and type(periodic().coupling) is int
+    assert type(mirror().coupling) is float and mirror().coupling == 1.0

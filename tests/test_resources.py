@@ -105,3 +105,25 @@ def test_cgroup_limit_counts_reclaimable_cache(tmp_path):
     assert resources.cgroup_room(str(tmp_path)) == 3000
     (tmp_path / "memory.stat").write_text("anon 3000\nfile 2000\nactive_file 500\ninactive_file 1500\n")
     assert resources.cgroup_room(str(tmp_path)) == 4500
+
+
+@pytest.mark.parametrize("symmetry", ["auto", "off"])
+def test_simulate_checks_memory_before_any_kernel_is_built(monkeypatch, symmetry):
+    """The run's memory is checked after its pieces are chosen (the block, the solver wrapped for it) and before
+    the kernel, the first large allocation: one line naming the block and the inner solver, and no kernel built."""
+    from tengsim.continuation import PathSpec
+    from tengsim.run import simulate as sim
+    from tengsim.shapes import Pyramid
+
+    def no_kernel(*a, **k):
+        raise AssertionError("a kernel was built before the memory check refused the run")
+
+    monkeypatch.setattr(sim, "MirrorKernel", no_kernel)
+    monkeypatch.setattr(sim, "make_kernel", no_kernel)
+    monkeypatch.setattr(resources, "available_bytes", lambda: 2**20)
+    shape = Pyramid(0.946, 3.78)
+    g = shape.grid(3.78 / 61)
+    with pytest.raises(TengsimError) as err:
+        sim.simulate(shape, 0.5, g.dx, PathSpec(-1.0, 0.0, 0.5), symmetry=symmetry)
+    n = (g.nx + 1) // 2 if symmetry == "auto" else g.nx  # the block of the odd grid, mirrored in X and Y
+    assert g.nx % 2 == 1 and f"a {n}×{n} grid (free boundary, fast solver) needs about" in str(err.value)

@@ -20,7 +20,7 @@ from __future__ import annotations
 import numpy as np
 
 from tengsim.backend import fft as _bf
-from tengsim.errors import TengsimError, positive
+from tengsim.errors import TengsimError
 from tengsim.grid import Grid
 from tengsim.kernels.film import _Film
 from tengsim.kernels.halfspace import periodic_multiplier
@@ -63,9 +63,9 @@ class SlabPeriodicKernel(_Film):
 
     def __init__(self, grid: Grid, coupling: float, comm, thickness=None, substrate: str = "bonded",
                  poisson: float = 0.5):
-        self.grid, self.coupling, self.comm = grid, positive("coupling", coupling), comm
+        self.grid, self.coupling, self.comm = grid, coupling, comm
         self.thickness, self.substrate, self.poisson = thickness, substrate, poisson
-        self._init_film()
+        self.coupling = self._init_body()
         self.size, self.rank = comm.Get_size(), comm.Get_rank()
         self.row_slabs = slabs(grid.nx, self.size)
         self.nyh = grid.ny // 2 + 1

@@ -202,7 +202,15 @@ def film_pixel_correction(X, Y, dx: float, dy: float, thickness: float, poisson:
 
 
 class _Film:
-    """The optional film fields shared by both kernels (validated; all None for the half-space)."""
+    """The elastic body every kernel shares: the coupling and the optional film fields (validated; the film's all
+    None for the half-space)."""
+
+    def _init_body(self) -> float:
+        """The body validated in one place, before anything is built from it: the coupling (finite and > 0; returned
+        as a float) and the film's fields (:meth:`_init_film`)."""
+        coupling = positive("coupling", self.coupling)
+        self._init_film()
+        return coupling
 
     def _init_film(self):
         if self.thickness is None:

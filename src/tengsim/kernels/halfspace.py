@@ -26,7 +26,6 @@ import numpy as np
 
 from tengsim import backend
 from tengsim.backend import fft as _bf
-from tengsim.errors import positive
 from tengsim.grid import Grid
 from tengsim.kernels import film
 from tengsim.kernels.convolve import PaddedConvolver, PeriodicConvolver
@@ -47,8 +46,7 @@ class FreeKernel(_Film):
     padded_shape: tuple = field(init=False)
 
     def __post_init__(self):
-        positive("coupling", self.coupling)
-        self._init_film()
+        self._init_body()
         g = self.grid
         self.padded_shape = (backend.fast_len(2 * g.nx - 1), backend.fast_len(2 * g.ny - 1))
         px, py = self.padded_shape
@@ -106,8 +104,7 @@ class PeriodicKernel(_Film):
     poisson: float = 0.5
 
     def __post_init__(self):
-        positive("coupling", self.coupling)
-        self._init_film()
+        self._init_body()
         g = self.grid
         mult = periodic_multiplier(self, g)
         self.mean_compliance = float(mult[0, 0])

@@ -29,7 +29,7 @@ import numpy as np
 
 from tengsim import backend
 from tengsim.backend import fft as _bf
-from tengsim.errors import TengsimError, positive
+from tengsim.errors import TengsimError
 from tengsim.grid import Grid, Mirror
 from tengsim.kernels import dct, film
 from tengsim.kernels.base import pixel_influence
@@ -106,12 +106,11 @@ class MirrorKernel(_Film):
         bad = sorted(set(params) - set(_FILM_KEYS))
         if bad:
             raise TengsimError(f"unknown kernel parameter {bad[0]!r} (known: {', '.join(_FILM_KEYS)})")
-        self.boundary, self.grid, self.mirror = boundary, grid, mirror
-        self.coupling = positive("coupling", coupling)
+        self.boundary, self.grid, self.mirror, self.coupling = boundary, grid, mirror, coupling
         self.thickness = params.get("thickness")
         self.substrate = params.get("substrate", "bonded")
         self.poisson = params.get("poisson", 0.5)
-        self._init_film()
+        self.coupling = self._init_body()
         self.periodic = boundary == "periodic"
         if self.periodic:
             modes, lengths, spectrum = self._periodic()

@@ -92,7 +92,8 @@ def resolve_plan(plan, observe=None, full_length: float | None = None, progress=
 
     if settings is None:  # a caller's settings for this refinement (no plan built for them), else the plan's
         settings = plan.resolve if plan.resolve is not None else ResolveSettings()
-    tol, shape = settings.tol, plan.shape
+    tol = settings.tol
+    shape = plan.shape
     if settings.pressures:
         from tengsim.run.area import area_at
 

@@ -83,21 +83,24 @@ def simulate_plan(plan: ContactPlan, progress=None, sink=None, throw: bool = Fal
         sym_label = "off (MPI run: the slabs hold the full grid)"
     mirror = Mirror(grid, axes) if axes else None
     bnx, bny = mirror.reduced_shape if mirror else (grid.nx, grid.ny)
-    if check_memory_first:  # before any large array: one clear error, needed vs available (the block's)
-        full_arrays = MAP_WORK * 2 * len(path.maps_at) + (MIRROR_FULL_ARRAYS if mirror else 0)
-        check_memory(bnx, bny, boundary, getattr(solver_obj, "name", ""), getattr(solver_obj, "memory", 10),
-                     maps=-(-full_arrays * grid.nx * grid.ny // (MAP_WORK * bnx * bny)))
     if (hasattr(progress, "monitor") and grid.nx * grid.ny >= MONITOR_MIN_POINTS and is_dataclass(solver_obj)
             and getattr(solver_obj, "monitor", 0) is None):  # long solves report as they go
         solver_obj = replace(solver_obj, monitor=progress.monitor(), monitor_every=10)
+    if comm is not None:  # the solver on this rank's slab, or on the mirror's block (small objects: nothing allocated)
+        solver_obj = SlabSolver(solver_obj)
+    elif mirror is not None:
+        solver_obj = MirrorSolver(solver_obj)
+    # the run's pieces chosen, the memory is checked right before the first large allocation it guards: the kernel
+    if check_memory_first:  # one clear error, needed vs available (the block's)
+        full_arrays = MAP_WORK * 2 * len(path.maps_at) + (MIRROR_FULL_ARRAYS if mirror else 0)
+        check_memory(bnx, bny, boundary, getattr(solver_obj, "name", ""), getattr(solver_obj, "memory", 10),
+                     maps=-(-full_arrays * grid.nx * grid.ny // (MAP_WORK * bnx * bny)))
     if comm is not None:
         kernel = SlabPeriodicKernel(grid, plan.coupling, comm, **plan.kernel_params)
-        solver_obj = SlabSolver(solver_obj)
     elif mirror is None:
         kernel = make_kernel(boundary, grid, plan.coupling, **plan.kernel_params)
     else:
         kernel = MirrorKernel(boundary, grid, plan.coupling, mirror, **plan.kernel_params)
-        solver_obj = MirrorSolver(solver_obj)
     walk = run_load_path if isinstance(path, LoadPathSpec) else run_path  # load or rigid-approach control
     params = {
         "tengsim_version": __version__,
