@@ -509,3 +509,23 @@ def test_approach_only_design_gives_the_full_designs_approach_and_says_the_rest_
     write_design(one, tmp_path / "d", figures=False)
     text = (tmp_path / "d" / "report.md").read_text()
     assert "(the approach only)" in text and NOT_RETRACTED in text and "| 0 J/m² |" not in text
+
+
+def test_auto_keeps_the_cpu_below_the_gpus_break_even(monkeypatch):
+    """On a GPU machine ``auto`` keeps the NumPy solver for a grid under the cost models' break-even (measured on an
+    H200: the tiny-pyramid calibration ran slower on the GPU than on 2 CPU cores, docs/benchmarks.md) and says so."""
+    from tengsim.resources import CPU_COST, GPU_COST, gpu_break_even_points
+    from tengsim.run.plan import plan_contact
+    from tengsim.solvers import choice
+
+    even = gpu_break_even_points()
+    assert even == pytest.approx(GPU_COST.floor / (CPU_COST.per_point - GPU_COST.per_point))
+    assert CPU_COST.iteration_seconds(even) == pytest.approx(GPU_COST.iteration_seconds(even))
+    monkeypatch.setattr(choice, "gpu_visible", lambda: True)
+    small, why = choice.choose("auto", points=81 * 81)
+    assert small == "fast" and "break-even" in why and "6561" in why
+    assert choice.choose("auto", points=351 * 351)[0] == "gpu"
+    assert choice.choose("gpu", points=9)[0] == "gpu"  # asked by name: taken as asked
+    tiny = plan_contact({"shape": "pyramid", "N": 0.946, "cell": 3.78, "tabor": 0.5, "dx": 0.1, "d_max": 1.0,
+                         "d_step": 0.2})
+    assert tiny.solver == "fast" and "break-even" in tiny.solver_note

@@ -161,6 +161,15 @@ CPU_COST = CostModel("CPU (NumPy fast solver; constant of the 2-core build machi
 GPU_COST = CostModel("GPU (JAX solver, float64; constants of one NVIDIA H200)", 6.2e-4, 3.5e-10)
 """The JAX solver on a GPU: a floor per iteration (launches and synchronisations) plus a per-point term, fitted to
 one H200's cold rough solves at 1024²–8192² (docs/benchmarks.md, "GPU")."""
+
+
+def gpu_break_even_points() -> float:
+    """Grid points from which an iteration costs less on the GPU than on the CPU by the two cost models (the
+    GPU's floor over the CPU's extra per point): about 11 800 (≈ 109²).  Below it the solver ``auto`` keeps the
+    CPU (tengsim.solvers.choice)."""
+    return GPU_COST.floor / (CPU_COST.per_point - GPU_COST.per_point)
+
+
 GPU_BYTES_PER_POINT = {"float64": 480, "float32": 240}
 """Peak device memory of the JAX solver per grid point, rounded up from the H200's (docs/benchmarks.md, "GPU")."""
 

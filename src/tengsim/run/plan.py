@@ -210,14 +210,15 @@ class ContactPlan:
         from tengsim.solvers.choice import choose
 
         mu = positive("tabor", self.tabor)
-        solver, note = choose(self.solver)  # 'auto': gpu where JAX sees one, else fast; 'gpu' without one: refused
+        grid = self.grid if self.grid is not None else self.shape.grid(self.dx)  # validates dx against the cell
+        # 'auto': gpu where JAX sees one and the grid gains from it, else fast; 'gpu' without one: refused
+        solver, note = choose(self.solver, points=grid.nx * grid.ny)
         if note:
             object.__setattr__(self, "solver", solver)
             object.__setattr__(self, "solver_note", note)
         if self.scaling is not None and abs(self.scaling.mu - mu) > 1e-9 * mu:
             raise TengsimError(f"tabor = {mu:g} does not match the scaling's μ = {self.scaling.mu:g}")
         law = make_law(self.law) if isinstance(self.law, str) else (self.law or LJ93())
-        grid = self.grid if self.grid is not None else self.shape.grid(self.dx)  # validates dx against the cell
         for k, v in (("tabor", mu), ("law", law), ("boundary", KERNELS.canonical(self.boundary)), ("grid", grid),
                      ("extra", dict(self.extra or {})), ("observers", tuple(self.observers or ())),
                      ("kernel_params", dict(self.kernel_params or {})), ("config", dict(self.config or {}))):

@@ -1,4 +1,5 @@
-"""The solver ``auto``: the JAX solver (float64) where JAX sees a GPU, the NumPy fast solver everywhere else.
+"""The solver ``auto``: the JAX solver (float64) where JAX sees a GPU and the grid is large enough to gain from it,
+the NumPy fast solver everywhere else.
 
 :func:`choose` turns a solver name into the one a run uses and the sentence that says why (printed before the
 run); ``auto`` is the default of every contact run and design.  Whether JAX sees a GPU is asked without
@@ -42,8 +43,9 @@ def _has_module(name: str) -> bool:
         return False
 
 
-def choose(name) -> tuple:
-    """(the solver a run uses, why): ``auto`` → 'gpu' when :func:`gpu_visible`, else 'fast'; any other name
+def choose(name, points=None) -> tuple:
+    """(the solver a run uses, why): ``auto`` → 'gpu' when :func:`gpu_visible` and the run's grid has at least
+    :func:`tengsim.resources.gpu_break_even_points` ``points`` (None: any size), else 'fast'; any other name
     (or a solver object) unchanged."""
     if not isinstance(name, str) or name.strip().lower() != "auto":
         if isinstance(name, str) and name.strip().lower() == "gpu" and not gpu_visible():
@@ -53,6 +55,12 @@ def choose(name) -> tuple:
                                "'tengsim[gpu]', CUDA 12 driver); use --solver auto or fast")
         return name, ""
     if gpu_visible():
+        from tengsim.resources import gpu_break_even_points
+
+        even = gpu_break_even_points()
+        if points is not None and points < even:
+            return "fast", (f"solver: fast (auto: JAX sees a GPU, but a grid of {int(points)} points is below its "
+                            f"break-even of about {even:.0f}; the NumPy fast solver on the CPU)")
         return "gpu", "solver: gpu (auto: JAX sees a GPU; the fast solver compiled with JAX, float64)"
     return "fast", "solver: fast (auto: JAX sees no GPU; the NumPy fast solver on the CPU)"
 
@@ -62,8 +70,8 @@ def auto_solver(tol: float = 1e-6, **kw):
     return SOLVERS.get(choose("auto")[0])(tol=tol, **kw)
 
 
-SOLVERS.register("auto", auto_solver, summary="the jax solver on a GPU when JAX sees one (float64), else fast "
-                 "(the default; the choice is printed before the run)")
+SOLVERS.register("auto", auto_solver, summary="the jax solver on a GPU when JAX sees one (float64) and the grid is over "
+                 "its break-even (≈ 109²), else fast (the default; the choice is printed before the run)")
 
 
 __all__ = ["GPU_PLUGINS", "auto_solver", "choose", "gpu_visible"]
