@@ -100,7 +100,7 @@ class Rec(np.ndarray):
         return _wrap(res)
 
 
-def rough_problem(n, xp_kernel=True):
+def rough_problem(n):
     from scaling import rough_surface
 
     from tengsim.grid import Grid
@@ -136,9 +136,7 @@ def _record(n, max_iter):
     from tengsim.solvers import _descent
 
     pb, _ = rough_problem(n)
-    saved = (backend.empty, backend.zeros, backend.sync, backend.to_host, _descent._Descent.convolve,
-             _descent._Descent.__init__)
-    real_sync = backend.sync
+    real_sync, real_convolve, real_init = backend.sync, _descent._Descent.convolve, _descent._Descent.__init__
 
     def empty(shape, dtype=float):
         return np.empty(shape, dtype).view(Rec)
@@ -169,19 +167,17 @@ def _record(n, max_iter):
             REC.quiet -= 1
 
     def init(self, problem, start, ws, lines=None):
-        saved[5](self, problem, start, ws, lines)
+        real_init(self, problem, start, ws, lines)
         for name in ("g0", "q", "w"):
             setattr(self, name, getattr(self, name).view(Rec))
 
+    swap = {"empty": empty, "zeros": zeros, "sync": sync, "to_host": to_host}
     mods = [m for k, m in sys.modules.items() if k.startswith("tengsim.solvers")] + [backend]
-    patched = []
-    for m in mods:
-        for name, f in (("empty", empty), ("zeros", zeros), ("sync", sync), ("to_host", to_host)):
-            if getattr(m, name, None) is getattr(backend, name):
-                patched.append((m, name, getattr(m, name)))
+    patched = [(m, name, getattr(m, name)) for m in mods for name in swap
+               if getattr(m, name, None) is getattr(backend, name)]
     try:
         for m, name, _ in patched:
-            setattr(m, name, {"empty": empty, "zeros": zeros, "sync": sync, "to_host": to_host}[name])
+            setattr(m, name, swap[name])
         _descent._Descent.convolve, _descent._Descent.__init__ = convolve, init
         REC.events.clear()
         t0 = time.perf_counter()
@@ -190,7 +186,7 @@ def _record(n, max_iter):
     finally:
         for m, name, f in patched:
             setattr(m, name, f)
-        _descent._Descent.convolve, _descent._Descent.__init__ = saved[4], saved[5]
+        _descent._Descent.convolve, _descent._Descent.__init__ = real_convolve, real_init
     t0 = time.perf_counter()
     ref = FastSolver(tol=TOL, max_iter=max_iter).solve(pb, State.zero((n, n)))
     t_numpy = time.perf_counter() - t0
