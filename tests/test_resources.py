@@ -7,6 +7,7 @@ import sys
 import pytest
 
 from tengsim import resources
+from tengsim.run import memory
 from tengsim.cli.main import main
 from tengsim.errors import TengsimError
 
@@ -51,18 +52,18 @@ def test_estimate_within_30_percent_of_measured_peak_rss(boundary, solver, n):
     periodic/fast 66 / 72, and at 1029² free/fast 83.6 / 83.0.  Below ~500² glibc serves arrays
     from heap holes left by the imports and the RSS growth undercounts."""
     nx, ny, peak = _measured_peak(boundary, solver, n)
-    est = resources.estimate_bytes(nx, ny, boundary, solver)
+    est = memory.estimate_bytes(nx, ny, boundary, solver)
     assert abs(est - peak) <= 0.3 * peak, (est, peak, est / peak)
 
 
 def test_estimate_scales_with_grid_and_memory():
-    a = resources.estimate_bytes(1025, 1025)
-    assert resources.estimate_bytes(2049, 2049) == pytest.approx(4 * a, rel=0.1)
-    assert resources.estimate_bytes(1025, 1025, memory=20) > a > resources.estimate_bytes(1025, 1025, "periodic")
-    assert resources.estimate_bytes(1025, 1025, solver="vsr") < a
+    a = memory.estimate_bytes(1025, 1025)
+    assert memory.estimate_bytes(2049, 2049) == pytest.approx(4 * a, rel=0.1)
+    assert memory.estimate_bytes(1025, 1025, memory=20) > a > memory.estimate_bytes(1025, 1025, "periodic")
+    assert memory.estimate_bytes(1025, 1025, solver="vsr") < a
     # the 1893² run of the issue: ~3 GB, far below what the old fixed 4096² limit let through (11 GB)
-    assert 2e9 < resources.estimate_bytes(1893, 1893) < 4e9
-    assert resources.estimate_bytes(4096, 4096) > 1e10
+    assert 2e9 < memory.estimate_bytes(1893, 1893) < 4e9
+    assert memory.estimate_bytes(4096, 4096) > 1e10
 
 
 def test_available_memory_is_read():
@@ -71,19 +72,19 @@ def test_available_memory_is_read():
 
 
 def test_check_memory_names_needed_and_available():
-    need = resources.check_memory(101, 101, available=1 << 40)
-    assert need == resources.estimate_bytes(101, 101)
+    need = memory.check_memory(101, 101, available=1 << 40)
+    assert need == memory.estimate_bytes(101, 101)
     with pytest.raises(TengsimError) as exc:
-        resources.check_memory(4001, 4001, "periodic", "vsr", available=2 * 2**30)
+        memory.check_memory(4001, 4001, "periodic", "vsr", available=2 * 2**30)
     msg = str(exc.value)
     assert "4001×4001" in msg and "periodic" in msg and "vsr" in msg
-    assert f"{resources.estimate_bytes(4001, 4001, 'periodic', 'vsr') / 2**30:.2f} GiB" in msg
+    assert f"{memory.estimate_bytes(4001, 4001, 'periodic', 'vsr') / 2**30:.2f} GiB" in msg
     assert "2.00 GiB is available" in msg
 
 
 def test_check_memory_can_be_switched_off(monkeypatch):
     monkeypatch.setenv("TENGSIM_NO_MEMORY_CHECK", "1")
-    assert resources.check_memory(4001, 4001, available=1) > 0
+    assert memory.check_memory(4001, 4001, available=1) > 0
 
 
 def test_cli_refuses_a_run_that_does_not_fit(tmp_path, capsys, monkeypatch):

@@ -311,9 +311,9 @@ def test_memory_check_of_a_symmetric_run_matches_its_peak_rss():
     import subprocess
     import sys
 
-    from tengsim import resources
+    from tengsim.run import memory
+    from tengsim.run.memory import MAP_WORK
     from tengsim.run.simulate import MIRROR_FULL_ARRAYS
-    from tengsim.resources import MAP_WORK
 
     sys.path.insert(0, os.path.dirname(__file__))
     import test_resources
@@ -323,8 +323,8 @@ def test_memory_check_of_a_symmetric_run_matches_its_peak_rss():
                          check=True, env={**os.environ, "OPENBLAS_NUM_THREADS": "1"}).stdout
     nx, ny, peak = json.loads(out)
     bx, by = (nx + 1) // 2, (ny + 1) // 2
-    est = resources.estimate_bytes(bx, by, "free", "fast", 10,
-                                   maps=-(-MIRROR_FULL_ARRAYS * nx * ny // (MAP_WORK * bx * by)))
+    est = memory.estimate_bytes(bx, by, "free", "fast", 10,
+                                maps=-(-MIRROR_FULL_ARRAYS * nx * ny // (MAP_WORK * bx * by)))
     assert abs(est - peak) <= 0.3 * peak, (est, peak)
 
 

@@ -15,7 +15,7 @@ import math
 
 from tengsim import backend
 from tengsim.grid import Grid
-from tengsim.resources import default_max_pixels  # noqa: F401  (the refinement's default bound)
+from tengsim.run.memory import check_memory
 
 FACTOR = math.sqrt(2.0)
 """Refinement factor in dx between two grids (twice the pixels)."""
@@ -43,8 +43,6 @@ def default_dx(shape, law, coupling: float, boundary: str = "free") -> float:
     if math.isfinite(lD) and lD > 0:
         dx = min(dx, lD / status.RESOLUTION)  # the zone spans the pixels the status asks for
     g = shape.grid(dx)
-    from tengsim.resources import check_memory
-
     check_memory(g.nx, g.ny, boundary)  # the kernel below is the grid's: one line, not an allocation that fails
     s = status.pixel_snap_number(law, make_kernel(boundary, g, coupling))
     if s > status.SNAP_LIMIT:

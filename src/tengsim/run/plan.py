@@ -403,7 +403,7 @@ def plan_contact(cfg: dict) -> ContactPlan:
         grid = shape.grid(dx)  # validates dx against the cell
     except GeometryError as exc:
         raise (exc.in_metres(lateral, _metres) if lateral is not None else exc) from None
-    from tengsim.resources import check_memory
+    from tengsim.run.memory import check_memory
 
     if kernel_params.get("thickness") is not None:  # a film thinner than its pixel allows: refused now
         film.check_film_pixels(kernel_params["thickness"], max(grid.dx, grid.dy), lateral)

@@ -6,9 +6,10 @@ and ``retraction`` (false: the approach only) — a :class:`tengsim.design.plan.
 
 1. The refinement's own numbers come first (:func:`sizes`: the first grid's dx, the grid sequence, the shortest
    path's time, the finest grid the estimate counts); then :func:`preflight` checks every bound from them, in one
-   place, before any array is allocated: the solver (a machine without it, a law it cannot solve), the first grid
-   (within ``max_pixels``, the film's pixels and the memory; in the user's units), the shortest path's time
-   against the budget, and counts the memory of the finest grid estimated.
+   place, before any array is allocated: the first grid's size (within ``max_pixels`` and the memory,
+   :mod:`tengsim.run.memory`; in the user's units) and counts the memory of the finest grid estimated; then the
+   solver (a machine without it, a law it cannot solve), the film's pixels and the shortest path's time against
+   the budget.
 2. :func:`refine` then finds the path's D range on a coarse grid (:func:`tengsim.run.reach.find_d_max`), says the
    grids, the memory and the expected time (:func:`tengsim.run.budget.estimate`) and the worst case up to the
    budget's largest grid, refuses an expected time over the budget, and refines (:func:`tengsim.run.reach.resolve_to`)
@@ -104,7 +105,7 @@ def preflight(cplan, ask) -> tuple:
     naming the value to change, a size that does not fit in the user's units; (the refinement's :class:`Sizes`
     (:func:`sizes`), the memory of the finest grid its estimate counts, bytes)."""
     from tengsim.errors import GeometryError
-    from tengsim.resources import check_memory, estimate_bytes
+    from tengsim.run.memory import check_memory, estimate_bytes
     from tengsim.run.plan import _metres
     from tengsim.solvers import make_solver
     from tengsim.units import length_text, time_text
@@ -113,6 +114,12 @@ def preflight(cplan, ask) -> tuple:
     try:
         size = sizes(cplan, ask)
         g = size.grids[0]
+        first = f"the first grid {g.nx}×{g.ny} (dx {length_text(g.dx * lateral)})"
+        if ask.max_pixels is not None and g.nx * g.ny > ask.max_pixels:
+            raise TengsimError(f"{ask.name[:80]}: {first} has {g.nx * g.ny} pixels, over max_pixels = "
+                               f"{ask.max_pixels}: give a larger --max-pixels or a coarser --dx")
+        check_memory(g.nx, g.ny, cplan.boundary, cplan.solver)
+        memory = estimate_bytes(size.finest.nx, size.finest.ny, cplan.boundary, cplan.solver)
         solver = make_solver(cplan.solver, tol=cplan.tol)  # a solver this machine lacks (gpu): refused now
         if hasattr(solver, "solves") and not solver.solves(cplan.law):  # a law it cannot solve: refused now
             from tengsim.solvers.pk import PKSolver, wall_model
@@ -120,20 +127,14 @@ def preflight(cplan, ask) -> tuple:
             if isinstance(solver, PKSolver):
                 wall_model(cplan.law)  # raises the solver's own line, naming the solvers that can
             raise TengsimError(f"solver {cplan.solver!r} cannot solve law {type(cplan.law).__name__}")
-        first = f"the first grid {g.nx}×{g.ny} (dx {length_text(g.dx * lateral)})"
-        if ask.max_pixels is not None and g.nx * g.ny > ask.max_pixels:
-            raise TengsimError(f"{ask.name[:80]}: {first} has {g.nx * g.ny} pixels, over max_pixels = "
-                               f"{ask.max_pixels}: give a larger --max-pixels or a coarser --dx")
         if (cplan.kernel_params or {}).get("thickness") is not None:
             from tengsim.kernels.film import check_film_pixels
 
             check_film_pixels(cplan.kernel_params["thickness"], max(g.dx, g.dy), lateral)
-        check_memory(g.nx, g.ny, cplan.boundary, cplan.solver)
         if size.shortest_s > ask.budget_s:
             raise TengsimError(f"{ask.name[:80]}: {first} alone is estimated at {time_text(size.shortest_s)}, over "
                                f"the budget of {time_text(ask.budget_s)}: give a coarser --dx, a coarser --tol (now "
                                f"{ask.tol:g}) or a larger --budget")
-        memory = estimate_bytes(size.finest.nx, size.finest.ny, cplan.boundary, cplan.solver)
     except GeometryError as exc:  # a size that does not fit, said in the user's units
         raise exc.in_metres(lateral, _metres) from None
     return size, memory

@@ -57,7 +57,8 @@ import numpy as np
 from tengsim.errors import TengsimError
 from tengsim.run.checkpoint import Checkpoint
 from tengsim.run.grids import (FACTOR, MIN_SIDE, PHASE_SPAN, PHASE_TOL, aligned, default_dx,  # noqa: F401
-                                default_max_pixels, edge_phases, next_grid)
+                                edge_phases, next_grid)
+from tengsim.run.memory import default_max_pixels
 from tengsim.run.tolerance import DEFAULT_TOL
 from tengsim.run.judge import (FLOORS, NEED_FLOOR, P_MAX, P_MIN, _dx_needed, _judge, _levels_table,  # noqa: F401
                                _why, contact_observables, floor_of, relative, richardson)
@@ -101,7 +102,7 @@ def resolve_plan(plan, observe=None, full_length: float | None = None, progress=
         observe = extra if observe is None else (lambda res, a=observe, b=extra: {**a(res), **b(res)})
     dx = default_dx(shape, plan.law, plan.coupling, plan.boundary) if settings.dx is None else settings.dx
     max_pixels = settings.max_pixels
-    if max_pixels is None:  # what the machine's memory holds (tengsim.resources)
+    if max_pixels is None:  # what the machine's memory holds (tengsim.run.memory)
         max_pixels = default_max_pixels(plan.boundary, plan.solver if isinstance(plan.solver, str) else "fast")
     levels, names, res, seen, watched = [], [], None, set(), []
     stop, phases, done = None, (), False

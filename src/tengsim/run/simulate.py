@@ -15,7 +15,7 @@ from tengsim.kernels.distributed import SlabPeriodicKernel, check_split
 from tengsim.kernels.mirror import SYMMETRY_CHOICES, MirrorKernel, choose_symmetry  # noqa: F401
 from tengsim.continuation import LoadPathSpec, run_load_path
 from tengsim.continuation import PathSpec, run_path
-from tengsim.resources import MAP_WORK, check_memory
+from tengsim.run.memory import MAP_WORK, check_memory
 from tengsim.solvers import make_solver
 from tengsim.solvers.mirror import MirrorSolver
 from tengsim.solvers.distributed import SlabSolver
