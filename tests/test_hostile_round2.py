@@ -319,7 +319,7 @@ def test_max_pixels_below_the_first_grid_is_refused_before_anything_is_created(h
 
 
 def test_a_design_out_is_locked_against_a_second_run(here, capsys):
-    from tengsim.io import folder_lock
+    from tengsim.outfolder import folder_lock
 
     with folder_lock(here / "o"):
         line = refused(capsys, ["design", *S, "--out", "o"], here / "o", contains="in use")

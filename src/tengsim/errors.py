@@ -12,6 +12,29 @@ class ConfigValueError(TengsimError):
     combination that cannot be built, e.g. a pyramid wider than its cell)."""
 
 
+class MachineError(TengsimError):
+    """What this machine cannot give a run, not a property of its input: a solver or extra not installed
+    (:class:`SolverUnavailable`), too little memory (:class:`MemoryRefused`), the time budget spent or expected
+    to be (:class:`BudgetExceeded`).  Told by its type, never by its text: a run that keeps results (a
+    calibration's designs) never keeps one of these as the input's answer; the next run tries again."""
+
+
+class SolverUnavailable(MachineError):
+    """The solver asked for cannot run here (JAX not installed, no GPU)."""
+
+
+class MemoryRefused(MachineError):
+    """A grid that would not fit in the memory available."""
+
+
+class BudgetExceeded(MachineError):
+    """A run expected to take longer than its time budget, or stopped at it (``budget_s``, s)."""
+
+    def __init__(self, message: str, budget_s: float = float("nan")):
+        self.budget_s = budget_s
+        super().__init__(message)
+
+
 class GeometryError(TengsimError):
     """A size that does not fit (a structure wider than its cell, a grid too fine for its cell), raised where
     the sizes are dimensionless: ``template`` with ``{name}`` fields and the ``lengths`` (in the shape's

@@ -186,45 +186,6 @@ def save_figure(fig, path, **kw) -> None:
         fig.savefig(tmp, format=path.suffix.lstrip(".") or "png", **kw)
 
 
-@contextlib.contextmanager
-def folder_lock(folder, what: str = "--out"):
-    """Hold an exclusive lock on output folder ``folder`` (a file ``.tengsim.lock`` in it) for the block: a
-    second run on the same folder is refused with one line instead of interleaving its files with ours."""
-    from tengsim.errors import TengsimError
-
-    folder = Path(folder)
-    made = [p for p in (folder, *folder.parents) if not p.exists()]  # removed again if left empty
-    folder.mkdir(parents=True, exist_ok=True)
-    lock = folder / ".tengsim.lock"
-    try:
-        fh = open(lock, "a+", encoding="utf-8")
-    except OSError as exc:
-        raise TengsimError(f"cannot write {folder}: {exc.strerror or exc}") from None
-    try:
-        try:
-            import fcntl
-
-            fcntl.flock(fh.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
-            if os.fstat(fh.fileno()).st_ino != os.stat(lock).st_ino:  # removed by its holder as we locked it
-                raise OSError
-        except ImportError:  # pragma: no cover - no fcntl (Windows): no lock
-            pass
-        except OSError:
-            fh.close()
-            raise TengsimError(f"{what} {folder} is in use by another tengsim run; wait for it or choose "
-                               "another folder") from None
-        try:
-            yield folder
-        finally:
-            with contextlib.suppress(OSError):
-                lock.unlink()  # before the unlock: a run that opens it now finds another file and retries
-            for p in made:  # a run refused or stopped before writing anything leaves no empty folder
-                with contextlib.suppress(OSError):
-                    p.rmdir()
-    finally:
-        fh.close()
-
-
 def write_text(path, text: str) -> None:
     """Write ``text`` atomically, UTF-8 whatever the locale (LC_ALL=C with PYTHONUTF8=0 wrote ASCII only)."""
     with atomic_path(path) as tmp:

@@ -27,7 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
-from tengsim.errors import TengsimError
+from tengsim.errors import SolverUnavailable, TengsimError
 
 LOO_PER_NOISE = 0.5
 """Zooming stops when the interpolation's leave-one-out error (rms over the nodes of the fitted region, in the
@@ -81,6 +81,7 @@ def plan_calibration(designs, data, free=None, bounds=None, noise="relative", vo
     from tengsim.calibrate.problem import (DEFAULT_BOUNDS, NOISES, PARAMS, VOC_MODELS, Problem, check_reachable,
                                            count_check, parse_bounds, parse_free, text)
     from tengsim.design import plan_design
+    from tengsim.run.refine import check_solver
 
     designs, data = list(designs), list(data)
     if not data:
@@ -138,10 +139,13 @@ def plan_calibration(designs, data, free=None, bounds=None, noise="relative", vo
         if "p_max" not in probe:
             probe["p_max"] = 1e3
         try:
-            plans.append(plan_design(probe, f"{where}: "))
-        except TengsimError as exc:  # a solver this machine lacks is not the design's fault
-            raise TengsimError(str(exc) if "--solver" in str(exc) else f"{exc} (not a design tengsim design accepts)"
-                               ) from None
+            plan = plan_design(probe, f"{where}: ")
+        except SolverUnavailable:  # a solver this machine lacks is not the design's fault: said as it is
+            raise
+        except TengsimError as exc:
+            raise TengsimError(f"{exc} (not a design tengsim design accepts)") from None
+        check_solver(plan.contact_plan)  # as tengsim design does: a solver missing here refused before any node
+        plans.append(plan)
     curves = [c if isinstance(c, Curve) else read_curve(c) for c in data]
     prob = Problem(tuple(plans), tuple(tables), tuple(curves), free, bnds, fixed, noise, voc, E_ref, tuple(names))
     count_check(prob)
@@ -171,9 +175,17 @@ def _p_max(prob, key, geo):
 
 def calibrate(prob, out_dir, n_nodes: int = 4, zooms: int = 2, progress=None, refine: int = REFINE,
               expected_noise=None) -> Calibration:
-    """Run the calibration of the checked problem ``prob`` (module doc); nodes kept in ``out_dir/designs``.
+    """Run the calibration of the checked problem ``prob`` (module doc); nodes kept in ``out_dir/designs``, which
+    the run holds locked (:func:`tengsim.outfolder.folder_lock`): two calibrations never share their designs.
     ``expected_noise``: the data's noise as known beforehand, in the noise model's unit (a fraction of V_OC for
     the relative model, volts for the absolute), for the warning when the fit's is much larger."""
+    from tengsim.outfolder import folder_lock
+
+    with folder_lock(Path(out_dir) / "designs", what="the designs folder", holder="tengsim calibrate"):
+        return _calibrate(prob, out_dir, n_nodes, zooms, progress, refine, expected_noise)
+
+
+def _calibrate(prob, out_dir, n_nodes, zooms, progress, refine, expected_noise) -> Calibration:
     from tengsim.calibrate.checks import interpolation_error
     from tengsim.calibrate.fit import Model, band, fit, residual_text
     from tengsim.calibrate.surrogate import (POINTS_PER_CURVE, Surrogate, geometry_key, grid_points, node_table,

@@ -9,7 +9,10 @@ solve of its own, only a wider pressure range.
 **Nodes.**  Each node is one converged design (:func:`tengsim.design.run_design`, status ok at the design's own
 tol) at (W_eff, ε), kept in ``DIR/designs/KEY.nc`` as soon as it is solved (KEY: a hash of the design's table), so a
 killed calibration loses at most the design in progress and a rerun takes every solved node back.  A node whose
-design is not ok (or fails) is recorded and left out: no model value comes from an unconverged design.
+design is not ok (or fails) is recorded and left out: no model value comes from an unconverged design.  Only the
+design's own answer is kept as failed (``KEY.failed.txt``); a failure of the machine (too little memory, the time
+budget spent, a solver missing: :class:`tengsim.errors.MachineError`, told by its type) or an interrupted node is
+never kept, and the next run solves it again.  KEY covers every file the table names (:func:`node_key`).
 
 **Interpolation: along the curve, not at a fixed pressure.**  A branch's A/S jumps (snap-in on the approach) at a
 pressure that moves with W and ε; blending two nodes' A/S at a fixed pressure, one jumped and one not, makes a
@@ -35,7 +38,7 @@ from pathlib import Path
 
 import numpy as np
 
-from tengsim.errors import TengsimError
+from tengsim.errors import MachineError, SolverUnavailable, TengsimError
 
 POINTS_PER_CURVE = 21
 """Pressures of a node's design, 0 to p_max (A/S is linear between them; more make the refinement judge more)."""
@@ -61,7 +64,26 @@ def node_table(table: dict, W: float, eps: float, E_ref: float, p_max: float) ->
 
 
 def node_key(table: dict) -> str:
-    return hashlib.sha256(json.dumps(table, sort_keys=True, default=str).encode()).hexdigest()[:16]
+    """The node's identity: a hash of its design table and of the content of every file the table names (a
+    topography's heights: a changed file is a new node, never a stale one taken back)."""
+    text = json.dumps(table, sort_keys=True, default=str)
+    files = input_files(table)
+    if files:  # (a table naming no file keeps the key it always had)
+        text += json.dumps({f: hashlib.sha256(Path(f).read_bytes()).hexdigest() for f in files}, sort_keys=True)
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+def input_files(table: dict) -> list:
+    """The files a design table names (its string values that are existing files: a topography's heights)."""
+    out = []
+    for v in table.values():
+        if isinstance(v, str) and 0 < len(v) < 4096:
+            try:
+                if Path(v).is_file():
+                    out.append(v)
+            except (OSError, ValueError):
+                continue
+    return sorted(out)
 
 
 @dataclass
@@ -75,6 +97,7 @@ class Node:
     seconds: float = 0.0
     cached: bool = False
     states: dict | None = None  # branch -> (P, A/S) of the states passed (Pa, increasing), where the file has them
+    machine: bool = False  # failed for this machine's reason (memory, the time budget): not kept, tried again
 
     def curve(self, branch: str, p_max: float):
         """(P, A/S) of the branch from 0 to ``p_max`` (Pa): the states passed, A/S held flat before the first and
@@ -131,18 +154,40 @@ def solve_node(table: dict, folder: Path, u: float, v: float, progress=None) -> 
         return Node(u, v, False, message=bad.read_text(encoding="utf-8").strip(), cached=True)
     folder.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
+    keep = folder / f"{key}.resolve.nc"
     try:
-        res = run_design(plan_design(table), progress=progress, keep=folder / f"{key}.resolve.nc")
-    except TengsimError as exc:
-        if "memory" not in str(exc):  # the design's own answer is kept; a machine short of memory is not
-            write_text(bad, str(exc) + "\n")
-        (folder / f"{key}.resolve.nc").unlink(missing_ok=True)
+        res = run_design(plan_design(table), progress=progress, keep=keep)
+    except SolverUnavailable:  # not this node's answer, nor any node's: the run stops (one line), nothing kept
+        raise
+    except (MachineError, MemoryError) as exc:  # the machine's failure, not the design's: never kept as failed
+        # (the next run tries again, from the grids kept in KEY.resolve.nc where a budget stopped it)
+        return Node(u, v, False, message=machine_text(exc, keep), seconds=time.perf_counter() - t0, machine=True)
+    except TengsimError as exc:  # the design's own answer (it cannot be solved as asked): kept
+        write_text(bad, str(exc) + "\n")
+        keep.unlink(missing_ok=True)
         return Node(u, v, False, message=str(exc), seconds=time.perf_counter() - t0)
     write_dataset(res.dataset, nc)
     (folder / f"{key}.resolve.nc").unlink(missing_ok=True)
     P, A, st = _read(res.dataset)
     ok = res.status == "ok"
     return Node(u, v, ok, P, A, "" if ok else f"status {res.status}", time.perf_counter() - t0, states=st)
+
+
+def machine_text(exc, keep: Path) -> str:
+    """What stopped a node for this machine's reason, with the advice calibrate can give (it has no --budget:
+    the design file's ``budget`` key)."""
+    from tengsim.errors import BudgetExceeded
+    from tengsim.run.budget import BUDGET_CLOCK
+    from tengsim.units import time_text
+
+    again = "not kept as failed: the next run tries it again"
+    if isinstance(exc, BudgetExceeded):
+        kept = f" from the grids kept in {keep}" if keep.exists() else ""
+        return (f"stopped at the design's time budget of {time_text(exc.budget_s)} ({BUDGET_CLOCK}); {again}"
+                f"{kept} (or give the design file a larger budget, e.g. budget = \"1800s\")")
+    if isinstance(exc, MemoryError):
+        return f"out of memory on this machine; {again}"
+    return f"{exc}; {again}"
 
 
 def _fill(y):
@@ -201,6 +246,10 @@ class Surrogate:
         if branch not in self._rbf:
             good = self.good()
             if not good:
+                machine = [n for n in self.nodes if n.machine]
+                if machine:  # not the design's answer: the advice is to run again, not to change the design
+                    raise TengsimError(f"no converged design among the nodes: {len(machine)} of {len(self.nodes)} "
+                                       f"were stopped by this machine ({machine[0].message})")
                 raise TengsimError("no converged design among the nodes: narrow the bounds or loosen the design's tol")
             self._rbf[branch] = self._build(good, branch)
         return self._rbf[branch]

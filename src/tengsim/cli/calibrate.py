@@ -56,10 +56,14 @@ def register(sub):
     p.set_defaults(func=run)
 
 
+WRITES = ("report.md", "fit.nc", "fit.csv", "fit.png", "residuals.png", "profiles.png", "material.toml")
+"""The files a calibration writes in --out (beside the designs/ folder it keeps its solved designs in)."""
+
+
 def run(args) -> int:
-    from tengsim.calibrate import calibrate, plan_calibration, write_calibration
-    from tengsim.calibrate.run import say_to_stderr
-    from tengsim.cli.design import _check_out
+    from tengsim.calibrate import plan_calibration
+    from tengsim.calibrate.surrogate import input_files
+    from tengsim.outfolder import check_folder, folder_lock
 
     if not 2 <= args.nodes <= 9:
         raise TengsimError(f"--nodes {args.nodes}: 2 to 9 designs per axis")
@@ -73,10 +77,28 @@ def run(args) -> int:
         raise TengsimError(f"--expected-noise {args.expected_noise}: the data give voc_err_V, their stated errors are "
                            "the noise; leave it out")
     out = Path(args.out)
-    _check_out(out)
+    inputs = [*args.designs, *args.data, *(f for t in prob.tables for f in input_files(t))]
+    check_folder(out, inputs, [out / name for name in WRITES])  # never over (or around) an input
+    with folder_lock(out, holder="tengsim calibrate"):  # the whole run: no design or calibration here meanwhile
+        return _run_locked(args, prob, out, expected)
+
+
+def _run_locked(args, prob, out, expected) -> int:
+    from tengsim.calibrate import calibrate, write_calibration
+    from tengsim.calibrate.run import say_to_stderr
+
     say = say_to_stderr(args.quiet)
-    cal = calibrate(prob, out, n_nodes=args.nodes, zooms=args.zooms, progress=say, refine=args.refine,
-                    expected_noise=expected)
+    try:
+        cal = calibrate(prob, out, n_nodes=args.nodes, zooms=args.zooms, progress=say, refine=args.refine,
+                        expected_noise=expected)
+    except KeyboardInterrupt:
+        kept = sorted((out / "designs").glob("*.nc")) if (out / "designs").is_dir() else []
+        kept = [p for p in kept if not p.name.endswith(".resolve.nc")]
+        print("tengsim: interrupted: " + (f"the {len(kept)} finished design(s) are kept in {out / 'designs'}; run "
+              "the same command again and it takes them back (and goes on from the interrupted design's finished "
+              "grids)" if kept else f"no design had finished; the interrupted design's finished grids, if any, "
+              f"are kept in {out / 'designs'} for a rerun"), file=sys.stderr)
+        return 130
     paths = write_calibration(cal, out)
     if say:
         for w in cal.fit.words:

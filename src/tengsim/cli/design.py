@@ -176,23 +176,19 @@ def _folders(plans) -> list:
 
 
 def _guard(out: Path, folders, inputs) -> None:
-    """Every file the command will write, checked before anything is computed (:func:`tengsim.io.check_output`):
-    none is an input (a topography file, a TOML file), each lies inside --out and can be written."""
-    from tengsim.io import check_output
+    """Every file the command will write, checked before anything is computed (:func:`tengsim.outfolder.check_folder`:
+    no input (a topography file, a TOML file, the material) is --out, lies in it or is linked to a file written
+    there), each lies inside --out and can be written."""
+    from tengsim.outfolder import check_folder
 
-    check_output(out, inputs, folder=True)
     files = [out / f / name for f in folders for name in DESIGN_FILES]
     if len(folders) > 1:
         files += [out / name for name in RESERVED]
+    check_folder(out, inputs, files)
     root = out.resolve()
     for f in files:
         if root != f.resolve().parent and root not in f.resolve().parents:  # pragma: no cover - safe_name
             raise TengsimError(f"--out {out}: {f} would lie outside it")
-        for inp in inputs:
-            if isinstance(inp, str) and len(inp) < 4096 and Path(inp).is_file() and \
-                    Path(inp).resolve() == f.resolve():
-                raise TengsimError(f"--out {out}: it would replace the input {inp} ({f.name}); choose another "
-                                   "folder")
 
 
 class _Say:
@@ -242,18 +238,18 @@ def run(args) -> int:
     out = Path(args.out)
     _check_out(out)
     folders = _folders(plans)
-    inputs = [*(x for x in args.inputs if x.lower().endswith(".toml")),
+    inputs = [*(x for x in args.inputs if x.lower().endswith(".toml")), *([args.material] if material else []),
               *(v for _, t in tables for v in t.values() if isinstance(v, str))]
     _guard(out, folders, inputs)
     from tengsim.design.run import preflight
-    from tengsim.io import folder_lock
+    from tengsim.outfolder import folder_lock
 
     for (where, _), plan in zip(tables, plans):  # every design's grids, memory, budget, solver, before any runs
         try:
             preflight(plan)
         except TengsimError as exc:
             raise TengsimError(f"{where}{exc}") from None
-    with folder_lock(out):
+    with folder_lock(out, holder="tengsim design"):  # the whole run: no second run on this folder meanwhile
         return _run_locked(args, plans, folders, out, material)
 
 

@@ -57,12 +57,13 @@ def persist(solver, problem: Problem, eq):
     sequence of single pixels snapping in, then a slow settling of the stiff contact; both make progress
     every iteration, only more slowly than the cap allows (measured, docs/benchmarks.md "Stiff laws").
     Runs only on a solve that did not converge, so every equilibrium that converges within the cap is
-    unchanged bit for bit.  Any other solver, or a solve that failed otherwise (line search, non-finite),
+    unchanged bit for bit.  Any other solver, or a solve that failed otherwise (line search, non-finite: not
+    ``eq.capped``, which the solver sets by value),
     is returned as it is; a continued solve that still fails says so in its message, with both counts."""
     inner = getattr(solver, "inner", solver)
     if (PERSIST_FACTOR < 1 or not getattr(inner, "resumes_from_state", False) or not is_dataclass(inner)
             or not np.isfinite(eq.residual)
-            or not str(eq.message).startswith("not converged")):
+            or not getattr(eq, "capped", False)):
         return eq
     more = replace(inner, max_iter=PERSIST_FACTOR * int(inner.max_iter))
     more = solver.with_inner(more) if hasattr(solver, "with_inner") else more

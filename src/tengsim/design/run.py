@@ -88,13 +88,12 @@ def run_design(plan, progress=None, keep=None) -> DesignResult:
     path's progress) and/or an object with ``say(text)``, which gets the lines said before and during the run
     (the Tabor number, the solver, the grids, memory and expected time).  ``keep`` (a file path, or None): where each
     finished grid is kept (:func:`tengsim.design.keep.checkpoint`), so a killed run of the same design resumes from it."""
-    import time
-
     from tengsim.design.curves import summarize
     from tengsim.design.write import to_dataset
+    from tengsim.run.budget import RunClock
     from tengsim.run.refine import Hooks, refine
 
-    started = time.monotonic()
+    started = RunClock.now()  # the budget counts the run's own CPU time from here (tengsim.run.budget)
     # the design's own floor first (the kept grids' identity, the maps' pressures, the solver, the first grid,
     # the observers); then one call to the run layer; then the design's numbers
     base = identity(plan)

@@ -14,13 +14,14 @@ solved or anything written; a run past its budget is stopped between two rows (:
 from __future__ import annotations
 
 import itertools
-
+import os
+import time
 from dataclasses import dataclass
 
 import numpy as np
 
 from tengsim.run.reach import D_MIN, D_STEP
-from tengsim.errors import TengsimError
+from tengsim.errors import BudgetExceeded
 from tengsim.resources import CostModel, cost_model
 
 ROWS_PER_STEP = 2.0
@@ -218,27 +219,62 @@ def check_budget(ask, est: Estimate, fit_pixels: int | None = None) -> None:
     what = f"a coarser --dx (the first grid's is {length_text(est.grids[0][2])})"
     if fit_pixels and two and fit_pixels >= two:
         what = f"--max-pixels {fit_pixels} (the grids that fit the budget), {what}"
-    raise TengsimError(f"this design is expected to take {time_text(est.seconds)} on {est.backend.split(' (')[0]}, "
-                       f"over the budget of {time_text(ask.budget_s)}: give {what}, a coarser --tol (now "
-                       f"{ask.tol:g}) or a larger --budget")
+    raise BudgetExceeded(f"this design is expected to take {time_text(est.seconds)} on {est.backend.split(' (')[0]}, "
+                         f"over the budget of {time_text(ask.budget_s)}: give {what}, a coarser --tol (now "
+                         f"{ask.tol:g}) or a larger --budget", ask.budget_s)
 
-class BudgetSpent(TengsimError):
+class BudgetSpent(BudgetExceeded):
     """A design stopped at its time budget (what finished is kept; the message says how to go on)."""
 
 
-def deadline(progress, ask, keep, started):
-    """``progress`` (called per path row) that also stops the run, cleanly, once ``ask.budget_s`` seconds
-    have passed since ``started``: the finished grids stay in ``keep`` and the message says how to go on."""
-    import time
+@dataclass(frozen=True)
+class RunClock:
+    """When a run started, by the wall clock and by its own CPU time (this process, all its threads, and its
+    children): :meth:`spent` is what its budget counts."""
+
+    wall: float
+    cpu: float
+
+    @staticmethod
+    def now() -> "RunClock":
+        return RunClock(time.monotonic(), cpu_seconds())
+
+    def spent(self, cpu: bool = True) -> float:
+        """Seconds the run has spent: its own CPU time, never more than the wall time (a run on a busy machine
+        is not charged the time other processes take; a run on several cores not charged more than the
+        clock), or the wall time alone (``cpu`` false: a GPU run, whose host waits on the device)."""
+        wall = time.monotonic() - self.wall
+        return min(wall, cpu_seconds() - self.cpu) if cpu else wall
+
+
+def cpu_seconds() -> float:
+    """CPU seconds of this process (user and system, all threads) and of its children waited for."""
+    t = os.times()
+    return t.user + t.system + t.children_user + t.children_system
+
+
+BUDGET_CLOCK = "the run's own CPU time, at most the wall time"
+"""How the budget is counted (said in the messages and docs/design.md)."""
+
+
+def deadline(progress, ask, keep, started, cpu: bool = True):
+    """``progress`` (called per path row) that also stops the run, cleanly, once it has spent ``ask.budget_s``
+    seconds since ``started`` (a :class:`RunClock`: its own CPU time, :meth:`RunClock.spent`; a bare
+    ``time.monotonic()`` value: the wall time): the finished grids stay in ``keep`` and the message says how to
+    go on."""
+    def spent():
+        return started.spent(cpu) if isinstance(started, RunClock) else time.monotonic() - started
 
     def call(*a, **k):
-        if time.monotonic() - started > ask.budget_s:
+        if spent() > ask.budget_s:
             from tengsim.units import time_text
 
             where = (f"the finished grids are kept in {keep}: run the same command with a larger --budget to go "
                      "on from them") if keep is not None and keep.exists() else \
                 "no grid had finished: give a larger --budget, a coarser --dx or a coarser --tol"
-            raise BudgetSpent(f"{ask.name[:80]}: stopped at the budget of {time_text(ask.budget_s)}; {where}")
+            clock = BUDGET_CLOCK if isinstance(started, RunClock) and cpu else "the wall time"
+            raise BudgetSpent(f"{ask.name[:80]}: stopped at the budget of {time_text(ask.budget_s)} ({clock}); "
+                              f"{where}", ask.budget_s)
         if callable(progress):
             return progress(*a, **k)
         return None

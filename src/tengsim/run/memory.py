@@ -23,7 +23,7 @@ from __future__ import annotations
 import os
 
 from tengsim import resources
-from tengsim.errors import TengsimError
+from tengsim.errors import MemoryRefused
 
 _F64 = 8
 KERNEL_BUILD_FREE = 10.5     # floats per padded point at the free kernel's build peak (measured 10.2)
@@ -81,7 +81,7 @@ def _gib(b: float) -> str:
 
 def check_memory(nx: int, ny: int, boundary: str = "free", solver: str = "fast", memory: int = 10,
                  maps: int = 0, available: int | None = None) -> int:
-    """Raise TengsimError (needed vs available) if the run cannot fit in memory; return the bytes needed.
+    """Raise MemoryRefused (a TengsimError) (needed vs available) if the run cannot fit in memory; return the bytes needed.
 
     ``available`` defaults to :func:`tengsim.resources.available_bytes`; the check is skipped when that is unknown or
     when the environment variable TENGSIM_NO_MEMORY_CHECK is set to 1."""
@@ -90,7 +90,7 @@ def check_memory(nx: int, ny: int, boundary: str = "free", solver: str = "fast",
         return need
     avail = resources.available_bytes() if available is None else int(available)
     if avail is not None and need > avail:
-        raise TengsimError(
+        raise MemoryRefused(
             f"a {nx}×{ny} grid ({boundary} boundary, {solver} solver) needs about {_gib(need)} of memory, "
             f"but {_gib(avail)} is available: use a larger dx or a smaller cell "
             f"(TENGSIM_NO_MEMORY_CHECK=1 skips this check)")

@@ -34,7 +34,7 @@ def first_dx(cplan, ask) -> float:
     """The first grid's dx in X units: ``ask.dx`` (a length, m) where given, else the refinement's first grid
     whose dx is at most the law's process zone over :data:`START_ZONE_PIXELS` (:func:`tengsim.run.grids.start_dx`);
     a size that does not fit the cell is said in the user's units."""
-    from tengsim.errors import GeometryError
+    from tengsim.errors import BudgetExceeded, GeometryError
     from tengsim.run.plan import _metres
 
     try:
@@ -63,8 +63,8 @@ class Hooks:
     """What a refinement reports to and keeps: ``progress`` (called per path row; its ``say(text)`` gets the
     lines), ``observe`` / ``watch`` (result -> {name: value}: judged / recorded per grid), ``maps_at`` (asked
     pressures, Pa, where maps are kept), ``keep`` (the checkpoint file or None) under ``base`` (its identity),
-    ``later`` (the D range of a kept second pass, or None) and ``started`` (``time.monotonic()`` at the start: the
-    budget counts from it)."""
+    ``later`` (the D range of a kept second pass, or None) and ``started`` (a :class:`tengsim.run.budget.RunClock`
+    made at the start, or a ``time.monotonic()`` value: the budget counts from it)."""
 
     progress: object = None
     observe: object = None
@@ -107,7 +107,6 @@ def preflight(cplan, ask) -> tuple:
     from tengsim.errors import GeometryError
     from tengsim.run.memory import check_memory, estimate_bytes
     from tengsim.run.plan import _metres
-    from tengsim.solvers import make_solver
     from tengsim.units import length_text, time_text
 
     lateral = cplan.scaling.lateral
@@ -120,24 +119,33 @@ def preflight(cplan, ask) -> tuple:
                                f"{ask.max_pixels}: give a larger --max-pixels or a coarser --dx")
         check_memory(g.nx, g.ny, cplan.boundary, cplan.solver)
         memory = estimate_bytes(size.finest.nx, size.finest.ny, cplan.boundary, cplan.solver)
-        solver = make_solver(cplan.solver, tol=cplan.tol)  # a solver this machine lacks (gpu): refused now
-        if hasattr(solver, "solves") and not solver.solves(cplan.law):  # a law it cannot solve: refused now
-            from tengsim.solvers.pk import PKSolver, wall_model
-
-            if isinstance(solver, PKSolver):
-                wall_model(cplan.law)  # raises the solver's own line, naming the solvers that can
-            raise TengsimError(f"solver {cplan.solver!r} cannot solve law {type(cplan.law).__name__}")
+        check_solver(cplan)
         if (cplan.kernel_params or {}).get("thickness") is not None:
             from tengsim.kernels.film import check_film_pixels
 
             check_film_pixels(cplan.kernel_params["thickness"], max(g.dx, g.dy), lateral)
         if size.shortest_s > ask.budget_s:
-            raise TengsimError(f"{ask.name[:80]}: {first} alone is estimated at {time_text(size.shortest_s)}, over "
-                               f"the budget of {time_text(ask.budget_s)}: give a coarser --dx, a coarser --tol (now "
-                               f"{ask.tol:g}) or a larger --budget")
+            raise BudgetExceeded(f"{ask.name[:80]}: {first} alone is estimated at {time_text(size.shortest_s)}, "
+                                 f"over the budget of {time_text(ask.budget_s)}: give a coarser --dx, a coarser --tol "
+                                 f"(now {ask.tol:g}) or a larger --budget", ask.budget_s)
     except GeometryError as exc:  # a size that does not fit, said in the user's units
         raise exc.in_metres(lateral, _metres) from None
     return size, memory
+
+
+def check_solver(cplan) -> None:
+    """The plan's solver made once, before anything is solved: a solver this machine lacks (JAX, a GPU) raises
+    :class:`tengsim.errors.SolverUnavailable`; a law it cannot solve, a :class:`tengsim.errors.TengsimError`
+    naming the solvers that can."""
+    from tengsim.solvers import make_solver
+
+    solver = make_solver(cplan.solver, tol=cplan.tol)
+    if hasattr(solver, "solves") and not solver.solves(cplan.law):
+        from tengsim.solvers.pk import PKSolver, wall_model
+
+        if isinstance(solver, PKSolver):
+            wall_model(cplan.law)  # raises the solver's own line, naming the solvers that can
+        raise TengsimError(f"solver {cplan.solver!r} cannot solve law {type(cplan.law).__name__}")
 
 
 def find_range(cplan, ask, dx: float, progress=None, guard=None):
@@ -157,7 +165,8 @@ def refine(cplan, ask, hooks: Hooks = Hooks()):
     """The refined :class:`tengsim.results.ContactResult` of ``cplan`` whose approach reaches ``ask``'s last
     pressure (module doc); a :class:`tengsim.errors.TengsimError` before anything is solved where a bound or the
     budget is exceeded."""
-    from tengsim.run.budget import budget_pixels, cap_line, check_budget, deadline, estimate, next_grid_line, run_cost
+    from tengsim.run.budget import (budget_pixels, cap_line, check_budget, deadline, estimate, next_grid_line, on_gpu,
+                                    run_cost)
     from tengsim.run.plan import ResolveSettings
     from tengsim.run.reach import resolve_to
 
@@ -166,8 +175,9 @@ def refine(cplan, ask, hooks: Hooks = Hooks()):
 
     # the run layer's own numbers first (the sizes, the guards), then every bound checked in one place
     p_max = ask.pressures[-1]
-    coarse_guard = deadline(None, ask, hooks.keep, hooks.started)
-    guard = deadline(hooks.progress, ask, hooks.keep, hooks.started)
+    cpu = not on_gpu(cplan)  # the budget in the run's own CPU time (a GPU run's host waits: the wall time)
+    coarse_guard = deadline(None, ask, hooks.keep, hooks.started, cpu)
+    guard = deadline(hooks.progress, ask, hooks.keep, hooks.started, cpu)
     size, memory = preflight(cplan, ask)
     dx, grids = size.dx, size.grids
     said(f"{ask.name}: Tabor number {cplan.tabor:.3g} (from eps = {cplan.scaling.eps * 1e9:.3g} nm), "

@@ -409,10 +409,10 @@ class _Descent:
         if self.red is not None:
             self._settle([hi, lo, dky, yky])
 
-    def finish(self, ok: bool, it: int, msg: str, t0: float) -> Equilibrium:
+    def finish(self, ok: bool, it: int, msg: str, t0: float, capped: bool = False) -> Equilibrium:
         st = State(self.q.reshape(self.shape), self.w.reshape(self.shape))
         return finish(self.problem, st, self.P.reshape(self.shape).copy(), self.r, self.E, ok, it,
-                       self.n_conv, t0, msg)
+                       self.n_conv, t0, msg, capped)
 
 
 def _weigh_law(lines, law, g, P, acc, sum_p):

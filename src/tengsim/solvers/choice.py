@@ -49,9 +49,9 @@ def choose(name, points=None) -> tuple:
     (or a solver object) unchanged."""
     if not isinstance(name, str) or name.strip().lower() != "auto":
         if isinstance(name, str) and name.strip().lower() == "gpu" and not gpu_visible():
-            from tengsim.errors import TengsimError
+            from tengsim.errors import SolverUnavailable
 
-            raise TengsimError("--solver gpu: JAX sees no GPU here (install JAX for CUDA: pip install "
+            raise SolverUnavailable("--solver gpu: JAX sees no GPU here (install JAX for CUDA: pip install "
                                "'tengsim[gpu]', CUDA 12 driver); use --solver auto or fast")
         return name, ""
     if gpu_visible():

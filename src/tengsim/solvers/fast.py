@@ -111,4 +111,4 @@ class FastSolver:
             run.accept(trial, ray, resync)                     # E at the new point (re-anchor w = K q)
             pair = run.new_residual(trial.alpha, resync)       # one convolution: r, G, y, K y
             run.remember(trial.alpha, ray, pair, resync)       # the L-BFGS memory (the pair unconfirmed)
-        return run.finish(False, self.max_iter, f"not converged in {self.max_iter} iterations", t0)
+        return run.finish(False, self.max_iter, f"not converged in {self.max_iter} iterations", t0, capped=True)

@@ -44,7 +44,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from tengsim.errors import TengsimError
+from tengsim.errors import MemoryRefused, SolverUnavailable, TengsimError
 from tengsim.laws.safe import SafeLaw
 from tengsim.registry import SOLVERS
 from tengsim.solvers.types import Equilibrium, Problem, State
@@ -98,7 +98,7 @@ def check_device_memory(dev, points: int, dtype: str, shards: int = 1, padded: i
     need = (GPU_BYTES_PER_POINT[dtype] * points + 24 * padded) / max(int(shards), 1)
     if limit and need > limit:
         more = -(-int(need * max(int(shards), 1)) // int(limit))
-        raise TengsimError(f"{points:.3g} points in {dtype} need about {need / 2**30:.0f} GiB per device, "
+        raise MemoryRefused(f"{points:.3g} points in {dtype} need about {need / 2**30:.0f} GiB per device, "
                            f"{dev.platform.upper()} {dev.id} allows {limit / 2**30:.0f} GiB: split the grid "
                            f"over {more} or more devices (JaxSolver(shards=...)) or use a coarser grid"
                            + (" (float32 halves the memory but may stop short of the tolerance on large grids)"
@@ -111,7 +111,7 @@ def _jax():
     try:
         import jax
     except ImportError:
-        raise TengsimError(f"the jax solver needs JAX, which is not installed: {INSTALL}") from None
+        raise SolverUnavailable(f"the jax solver needs JAX, which is not installed: {INSTALL}") from None
     jax.config.update("jax_enable_x64", True)
     return jax
 
@@ -127,7 +127,7 @@ def find_device(device: str):
         found = []
     if not found:
         have = ", ".join(sorted({d.platform for d in jax.devices()}))
-        raise TengsimError(f"device {device!r}: JAX finds no {device.upper()} (it has: {have}); install JAX with "
+        raise SolverUnavailable(f"device {device!r}: JAX finds no {device.upper()} (it has: {have}); install JAX with "
                            f"CUDA, {INSTALL.split(' or ')[0]}, or use --solver jax (CPU) or fast")
     return found[0]
 
@@ -300,6 +300,7 @@ def _result(problem, out, shape, max_iter, compile_s, t0):
     w = np.asarray(out["w"], dtype=float).reshape(shape)
     r = np.asarray(out["r"], dtype=float)
     it, status, rmax = int(out["it"]), int(out["status"]), float(out["rmax"])
+    capped = False
     if status == 4:
         ok, msg = False, "line search failed"
     elif not np.isfinite(rmax):
@@ -307,13 +308,13 @@ def _result(problem, out, shape, max_iter, compile_s, t0):
     elif bool(out["converged"]):
         ok, msg = True, "converged"
     else:
-        ok, msg = False, f"not converged in {max_iter} iterations"
+        ok, msg, capped = False, f"not converged in {max_iter} iterations", True
     if compile_s > 0:
         msg += f" (compiled in {compile_s:.1f} s)"
     H = problem.g0 + w - 1.0
     return Equilibrium(State(q, w), H, np.asarray(out["P"], dtype=float).reshape(shape),
                        float(np.max(np.abs(r))), ok, it, int(out["n_conv"]), float(out["E"]),
-                       time.perf_counter() - t0, msg)
+                       time.perf_counter() - t0, msg, capped)
 
 
 SOLVERS.register("jax", JaxSolver, summary="the fast solver compiled with JAX (GPU if JAX has one, else CPU)")

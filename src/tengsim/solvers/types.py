@@ -60,13 +60,16 @@ class Equilibrium:
     energy: float
     seconds: float
     message: str = ""
+    capped: bool = False     # stopped at its iteration cap while still descending (a solver that resumes
+    # from its state may go on from here: tengsim.continuation.walker.persist); False on every other stop
 
     def max_change(self, other: "Equilibrium") -> float:
         """max |H − other.H| over the grid (the path's jump test)."""
         return float(np.max(np.abs(self.H - other.H)))
 
 
-def finish(problem, state, P, r, energy, converged, it, n_conv, t0, msg):
+def finish(problem, state, P, r, energy, converged, it, n_conv, t0, msg, capped=False):
     H = problem.g0 + state.w - 1.0
     res = float(np.max(np.abs(r)))
-    return Equilibrium(state, H, P, res, converged, it, n_conv, float(energy), time.perf_counter() - t0, msg)
+    return Equilibrium(state, H, P, res, converged, it, n_conv, float(energy), time.perf_counter() - t0, msg,
+                       capped)
