@@ -8,6 +8,18 @@ import math
 import numpy as np
 
 
+def expected_designs(prob, n_nodes: int, zooms: int, refine: int, dims: int, geometries: int) -> tuple:
+    """([designs of each batch expected], at most): the first grid (``n_nodes`` per varying axis, per geometry) and
+    its checks (:func:`check_points`: the best fit and, per free contact parameter, both interval ends and half-way
+    beyond each), then a grid and its checks per zoom; at most, every refinement's checks too.  A zoom's grid
+    leaves out nodes near solved ones, and the zooms stop once the interpolation is within half the noise: the
+    expected count is the usual run's, not a bound."""
+    grid = n_nodes ** dims * geometries
+    checks = (1 + 4 * len(prob.contact_free)) * geometries if dims else 0
+    batches = [grid, checks] + ([grid, checks] * zooms if dims else [])
+    return batches, sum(batches) + (refine * checks if dims else 0)
+
+
 def check_points(f, prob) -> list:
     """Log contact parameters where the interpolation is checked: the best fit and, for each free contact
     parameter, both ends of its 95 % interval (the others at their profile optimum there): a check at the best fit

@@ -188,10 +188,11 @@ def calibrate(prob, out_dir, n_nodes: int = 4, zooms: int = 2, progress=None, re
 def _calibrate(prob, out_dir, n_nodes, zooms, progress, refine, expected_noise) -> Calibration:
     from tengsim.calibrate.checks import interpolation_error
     from tengsim.calibrate.fit import Model, band, fit, residual_text
+    from tengsim.calibrate.checks import expected_designs
     from tengsim.calibrate.surrogate import (POINTS_PER_CURVE, Surrogate, geometry_key, grid_points, node_table,
-                                             solve_node,
-                                             estimate_seconds)
+                                             solve_node)
     from tengsim.design.units import time_text
+    from tengsim.design.write import to_dataset  # noqa: F401 - its imports (xarray) before the first design is timed
 
     t0 = time.perf_counter()
     folder = Path(out_dir) / "designs"
@@ -203,22 +204,28 @@ def _calibrate(prob, out_dir, n_nodes, zooms, progress, refine, expected_noise) 
     (u0, u1), (v0, v1), dims = _node_ranges(prob)
     span = (max(u1 - u0, 1e-12), max(v1 - v0, 1e-12))
     surr = {k: Surrogate(np.linspace(0, pmax[k], POINTS_PER_CURVE), [], span, dims) for k in keys}
-    count = {"solved": 0, "cached": 0}
+    count = {"solved": 0, "cached": 0, "seconds": 0.0, "batch": 0}
     failed = []
+    batches, most = expected_designs(prob, n_nodes, zooms, refine, len(dims), len(keys))
+    _say(progress, f"the calibration: about {sum(batches)} designs (at most {most}: every zoom and refinement); its "
+                   "time is said after the first design, measured on this machine as loaded now")
+
+    def whole(extra: int) -> str:
+        """The rest of the whole calibration at the time per design measured so far (this machine's load)."""
+        per = count["seconds"] / count["solved"]
+        rest = extra + sum(batches[count["batch"]:])
+        return (f"the whole calibration: about {time_text(per * rest)} more ({rest} designs expected at "
+                f"{time_text(per)} each, measured; at most {time_text(per * max(most - count['solved'], rest))})")
 
     def solve(todo, title):
         from tengsim.calibrate.surrogate import node_key
 
         new = [x for x in todo if not (folder / f"{node_key(x[3])}.nc").is_file()
                and not (folder / f"{node_key(x[3])}.failed.txt").is_file()]
+        count["batch"] += 1
         if new:
-            try:
-                est = sum(estimate_seconds(x[3]) for x in new)
-            except TengsimError:
-                est = math.nan
             _say(progress, f"{title}: {len(todo)} designs ({len(todo) - len(new)} kept in {folder}), {len(new)} to "
-                           f"solve; estimated {time_text(est) if math.isfinite(est) else 'n/a'} (the designs' own "
-                           "estimate; tiny designs take longer)")
+                           "solve" + (f"; {whole(len(new))}" if count["solved"] else ""))
         done_t, n_done, out = 0.0, 0, []
         for m, (k, u, v, table) in enumerate(todo):
             node = solve_node(table, folder, u, v)
@@ -227,12 +234,14 @@ def _calibrate(prob, out_dir, n_nodes, zooms, progress, refine, expected_noise) 
                 count["cached"] += 1
             else:
                 count["solved"] += 1
+                count["seconds"] += node.seconds
                 n_done += 1
                 done_t += node.seconds
                 left = done_t / n_done * (len(new) - n_done)
                 _say(progress, f"design {m + 1}/{len(todo)} (W {math.exp(u) * 1e3:.4g} mJ/m², ε "
                                f"{math.exp(v) * 1e9:.4g} nm): {'ok' if node.ok else node.message} in "
-                               f"{node.seconds:.0f} s; about {time_text(max(left, 0))} left")
+                               f"{node.seconds:.0f} s; about {time_text(max(left, 0))} left of these"
+                               + (f"; {whole(len(new) - n_done)}" if count["solved"] == 1 else ""))
             if not node.ok:
                 failed.append(f"W {math.exp(u) * 1e3:.4g} mJ/m², ε {math.exp(v) * 1e9:.4g} nm: {node.message}")
         return out

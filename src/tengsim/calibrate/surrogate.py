@@ -323,22 +323,6 @@ def _interp_rows(xp, Y, x):
     return Y[rows, i] * (1 - w) + Y[rows, i + 1] * w
 
 
-def estimate_seconds(table: dict) -> float:
-    """The design's own printed estimate (s) for a node table (:func:`tengsim.design.run.estimate`)."""
-    import dataclasses
-
-    from tengsim.design import plan_design
-    from tengsim.design.run import estimate, height_eps, run_cost, solver_tol, start_dx
-    from tengsim.run.grids import GridSequence
-    from tengsim.run.plan import as_plan
-
-    plan = plan_design(table)
-    cplan = dataclasses.replace(as_plan(plan.contact_plan), tol=solver_tol(plan))
-    dx = start_dx(plan, cplan)
-    d_max = 1.2 * height_eps(cplan, dx) + 2.0
-    return float(estimate(plan, cplan, GridSequence(cplan.shape, dx), d_max, run_cost(cplan, d_max)).seconds)
-
-
 def grid_points(lo, hi, n) -> np.ndarray:
     return np.array([0.5 * (lo + hi)]) if n <= 1 or hi <= lo else np.linspace(lo, hi, n)
 

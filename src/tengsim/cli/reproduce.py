@@ -20,12 +20,13 @@ def run(args) -> int:
     from tengsim.cases.paper.reproduce import reproduce, summary_text
     from tengsim.progress import Progress
 
-    from tengsim.io import check_output
+    from tengsim.outfolder import output_folder
 
-    check_output(args.out, folder=True)  # an existing file or an unwritable folder: refused before computing
     log = None if args.quiet else (lambda m: print(m, file=sys.stderr, flush=True))
-    summary = reproduce(args.out, quick=args.quick, log=log,
-                        progress_factory=lambda label: Progress(args.quiet))
+    # an existing file or an unwritable folder: refused before computing; no other run on it meanwhile
+    with output_folder(args.out, holder="tengsim reproduce"):
+        summary = reproduce(args.out, quick=args.quick, log=log,
+                            progress_factory=lambda label: Progress(args.quiet))
     if not args.quiet:
         for line in summary_text(summary):
             print(line, file=sys.stderr)

@@ -52,10 +52,10 @@ def run(args) -> int:
         vals = Table("reproduce", [Field("out", "str", "tengsim-paper", help="output folder"),
                                    Field("quick", "bool", False, help="coarse grids (minutes)")]).parse(section)
         out, quick = vals["out"], vals["quick"]
-        from tengsim.io import check_output
+        from tengsim.outfolder import output_folder
 
-        check_output(out, [args.config], folder=True, what="out =")
-        reproduce(out, quick=quick, log=None if args.quiet else (lambda m: print(m, file=sys.stderr)))
+        with output_folder(out, [args.config], what="out =", holder="tengsim run"):
+            reproduce(out, quick=quick, log=None if args.quiet else (lambda m: print(m, file=sys.stderr)))
         return 0
 
 
