@@ -64,13 +64,15 @@ def _say(progress, text):
 
 
 def _read_design_file(path) -> dict:
-    from tengsim.calibrate.data import read_toml
+    """The design table of a design file: read by :func:`tengsim.schema.read_config` and taken by the one reading of
+    a design's tables, :func:`tengsim.design.design_table` (``tengsim design``'s: a table it refuses, calibrate
+    refuses the same way)."""
+    from tengsim.design import design_table
+    from tengsim.schema import read_config
 
-    data = read_toml(path, str(path), "no such file (give a design TOML that tengsim design accepts)")
-    t = data.get("design", data)
-    if not isinstance(t, dict) or "shape" not in t:
-        raise TengsimError(f"{path}: not a design (no shape key in [design] or at the top level)")
-    return dict(t)
+    if not Path(path).is_file():
+        raise TengsimError(f"{path}: no such file (give a design TOML that tengsim design accepts)")
+    return design_table(read_config(path), str(path))
 
 
 def plan_calibration(designs, data, free=None, bounds=None, noise="relative", voc="eq12", solver=None):
@@ -97,9 +99,11 @@ def plan_calibration(designs, data, free=None, bounds=None, noise="relative", vo
     free = parse_free(free)
     user = parse_bounds(bounds)
     bnds = {k: user.get(k, DEFAULT_BOUNDS[k]) for k in PARAMS}
+    from tengsim.design import design_table
+
     tables, names = [], []
     for d in designs:
-        t = _read_design_file(d) if not isinstance(d, dict) else dict(d)
+        t = _read_design_file(d) if not isinstance(d, dict) else design_table(d)
         if solver is not None:
             t["solver"] = solver
         tables.append(t)
