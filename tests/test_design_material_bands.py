@@ -95,3 +95,10 @@ def test_comparison_of_two_designs_with_material_writes_each_band(tmp_path, caps
         hi = np.array([float(r["voc_eq12_upper_V"]) for r in rows])
         np.testing.assert_allclose(lo, voc_polymer(a_s, 5e-6, 2.4, 400e-6), rtol=1e-9)
         np.testing.assert_allclose(hi, voc_polymer(a_s, 7e-6, 2.4, 400e-6), rtol=1e-9)
+
+
+def test_design_help_says_the_boundary_is_periodic(capsys):
+    assert main(["design", "--help"]) == 0
+    out = capsys.readouterr().out
+    i = out.index("--boundary")
+    assert "periodic (a design's default)" in out[i:i + 200] and "defaults as tengsim contact):" not in out

@@ -9,7 +9,6 @@ import xarray as xr
 
 from tengsim.cli.main import main
 from tengsim.device import area_table_from_design
-from tengsim.device.areas import passed_curve
 from tengsim.device.formulas import voc_polymer
 
 P = np.array([0.0, 5e3, 10e3])  # the asked pressures
@@ -46,6 +45,8 @@ def snapped_design(folder):
 
 
 def test_passed_curve_is_the_states_between_the_asked_ends():
+    from tengsim.device.areas import passed_curve
+
     p, a = passed_curve(SP, SA, 0.0, 10e3)
     np.testing.assert_array_equal(p, [0.0, 0.4e3, 0.77e3, 0.77e3, 2e3, 5e3, 8e3, 10e3])
     assert a[-1] == pytest.approx(0.53 + (0.56 - 0.53) * 2 / 3)  # the end read off the states, none beyond

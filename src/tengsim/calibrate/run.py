@@ -76,9 +76,11 @@ def _read_design_file(path) -> dict:
 
 
 def plan_calibration(designs, data, free=None, bounds=None, noise="relative", voc="eq12", solver=None):
-    """The checked :class:`tengsim.calibrate.problem.Problem`.  ``designs``: design TOML paths or [design] tables,
-    one per curve (or one for all); ``data``: CSV paths or :class:`Curve` s; ``solver``: the designs' solver (a
-    design's ``solver`` key; None: as the design files say)."""
+    """The checked :class:`tengsim.calibrate.problem.Problem`.  ``designs``: one per curve (or one for all), each a
+    design's table, a (label, table) pair (the CLI's: the file read at the edge, named by its path) or a design TOML
+    path; every table taken by the one reading of a design's tables (:func:`tengsim.design.design_table`);
+    ``data``: CSV paths or :class:`Curve` s; ``solver``: the designs' solver (a design's ``solver`` key; None: as
+    the design files say)."""
     from tengsim.calibrate.data import Curve, read_curve
     from tengsim.calibrate.problem import (DEFAULT_BOUNDS, NOISES, PARAMS, VOC_MODELS, Problem, check_reachable,
                                            count_check, parse_bounds, parse_free, text)
@@ -103,11 +105,17 @@ def plan_calibration(designs, data, free=None, bounds=None, noise="relative", vo
 
     tables, names = [], []
     for d in designs:
-        t = _read_design_file(d) if not isinstance(d, dict) else design_table(d)
+        if isinstance(d, tuple) and len(d) == 2 and isinstance(d[1], dict):
+            name, t = str(d[0]), design_table(d[1], str(d[0]))
+        elif isinstance(d, dict):
+            t = design_table(d)
+            name = t.get("name", t.get("shape"))
+        else:
+            name, t = str(d), _read_design_file(d)
         if solver is not None:
             t["solver"] = solver
         tables.append(t)
-        names.append(str(d) if not isinstance(d, dict) else t.get("name", t.get("shape")))
+        names.append(name)
     # the material: fixed values from the designs (one material), starting values for the free ones
     fixed = {}
     for k in PARAMS:
