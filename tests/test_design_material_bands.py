@@ -102,3 +102,9 @@ def test_design_help_says_the_boundary_is_periodic(capsys):
     out = capsys.readouterr().out
     i = out.index("--boundary")
     assert "periodic (a design's default)" in out[i:i + 200] and "defaults as tengsim contact):" not in out
+
+
+def test_band_point_that_cannot_run_here_is_refused_before_the_design_runs(tmp_path, capsys):
+    """A band point whose design no machine can run (ε 0.1 nm: a grid 500 times finer per side than the design's)
+    is planned and preflighted with the design: one line naming the point, nothing run or written."""
+    _refused(tmp_path, capsys, MATERIAL + _points({"sigma": "5uC/m2"}, {"eps": "0.1nm"}), "[[uncertainty.point]] 2")

@@ -258,10 +258,12 @@ def run(args) -> int:
     from tengsim.io import folder_lock
 
     for (where, _), plan in zip(tables, plans):  # every design's grids, memory, budget, solver, before any runs
-        try:
-            preflight(plan)
-        except TengsimError as exc:
-            raise TengsimError(f"{where}{exc}") from None
+        for k, p in enumerate((plan, *plan.bands)):  # the band points' designs too
+            try:
+                preflight(p)
+            except TengsimError as exc:
+                point = f"--material {args.material} [[uncertainty.point]] {k}: " if k else ""
+                raise TengsimError(f"{where}{point}{exc}") from None
     with folder_lock(out):
         return _run_locked(args, plans, folders, out)
 
