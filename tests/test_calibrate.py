@@ -86,12 +86,12 @@ def test_files_report_material_and_cf(fitted):
         assert (out / f).is_file(), f
     rep = (out / "report.md").read_text()
     assert "profile likelihood" in rep and "Noise model: relative" in rep and "## What the data determine\n\n* σ is " in rep
-    from tengsim.calibrate.material import read_material
-    from tengsim.design import plan_design
+    from tengsim.design import material_table, plan_design
+    from tengsim.schema import read_config
 
-    mat = read_material(out / "material.toml")
-    assert set(mat["values"]) == {"E_star", "W", "eps", "sigma"} and len(mat["points"]) == 4
-    plan = plan_design({**{k: v for k, v in G1.items()}, **mat["values"], "p_max": "10kPa"})
+    mat = material_table(read_config(out / "material.toml"), out / "material.toml")
+    assert set(mat.values) == {"E_star", "W", "eps", "sigma"} and len(mat.points) == 4
+    plan = plan_design({**{k: v for k, v in G1.items()}, **mat.values, "p_max": "10kPa"})
     assert 0.8 * TRUE["W"] < plan.W < 1.2 * TRUE["W"]
     runner = pytest.importorskip("compliance_checker.runner")
     cs = runner.CheckSuite()

@@ -29,13 +29,13 @@ def test_repulsive_cube_charges_its_top_and_has_no_pull_off(cube):
 
 
 def test_full_contact_interpolated_inside_the_asked_range(cube):
-    from tengsim.design.curves import FULL_CONTACT_FRACTION, _full_fraction, _params, _shape, crossing, states
+    from tengsim.design.curves import FULL_CONTACT_AREA_FRACTION, _full_fraction, _params, _shape, crossing, states
     st = states(cube.finest, cube.plan)["approach"]
     full = _full_fraction(cube.finest, _params(cube.finest, cube.plan), _shape(cube.plan))
     p = cube.summary["full_contact_Pa"]
     if math.isfinite(p):
         assert p <= cube.plan.pressures[-1]
-        assert np.interp(p, st["P"], st["area"]) == pytest.approx(FULL_CONTACT_FRACTION * full, rel=1e-6)
+        assert np.interp(p, st["P"], st["area"]) == pytest.approx(FULL_CONTACT_AREA_FRACTION * full, rel=1e-6)
     assert crossing([0.0, 10.0, 20.0], [0.0, 0.5, 1.0], 0.95) == pytest.approx(19.0)
     assert crossing([0.0, 10.0], [0.0, 0.5], 0.95) != crossing([0.0, 10.0], [0.0, 0.5], 0.95)  # never: NaN
 

@@ -117,19 +117,3 @@ def write_curve(path, pressure_Pa, voc_V, err_V=None, comment: str = "") -> None
     for i, (p, v) in enumerate(zip(pressure_Pa, voc_V)):
         lines.append(f"{p / 1e3:.10g},{v:.10g}" + (f",{err_V[i]:.6g}" if err_V is not None else ""))
     write_text(path, "\n".join(lines) + "\n")
-
-
-def read_toml(path, label: str, missing: str = "no such file") -> dict:
-    """The TOML file at ``path`` as a dict (UTF-8 whatever the locale); a missing or unreadable file: one line
-    starting with ``label``."""
-    try:
-        import tomllib
-    except ModuleNotFoundError:  # pragma: no cover
-        import tomli as tomllib
-    p = Path(path)
-    if not p.is_file():
-        raise TengsimError(f"{label}: {missing}")
-    try:
-        return tomllib.loads(p.read_text(encoding="utf-8"))
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-        raise TengsimError(f"{label}: not a TOML file: {str(exc).splitlines()[0]}") from None

@@ -132,10 +132,10 @@ class Problem:
 
     def factor(self, i: int) -> float:
         """V_OC per unit σ per unit A/S of curve ``i`` (V m²/C): T/(ε_r ε0) (Eq. 12) or d0/ε0 (Eq. 17)."""
-        from tengsim.device.params import EPS0
+        from tengsim.device.formulas import eq12_volts_per_charge, eq17_volts_per_charge
 
         p = self.plans[i]
-        return p.T / (p.eps_r * EPS0) if self.voc == "eq12" else p.gap / EPS0
+        return eq12_volts_per_charge(p.eps_r, p.T) if self.voc == "eq12" else float(eq17_volts_per_charge(p.gap))
 
     def value(self, name: str, theta: dict | None = None) -> float:
         if theta is not None and name in theta:

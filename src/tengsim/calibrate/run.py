@@ -64,19 +64,23 @@ def _say(progress, text):
 
 
 def _read_design_file(path) -> dict:
-    from tengsim.calibrate.data import read_toml
+    """The design table of a design file: read by :func:`tengsim.schema.read_config` and taken by the one reading of
+    a design's tables, :func:`tengsim.design.design_table` (``tengsim design``'s: a table it refuses, calibrate
+    refuses the same way)."""
+    from tengsim.design import design_table
+    from tengsim.schema import read_config
 
-    data = read_toml(path, str(path), "no such file (give a design TOML that tengsim design accepts)")
-    t = data.get("design", data)
-    if not isinstance(t, dict) or "shape" not in t:
-        raise TengsimError(f"{path}: not a design (no shape key in [design] or at the top level)")
-    return dict(t)
+    if not Path(path).is_file():
+        raise TengsimError(f"{path}: no such file (give a design TOML that tengsim design accepts)")
+    return design_table(read_config(path), str(path))
 
 
 def plan_calibration(designs, data, free=None, bounds=None, noise="relative", voc="eq12", solver=None):
-    """The checked :class:`tengsim.calibrate.problem.Problem`.  ``designs``: design TOML paths or [design] tables,
-    one per curve (or one for all); ``data``: CSV paths or :class:`Curve` s; ``solver``: the designs' solver (a
-    design's ``solver`` key; None: as the design files say)."""
+    """The checked :class:`tengsim.calibrate.problem.Problem`.  ``designs``: one per curve (or one for all), each a
+    design's table, a (label, table) pair (the CLI's: the file read at the edge, named by its path) or a design TOML
+    path; every table taken by the one reading of a design's tables (:func:`tengsim.design.design_table`);
+    ``data``: CSV paths or :class:`Curve` s; ``solver``: the designs' solver (a design's ``solver`` key; None: as
+    the design files say)."""
     from tengsim.calibrate.data import Curve, read_curve
     from tengsim.calibrate.problem import (DEFAULT_BOUNDS, NOISES, PARAMS, VOC_MODELS, Problem, check_reachable,
                                            count_check, parse_bounds, parse_free, text)
@@ -98,13 +102,21 @@ def plan_calibration(designs, data, free=None, bounds=None, noise="relative", vo
     free = parse_free(free)
     user = parse_bounds(bounds)
     bnds = {k: user.get(k, DEFAULT_BOUNDS[k]) for k in PARAMS}
+    from tengsim.design import design_table
+
     tables, names = [], []
     for d in designs:
-        t = _read_design_file(d) if not isinstance(d, dict) else dict(d)
+        if isinstance(d, tuple) and len(d) == 2 and isinstance(d[1], dict):
+            name, t = str(d[0]), design_table(d[1], str(d[0]))
+        elif isinstance(d, dict):
+            t = design_table(d)
+            name = t.get("name", t.get("shape"))
+        else:
+            name, t = str(d), _read_design_file(d)
         if solver is not None:
             t["solver"] = solver
         tables.append(t)
-        names.append(str(d) if not isinstance(d, dict) else t.get("name", t.get("shape")))
+        names.append(name)
     # the material: fixed values from the designs (one material), starting values for the free ones
     fixed = {}
     for k in PARAMS:

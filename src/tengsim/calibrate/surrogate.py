@@ -106,11 +106,9 @@ class Node:
         if st is None or len(st[0]) < 2:
             P = np.asarray(self.pressures, float)
             return P, np.maximum.accumulate(np.clip(_fill(self.area[branch]), 0.0, 1.0))
-        P, A = st
-        A = np.maximum.accumulate(np.clip(A, 0.0, 1.0))
-        inside = (P > 0.0) & (P < p_max)
-        ends = np.interp([0.0, p_max], P, A)
-        return np.concatenate([[0.0], P[inside], [p_max]]), np.concatenate([[ends[0]], A[inside], [ends[1]]])
+        from tengsim.device.areas import passed_curve
+
+        return passed_curve(*st, 0.0, p_max)  # the device reads a design's states the same way
 
     def area_at(self, branch: str, pressures) -> np.ndarray:
         """The node's own A/S at ``pressures`` (Pa) on ``branch``, off :meth:`curve`."""

@@ -72,7 +72,8 @@ def run(args) -> int:
     if not 0 <= args.refine <= 10:
         raise TengsimError(f"--refine {args.refine}: 0 to 10")
     expected = _expected_noise(args.expected_noise, args.noise)
-    prob = plan_calibration(args.designs, args.data, args.free, args.bounds, args.noise, args.voc, args.solver)
+    prob = plan_calibration(_designs(args.designs), args.data, args.free, args.bounds, args.noise, args.voc,
+                            args.solver)
     if expected is not None and prob.known_errors:
         raise TengsimError(f"--expected-noise {args.expected_noise}: the data give voc_err_V, their stated errors are "
                            "the noise; leave it out")
@@ -129,3 +130,17 @@ def _expected_noise(text, noise):
     if not (value > 0 and value < (100 if unit == "%" else float("inf"))):
         raise TengsimError(f"--expected-noise {text}: a positive noise{' below 100 %' if unit == '%' else ''}")
     return value / 100 if unit == "%" else value
+
+
+def _designs(paths) -> list:
+    """[(path, table)] of the design files, read at the edge (:func:`tengsim.schema.read_config`) and taken by the
+    one reading of a design's tables (:func:`tengsim.design.design_table`, as ``tengsim design`` reads them)."""
+    from tengsim.design import design_table
+    from tengsim.schema import read_config
+
+    out = []
+    for p in paths:
+        if not Path(p).is_file():
+            raise TengsimError(f"{p}: no such file (give a design TOML that tengsim design accepts)")
+        out.append((p, design_table(read_config(p), p)))
+    return out

@@ -58,6 +58,13 @@ def register(sub):
     p.set_defaults(func=run)
 
 
+BOUNDARY_HELP = ("periodic (a design's default): the periodic array of cells the shape's cell describes, every "
+                 "cell beside its neighbours; free: one isolated cell on a half-space, Eq. (9) (a single "
+                 "structure, or an array whose pitch is large against each contact); either on a film")
+"""--boundary in a design's help: a design's default is periodic (:func:`tengsim.design.plan.plan_design`), not
+tengsim contact's free."""
+
+
 def help_text(shape: str | None = None) -> str:
     """The command's help: the design's keys, the material, then the keys of ``shape`` (all shapes' names if
     None) and the contact options a design leaves to the user."""
@@ -88,7 +95,8 @@ def help_text(shape: str | None = None) -> str:
         out += ["", f"the shape {name}:"] + [line(k, table[k].help) for k in mine]
     rest = [k for k in common if k not in CONTROLLED and k not in own and k not in ("E_star", "W", "eps", "shape")
             and not k.startswith("roughness_")]
-    out += ["", "contact options (defaults as tengsim contact):"] + [line(k, common[k].help) for k in rest]
+    out += ["", "contact options (defaults as tengsim contact, but the boundary):"]
+    out += [line(k, BOUNDARY_HELP if k == "boundary" else common[k].help) for k in rest]
     out += ["", "keys of the law (plain numbers in units of W and ε):"]
     out += [line(k, law_key_help(v)) for k, v in laws.items()]
     out += ["  --roughness-*            a roughness on the shape (keys as tengsim contact)",
@@ -98,27 +106,29 @@ def help_text(shape: str | None = None) -> str:
 
 
 def _read_toml(path: str) -> dict:
-    """The design table of a TOML file: its [design] table, or its top-level keys when it has none; any other
-    table beside [design] is refused by name (one reader: :func:`tengsim.schema.read_config`)."""
-    from tengsim.errors import listed, shown
+    """The design table of a TOML file, read at the edge (:func:`tengsim.schema.read_config`) and taken by the one
+    reading of a design's tables (:func:`tengsim.design.design_table`, which calibrate uses too)."""
+    from tengsim.design import design_table
+    from tengsim.errors import shown
     from tengsim.schema import read_config
 
     if not Path(path).is_file():
         raise TengsimError(f"{shown(path, 200)[1:-1]}: no such file (give a registered shape or a TOML file)")
-    data = read_config(path)
-    if "design" not in data:
-        tables = [k for k, v in data.items() if isinstance(v, dict)]
-        if tables:
-            raise TengsimError(f"{path}: unknown table(s) {listed(tables)}: a design file holds [design] or the "
-                               "design's keys at its top level")
-        return dict(data)
-    design = data["design"]
-    if not isinstance(design, dict):
-        raise TengsimError(f"{path}: design must be a table ([design] with its keys), got {shown(design)}")
-    others = [k for k in data if k != "design"]
-    if others:
-        raise TengsimError(f"{path}: {listed(others)} beside [design]: a design file holds [design] only")
-    return dict(design)
+    return design_table(read_config(path), path)
+
+
+def _read_material(path: str):
+    """The fitted material of ``--material`` (:func:`tengsim.design.material_table` of the file's tables)."""
+    from tengsim.design import material_table
+    from tengsim.schema import read_config
+
+    if not Path(path).is_file():
+        raise TengsimError(f"--material {path}: no such file (give the material.toml tengsim calibrate wrote)")
+    try:
+        cfg = read_config(path)
+    except TengsimError as exc:
+        raise TengsimError(f"--material {path}: {exc}") from None
+    return material_table(cfg, path)
 
 
 def _tables(args) -> list:
@@ -156,7 +166,8 @@ def _check_out(out: Path) -> None:
 
 RESERVED = ("compare.csv", "compare.png")
 """A comparison's own files in --out: no design's folder may take their names."""
-DESIGN_FILES = ("design.nc", "design.csv", "design.png", "maps.png", "report.md")
+DESIGN_FILES = ("design.nc", "design.csv", "design.png", "maps.png", "report.md", "bands.csv", "bands.png")
+"""The files of one design's folder (bands.csv, bands.png: with --material's uncertainty points)."""
 
 
 def _folders(plans) -> list:
@@ -229,12 +240,10 @@ def run(args) -> int:
     tables = _tables(args)
     material = None
     if getattr(args, "material", None):  # the fitted material replaces the design's own (options given win)
-        from tengsim.calibrate.material import read_material
-
-        material = read_material(args.material)
-        tables = [(w, {**t, **{k: v for k, v in material["values"].items() if getattr(args, k, None) in (None, "")}})
-                  for w, t in tables]
-    plans = [plan_design(t, where) for where, t in tables]  # every design checked before anything runs
+        material = _read_material(args.material)
+        material = material.without(k for k in material.values if getattr(args, k, None) not in (None, ""))
+    # every design, and every band point of the material, checked before anything runs
+    plans = [plan_design(t, where, material) for where, t in tables]
     out = Path(args.out)
     _check_out(out)
     folders = _folders(plans)
@@ -245,16 +254,18 @@ def run(args) -> int:
     from tengsim.outfolder import folder_lock
 
     for (where, _), plan in zip(tables, plans):  # every design's grids, memory, budget, solver, before any runs
-        try:
-            preflight(plan)
-        except TengsimError as exc:
-            raise TengsimError(f"{where}{exc}") from None
+        for k, p in enumerate((plan, *plan.bands)):  # the band points' designs too
+            try:
+                preflight(p)
+            except TengsimError as exc:
+                point = f"--material {args.material} [[uncertainty.point]] {k}: " if k else ""
+                raise TengsimError(f"{where}{point}{exc}") from None
     with folder_lock(out, holder="tengsim design"):  # the whole run: no second run on this folder meanwhile
-        return _run_locked(args, plans, folders, out, material)
+        return _run_locked(args, plans, folders, out)
 
 
-def _run_locked(args, plans, folders, out, material=None) -> int:
-    from tengsim.design import run_design, write_comparison, write_design
+def _run_locked(args, plans, folders, out) -> int:
+    from tengsim.design import predict_bands, run_design, write_bands, write_comparison, write_design
 
     say = _Say(args.quiet)
     results = []
@@ -278,13 +289,9 @@ def _run_locked(args, plans, folders, out, material=None) -> int:
         for r, f in zip(results, folders):
             paths += write_design(r, out / f)
         paths += write_comparison(results, out)
-    if material is not None and material["points"]:  # the prediction's band: the design at each uncertainty point
-        from tengsim.calibrate.material import predict_bands, write_bands
-
-        taken = set()
-        for r in results:
-            folder = out if len(results) == 1 else out / _slug(r.plan.name, taken)
-            paths += write_bands(predict_bands(r.plan, r, material, say.say), folder, r.plan.name)
+    for r, f in zip(results, folders):  # the prediction's band: the design at each of the material's points
+        if r.plan.bands:
+            paths += write_bands(predict_bands(r, say.say), out / f, r.plan.name)
     for k in range(len(plans)):  # the results are saved: the kept grids are no longer needed
         (out / f".design-{k}.resolve.nc").unlink(missing_ok=True)
     if not args.quiet:

@@ -7,11 +7,26 @@ linear range and hysteresis, on a grid chosen and refined to a stated tolerance:
                         "E_star": "1MPa", "W": "50mJ/m2", "eps": "100nm", "p_max": "100kPa", "p_step": "5kPa"})
     result = run_design(plan)          # a frozen DesignResult: .dataset (xarray), .summary, .status
     write_design(result, "d1")         # d1/design.nc, design.csv, design.png, maps.png, report.md
+
+A file's tables (read at the edge, :func:`tengsim.schema.read_config`) become a design's table through
+:func:`design_table`; a fitted material (``tengsim calibrate``'s material.toml) through :func:`material_table`, and
+``plan_design(table, material=material)`` plans the design at it and its uncertainty points, whose band
+:func:`predict_bands` runs after the design (:func:`write_bands`: bands.csv, bands.png)::
+
+    from tengsim.schema import read_config
+    mat = material_table(read_config("fit/material.toml"), "fit/material.toml")
+    plan = plan_design(design_table(read_config("new.toml"), "new.toml"), material=mat)
+    result = run_design(plan)
+    write_bands(predict_bands(result), "new")
 """
+from tengsim.design.bands import predict_bands, write_bands
 from tengsim.design.compare import compare_table, write_comparison
+from tengsim.design.material import Material, material_table
 from tengsim.design.plan import PAPER_DEVICE, DesignPlan, plan_design
 from tengsim.design.run import DesignResult, run_design
+from tengsim.design.tables import design_table
 from tengsim.design.write import write_design
 
-__all__ = ["PAPER_DEVICE", "DesignPlan", "DesignResult", "compare_table", "plan_design", "run_design",
-           "write_comparison", "write_design"]
+__all__ = ["PAPER_DEVICE", "DesignPlan", "DesignResult", "Material", "compare_table", "design_table",
+           "material_table", "plan_design", "predict_bands", "run_design", "write_bands", "write_comparison",
+           "write_design"]

@@ -30,7 +30,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-FULL_CONTACT_FRACTION = 0.95
+from tengsim.run.area import FULL_CONTACT_AREA_FRACTION
+
 
 DEFINITIONS = {
     "square": "the paper's definition, A/S = Λc²/S: the square patch of side Λc, Greenwood's contact length (the "
@@ -243,10 +244,10 @@ def summarize(res, plan) -> tuple[dict, dict, list]:
     jump_in = snap_in(k_p * np.asarray(a["F"], float), a[col], (plan.pressures[0], plan.pressures[-1]))
     full_P = math.nan
     if math.isfinite(full):
-        full_P = crossing(st["P"], st["area"], FULL_CONTACT_FRACTION * full)
+        full_P = crossing(st["P"], st["area"], FULL_CONTACT_AREA_FRACTION * full)
         if not full_P <= plan.pressures[-1] * (1 + 1e-9):
             full_P = math.nan
-            notes.append(f"full contact (A/S >= {FULL_CONTACT_FRACTION:g} × {full:.3g}) is not reached by "
+            notes.append(f"full contact (A/S >= {FULL_CONTACT_AREA_FRACTION:g} × {full:.3g}) is not reached by "
                          f"{pressure_text(plan.pressures[-1])}")
     diff = ret["area"] - app["area"]
     loop = res.loop_energy  # 0 where within its uncertainty, never a negative energy of quadrature error
@@ -290,7 +291,7 @@ def na_reasons(summary: dict, numbers, plan, full: float, drawn_in: bool = False
     start = "the apex is drawn in at zero load, then " if drawn_in else ""
     why = {"jump_in_Pa": f"no jump into contact on the approach between {pressure_text(plan.pressures[0])} and "
                          f"{top}: {start}the contact grows under the load without a snap",
-           "full_contact_Pa": (f"A/S does not reach {FULL_CONTACT_FRACTION:g} of the footprint's by {top}"
+           "full_contact_Pa": (f"A/S does not reach {FULL_CONTACT_AREA_FRACTION:g} of the footprint's by {top}"
                                if math.isfinite(full) else "the shape has no known full-contact area"),
            "pull_off_N": "no tensile load on the retraction", "pull_off_Pa": "no tensile load on the retraction",
            "area_hysteresis": "the retraction reaches none of the asked pressures",

@@ -140,6 +140,9 @@ class DesignPlan:
     contact_plan: ContactPlan | None = field(default=None, compare=False, repr=False)
     """The plan of ``contact_table`` the design runs (with its solver tolerance, :func:`solver_tol`, and its
     solver): always set by :func:`plan_design`, the one place a design is planned."""
+    bands: tuple = field(default=(), compare=False, repr=False)
+    """The designs of a fitted material's uncertainty points (:func:`plan_bands`; empty
+    without a material or its points): what a prediction's band runs (:func:`tengsim.design.bands.predict_bands`)."""
 
     def shape_params_json(self) -> str:
         return json.dumps(self.shape_params, sort_keys=True)
@@ -189,9 +192,30 @@ def _shape_params(shape: str, extra: dict) -> dict:
     return out
 
 
-def plan_design(table: dict, where: str = "") -> DesignPlan:
+def plan_design(table: dict, where: str = "", material=None) -> DesignPlan:
     """Validate a [design] table and build its :class:`DesignPlan` (no solving).  A bad value raises one
-    :class:`tengsim.errors.TengsimError` line naming it in the user's units."""
+    :class:`tengsim.errors.TengsimError` line naming it in the user's units.  ``material``: a fitted
+    :class:`tengsim.design.material.Material` whose values replace the table's and whose uncertainty points are
+    planned too (``bands``), each within the design's own bounds, before anything runs."""
+    if material is not None:
+        merged = {**table, **material.values} if isinstance(table, dict) else table
+        try:
+            plan = _plan_design(merged, where)
+        except TengsimError as exc:  # the design with the material's values: say both
+            raise type(exc)(f"{exc} (with the material of {material.where})") from None
+        return dataclasses.replace(plan, bands=plan_bands(merged, material, where))
+    return _plan_design(table, where)
+
+
+def plan_bands(table: dict, material, where: str = "") -> tuple:
+    """The :class:`DesignPlan` of each of ``material``'s uncertainty points: ``table`` (the design's, the
+    material's values in it) with the point's values and no maps, within the design's own bounds; a bad point is
+    one line naming it (what :func:`tengsim.design.bands.predict_bands` runs)."""
+    return tuple(_plan_design({**table, **pt, "maps": False}, f"{where}{material.where} [[uncertainty.point]] "
+                                                               f"{i + 1}: ") for i, pt in enumerate(material.points))
+
+
+def _plan_design(table: dict, where: str) -> DesignPlan:
     from tengsim.run.keys import contact_table
     from tengsim.run.plan import plan_contact
     from tengsim.plugins import SHAPES

@@ -5,7 +5,8 @@ pressure -> A/S) and a waveform (:data:`WAVEFORMS`), and knows nothing of the pa
 live in :mod:`tengsim.cases.paper`.
 """
 from tengsim.device.dynamics import simulate
-from tengsim.device.params import (EPS0, AreaFunction, AreaTable, ConstantArea, DeviceParams, SolverOptions,
+from tengsim.constants import EPS0
+from tengsim.device.params import (AreaFunction, AreaTable, ConstantArea, DeviceParams, SolverOptions,
                                    area_model)
 from tengsim.device.result import DeviceResult
 from tengsim.device.waveforms import WAVEFORMS, Sine, SquareWave, Staircase, TableWaveform

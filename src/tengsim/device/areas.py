@@ -3,9 +3,13 @@ physical ``tengsim contact`` result (.nc or .csv; best a load-controlled one).
 
 The design-result file holds, per nominal pressure (coordinate ``pressure``, Pa) and branch
 (``approach``, ``retraction``), the charged-area fraction A/S (``charged_area_fraction``; NaN where a
-pressure was not reached on that branch).  A pressed device follows the stable approach branch, so
-the device takes that branch: NaN rows dropped, and at a snap (the same pressure met twice) the first
-state reached at that pressure kept, so the pressures increase strictly.
+pressure was not reached on that branch), and the states a pressed device passes (``state_pressure``,
+``state_charged_area_fraction``).  A pressed device follows the stable approach branch, so the device takes
+that branch's states (:func:`passed_curve`, the curve calibrate's nodes are read off too) between the lowest
+and the highest asked pressure the approach reached: across a snap between two asked pressures A/S is the
+branch the device is on, not a straight line from one asked pressure to the next.  A file without states:
+its asked pressures, NaN rows dropped, and at a snap (the same pressure met twice) the first state reached at
+that pressure kept, so the pressures increase strictly.
 """
 from __future__ import annotations
 
@@ -42,6 +46,21 @@ def stable_branch(pressure_Pa, area_fraction, where: str = "area table", rows=No
     return p[keep], a[keep]
 
 
+def passed_curve(pressure_Pa, area_fraction, p_lo: float, p_hi: float):
+    """(P, A/S) of the states a pressed device passes, from ``p_lo`` to ``p_hi`` (Pa): the finite states, A/S
+    clipped to [0, 1] and made monotone (the device passes the states whose load is above every earlier one), the
+    states strictly inside (p_lo, p_hi) and both ends read off the states (held flat beyond the first and the
+    last).  The one reading of a design's states: the device's area table (:func:`area_table_from_design`) and
+    calibrate's nodes (:meth:`tengsim.calibrate.surrogate.Node.curve`)."""
+    P = np.asarray(pressure_Pa, float).ravel()
+    A = np.asarray(area_fraction, float).ravel()
+    ok = np.isfinite(P) & np.isfinite(A)
+    P, A = P[ok], np.maximum.accumulate(np.clip(A[ok], 0.0, 1.0))
+    inside = (P > p_lo) & (P < p_hi)
+    ends = np.interp([p_lo, p_hi], P, A)
+    return np.concatenate([[p_lo], P[inside], [p_hi]]), np.concatenate([[ends[0]], A[inside], [ends[1]]])
+
+
 def design_path(path) -> Path:
     """The design.nc of ``path`` (the file, or the folder a ``tengsim design --out DIR`` wrote)."""
     p = Path(path)
@@ -55,7 +74,9 @@ def design_path(path) -> Path:
 
 def area_table_from_design(path) -> AreaTable:
     """The :class:`AreaTable` A/S(P) of a design result (``DIR/design.nc`` or ``DIR``): its approach
-    branch, NaN rows dropped, one value per pressure (the first state reached at a snap's pressure)."""
+    branch's states between the lowest and the highest asked pressure reached (:func:`passed_curve`); a file
+    without states: its asked pressures, NaN rows dropped, one value per pressure (the first state reached at a
+    snap's pressure)."""
     import xarray as xr
 
     p = design_path(path)
@@ -84,7 +105,45 @@ def area_table_from_design(path) -> AreaTable:
         raise TengsimError(f"area: {str(p)!r}: the approach branch reached {int(ok.sum())} of {pres.size} "
                            "pressures; the device needs at least 2")
     pres, a = stable_branch(pres[ok], a[ok], where=f"area: {p}")
+    states = _approach_states(ds)
+    if states is not None and np.count_nonzero(np.isfinite(states[0]) & np.isfinite(states[1])) >= 2:
+        sp, sa = passed_curve(*states, float(pres[0]), float(pres[-1]))
+        pres, a = stable_branch(_landing_after(sp), sa, where=f"area: {p} (its states)")
     return AreaTable(pres, a)
+
+
+SNAP_STEP = 1e-8
+"""A snap's landing state, met at the pressure of the state it jumps from, is placed this fraction of that pressure
+above it in the device's table (which needs pressures that increase strictly): below the snap's pressure the
+device is on the branch before the jump, above it on the branch it landed on.  Far below any pressure a waveform
+resolves; above the 1e-9 within which :func:`stable_branch` takes two pressures as one."""
+
+
+def _landing_after(P):
+    """``P`` with each repeat of a pressure (a snap at constant load: its landing state) moved
+    :data:`SNAP_STEP` above the one before it, where that stays below the next state's (else left for
+    :func:`stable_branch` to take as one)."""
+    P = np.array(P, float)
+    for i in range(1, len(P)):
+        last = P[i - 1]
+        if abs(P[i] - last) <= 1e-9 * max(abs(last), abs(P[i])):
+            up = last + SNAP_STEP * max(abs(last), 1.0)
+            if i + 1 == len(P) or up < P[i + 1]:
+                P[i] = up
+    return P
+
+
+def _approach_states(ds):
+    """(P, A/S) of the approach states a design result holds (None: a file written without them)."""
+    if "state_pressure" not in ds or "state_charged_area_fraction" not in ds:
+        return None
+    sp, sa = ds["state_pressure"], ds["state_charged_area_fraction"]
+    if "branch" in sp.dims:
+        branches = [b.decode() if isinstance(b, bytes) else str(b) for b in ds["branch"].values]
+        sp, sa = (x.isel(branch=branches.index("approach")) for x in (sp, sa))
+    if sp.ndim != 1 or sp.shape != sa.shape or sp.dtype.kind != "f" or sa.dtype.kind != "f":
+        return None
+    return np.asarray(sp.values, float), np.asarray(sa.values, float)
 
 
 def area_table_from_contact(path) -> AreaTable:
@@ -164,4 +223,4 @@ def area_table_from_file(path) -> AreaTable:
 
 
 __all__ = ["area_table_from_contact", "area_table_from_design", "area_table_from_file", "design_path",
-           "stable_branch", "DESIGN_FILE"]
+           "passed_curve", "stable_branch", "DESIGN_FILE"]

@@ -17,12 +17,23 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.integrate import trapezoid
 
-from tengsim.device.params import EPS0
+from tengsim.constants import EPS0
+
+
+def eq12_volts_per_charge(eps_r, thickness):
+    """Eq. (12)'s V_OC per unit σ per unit A/S, T/(ε_r ε0) (V m²/C): the polymer's own capacitance per area,
+    inverted.  The one definition: :func:`voc_polymer`, calibration's V_OC model and a prediction's bands use it."""
+    return thickness / (eps_r * EPS0)
+
+
+def eq17_volts_per_charge(gap, plate_area=1.0):
+    """Eq. (17)'s V_OC per unit σ per unit charged area A (per unit A/S for ``plate_area`` 1), d/(S ε0) (V m²/C)."""
+    return np.asarray(gap, dtype=float) / (plate_area * EPS0)
 
 
 def voc_polymer(area_fraction, sigma, eps_r, thickness):
     """Eq. (12): V_OC = sigma (A/S) T / (eps_r eps0) (V)."""
-    return sigma * np.asarray(area_fraction, dtype=float) * thickness / (eps_r * EPS0)
+    return sigma * np.asarray(area_fraction, dtype=float) * eq12_volts_per_charge(eps_r, thickness)
 
 
 def voc_from_contact_length(lambda_c, cell_length, sigma, eps_r, thickness):
@@ -33,7 +44,7 @@ def voc_from_contact_length(lambda_c, cell_length, sigma, eps_r, thickness):
 
 def voc_apart(sigma, area, gap, plate_area):
     """Eq. (17): V_OC = sigma A d / (S eps0) (V)."""
-    return sigma * area * np.asarray(gap, dtype=float) / (plate_area * EPS0)
+    return sigma * area * eq17_volts_per_charge(gap, plate_area)
 
 
 def qsc_apart(sigma, area, gap, thickness, eps_r):

@@ -11,11 +11,9 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
+from tengsim.constants import EPS0
 from tengsim.errors import TengsimError, finite, positive, require
 from tengsim.schema import REQUIRED
-
-EPS0 = 8.8541878128e-12
-"""Vacuum permittivity (F/m, CODATA 2018); the paper rounds it to 8.85e-12."""
 
 FORCE_MODELS = ("field", "eq20", "none")
 AREA_PRESSURES = ("applied", "contact")

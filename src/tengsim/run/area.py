@@ -162,6 +162,16 @@ DEFINITIONS = {
 
 CHARGED_COLUMN = "charged_fraction"
 
+FULL_CONTACT_AREA_FRACTION = 0.95
+"""Full contact as a design reports it (``full_contact_Pa``): the approach pressure at which the charged area A/S
+reaches this fraction of its full-contact value (the footprint's): where the area saturates under the load."""
+ADHESIVE_FULL_CONTACT_LENGTH_FRACTION = 0.9
+"""A study's ``adhesive_full_contact`` flag (its default ``full_contact_fraction``): the contact length Λc at zero
+load at least this fraction of the full-contact length, a pattern that adhesion alone pulls (nearly) shut.  A
+different question from :data:`FULL_CONTACT_AREA_FRACTION`'s (a yes/no of the zero-load state, not the pressure at
+which the area saturates) on a different measure (a length: 0.9 of Λc is 0.81 of a square patch's area); both kept
+at the values their results were published with."""
+
 
 def check_definition(definition: str) -> str:
     """``definition`` if it names one of :data:`DEFINITIONS`; a TengsimError otherwise."""

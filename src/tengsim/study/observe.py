@@ -12,7 +12,8 @@ import math
 import numpy as np
 
 from tengsim.errors import TengsimError
-from tengsim.run.area import cell_side, full_length, loaded_area, physical_scale
+from tengsim.run.area import (ADHESIVE_FULL_CONTACT_LENGTH_FRACTION, cell_side, full_length, loaded_area,
+                               physical_scale)
 
 OBSERVABLE_DEFAULTS = {
     "pressures": ("1kPa", "10kPa", "100kPa"),
@@ -20,7 +21,7 @@ OBSERVABLE_DEFAULTS = {
     "grid_max": "150kPa",
     "grid_num": 61,
     "transition_fraction": 0.95,
-    "full_contact_fraction": 0.9,
+    "full_contact_fraction": ADHESIVE_FULL_CONTACT_LENGTH_FRACTION,
 }
 
 SCALARS = {
@@ -62,7 +63,7 @@ def parse_observables(table: dict, where: str = "study") -> dict:
               help="top of the common pressure grid (from 0)"),
         Field("grid_num", "int", 61, help="points of the common pressure grid"),
         Field("transition_fraction", "float", 0.95, help="Λc fraction of full contact for transition_D"),
-        Field("full_contact_fraction", "float", 0.9, help="Λc fraction of full contact at zero load flagged"),
+        Field("full_contact_fraction", "float", OBSERVABLE_DEFAULTS["full_contact_fraction"], help="Λc fraction of full contact at zero load flagged"),
     ])
     raw = dict(table)
     labels = raw.get("pressures", OBSERVABLE_DEFAULTS["pressures"])
