@@ -243,7 +243,9 @@ def test_a_nodes_key_covers_the_content_of_its_topography_file(tmp_path):
     h.write_text("0,1\n1,0\n")
     table = {"shape": "topography", "file": str(h), "W": 0.025}
     first = node_key(table)
-    h.write_text("0,2\n2,0\n")
+    st = h.stat()
+    h.write_text("0,2\n2,0\n")  # the same size; a later modification time, as an edit gives
+    os.utime(h, ns=(st.st_atime_ns, st.st_mtime_ns + 10**9))
     assert node_key(table) != first
     assert node_key({"shape": "pyramid", "W": 0.025}) == node_key({"W": 0.025, "shape": "pyramid"})
 

@@ -29,6 +29,7 @@ the data's noise.
 """
 from __future__ import annotations
 
+import functools
 import hashlib
 import json
 import math
@@ -69,8 +70,23 @@ def node_key(table: dict) -> str:
     text = json.dumps(table, sort_keys=True, default=str)
     files = input_files(table)
     if files:  # (a table naming no file keeps the key it always had)
-        text += json.dumps({f: hashlib.sha256(Path(f).read_bytes()).hexdigest() for f in files}, sort_keys=True)
+        text += json.dumps({f: _digest(f) for f in files}, sort_keys=True)
     return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+def _digest(path: str) -> str:
+    """SHA-256 of a file's content, computed once per (file, size, modification time)."""
+    st = Path(path).stat()
+    return _digest_of(str(Path(path).resolve()), st.st_size, st.st_mtime_ns)
+
+
+@functools.lru_cache(maxsize=64)
+def _digest_of(path: str, size: int, mtime_ns: int) -> str:
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for block in iter(lambda: fh.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
 
 
 def input_files(table: dict) -> list:
