@@ -254,7 +254,11 @@ def run(args) -> int:
     from tengsim.outfolder import folder_lock
 
     for (where, _), plan in zip(tables, plans):  # every design's grids, memory, budget, solver, before any runs
-        for k, p in enumerate((plan, *plan.bands)):  # the band points' designs too
+        seen = set()
+        for k, p in enumerate((plan, *plan.bands)):  # the band points' designs too, each distinct one once
+            if (p.E_star, p.W, p.eps) in seen:
+                continue
+            seen.add((p.E_star, p.W, p.eps))
             try:
                 preflight(p)
             except TengsimError as exc:
