@@ -308,3 +308,96 @@ def test_generated_device_tables_through_run(tmp_path_factory, capsys, device, w
     if rc == 0:
         (d / "o.csv").unlink()
         (d / "o.json").unlink()
+
+
+# ---- calibrate: measured-data files and options (issue 48) ---------------------------------------------------
+# Nothing is solved: a calibration that plans is stopped by PLANNED the moment plan_calibration returns (before
+# the output folder is checked or any design runs), so what is drawn is judged by the reader and the planning.
+class PLANNED(BaseException):
+    """Raised where a calibration would start solving (main() does not catch a BaseException)."""
+
+
+CAL_DESIGN = ('[design]\nshape = "pyramid"\npitch = "1um"\nbase = "0.5um"\nheight = "0.2um"\nE_star = "10MPa"\n'
+              'eps = "50nm"\ntol = 0.05\n')
+
+
+def check_calibrate(folder: Path, argv, capsys, monkeypatch):
+    """``check`` for calibrate: a calibration that plans counts as exit 0 and has written nothing."""
+    import tengsim.calibrate as cal
+
+    real = cal.plan_calibration
+
+    def planned(*a, **k):
+        real(*a, **k)
+        raise PLANNED
+
+    monkeypatch.setattr(cal, "plan_calibration", planned)
+    before = sorted(os.listdir(folder))
+    try:
+        return check(folder, argv, capsys)
+    except PLANNED:
+        err = capsys.readouterr().err
+        assert "Traceback" not in err and "error" not in err, err[-500:]
+        assert sorted(os.listdir(folder)) == before
+        return 0
+
+
+def _sheet(rows, sep, crlf, bom, comma):
+    """A measured curve as a spreadsheet may write it: the separator, CRLF, a BOM, decimal commas."""
+    num = (lambda x: repr(x).replace(".", ",")) if comma else repr
+    end = "\r\n" if crlf else "\n"
+    text = end.join([f"pressure_kPa{sep}voc_V"] + [f"{num(p)}{sep}{num(v)}" for p, v in rows]) + end
+    return ("\ufeff" if bom else "") + text
+
+
+sheet_rows = st.lists(st.tuples(st.floats(0, 50), st.floats(0, 20)), min_size=0, max_size=6)
+header_words = st.sampled_from(["pressure_kPa", "pressure_Pa", "pressure_MPa", "pressure_mPa", "pressure_MPA",
+                                "pressure", "Pressure (kPa)", "voc_V", "VOC_V", "voc_err_V", "branch", "x"])
+csv_content = st.one_of(
+    st.builds(_sheet, sheet_rows, st.sampled_from([",", ";", "\t", " "]), st.booleans(), st.booleans(),
+              st.booleans()),
+    st.builds(lambda h, sep, rows: sep.join(h) + "\n" + "\n".join(sep.join(r) for r in rows),
+              st.lists(header_words, min_size=1, max_size=4), st.sampled_from([",", ";", "\t"]),
+              st.lists(st.lists(st.one_of(number_text, st.sampled_from(["approach", "retraction", ""])),
+                                max_size=5), max_size=5)),
+    st.sampled_from(["pressure_kPa,voc_V\n2," + "9" * 140_000 + "\n", "pressure_kPa,voc_V\n2,0\n4,0\n6,0\n8,0\n",
+                     "pressure_kPa,voc_V\n2,1e-12\n4,2e-12\n6,3e-12\n8,4e-12\n", "\x00\x01", ""]),
+    st.text(max_size=300),
+)
+
+
+@SETTINGS(30)
+@given(content=csv_content, encoding=st.sampled_from(["utf-8", "utf-16", "latin-1"]))
+def test_generated_measured_data_for_calibrate(tmp_path_factory, capsys, monkeypatch, content, encoding):
+    d = tmp_path_factory.mktemp("cd")
+    (d / "d.toml").write_text(CAL_DESIGN)
+    f = d / "m.csv"
+    f.write_bytes(content.encode(encoding, errors="replace"))
+    check_calibrate(d, ["calibrate", d / "d.toml", "--data", f, "--free", "sigma,W", "--quiet", "--out", d / "o"],
+                    capsys, monkeypatch)
+
+
+bound_text = st.one_of(
+    st.builds(lambda k, lo, hi: f"{k}={lo}:{hi}", st.sampled_from(["W", "eps", "sigma", "E_star", "w", "x", ""]),
+              st.one_of(number_text, st.sampled_from(["10mJ/m2", "30nm", "1uC/m2", "1e5mJ/m2", "1MPa"])),
+              st.one_of(number_text, st.sampled_from(["100mJ/m2", "300nm", "100uC/m2", "1e6mJ/m2", "5MPa"]))),
+    st.sampled_from(["W=10mJ/m2", "W=", "W", "=", ",", "W=1:2:3", "W=20mJ/m2:200mJ/m2,W=30mJ/m2:40mJ/m2",
+                     "E_star=1MPa:2MPa", "eps=30nm:300nm"]),
+    st.text(max_size=60))
+CAL_OPTIONS = st.one_of(
+    st.tuples(st.just("--bounds"), bound_text),
+    st.tuples(st.sampled_from(["--expected-noise", "--nodes", "--zooms", "--refine"]),
+              st.one_of(number_text, st.sampled_from(["2%", "0_5%", "-1%", "0.5V", "50mV", "150%", "4", "0_4"]),
+                        st.text(max_size=20))))
+
+
+@SETTINGS(40)
+@given(opt=CAL_OPTIONS, eq=st.booleans())
+def test_generated_calibrate_options(tmp_path_factory, capsys, monkeypatch, opt, eq):
+    d = tmp_path_factory.mktemp("co")
+    (d / "d.toml").write_text(CAL_DESIGN)
+    (d / "m.csv").write_text("pressure_kPa,voc_V\n2,6.1\n4,6.4\n6,6.6\n8,6.7\n")
+    key, value = opt
+    given_opt = [f"{key}={value}"] if eq else [key, value]
+    check_calibrate(d, ["calibrate", d / "d.toml", "--data", d / "m.csv", "--free", "sigma,W", *given_opt,
+                        "--quiet", "--out", d / "o"], capsys, monkeypatch)

@@ -11,6 +11,7 @@ _PREFIX = {"": 1.0, "k": 1e3, "M": 1e6, "G": 1e9, "m": 1e-3, "u": 1e-6, "µ": 1e
            "n": 1e-9, "p": 1e-12, "c": 1e-2}
 _BASE = {
     "m": ("length", 1.0),
+    "m2": ("area", 1.0),  # its prefix is squared: 4cm2 is 4e-4 m2
     "Pa": ("pressure", 1.0),
     "N/m2": ("pressure", 1.0),
     "J/m2": ("energy/area", 1.0),
@@ -102,8 +103,8 @@ def number_or_text(v, label: str, quantity: str):
 def parse_quantity(text, kind: str | None = None, name: str = "value") -> float:
     """'0.59MPa' → 590000.0 (SI).  A bare number is taken as SI.  ``kind`` checks the dimension.
 
-    Units: m, Pa, N/m2, J/m2, N/m, N, C/m2, ohm, Hz, s, g, kg, with prefixes k M G m u µ n p c
-    (e.g. um, mJ/m2, uC/m2, MOhm, cm).  'm2' and '^2' are both accepted.
+    Units: m, m2, Pa, N/m2, J/m2, N/m, N, C/m2, ohm, Hz, s, g, kg, with prefixes k M G m u µ n p c
+    (e.g. um, mJ/m2, uC/m2, MOhm, cm, cm2: an area's prefix is squared).  'm2', '^2' and '²' are all accepted.
     """
     if isinstance(text, (int, float)) and not isinstance(text, bool):
         v = read_number(text, name)
@@ -121,12 +122,13 @@ def parse_quantity(text, kind: str | None = None, name: str = "value") -> float:
             for base, (dim, f) in _BASE.items():
                 for pre, pf in _PREFIX.items():
                     if unit == pre + base and (found is None or len(base) > len(found[0])):
-                        found = (base, dim, f * pf)
+                        found = (base, dim, f * (pf * pf if dim == "area" else pf))
             if found is None:
                 raise TengsimError(f"unknown unit {shown(unit)} in {name} = {shown(text)}")
             _, dim, factor = found
             if kind and dim != kind:
-                raise TengsimError(f"{name} = {shown(text)} is a {dim}, expected a {kind}")
+                raise TengsimError(f"{name} = {shown(text)} is a {dim}, expected {'an' if kind[0] in 'aeiou' else 'a'} "
+                                   f"{kind}")
             v = bounded(v * factor, text, name)
     if not math.isfinite(v):
         raise TengsimError(f"{name} must be finite, got {shown(text)}")
@@ -153,6 +155,7 @@ def quantity_dim(text) -> str | None:
 
 DIMENSIONS = {
     "length": (0, 1, 0, 0),
+    "area": (0, 2, 0, 0),
     "pressure": (1, -1, -2, 0),
     "energy/area": (1, 0, -2, 0),
     "force": (1, 1, -2, 0),
@@ -165,7 +168,7 @@ DIMENSIONS = {
 }
 """Each dimension of :func:`parse_quantity` as exponents of (kg, m, s, A); expressions multiply them."""
 
-SI_UNIT = {"length": "m", "pressure": "Pa", "energy/area": "J/m2", "force": "N", "charge/area": "C/m2",
+SI_UNIT = {"length": "m", "area": "m2", "pressure": "Pa", "energy/area": "J/m2", "force": "N", "charge/area": "C/m2",
            "permittivity": "F/m", "resistance": "ohm", "frequency": "Hz", "time": "s", "mass": "kg"}
 """The SI unit text of each dimension (what :func:`parse_quantity` reads back with factor 1)."""
 

@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from tengsim.errors import TengsimError
+from tengsim.errors import TengsimError, shown
 
 PARAMS = ("sigma", "W", "eps", "E_star")
 UNITS = {"sigma": ("µC/m²", 1e-6, "uC/m2"), "W": ("mJ/m²", 1e-3, "mJ/m2"), "eps": ("nm", 1e-9, "nm"),
@@ -75,29 +75,73 @@ def _bound(text, name: str) -> float:
     return value
 
 
-def parse_bounds(spec) -> dict:
-    """'W=20mJ/m2:200mJ/m2,eps=30nm:300nm' (or a dict {name: (lo, hi)} of strings or SI numbers) → {name: (lo, hi)}."""
-    from tengsim.units import parse_quantity
+ALLOWED = {"sigma": (1e-9, 1e-2), "W": (1e-6, 10.0), "eps": (0.1e-9, 10e-6), "E_star": (1e2, 1e12)}
+"""The range (SI) a bound may lie in: σ a design's own (:data:`tengsim.design.plan.DEVICE_BOUNDS`, 1 nC/m² …
+10 mC/m²), W and E* what a design's keys take as plausible (:data:`tengsim.units.PLAUSIBLE`: 0.001 … 10 000 mJ/m²,
+100 Pa … 1 TPa), ε from an atomic spacing to the largest micro-structures (0.1 nm … 10 µm)."""
 
+
+def _range_text(name: str) -> str:
+    from tengsim.units import format_si
+
+    unit = {"sigma": "C/m²", "W": "J/m²", "eps": "m", "E_star": "Pa"}[name]
+    return " to ".join(format_si(x, unit, 4) for x in ALLOWED[name])
+
+
+def _one_bound(name: str, v) -> tuple:
+    if isinstance(v, str):
+        parts = v.split(":")
+        if len(parts) != 2 or not all(x.strip() for x in parts):
+            raise TengsimError(f"--bounds {name}={shown(v)}: give {name}=LOW:HIGH, e.g. {name}="
+                               f"{EXAMPLE[name]}")
+    else:
+        parts = tuple(v) if isinstance(v, (tuple, list)) else ()
+        if len(parts) != 2:
+            raise TengsimError(f"--bounds {name}: give (LOW, HIGH), got {shown(v)}")
+    try:
+        lo, hi = (_bound(x, name) for x in parts)
+    except TengsimError as exc:
+        raise TengsimError(f"--bounds {name}: {exc}") from None
+    if not 0 < lo < hi:
+        raise TengsimError(f"--bounds {name}: need 0 < low < high, got {text(name, lo)} to {text(name, hi)}")
+    a, b = ALLOWED[name]
+    if lo < a or hi > b:
+        raise TengsimError(f"--bounds {name}: {text(name, lo)} to {text(name, hi)} is outside the allowed range "
+                           f"{_range_text(name)}")
+    return lo, hi
+
+
+EXAMPLE = {"sigma": "1uC/m2:100uC/m2", "W": "20mJ/m2:200mJ/m2", "eps": "30nm:300nm", "E_star": "0.5MPa:5MPa"}
+
+
+def parse_bounds(spec, free=None) -> dict:
+    """'W=20mJ/m2:200mJ/m2,eps=30nm:300nm' (or a dict {name: (lo, hi)} of strings or SI numbers) → {name: (lo, hi)}
+    (SI), each within :data:`ALLOWED`; a parameter named twice, or (given ``free``) one that is not free, is
+    refused."""
     if not spec:
         return {}
-    items = spec.items() if isinstance(spec, dict) else [s.split("=", 1) for s in spec.split(",") if s.strip()]
+    if isinstance(spec, dict):
+        items = list(spec.items())
+    else:
+        items = []
+        for s in str(spec).split(","):
+            if not s.strip():
+                continue
+            if "=" not in s:
+                raise TengsimError(f"--bounds {shown(s.strip())}: give NAME=LOW:HIGH, e.g. W=20mJ/m2:200mJ/m2")
+            items.append(tuple(s.split("=", 1)))
     out = {}
-    for item in items:
-        if len(item) != 2:
-            raise TengsimError(f"--bounds {'='.join(item)!r}: give NAME=LOW:HIGH, e.g. W=20mJ/m2:200mJ/m2")
-        k, v = item
-        name = ALIASES.get(str(k).strip().lower()) if str(k).strip() not in PARAMS else str(k).strip()
+    for k, v in items:
+        key = str(k).strip()
+        name = key if key in PARAMS else ALIASES.get(key.lower())
         if name is None:
-            raise TengsimError(f"--bounds {k!r}: not a parameter (sigma, W, eps, E_star)")
-        lo, hi = v.split(":", 1) if isinstance(v, str) else v
-        try:
-            lo, hi = (_bound(x, name) for x in (lo, hi))
-        except TengsimError as exc:
-            raise TengsimError(f"--bounds {name}: {exc}") from None
-        if not 0 < lo < hi:
-            raise TengsimError(f"--bounds {name}: need 0 < low < high, got {text(name, lo)} to {text(name, hi)}")
-        out[name] = (lo, hi)
+            raise TengsimError(f"--bounds {shown(key)}: not a parameter (sigma, W, eps, E_star)")
+        if name in out:
+            raise TengsimError(f"--bounds {name} is given twice: give each parameter's bounds once")
+        if free is not None and name not in free:
+            raise TengsimError(f"--bounds {name}: {name} is not free (--free {','.join(free)}): its bounds would "
+                               f"be ignored; add it to --free or leave its bounds out")
+        out[name] = _one_bound(name, v)
     return out
 
 
@@ -144,17 +188,33 @@ class Problem:
 
 
 def check_reachable(prob: Problem) -> None:
-    """A curve whose voltage exceeds what its geometry can give at any σ within bounds (the whole cell charged,
-    A/S = 1): refused with the numbers."""
+    """A curve whose voltages no σ within bounds can give, refused with the numbers and the reason: one above
+    what its geometry gives with the whole cell charged (A/S = 1); one that is 0 V at every point (nothing to
+    fit: σ is at least its lower bound); one whose largest voltage needs, at the lowest σ, a charged area below
+    one pixel of the largest grid any design may use (:data:`tengsim.resources.MAX_PIXELS_PER_SIDE` ²)."""
+    from tengsim.resources import MAX_PIXELS_PER_SIDE
+
     s_hi = prob.bounds["sigma"][1] if "sigma" in prob.free else prob.fixed["sigma"]
+    s_lo = prob.bounds["sigma"][0] if "sigma" in prob.free else prob.fixed["sigma"]
+    which = "the upper bound of σ" if "sigma" in prob.free else "the fixed σ"
+    a_min = 1.0 / MAX_PIXELS_PER_SIDE**2
     for i, c in enumerate(prob.curves):
         top = s_hi * prob.factor(i) * 1.0
         k = int(np.argmax(c.voc))
         if c.voc[k] > top:
-            which = "the upper bound of σ" if "sigma" in prob.free else "the fixed σ"
             raise TengsimError(f"--data {c.source}: {c.voc[k]:.4g} V at {c.pressure[k] / 1e3:g} kPa exceeds what "
                                f"the design can give at any σ within bounds: at most {top:.4g} V ({which} "
                                f"{text('sigma', s_hi)}, the whole cell charged, A/S = 1, {prob.voc})")
+        if not c.voc[k] > 0:
+            raise TengsimError(f"--data {c.source}: every voc_V is 0 V: nothing to fit (V_OC = σ (A/S) k, and σ is at "
+                               f"least {text('sigma', s_lo)}); give a curve with voltages above 0")
+        low = s_lo * prob.factor(i) * a_min
+        if c.voc[k] < low:
+            lower = "the lower bound of σ" if "sigma" in prob.free else "the fixed σ"
+            raise TengsimError(f"--data {c.source}: its largest voltage {c.voc[k]:.4g} V is below what the design "
+                               f"can give at any σ within bounds: at least {low:.3g} V ({lower} "
+                               f"{text('sigma', s_lo)}, one pixel of a {MAX_PIXELS_PER_SIDE}² grid charged, "
+                               f"{prob.voc}): check the voltage's unit (voc_V is in volts)")
 
 
 def count_check(prob: Problem) -> None:

@@ -100,7 +100,7 @@ def plan_calibration(designs, data, free=None, bounds=None, noise="relative", vo
     if voc not in VOC_MODELS:
         raise TengsimError(f"--voc {voc!r}: eq12 or eq17")
     free = parse_free(free)
-    user = parse_bounds(bounds)
+    user = parse_bounds(bounds, free)
     bnds = {k: user.get(k, DEFAULT_BOUNDS[k]) for k in PARAMS}
     from tengsim.design import design_table
 

@@ -24,7 +24,8 @@ DESCRIPTION = (
     "and ε come from converged designs on a grid in (W, ε), interpolated, their error reported; E* scales the "
     "pressure. Writes DIR/report.md, fit.nc, fit.csv, fit.png, residuals.png, profiles.png and material.toml "
     "(tengsim design --material); every solved design is kept in DIR/designs (a rerun takes them back). "
-    "CSV: a header, pressure_kPa or pressure_Pa, voc_V, optional branch and voc_err_V, '#' comments.")
+    "CSV: a header, pressure_kPa or pressure_Pa, voc_V, optional branch and voc_err_V, '#' comments; ',' ';' or "
+    "a tab between columns, a decimal point (6.1, never 6,1), at most 10 000 points.")
 
 
 def register(sub):
@@ -41,16 +42,16 @@ def register(sub):
                    help="noise model when no voc_err_V column is given (default relative; its scale is estimated)")
     p.add_argument("--voc", default="eq12", choices=("eq12", "eq17"),
                    help="the V_OC model the data are compared with (default eq12: σ (A/S) T/(ε_r ε0))")
-    p.add_argument("--nodes", type=int, default=4, help="designs per free axis of each (W, ε) grid (default 4)")
-    p.add_argument("--zooms", type=int, default=2, help="new grids on the region that fits, at most (default 2)")
-    p.add_argument("--refine", type=int, default=3, help="rounds after the zooms in which the checks (designs at the "
+    p.add_argument("--nodes", type=_whole, default=4, help="designs per free axis of each (W, ε) grid (default 4)")
+    p.add_argument("--zooms", type=_whole, default=2, help="new grids on the region that fits, at most (default 2)")
+    p.add_argument("--refine", type=_whole, default=3, help="rounds after the zooms in which the checks (designs at the "
                    "best fit and the interval ends) become designs of the interpolation, while its error is above "
                    "half the noise (default 3)")
     p.add_argument("--solver", default=None, help="the designs' solver, as a design's solver key (auto, numpy, "
                    "gpu, ...; default: as the design files say)")
     p.add_argument("--expected-noise", default=None, metavar="NOISE",
-                   help="the data's noise as known beforehand (relative noise: e.g. 2%%; absolute: e.g. 0.5V): "
-                        "the report warns when the fitted noise is more than twice it")
+                   help="the data's noise as known beforehand (relative noise: e.g. 2%%; absolute: e.g. 0.5V or "
+                        "50mV): the report warns when the fitted noise is more than twice it")
     p.add_argument("--out", required=True, help="output folder (created; not on bad input)")
     p.add_argument("--quiet", action="store_true", help="no progress lines")
     p.set_defaults(func=run)
@@ -113,23 +114,55 @@ def _run_locked(args, prob, out, expected) -> int:
     return 0
 
 
+def _whole(text) -> int:
+    """--nodes, --zooms, --refine: a whole number read by :func:`tengsim.units.read_number` (no underscores:
+    '0_4' is refused, not read as 4); argparse names the option."""
+    import argparse
+
+    from tengsim.errors import ConfigValueError, shown
+    from tengsim.units import read_number
+
+    try:
+        n = read_number(text, "value")
+    except ConfigValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc).replace("value = ", "", 1)) from None
+    except ValueError:
+        n = float("nan")
+    if not (n == n and n == int(n)):
+        raise argparse.ArgumentTypeError(f"{shown(text)} is not a whole number")
+    return int(n)
+
+
+_VOLTS = {"V": 1.0, "mV": 1e-3, "uV": 1e-6, "µV": 1e-6}
+
+
 def _expected_noise(text, noise):
-    """--expected-noise in the noise model's unit: a fraction of V_OC from "2%" (relative), volts from "0.5V"
-    (absolute); None when not given."""
+    """--expected-noise in the noise model's unit: a fraction of V_OC from "2%" (relative), volts from "0.5V" or
+    "50mV" (absolute); None when not given.  The number is read by :func:`tengsim.units.read_number` ('0_5%' is
+    refused, not read as 5 %)."""
+    import re
+
+    from tengsim.errors import ConfigValueError
+    from tengsim.units import read_number
+
     if text is None:
         return None
     t = str(text).strip()
-    unit = "%" if noise == "relative" else "V"
+    units = {"%": 1e-2} if noise == "relative" else _VOLTS
+    m = re.fullmatch(r"(.*?)\s*(%|V|mV|uV|µV)", t)
     try:
-        if not t.endswith(unit):
+        if not m or m.group(2) not in units:
             raise ValueError
-        value = float(t[:-len(unit)])
+        value = read_number(m.group(1), f"--expected-noise {t}") * units[m.group(2)]
+    except ConfigValueError as exc:
+        raise TengsimError(str(exc).replace(f"--expected-noise {t} = {m.group(1)!r}", f"--expected-noise {t}")
+                           ) from None
     except ValueError:
         raise TengsimError(f"--expected-noise {text}: give it with its unit, e.g. "
-                           f"{'2%' if unit == '%' else '0.5V'} ({noise} noise)") from None
-    if not (value > 0 and value < (100 if unit == "%" else float("inf"))):
-        raise TengsimError(f"--expected-noise {text}: a positive noise{' below 100 %' if unit == '%' else ''}")
-    return value / 100 if unit == "%" else value
+                           f"{'2%' if noise == 'relative' else '0.5V'} ({noise} noise)") from None
+    if not (value > 0 and value < (1 if noise == "relative" else float("inf"))):
+        raise TengsimError(f"--expected-noise {text}: a positive noise{' below 100 %' if noise == 'relative' else ''}")
+    return value
 
 
 def _designs(paths) -> list:

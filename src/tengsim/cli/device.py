@@ -97,7 +97,8 @@ def register(subparsers) -> None:
     dz.add_argument("--frequency", help="square-wave frequency, e.g. 2Hz (default 2 Hz, the paper's Fig. 8)")
     dz.add_argument("--mass", help="moving plate mass, e.g. 13.45g (default: the paper's Fig. 8 device, 13.45 g)")
     dz.add_argument("--stiffness", help="spring stiffness, e.g. 5.12kN/m (default 5.12 kN/m, Fig. 8)")
-    dz.add_argument("--electrode-area", help="electrode area S in m2, plain number (default 4e-4, Fig. 8's 4 cm²)")
+    dz.add_argument("--electrode-area", help="electrode area S, e.g. 4cm2 (a bare number is m², as every bare "
+                    "number is SI; default 4 cm², Fig. 8's)")
     dz.set_defaults(func=lambda a: execute("design", given.read(a.config), given.options(a), a.quiet, a.config))
     fl = sub.add_parser("fields", help="list every config table and key (from the dataclasses)")
     fl.set_defaults(func=_cmd_fields)
@@ -237,7 +238,32 @@ def _designed(cfg, cli, dev_cli):
         if key in dev_cli and not dev_cli[key] > 0:
             raise TengsimError(f"--{opt.replace('_', '-')} must be > 0, got {cli['device'][key]!r}")
     wcli = given.typed(None, cli.get("waveform", {}))
+    for opt in ("pressure", "frequency"):
+        key = given.OPTIONS[opt][1]
+        if key in wcli and not wcli[key] > 0:
+            raise TengsimError(f"the {opt} must be > 0 {_unit_of(cli['waveform'][key], key)}, got "
+                               f"{_as_given(cli['waveform'][key], key)}")
     return designed_device(raw, dev, cfg.get("waveform"), wcli.get("amplitude_Pa"), wcli.get("frequency_Hz"))
+
+
+def _unit_of(raw, key: str) -> str:
+    """The unit the user gave ``raw`` in ('-5kPa' → 'kPa'), or the key's SI unit for a bare number."""
+    import re
+
+    from tengsim.units import _NUM, _compact
+
+    m = re.fullmatch(f"({_NUM})(.*)", _compact(raw)) if isinstance(raw, str) else None
+    return m.group(2) if m and m.group(2) else key.rsplit("_", 1)[-1]
+
+
+def _as_given(raw, key: str) -> str:
+    """'-5 kPa' of '-5kPa': the value in the user's own unit."""
+    import re
+
+    from tengsim.units import _NUM, _compact
+
+    m = re.match(_NUM, _compact(raw)) if isinstance(raw, str) else None
+    return f"{m.group(0) if m else raw} {_unit_of(raw, key)}"
 
 
 def _note_paper_device(case, cfg, dev_cli, quiet):

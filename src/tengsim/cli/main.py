@@ -20,19 +20,22 @@ SUBCOMMANDS = ["design", "calibrate", "contact", "device", "reproduce", "run", "
 
 class Parser(argparse.ArgumentParser):
     """argparse with tengsim's manners: a bad option is one line naming it (no usage wall), and a negative
-    number in any notation ('-1e+16', '-.5'), with or without a unit ('-5kPa'), is a value, not an option."""
+    number in any notation ('-1e+16', '-.5'), with or without a unit ('-5kPa', '-1%'), is a value, not an option;
+    any other value starting with '-' is given as --option=VALUE, which "expected one argument" says."""
 
     def __init__(self, *args, **kwargs):
         super().__init__(*args, **kwargs)
         # a negative number, or a negative quantity ('-0.59MPa', '-2 kPa', '-5um'): a value, not an option
         self._negative_number_matcher = re.compile(
-            r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?(\s*[A-Za-zµμΩ][A-Za-zµμΩ/^²0-9]*)?$|^-(inf|nan)$", re.I)
+            r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?(\s*(%|[A-Za-zµμΩ][A-Za-zµμΩ/^²0-9]*))?$|^-(inf|nan)$", re.I)
 
     argv: list = []
     """The command line being parsed (set by :func:`_main`): a wrong key points to its command's help."""
 
     def error(self, message):
         # a hostile value echoed by argparse ('invalid int value: ...') is cut, as tengsim's own messages cut it
+        if message.endswith("expected one argument"):
+            message += " (a value starting with '-' is given as --option=VALUE)"
         self.exit(2, f"tengsim: error: {cut(message, 60)} (see '{help_for(Parser.argv, self.prog)}')\n")
 
 

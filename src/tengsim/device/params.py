@@ -168,7 +168,7 @@ class DeviceParams:
     mass_kg: float = _f("moving plate mass M")
     stiffness_N_per_m: float = _f("spring stiffness k_e (N/m; a unit such as '5.12kN/m' is read)",
                                   dim="energy/area")
-    area_m2: float = _f("electrode area S (m2, plain number)")
+    area_m2: float = _f("electrode area S (m2; a unit such as '4cm2' is read)", dim="area")
     thickness_m: float = _f("dielectric thickness T")
     gap_m: float = _f("rest air gap d0")
     eps_r: float = _f("relative permittivity of the dielectric")
