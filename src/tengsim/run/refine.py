@@ -34,7 +34,7 @@ def first_dx(cplan, ask) -> float:
     """The first grid's dx in X units: ``ask.dx`` (a length, m) where given, else the refinement's first grid
     whose dx is at most the law's process zone over :data:`START_ZONE_PIXELS` (:func:`tengsim.run.grids.start_dx`);
     a size that does not fit the cell is said in the user's units."""
-    from tengsim.errors import BudgetExceeded, GeometryError
+    from tengsim.errors import GeometryError
     from tengsim.run.plan import _metres
 
     try:
@@ -104,7 +104,7 @@ def preflight(cplan, ask) -> tuple:
     """Every bound checked from the sizes alone (module doc, 1), in one place: a :class:`tengsim.errors.TengsimError`
     naming the value to change, a size that does not fit in the user's units; (the refinement's :class:`Sizes`
     (:func:`sizes`), the memory of the finest grid its estimate counts, bytes)."""
-    from tengsim.errors import GeometryError
+    from tengsim.errors import BudgetExceeded, GeometryError
     from tengsim.run.memory import check_memory, estimate_bytes
     from tengsim.run.plan import _metres
     from tengsim.units import length_text, time_text
