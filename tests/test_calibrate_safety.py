@@ -328,14 +328,14 @@ def test_no_error_is_classified_by_its_text():
 # ---- estimates that hold -----------------------------------------------------------------------------------
 
 def test_the_expected_designs_count_the_whole_run_not_the_first_grid(tmp_path):
-    """The README's calibration (W free, ε fixed, 4 nodes, 2 zooms, 3 refinements): 27 designs expected, 42 at
-    most (the old estimate counted the first grid's 4)."""
+    """The README's calibration (W free, ε fixed, 4 nodes, 2 zooms, 3 refinements): 37 designs expected (it made
+    34), 42 at most (the old estimate counted the first grid's 4)."""
     from tengsim.calibrate import plan_calibration
     from tengsim.calibrate.checks import expected_designs
 
     prob = plan_calibration([_toml(tmp_path / "d.toml")], [_csv(tmp_path / "m.csv")], "sigma,W")
     batches, most = expected_designs(prob, 4, 2, 3, 1, 1)
-    assert batches == [4, 5, 4, 5, 4, 5] and most == 42
+    assert batches == [4, 5, 4, 5, 4, 5, 5, 5] and most == 42
     prob2 = plan_calibration([_toml(tmp_path / "d.toml")], [_csv(tmp_path / "m.csv")], "sigma,W,eps")
     assert expected_designs(prob2, 3, 1, 0, 2, 2) == ([18, 18, 18, 18], 72)
 
@@ -356,6 +356,6 @@ def test_calibrate_says_the_whole_runs_time_after_the_first_design(tmp_path, cap
                "sigma,W", "--bounds", "W=10mJ/m2:60mJ/m2", "--out", str(tmp_path / "o")])
     err = capsys.readouterr().err
     assert rc == 130
-    assert "the calibration: about 27 designs (at most 42" in err, err
-    # after the first design (30 s): the 26 left at 30 s each, 13 min
-    assert "the whole calibration: about 13.0 min more (26 designs expected at 30 s each" in err, err
+    assert "the calibration: about 37 designs (at most 42" in err, err
+    # after the first design (30 s): the 36 left at 30 s each, 18 min
+    assert "the whole calibration: about 18.0 min more (36 designs expected at 30 s each" in err, err

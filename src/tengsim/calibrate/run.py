@@ -4,7 +4,8 @@
 parameters and bounds, that the voltage can be reached).  :func:`calibrate` then
 
 1. lays an n × n grid of nodes (default 4 × 4) over the bounds of (W_eff, ε) (the axes that are free), prints how
-   many designs it will solve and the designs' own time estimate, and solves each (kept in ``DIR/designs``);
+   many designs the whole run is expected to solve (:func:`tengsim.calibrate.checks.expected_designs`; after the
+   first, their time at the time per design measured), and solves each (kept in ``DIR/designs``);
 2. fits (:func:`tengsim.calibrate.fit.fit`) and measures the interpolation's error
    (:func:`tengsim.calibrate.checks.interpolation_error`: designs at the best fit, at both ends of each free contact
    parameter's interval and half-way beyond each end), the largest; if it is above half the data's noise, lays a
@@ -198,9 +199,8 @@ def calibrate(prob, out_dir, n_nodes: int = 4, zooms: int = 2, progress=None, re
 
 
 def _calibrate(prob, out_dir, n_nodes, zooms, progress, refine, expected_noise) -> Calibration:
-    from tengsim.calibrate.checks import interpolation_error
+    from tengsim.calibrate.checks import expected_designs, interpolation_error
     from tengsim.calibrate.fit import Model, band, fit, residual_text
-    from tengsim.calibrate.checks import expected_designs
     from tengsim.calibrate.surrogate import (POINTS_PER_CURVE, Surrogate, geometry_key, grid_points, node_table,
                                              solve_node)
     from tengsim.design.units import time_text
