@@ -55,6 +55,13 @@ class ParallelBar:
     def usig(self, xb, der=0):
         return self.voc(xb, der)
 
+    def wq(self, xb):
+        """The layer's voltage per unit q (sheet minus back electrode): -g3."""
+        return -self.g3 + 0.0 * xb
+
+    def ws(self, xb):
+        return 0.0 * xb
+
 
 @dataclass(frozen=True, eq=False)
 class FiniteBar:
@@ -72,12 +79,19 @@ class FiniteBar:
     def usig(self, xb, der=0):
         return self.splines[2](xb, der)
 
+    def wq(self, xb):
+        return self.splines[3](xb)
+
+    def ws(self, xb):
+        return self.splines[4](xb)
+
 
 def gap_coefficients(shape: str, size_m: float, thickness_m: float, eps_r: float, gaps_m, n: int | None = None):
-    """SI coefficients at each gap: (1/C in 1/F, v in V/C, u in J/C^2), arrays over ``gaps_m``."""
+    """SI coefficients at each gap: 1/C (1/F), v (V/C), u (J/C^2), and the layer's voltage per unit Q and
+    per unit sigma A (V/C; the air gap's mean voltage is V - Q wq - sigma A ws), arrays over ``gaps_m``."""
     n = PANELS[shape] if n is None else n
     te = thickness_m / eps_r / size_m
-    out = np.array([[getattr(field_bem.solve(shape, g / size_m, te, n), k) for k in ("cinv", "voc", "usig")]
+    out = np.array([[getattr(field_bem.solve(shape, g / size_m, te, n), k) for k in ("cinv", "voc", "usig", "wq", "ws")]
                     for g in np.atleast_1d(np.asarray(gaps_m, float))])
     return out.T / (4.0 * math.pi * EPS0 * size_m)
 
@@ -88,7 +102,7 @@ def _finite_bar(shape, area_m2, thickness_m, eps_r, gap_m, xb_max, n_gaps, n):
     xb = xb_max * (np.arange(n_gaps) / (n_gaps - 1)) ** 2
     coef = gap_coefficients(shape, size, thickness_m, eps_r, xb * gap_m, n)
     bar = coef * EPS0 * area_m2 / gap_m
-    bar[1:, 0] = 0.0  # v(0) = u(0) = 0 exactly (the sheet lies on the moving electrode)
+    bar[1:3, 0] = 0.0  # v(0) = u(0) = 0 exactly (the sheet lies on the moving electrode)
     return FiniteBar(tuple(CubicSpline(xb, b) for b in bar), float(xb_max))
 
 

@@ -109,7 +109,7 @@ def _square_influence(t, dz):
     return d.transpose(0, 2, 1, 3).reshape(n * n, n * n)
 
 
-_T, _W = np.polynomial.legendre.leggauss(24)
+_T, _W = np.polynomial.legendre.leggauss(16)
 _T, _W = 0.5 * (_T + 1.0), 0.5 * _W
 
 
@@ -162,6 +162,10 @@ class GapSolution:
     cinv: float
     voc: float
     usig: float
+    wq: float = 0.0
+    """Mean sheet potential minus the back electrode's, per unit Q (problem a): the layer's own voltage."""
+    ws: float = 0.0
+    """The same per unit sigma A (problem b); the air gap's mean voltage is V - (Q wq + sigma A ws)."""
 
 
 def solve(shape: str, gap: float, t_e: float, n: int = 40) -> GapSolution:
@@ -193,4 +197,8 @@ def solve(shape: str, gap: float, t_e: float, n: int = 40) -> GapSolution:
     voc = sol[2 * m, 1] - sol[2 * m + 1, 1]
     phi_sheet = g_ts @ sol[:m, 1] + g_bs @ sol[m:2 * m, 1] + g0 @ np.full(m, s_sheet)
     usig = sol[2 * m, 1] + float(np.sum(pan.area * s_sheet * phi_sheet))
-    return GapSolution(float(cinv), float(voc), float(usig))
+    phi_sheet_a = g_ts @ sol[:m, 0] + g_bs @ sol[m:2 * m, 0]
+    mean = lambda phi: float(np.sum(pan.area * phi) / pan.area.sum())  # noqa: E731
+    wq = mean(phi_sheet_a) - sol[2 * m + 1, 0]
+    ws = mean(phi_sheet) - sol[2 * m + 1, 1]
+    return GapSolution(float(cinv), float(voc), float(usig), wq, ws)
