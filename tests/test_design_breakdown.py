@@ -33,3 +33,17 @@ def test_a_charge_above_the_cap_is_flagged():
     b = design_breakdown(500e-6, 3.0, 200e-6, 0.2e-3, 0.5)  # calibrate's upper bound, half the area charged
     assert b["breakdown_exceeded"] and b["sigma_area_fraction_C_m2"] == pytest.approx(250e-6)
     assert 30e-6 < b["sigma_breakdown_C_m2"] < 200e-6
+
+
+def test_calibrate_flags_a_fitted_sigma_above_the_cap():
+    from types import SimpleNamespace as NS
+
+    from tengsim.calibrate.write import breakdown_warning
+
+    plan = NS(eps_r=3.0, T=200e-6, gap=0.2e-3)
+    cap = design_breakdown(1.0, 3.0, 200e-6, 0.2e-3, 1.0)["sigma_breakdown_C_m2"]
+    high = NS(problem=NS(fixed={}, plans=[plan]), fit=NS(best={"sigma": 2 * cap}))
+    lines = breakdown_warning(high)
+    assert len([ln for ln in lines if ln]) == 1 and "above the air-breakdown cap" in lines[-1]
+    low = NS(problem=NS(fixed={}, plans=[plan]), fit=NS(best={"sigma": 0.5 * cap}))
+    assert breakdown_warning(low) == []
