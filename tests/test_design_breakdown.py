@@ -47,3 +47,22 @@ def test_calibrate_flags_a_fitted_sigma_above_the_cap():
     assert len([ln for ln in lines if ln]) == 1 and "above the air-breakdown cap" in lines[-1]
     low = NS(problem=NS(fixed={}, plans=[plan]), fit=NS(best={"sigma": 0.5 * cap}))
     assert breakdown_warning(low) == []
+
+
+def test_comparison_ranks_by_the_charge_held_when_a_design_exceeds_the_cap():
+    from types import SimpleNamespace as NS
+
+    from tengsim.design.compare import compare_table, ranked
+
+    def design(name, sigma, gap, a):
+        return NS(plan=NS(name=name, shape="pyramid", sigma=sigma, eps_r=3.0, T=200e-6, gap=gap),
+                  summary={"area_at_p_max": a})
+
+    wide = design("wide", 100e-6, 0.2e-3, 0.9)  # 90 uC/m2 over a cap of about 66 at a 0.2 mm gap
+    narrow = design("narrow", 100e-6, 0.05e-3, 0.8)  # 80 uC/m2 under a cap of about 106 at 50 um
+    assert wide.plan.sigma * 0.9 > design_breakdown(1, 3.0, 200e-6, 0.2e-3, 1)["sigma_breakdown_C_m2"]
+    assert [r.plan.name for r in ranked([wide, narrow])] == ["narrow", "wide"]  # by the charge held
+    t = compare_table([wide, narrow])
+    assert t["held_charge_C_m2"][0] == pytest.approx(80e-6) and t["held_charge_C_m2"][1] == t["sigma_breakdown_C_m2"][1]
+    low = [design("wide", 10e-6, 0.2e-3, 0.9), design("narrow", 10e-6, 0.05e-3, 0.8)]
+    assert [r.plan.name for r in ranked(low)] == ["wide", "narrow"]  # none capped: by A/S, as before
