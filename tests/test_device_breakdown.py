@@ -52,3 +52,23 @@ def test_open_circuit_run_holds_the_open_circuit_bound():
     assert sigma_breakdown_run(r) == pytest.approx(bound, rel=2e-3)
     loaded = sigma_breakdown_run(simulate(p.replace(load_ohm=1e6), fig7_waveform(), 0.4, dt_out=2e-5))
     assert loaded >= bound * (1 - 2e-3)  # the transferred charge only lowers the gap voltage
+
+
+def test_breakdown_cycle_is_the_cmeo_capped():
+    from tengsim.device import cmeo_cycle, fom_structural
+    from tengsim.device.breakdown import breakdown_cycle
+
+    p = flat(0.02)
+    below = breakdown_cycle(p.replace(sigma_C_per_m2=10e-6), 1e-3)
+    ref = cmeo_cycle(10e-6, p.area_m2, p.thickness_m, p.eps_r, 1e-3)
+    assert below.energy_J == pytest.approx(ref.energy_J, rel=1e-9) and below.energy_unlimited_J == below.energy_J
+    assert below.fom_structural == pytest.approx(fom_structural(1e-3, p.thickness_m, p.eps_r), rel=1e-9)
+    above = breakdown_cycle(p.replace(sigma_C_per_m2=200e-6), 1e-3)
+    cap = sigma_breakdown(p, x_max_m=1e-3).sigma_breakdown_C_m2
+    assert above.sigma_held_C_m2 == pytest.approx(cap)
+    assert above.energy_J == pytest.approx(above.energy_unlimited_J * (cap / 200e-6) ** 2, rel=1e-9)
+    fin = breakdown_cycle(flat(0.02, "finite").replace(sigma_C_per_m2=10e-6), 1e-3)
+    assert fin.energy_J < below.energy_J  # fringing lowers V_OC and Q_SC
+    from scipy.integrate import trapezoid
+
+    assert trapezoid(fin.voltage_V, fin.charge_C) == pytest.approx(fin.energy_J, rel=1e-9)
