@@ -31,10 +31,32 @@ def _eq17(d1, pressure):
     return float(np.interp(pressure, P, v))
 
 
+def test_its_default_field_is_finite_a_square_of_the_electrode_area(d1, tmp_path, capsys):
+    from tengsim.device import EPS0
+    from tengsim.device.field import gap_coefficients
+
+    out = tmp_path / "dev.csv"
+    assert main(["device", "design", "--area-from", str(d1 / "design.nc"), "--load-ohm", "1MOhm", "--out",
+                 str(out)]) == 0
+    err = capsys.readouterr().err
+    assert "field model finite: a square electrode of area S (side 20 mm" in err
+    side = json.loads(out.with_suffix(".json").read_text())
+    s = side["summary"]
+    assert s["field_model"] == "finite" and side["params"]["field"] == "finite"
+    assert s["electrode"] == {"shape": "square", "size_m": pytest.approx(0.02), "area_m2": pytest.approx(4e-4)}
+    v = gap_coefficients("square", 0.02, 200e-6, 3.0, [s["gap_at_rest_m"]])[1][0]
+    ratio = v * EPS0 * 4e-4 / s["gap_at_rest_m"]  # finite V_OC over the parallel plates' at the rest gap
+    assert 0.9 < ratio < 0.99  # 0.2 mm on 2 cm: fringing
+    assert s["voc_at_rest_gap_V"] == pytest.approx(ratio * _eq17(d1, 20e3), rel=0.01)
+    assert s["voc_at_max_gap_V"]["finite"] < s["voc_at_max_gap_V"]["parallel"]
+    assert 0 < s["sigma_breakdown_C_m2"] < 1e-3 and s["breakdown_exceeded"] is False  # 8 uC/m2 is held
+
+
 @pytest.mark.parametrize("pressure", [None, "10kPa"])
 def test_its_voc_at_the_rest_gap_is_the_designs_eq17(d1, tmp_path, capsys, pressure):
     out = tmp_path / "dev.csv"
-    argv = ["device", "design", "--area-from", str(d1 / "design.nc"), "--load-ohm", "1MOhm", "--out", str(out)]
+    argv = ["device", "design", "--area-from", str(d1 / "design.nc"), "--load-ohm", "1MOhm", "--out", str(out),
+            "--field", "parallel"]  # Eq. 17 is the parallel plates' (the finite default: the test below)
     assert main(argv + (["--pressure", pressure] if pressure else [])) == 0
     err = capsys.readouterr().err
     side = json.loads(out.with_suffix(".json").read_text())
@@ -73,7 +95,7 @@ def test_options_and_config_replace_the_defaults(d1, tmp_path, capsys):
     assert side["params"]["mass_kg"] == pytest.approx(0.02) and side["params"]["stiffness_N_per_m"] == 6e3
     assert side["waveform"]["frequency_Hz"] == 4.0
     defaults = side["summary"]["designed_device"]["defaults"]
-    assert set(defaults) == {"area_m2", "load_ohm", "amplitude_Pa"}
+    assert set(defaults) == {"area_m2", "load_ohm", "amplitude_Pa", "field"}  # field: finite, issue 51
     # the defaults are the paper's Fig. 8 device, whose σ, ε_r, T and d0 a design takes by default
     from tengsim.cases.paper import fig8_params
 

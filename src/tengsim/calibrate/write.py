@@ -143,6 +143,24 @@ def material_text(cal) -> str:
     return "\n".join(lines) + "\n"
 
 
+def breakdown_warning(cal) -> list:
+    """One warning line when the fitted σ is above the air-breakdown cap of a curve's device (issue 51;
+    tengsim.design.breakdown: open circuit, 4 cm² electrode, gaps up to d0): no device holds that charge."""
+    from tengsim.design.breakdown import design_breakdown
+
+    prob = cal.problem
+    sigma = {**prob.fixed, **cal.fit.best}.get("sigma")
+    if sigma is None:
+        return []
+    caps = [design_breakdown(sigma, p.eps_r, p.T, p.gap, 1.0)["sigma_breakdown_C_m2"] for p in prob.plans]
+    cap = min(caps)
+    if sigma <= cap:
+        return []
+    return ["", f"**Warning: the fitted σ = {sigma * 1e6:.4g} µC/m² is above the air-breakdown cap "
+                f"{cap * 1e6:.3g} µC/m² of the curves' device (Paschen, open circuit, 4 cm², gaps up to d0): the "
+                "gap would discharge; no device holds that charge (docs/device.md).**"]
+
+
 def report_text(cal, figures) -> str:
     from tengsim.calibrate.fit import inflation, residual_text
 
@@ -157,6 +175,7 @@ def report_text(cal, figures) -> str:
         out.append(f"| {label(k)} | {text(k, f.best[k])} | {text(k, lo)} – {text(k, hi)} | {note} |")
     for k, v in prob.fixed.items():
         out.append(f"| {label(k)} | {text(k, v)} (fixed) | | |")
+    out += breakdown_warning(cal)
     out += ["", "## What the data determine", ""] + [f"* {w}" for w in f.words]
     if len(f.names):
         out += ["", "## Correlation (log parameters)", "", "| | " + " | ".join(label(n) for n in f.names) + " |",

@@ -67,6 +67,9 @@ def register(subparsers) -> None:
         sp.add_argument("--force-model", choices=FORCE_MODELS, default=None, help="electrostatic force (default field)")
         sp.add_argument("--initial-charge", choices=INITIAL_CHARGES, default=None,
                         help="Q(0): zero (paper) or rest (V = 0, no start spike)")
+        from tengsim.cli import device_field
+
+        device_field.add_options(sp)
 
     f7 = sub.add_parser("fig7", help="flat device, 10 N 5 Hz square wave (Fig. 7)", description=CONFIG_HELP)
     common(f7, 5)
@@ -183,6 +186,11 @@ def execute(case: str, cfg: dict, cli: dict | None = None, quiet: bool = False, 
             from tengsim.io import jsonable
 
             summary = jsonable(res.summary(skip))
+    from tengsim.cli import device_field
+
+    summary = {**summary, **device_field.field_summary(params, res, cli.get("air_pressure_Pa"))}
+    if not quiet and device_field.warning(summary):
+        print(device_field.warning(summary), file=sys.stderr)
     return _write(res, out, summary, quiet, {"case": case, "config": cfg, "config_file": source})
 
 

@@ -20,7 +20,8 @@ OPTIONS = {"out": ("run", "out"), "cycles": ("run", "cycles"), "t_end": ("run", 
             "r_min": ("sweep", "r_min_ohm"), "r_max": ("sweep", "r_max_ohm"), "points": ("sweep", "points"),
             "area_from": ("device", "area"), "mass": ("device", "mass_kg"),
             "stiffness": ("device", "stiffness_N_per_m"), "electrode_area": ("device", "area_m2"),
-            "pressure": ("waveform", "amplitude_Pa"), "frequency": ("waveform", "frequency_Hz")}
+            "pressure": ("waveform", "amplitude_Pa"), "frequency": ("waveform", "frequency_Hz"),
+            "field": ("device", "field")}
 
 
 def read(path) -> dict:
@@ -38,6 +39,12 @@ def options(args) -> dict:
         v = getattr(args, opt, None)
         if v is not None and v != "":
             out.setdefault(table, {})[key] = v
+    from tengsim.cli import device_field  # --electrode-side/--electrode-diameter: S and the shape
+
+    for key, v in device_field.device_values(args).items():
+        out.setdefault("device", {})[key] = v
+    if getattr(args, "air_pressure", None) is not None:
+        out["air_pressure_Pa"] = device_field.air_pressure(args)
     return out
 
 
@@ -55,7 +62,7 @@ def typed(table, values: dict) -> dict:
 
             out[key] = area_table_from_file(raw)
             continue
-        f = dataclasses.replace(table.fields[key], name=names[key])
+        f = dataclasses.replace(table.fields[key], name=names.get(key, key))
         out[key] = f.parse(raw)
     return out
 

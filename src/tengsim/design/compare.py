@@ -13,13 +13,34 @@ COLUMNS = ("status", "tabor", "jump_in_Pa", "pull_off_N", "pull_off_Pa", "full_c
            "voc_eq17_at_p_max_V", "grids", "tolerance")
 
 
+def _area(r) -> float:
+    a = r.summary.get("area_at_p_max")
+    return float(a) if a is not None and np.isfinite(float(a)) else np.nan
+
+
+def held(r) -> tuple:
+    """(σ A/S at p_max, the air-breakdown cap, the charge density the device holds: the smaller; C/m²)."""
+    from tengsim.design.breakdown import breakdown_cap
+
+    p = r.plan
+    cap = breakdown_cap(float(p.eps_r), float(p.T), float(p.gap))
+    q = float(p.sigma) * _area(r)
+    return q, cap, min(q, cap) if np.isfinite(q) else np.nan
+
+
 def ranked(results) -> list:
     """The designs ranked by their charged area A/S at p_max (largest first; NaN last): V_OC (Eq. 12 and 17) goes
-    as A/S, a device's power as its square."""
-    def key(r):
-        a = r.summary.get("area_at_p_max")
-        return -float(a) if a is not None and np.isfinite(float(a)) else np.inf
-    return sorted(results, key=key)
+    as A/S, a device's power as its square. When a design's σ A/S exceeds its air-breakdown cap (issue 51;
+    tengsim.design.breakdown), by the charge density each device can hold, min(σ A/S, cap), then by A/S."""
+    rows = [(r, *held(r)) for r in results]
+    capped = any(np.isfinite(q) and q > cap for _, q, cap, _ in rows)
+
+    def key(row):
+        r, _, _, h = row
+        a = _area(r)
+        by_area = -a if np.isfinite(a) else np.inf
+        return ((-h if np.isfinite(h) else np.inf), by_area) if capped else (by_area,)
+    return [row[0] for row in sorted(rows, key=key)]
 
 
 def compare_table(results) -> dict:
@@ -33,6 +54,8 @@ def compare_table(results) -> dict:
     for c in COLUMNS:
         vals = [r.summary.get(c) for r in results]
         cols[c] = np.array(vals, dtype=object if any(isinstance(v, str) for v in vals) else float)
+    h = np.array([held(r) for r in results], float).reshape(-1, 3)
+    cols["sigma_area_at_p_max_C_m2"], cols["sigma_breakdown_C_m2"], cols["held_charge_C_m2"] = h.T
     return cols
 
 

@@ -109,6 +109,12 @@ def designed_device(path, device: dict | None = None, waveform: dict | None = No
         if name not in device:
             values[name], defaults[name] = DEFAULTS[name][0], DEFAULTS[name][1]
     values.update(device)
+    if "field" not in device:  # the designed device's own field: finite electrodes, a square of area S
+        values["field"] = "finite"
+        values.setdefault("electrode_shape", "square")
+        defaults["field"] = (f"field model finite: a {values['electrode_shape']} electrode of area S "
+                             f"({'side' if values['electrode_shape'] == 'square' else 'diameter'} "
+                             f"{format_si(_size(values), 'm')}; --field parallel for the paper's plates)")
     if "area" not in device:
         values["area"] = table
     params = DeviceParams(**values)
@@ -135,6 +141,12 @@ def designed_device(path, device: dict | None = None, waveform: dict | None = No
     waveform = wave
     designed = DesignedDevice(params, waveform, str(p), from_design, defaults, (lo, hi))
     return designed
+
+
+def _size(values) -> float:
+    from tengsim.device.field import electrode_size
+
+    return electrode_size(values["electrode_shape"], float(values["area_m2"]))
 
 
 def rest_gap_voltage(designed: DesignedDevice, result) -> dict:

@@ -54,6 +54,22 @@ def sensor_lines(numbers) -> list:
             *describe(numbers)]
 
 
+def _breakdown_line(result) -> str:
+    """The air-breakdown cap on σ A/S and whether the design's exceeds it (tengsim.design.breakdown)."""
+    import math
+
+    import numpy as np
+
+    from tengsim.design.breakdown import design_breakdown, report_line
+    from tengsim.design.curves import branch_curves
+
+    p = result.plan
+    a = np.asarray(branch_curves(result.finest, p)["approach"].get("area", []), float) \
+        if hasattr(result, "finest") else np.array([])
+    a_max = float(np.nanmax(a)) if a.size and np.any(np.isfinite(a)) else math.nan
+    return report_line(design_breakdown(p.sigma, p.eps_r, p.T, p.gap, a_max))
+
+
 def report_text(result, figures) -> str:
     p, s = result.plan, result.summary
     lines = [f"# Design: {p.name}", "",
@@ -66,6 +82,7 @@ def report_text(result, figures) -> str:
              f"Device (Eq. 12 and Eq. 17): σ = {p.sigma * 1e6:.4g} µC/m², ε_r = {p.eps_r:.4g}, "
              f"T = {length_text(p.T)}, "
              f"rest gap d0 = {length_text(p.gap)} (defaults: the paper's 5.84 µC/m², 2.40, 400 µm, 0.1 mm).",
+             _breakdown_line(result),
              f"Pressures: {pressure_text(p.pressures[0])} to {pressure_text(p.pressures[-1])}, "
              f"{len(p.pressures)} values.",
              "", f"Charged area ({'the default' if p.area == 'contact' else 'area = paper'}): "

@@ -83,6 +83,12 @@ def to_dataset(res, plan, summary: dict):
         "branches_solved": "approach and retraction" if getattr(plan, "retraction", True) else "approach",
         "contact_config": json.dumps({k: v for k, v in plan.contact_table.items()}, sort_keys=True, default=str),
     }
+    from tengsim.design.breakdown import design_breakdown  # issue 51: the air gap's cap on σ A/S
+
+    a_max = float(np.nanmax(data["charged_area_fraction"][1][0])) if np.any(
+        np.isfinite(data["charged_area_fraction"][1][0])) else math.nan
+    b = design_breakdown(plan.sigma, plan.eps_r, plan.T, plan.gap, a_max)
+    attrs.update({**b, "breakdown_exceeded": int(b["breakdown_exceeded"])})  # 0/1: NetCDF has no booleans
     sensor, reasons = summary.get("sensor"), summary.get("reasons") or {}
     for k, v in summary.items():
         if k in SUMMARY_UNITS and k != "tabor":

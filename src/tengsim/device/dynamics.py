@@ -24,6 +24,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
+from tengsim.device.field import bar_field
 from tengsim.device.params import DeviceParams, SolverOptions
 from tengsim.device.result import DeviceResult
 from tengsim.errors import finite, positive, require
@@ -45,6 +46,8 @@ class _Core:
         self.two_zeta = 2.0 * p.damping_ratio
         self.mode = p.load_mode
         self.reg = p.eq20_reg
+        self.fld = bar_field(p)  # C(x), v(x), u(x) of the field model (parallel: g3 + xb, xb, xb)
+        self.cinv0 = float(self.fld.cinv(0.0))  # eps0 S/(d0 C) in contact (parallel: g3)
         self.g1 = 0.0  # area fraction, set per phase
         self.t_lo, self.t_hi = 0.0, math.inf  # inside of the current smooth segment (tbar)
 
@@ -56,13 +59,19 @@ class _Core:
         """Fbar_e toward the polymer."""
         fm = self.p.force_model
         if fm == "field":
+            if self.p.field == "finite":  # dU/dx at fixed charge, U = kappa/2 (q^2 cinv - 2 q g1 voc + g1^2 usig)
+                f, xb = self.fld, 1.0 - y
+                return 0.5 * self.kappa * (q * q * f.cinv(xb, 1) - 2.0 * q * g1 * f.voc(xb, 1)
+                                           + g1 * g1 * f.usig(xb, 1))
             return 0.5 * self.kappa * (g1 - q) ** 2
         if fm == "eq20":
             return 0.5 * g1 * self.kappa * ((g1 - q) ** 2 - (q * self.g3 / (1.0 - y + self.reg)) ** 2)
         return 0.0 * q
 
     def vbar(self, y, q, g1):
-        """V / (sigma d0/eps0), Eq. (14)."""
+        """V / (sigma d0/eps0), Eq. (14) (finite field: -q cinv + g1 voc)."""
+        if self.p.field == "finite":
+            return -q * self.fld.cinv(1.0 - y) + g1 * self.fld.voc(1.0 - y)
         return -q * (self.g3 + 1.0 - y) + g1 * (1.0 - y)
 
     def rhs(self, tb, s):
@@ -75,6 +84,11 @@ class _Core:
             vb = self.vbar(y, q, g1)
             dq = self.g2 * vb
             de = self.g2 * self.kappa * vb * vb
+        elif self.mode == "short" and self.p.field == "finite":  # Q = g1 voc/cinv along the travel
+            f, xb = self.fld, 1.0 - y
+            ci = f.cinv(xb)
+            dq = -g1 * (f.voc(xb, 1) * ci - f.voc(xb) * f.cinv(xb, 1)) / ci ** 2 * v
+            de = 0.0
         elif self.mode == "short":
             dq = -g1 * self.g3 * v / (self.g3 + 1.0 - y) ** 2  # Eq. (19)
             de = 0.0
@@ -126,7 +140,7 @@ def simulate(params: DeviceParams, waveform, t_end: float, *, dt_out: float | No
     require(0.0 <= g1 <= 1.0, f"area0 must be a fraction A/S in [0, 1], got {g1!r}")
     s = np.zeros(_NSTATE)
     if params.initial_charge == "rest" or params.load_mode == "short":
-        s[2] = g1 / (core.g3 + 1.0)  # Q_SC at the rest gap: V = 0
+        s[2] = g1 * float(core.fld.voc(1.0)) / float(core.fld.cinv(1.0))  # Q_SC at the rest gap: V = 0
     if q0_C is not None and params.load_mode != "short":
         s[2] = finite("q0_C", q0_C) / params.charge_scale
     contact = released = False
@@ -166,7 +180,7 @@ def simulate(params: DeviceParams, waveform, t_end: float, *, dt_out: float | No
                     contact, released = False, True
                     releases.append(a * tau)
                     continue
-                lam = 0.0 if core.mode == "open" else (math.inf if core.mode == "short" else core.g2 * core.g3)
+                lam = 0.0 if core.mode == "open" else (math.inf if core.mode == "short" else core.g2 * core.cinv0)
                 q_in = _contact_charge(s[2], lam, a)
 
                 def pull(x):
@@ -184,7 +198,7 @@ def simulate(params: DeviceParams, waveform, t_end: float, *, dt_out: float | No
                 st = np.tile(s, (tg.size, 1))
                 st[:, 2] = q0 * decay
                 if core.mode == "finite":
-                    st[:, 5] = e0 + 0.5 * core.kappa * core.g3 * q0 ** 2 * (1 - decay ** 2)
+                    st[:, 5] = e0 + 0.5 * core.kappa * core.cinv0 * q0 ** 2 * (1 - decay ** 2)
                 if tg.size:
                     demand = _area_fraction(core, tg)
                     gs = (np.maximum.accumulate(np.maximum(demand, g1)) if params.area_memory == "max"
@@ -192,7 +206,7 @@ def simulate(params: DeviceParams, waveform, t_end: float, *, dt_out: float | No
                     emit(tg, st, True, gs, e_impact)
                 dec = math.exp(-lam * (t_rel - a)) if lam < math.inf else 0.0
                 if core.mode == "finite":
-                    s[5] = e0 + 0.5 * core.kappa * core.g3 * q0 ** 2 * (1 - dec ** 2)
+                    s[5] = e0 + 0.5 * core.kappa * core.cinv0 * q0 ** 2 * (1 - dec ** 2)
                 s[2] = q0 * dec
                 g1 = _contact_area(core, g1, a, t_rel)
                 if t_rel < b - eps_t:

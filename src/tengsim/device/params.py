@@ -16,6 +16,8 @@ from tengsim.errors import TengsimError, finite, positive, require
 from tengsim.schema import REQUIRED
 
 FORCE_MODELS = ("field", "eq20", "none")
+FIELD_MODELS = ("parallel", "finite")  # device/field.py
+ELECTRODE_SHAPES = ("square", "disk")
 AREA_PRESSURES = ("applied", "contact")
 AREA_MEMORIES = ("max", "release")
 INITIAL_CHARGES = ("zero", "rest")
@@ -185,6 +187,10 @@ class DeviceParams:
                           choices=AREA_MEMORIES)
     initial_charge: str = _f("Q(0): zero (paper), or rest (V = 0, no start spike)", "zero",
                              choices=INITIAL_CHARGES)
+    field: str = _f("field model: parallel plates (Eqs. 14-19) or finite electrodes (boundary elements)",
+                    "parallel", choices=FIELD_MODELS)
+    electrode_shape: str = _f("finite field only: square (side sqrt S) or disk (diameter sqrt(4 S/pi))",
+                              "square", choices=ELECTRODE_SHAPES)
 
     def __post_init__(self):
         for name in ("mass_kg", "stiffness_N_per_m", "area_m2", "thickness_m", "gap_m", "eps_r",
@@ -204,6 +210,10 @@ class DeviceParams:
         _choice("area_pressure", self.area_pressure, AREA_PRESSURES)
         _choice("area_memory", self.area_memory, AREA_MEMORIES)
         _choice("initial_charge", self.initial_charge, INITIAL_CHARGES)
+        _choice("field", self.field, FIELD_MODELS)
+        _choice("electrode_shape", self.electrode_shape, ELECTRODE_SHAPES)
+        require(self.field == "parallel" or self.force_model != "eq20",
+                "force_model 'eq20' is the parallel plates' Eq. 20; the finite field takes 'field' or 'none'")
 
     # --- scales and dimensionless groups (Eq. 23) ---
     @property

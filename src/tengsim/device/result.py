@@ -83,6 +83,15 @@ class DeviceResult:
             fe = np.zeros_like(t)
         fe = np.where(contact, 0.0, fe)
         es = p.energy_scale
+        finite_field = {}
+        if p.field == "finite":  # the boundary-element field (device/field.py) replaces Eqs. 14, 17-19
+            from tengsim.device.field import si_series
+
+            finite_field = si_series(p, q, a, gap, ydot)
+            volt = finite_field["V"] if p.load_mode != "short" else volt
+            cur = (volt / p.load_ohm if p.load_mode == "finite"
+                   else finite_field["I_sc"] if p.load_mode == "short" else cur)
+            fe = np.where(contact, 0.0, finite_field["F_e"]) if p.force_model == "field" else fe
         series = {
             "t": t, "y": y, "ydot": ydot, "gap": gap, "Q": q, "I": cur, "V": volt,
             "V_oc": fm.voc_apart(sig, a, gap, S), "Q_sc": fm.qsc_apart(sig, a, gap, T, er), "I_sc": isc,
@@ -92,6 +101,11 @@ class DeviceResult:
             "E_mech": 0.5 * p.mass_kg * ydot ** 2 + 0.5 * p.stiffness_N_per_m * y ** 2,
             "U": fm.electrostatic_energy(q, sig, a, gap, S, T, er),
         }
+        for k in ("V_oc", "Q_sc", "I_sc", "U"):
+            if finite_field:
+                series[k] = finite_field[k]
+        if finite_field:
+            series["power"] = cur * volt
         return cls(p, waveform, options, series, impacts, releases, int(nfev), float(wall_s))
 
     # --- cycles ---

@@ -1,0 +1,102 @@
+"""The field-model options of ``tengsim device`` (--field, --electrode-side, --electrode-diameter, --air-pressure)
+and the field's lines of a run's summary: the field model, V_OC under both models, the breakdown-limited σ.
+
+Additive to cli/device.py: :func:`add_options` adds the options to a case's parser, :func:`device_values` turns
+them into DeviceParams values (merged by cli/device_inputs.options), :func:`field_summary` the output keys.
+"""
+from __future__ import annotations
+
+import math
+
+from tengsim.errors import TengsimError
+
+FIELD_HELP = ("field model: parallel (infinite plates, Eqs. 14-19, the paper's) or finite (electrodes of the given "
+              "size and shape, boundary elements; docs/device.md); default parallel, device design: finite")
+
+
+def add_options(sp) -> None:
+    sp.add_argument("--field", choices=("parallel", "finite"), default=None, help=FIELD_HELP)
+    sp.add_argument("--electrode-side", help="square electrode of this side, e.g. 2cm (sets S = side²)")
+    sp.add_argument("--electrode-diameter", help="disk electrode of this diameter, e.g. 2cm (sets S = π D²/4)")
+    sp.add_argument("--air-pressure", help="air pressure for Paschen's breakdown, e.g. 101.3kPa (default 1 atm)")
+
+
+def device_values(args) -> dict:
+    """{DeviceParams key: value} from --electrode-side / --electrode-diameter (S and the shape); one-line errors."""
+    from tengsim.units import parse_quantity
+
+    side, diam = getattr(args, "electrode_side", None), getattr(args, "electrode_diameter", None)
+    if side is None and diam is None:
+        return {}
+    if side is not None and diam is not None:
+        raise TengsimError("give --electrode-side (square) or --electrode-diameter (disk), not both")
+    if getattr(args, "electrode_area", None) is not None:
+        raise TengsimError("give --electrode-area or the electrode's size (--electrode-side/--electrode-diameter), "
+                           "not both")
+    opt, raw = ("--electrode-side", side) if side is not None else ("--electrode-diameter", diam)
+    size = parse_quantity(raw, "length", opt)
+    if not size > 0:
+        raise TengsimError(f"{opt} must be > 0, got {raw!r}")
+    if side is not None:
+        return {"area_m2": size * size, "electrode_shape": "square"}
+    return {"area_m2": math.pi * size * size / 4, "electrode_shape": "disk"}
+
+
+def air_pressure(args) -> float:
+    from tengsim.device.paschen import ATM_PA
+    from tengsim.units import parse_quantity
+
+    raw = getattr(args, "air_pressure", None)
+    if raw is None:
+        return ATM_PA
+    p = parse_quantity(raw, "pressure", "--air-pressure")
+    if not p > 0:
+        raise TengsimError(f"--air-pressure must be > 0, got {raw!r}")
+    return p
+
+
+def field_summary(params, result, pressure_Pa: float | None = None) -> dict:
+    """The field's keys of a run's summary: model, electrode, V_OC at the largest gap under both models,
+    sigma_breakdown_C_m2 (open-circuit cap on σ A/S), the short-circuit and the load's, and whether σ A/S exceeds."""
+    import numpy as np
+
+    from tengsim.device.breakdown import sigma_breakdown, sigma_breakdown_run
+    from tengsim.device.field import electrode_size, gap_coefficients
+    from tengsim.device.paschen import ATM_PA, SOURCE
+    from tengsim.device.params import EPS0
+
+    p = params
+    pa = ATM_PA if pressure_Pa is None else pressure_Pa
+    s = result.series
+    x_max = float(np.max(s["gap"]))
+    charged = float(np.max(s["area"])) / p.area_m2  # A/S held in flight
+    sa = p.sigma_C_per_m2 * charged * p.area_m2
+    size = electrode_size(p.electrode_shape, p.area_m2)
+    ci, v = gap_coefficients(p.electrode_shape, size, p.thickness_m, p.eps_r, [x_max])[:2]
+    b = sigma_breakdown(p, x_max_m=x_max, pressure_Pa=pa)
+    eff = p.sigma_C_per_m2 * charged
+    return {
+        "field_model": p.field,
+        "electrode": {"shape": p.electrode_shape, "size_m": size, "area_m2": p.area_m2},
+        "voc_at_max_gap_V": {"parallel": float(sa * x_max / (EPS0 * p.area_m2)), "finite": float(sa * v[0]),
+                             "gap_m": x_max},
+        "sigma_breakdown_C_m2": b.sigma_breakdown_C_m2,
+        "sigma_breakdown_gap_m": b.gap_at_limit_m,
+        "sigma_breakdown_short_C_m2": b.sigma_short_C_m2,
+        "sigma_breakdown_load_C_m2": sigma_breakdown_run(result, pa),
+        "sigma_times_area_fraction_C_m2": eff,
+        "breakdown_exceeded": bool(eff > b.sigma_breakdown_C_m2),
+        "air_pressure_Pa": pa,
+        "paschen": SOURCE,
+    }
+
+
+def warning(summary: dict) -> str:
+    """One warning line when σ A/S exceeds the breakdown cap ('' otherwise)."""
+    if not summary.get("breakdown_exceeded"):
+        return ""
+    from tengsim.units import format_si
+
+    return (f"tengsim: warning: σ A/S = {format_si(summary['sigma_times_area_fraction_C_m2'], 'C/m²')} exceeds the "
+            f"air-breakdown cap {format_si(summary['sigma_breakdown_C_m2'], 'C/m²')} (Paschen, open circuit, at gap "
+            f"{format_si(summary['sigma_breakdown_gap_m'], 'm')}): the gap discharges; the device cannot hold it")

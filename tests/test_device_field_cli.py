@@ -1,0 +1,36 @@
+"""`tengsim device ... --field parallel|finite --electrode-side/--electrode-diameter`: the outputs and the refusals."""
+import json
+
+import pytest
+
+from tengsim.cli.main import main
+
+
+def test_fig7_finite_disk_outputs(tmp_path, capsys):
+    out = tmp_path / "f7.csv"
+    assert main(["device", "fig7", "--field", "finite", "--electrode-diameter", "7cm", "--cycles", "2", "--out",
+                 str(out), "--quiet"]) == 0
+    side = json.loads(out.with_suffix(".json").read_text())
+    s = side["summary"]
+    assert s["field_model"] == "finite" and side["params"]["field"] == "finite"
+    assert s["electrode"]["shape"] == "disk" and s["electrode"]["size_m"] == pytest.approx(0.07)
+    assert side["params"]["area_m2"] == pytest.approx(3.14159265 * 0.035 ** 2)
+    v = s["voc_at_max_gap_V"]
+    assert 0.85 < v["finite"] / v["parallel"] < 1.0  # ~1 mm on 7 cm: a few % of fringing
+    assert s["voc_V"] == pytest.approx(v["finite"], rel=1e-3)
+    assert s["sigma_breakdown_C_m2"] > s["sigma_times_area_fraction_C_m2"] and s["breakdown_exceeded"] is False
+    assert s["sigma_breakdown_short_C_m2"] > s["sigma_breakdown_C_m2"]
+
+
+@pytest.mark.parametrize("argv, msg", [
+    (["--electrode-side", "-2cm"], "--electrode-side must be > 0, got '-2cm'"),
+    (["--electrode-side", "2kg"], "--electrode-side = '2kg' is a mass, expected a length"),
+    (["--electrode-side", "2cm", "--electrode-diameter", "1cm"], "not both"),
+    (["--air-pressure", "0Pa"], "--air-pressure must be > 0"),
+])
+def test_bad_field_options_one_line_exit_2_nothing_written(tmp_path, capsys, argv, msg):
+    out = tmp_path / "f7.csv"
+    assert main(["device", "fig7", "--out", str(out)] + argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and msg in err[0]
+    assert not out.exists() and not out.with_suffix(".json").exists()
