@@ -59,8 +59,9 @@ def run_tengsim(h, solver_name, tol, path=PATH):
     grid = Grid(n, n, L / n, L / n)
     K = PeriodicKernel(grid, KAPPA)
     law = Exponential(range=1.0)
-    kw = {"max_iter": 20000} if solver_name == "ram" else {"md_zone": "sharp"}
-    solver = make_solver(solver_name, tol=tol, **kw)
+    name, _, start = solver_name.partition(":")
+    kw = {"max_iter": 20000, "start": start or "scaled"} if name == "ram" else {}
+    solver = make_solver(name, tol=tol, **kw)
     st = State.zero(h.shape)
     steps = []
     c0, w0 = time.process_time(), time.perf_counter()
@@ -115,11 +116,18 @@ def run_tamaas(h, python, tol):
             return {"error": got.stderr.strip().splitlines()[-1] if got.stderr.strip() else "failed"}
         with open(out) as f:
             res = json.load(f)
-        # Tamaas prints its iterations per solve ("Iterations: n" lines in its log): count them if present
-        its = [int(line.split()[-1]) for line in got.stdout.splitlines() + got.stderr.splitlines()
-               if "iterations" in line.lower() and line.split()[-1].isdigit()]
-        if len(its) == len(res["steps"]):
-            for s, i in zip(res["steps"], its):
+        # Tamaas logs "iteration energy error" lines, the iteration counting from 0 in each solve: the last of a
+        # run is that solve's iteration count
+        runs, last = [], None
+        for line in got.stdout.splitlines():
+            f = line.split()
+            if len(f) == 3 and f[0].isdigit():
+                i = int(f[0])
+                if last is None or i < last:
+                    runs.append(i)
+                runs[-1], last = i, i
+        if len(runs) == len(res["steps"]):
+            for s, i in zip(res["steps"], runs):
                 s["iterations"] = i
         return res
 
@@ -130,7 +138,7 @@ def main(argv=None):
     ap.add_argument("--tol", type=float, default=1e-6, help="tengsim's gap residual (ε)")
     ap.add_argument("--tamaas-tol", type=float, default=1e-10, help="Tamaas' PolonskyKeerRey tolerance")
     ap.add_argument("--tamaas-python", default="/work/venvs/tamaas/bin/python")
-    ap.add_argument("--solvers", nargs="+", default=["ram"], help="tengsim solvers to run (ram, pk)")
+    ap.add_argument("--solvers", nargs="+", default=["ram"], help="tengsim solvers to run (ram = ram:scaled, ram:shifted, pk)")
     ap.add_argument("--out", default=None, help="a JSON file for the rows")
     ap.add_argument("--tamaas-child", nargs=3, help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
