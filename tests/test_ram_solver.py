@@ -214,3 +214,13 @@ def test_rough_path_against_tamaas():
         assert eq.P.mean() == pytest.approx(d["mean_p"][i], rel=1e-6)
         assert np.mean(eq.H <= 1e-9 * h.std()) == d["area"][i]
     assert np.abs(eqs[2].H - d["gap"]).max() < 1e-5
+
+
+def test_design_choice_asks_the_law():
+    """A design's constrained solver is asked of the law: 'pk' for md and exp (as before), 'ram' for a plugin
+    law that declares an adhesive hard-wall limit 'pk' does not know, none for LJ93 and the bare wall."""
+    from tengsim.design.plan import constrained_solver
+
+    assert constrained_solver(MaugisDugdale()) == "pk" and constrained_solver(Exponential()) == "pk"
+    assert constrained_solver(LinearSoftening()) == "ram"
+    assert constrained_solver(LJ93()) is None and constrained_solver(Repulsive()) is None
