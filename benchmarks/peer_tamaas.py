@@ -119,7 +119,7 @@ def run_tamaas(h, python, tol):
         # Tamaas logs "iteration energy error" lines, the iteration counting from 0 in each solve: the last of a
         # run is that solve's iteration count
         runs, last = [], None
-        for line in got.stdout.splitlines():
+        for line in (got.stdout + "\n" + got.stderr).splitlines():
             f = line.split()
             if len(f) == 3 and f[0].isdigit():
                 i = int(f[0])
