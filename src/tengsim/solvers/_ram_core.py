@@ -139,6 +139,7 @@ def solve_gap(op: Compliance, h, cell, law, u, tol: float, max_iter: int, monito
     d = backend.zeros(n)
     G_old, restart, since = 1.0, True, 0
     trust = 4.0 * float(law.length)
+    adhesive = float(law.tension) > 0
     side = law.side(u[cellm], np)
     phi = on_cell(law.energy, u)
     res = pres = math.inf
@@ -198,8 +199,8 @@ def solve_gap(op: Compliance, h, cell, law, u, tol: float, max_iter: int, monito
         curv = float(np.dot(d, Kd)) + float(np.dot(on_cell(law.curvature, u) * d, d))
         dmax = float(np.abs(d).max())
         tau = -slope / curv if curv > 0 else trust / dmax
-        if curv <= 0 or tau * dmax > trust:
-            tau = min(tau, trust / dmax)
+        if adhesive and tau * dmax > trust:           # a trust step where the energy is not convex
+            tau = trust / dmax
         accepted = False
         for _ in range(HALVINGS):
             un = u + tau * d
