@@ -60,7 +60,7 @@ def run_tengsim(h, solver_name, tol, path=PATH):
     K = PeriodicKernel(grid, KAPPA)
     law = Exponential(range=1.0)
     name, _, start = solver_name.partition(":")
-    kw = {"max_iter": 20000, "start": start or "scaled"} if name == "ram" else {}
+    kw = {"max_iter": 20000, "start": start or "scaled"} if name == "ram" else {}   # 'ram': the run's 'scaled' 
     solver = make_solver(name, tol=tol, **kw)
     st = State.zero(h.shape)
     steps = []
@@ -138,7 +138,7 @@ def main(argv=None):
     ap.add_argument("--tol", type=float, default=1e-6, help="tengsim's gap residual (ε)")
     ap.add_argument("--tamaas-tol", type=float, default=1e-10, help="Tamaas' PolonskyKeerRey tolerance")
     ap.add_argument("--tamaas-python", default="/work/venvs/tamaas/bin/python")
-    ap.add_argument("--solvers", nargs="+", default=["ram"], help="tengsim solvers to run (ram = ram:scaled, ram:shifted, pk)")
+    ap.add_argument("--solvers", nargs="+", default=["ram"], help="tengsim solvers to run (ram = ram:scaled here, ram:shifted: the default start, pk)")
     ap.add_argument("--out", default=None, help="a JSON file for the rows")
     ap.add_argument("--tamaas-child", nargs=3, help=argparse.SUPPRESS)
     args = ap.parse_args(argv)

@@ -49,16 +49,17 @@ def supports(law) -> bool:
 @dataclass(frozen=True)
 class RAMSolver:
     """The adhesive constrained CG (module doc).  ``tol``: the gap residual (ε); ``max_iter``: iterations;
-    ``start``: where the mean gap is held (a periodic half-space), 'scaled' starts from the start state's own
-    gap (its contact kept) scaled to the new mean (as Tamaas does: a retraction keeps its adhesive contact),
-    'shifted' from the start's displacement at the new gap (h + w, the rigid shift: a large step off loses
-    the contact); elsewhere always h + w; ``monitor(iteration, residual, nan)``: progress every
-    ``monitor_every`` iterations."""
+    ``start``: where the mean gap is held (a periodic half-space), 'shifted' (the default) starts from the start
+    state's displacement at the new gap, h + w (every tengsim solver's warm start), 'scaled' from the start
+    state's own gap (its contact kept) scaled to the new mean; the problem is non-convex, so a large step may
+    end in another local minimum from each (docs/benchmarks.md: on the 256² rough path 'shifted' lands in
+    Tamaas' states at every step, 'scaled' keeps more contact on a retraction); elsewhere always h + w;
+    ``monitor(iteration, residual, nan)``: progress every ``monitor_every`` iterations."""
 
     tol: float = 1e-6
     max_iter: int = 20000
     name: str = "ram"
-    start: str = "scaled"
+    start: str = "shifted"
     monitor: object = None
     monitor_every: int = 50
     weighted_block: ClassVar[bool] = False
