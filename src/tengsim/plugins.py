@@ -20,6 +20,7 @@ import tengsim.shapes  # noqa: F401  (registers every built-in shape)
 import tengsim.solvers  # noqa: F401  (registers 'fast', 'vsr')
 import tengsim.solvers.homotopy  # noqa: F401  (registers 'homotopy')
 import tengsim.solvers.pk  # noqa: F401  (registers 'pk')
+import tengsim.solvers.ram  # noqa: F401  (registers 'ram')
 import tengsim.solvers.jax_fast  # noqa: F401  (registers 'jax', 'gpu'; imports JAX only when one is made)
 import tengsim.solvers.choice  # noqa: F401  (registers 'auto': gpu where JAX sees one, else fast)
 from tengsim.errors import TengsimError

@@ -42,8 +42,21 @@ DEVICE_BOUNDS = {"sigma": (1e-9, 1e-2, "1 nC/m2 ... 10 mC/m2 (air breaks down fa
 SOLVER_TOL_PER_TOL = 0.01
 """Each equilibrium of a design is solved to max|r| <= this × the design's tol (ε; 1e-4 at the default 1 %): the
 solver's share of a reported number is then far below tol (docs/validation.md, "A design's solver tolerance")."""
-PK_LAWS = ("MaugisDugdale", "Exponential")
-"""Laws a design runs on the constrained solver 'pk' (their hard-wall limit) unless it names its solver."""
+
+
+def constrained_solver(law):
+    """The constrained solver a design runs ``law`` on unless it names its solver, asked of the law: one that
+    declares an adhesive hard-wall limit (``Law.hard_wall()`` with a tension: ``md``, ``exp``, a plugin's) runs
+    on 'pk' where 'pk' solves it, else on 'ram' (tengsim.solvers.ram); None for any other law (LJ93; the wall
+    without adhesion): the design's default solver."""
+    from tengsim.solvers import pk, ram
+
+    lim = law.hard_wall() if hasattr(law, "hard_wall") else None
+    if lim is None or not float(lim.tension) > 0:
+        return None
+    return "pk" if pk.supports(law) else "ram"
+
+
 TOL_FLOOR = 1e-4
 """The smallest design tolerance (0.01 %): each equilibrium is solved to 0.01 × tol, and a grid refinement to
 1e-4 is already far beyond what a design's budget pays for."""
@@ -294,7 +307,8 @@ def _plan_design(table: dict, where: str) -> DesignPlan:
     sc = plan.scaling
     draft = DesignPlan("", shape, {}, sp, (), 0, 0, 0, 0, 0, None, None, 0, 0, 0, 0, 0)
     name = own["name"] or f"{shape} {draft.shape_text()}"
-    pk = {"solver": "pk", "solver_note": ""} if not solver_given and type(plan.law).__name__ in PK_LAWS else {}
+    own_solver = None if solver_given else constrained_solver(plan.law)
+    pk = {"solver": own_solver, "solver_note": ""} if own_solver else {}
     plan = dataclasses.replace(plan, tol=SOLVER_TOL_PER_TOL * tol, **pk)  # the plan the design runs
     return DesignPlan(name=name, shape=shape, contact_table=cfg, shape_params=sp, pressures=pressures,
                       sigma=own["sigma"], eps_r=own["eps_r"], T=own["T"], gap=own["gap"], tol=tol, dx=own["dx"],

@@ -32,7 +32,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from tengsim.design.plan import PK_LAWS, SOLVER_TOL_PER_TOL, solver_tol  # noqa: F401
+from tengsim.design.plan import SOLVER_TOL_PER_TOL, constrained_solver, solver_tol  # noqa: F401
 from tengsim.design.keep import checkpoint, identity, kept_path  # noqa: F401
 from tengsim.design.walk import (D_MIN, D_STEP, _reach, _say, _simulate,  # noqa: F401
                                  find_d_max, grid_path, height_eps, map_pressures, maps_asked, observers, path_to,
@@ -77,9 +77,13 @@ def choose_solver(plan, cplan, progress=None):
     """The contact plan a design runs: :func:`tengsim.design.plan.plan_design` put a cohesive law with a wall
     (``md``, ``exp``) on the constrained solver 'pk' (tengsim.solvers.pk) unless the design names its solver;
     said here in one line."""
-    if not plan.solver_given and type(cplan.law).__name__ in PK_LAWS and cplan.solver == "pk":
+    own = None if plan.solver_given else constrained_solver(cplan.law)
+    if own == "pk" and cplan.solver == "pk":
         _say(progress, "solver: pk (Polonsky–Keer constrained CG with a cohesive zone: the law's hard-wall "
                        "limit; give solver = 'fast' or 'homotopy' for the penalty wall)")
+    elif own == "ram" and cplan.solver == "ram":
+        _say(progress, "solver: ram (constrained CG on the gap: the hard-wall limit the law declares; give "
+                       "solver = 'fast' or 'homotopy' for the penalty wall)")
     return cplan
 
 

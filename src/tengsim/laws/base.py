@@ -141,6 +141,12 @@ class Law:
     #: (Maugis–Dugdale, exponential: the edge of a cohesive zone).  It locates the edge within a pixel.
     edge_opening = 1.0
 
+    def hard_wall(self):
+        """The law's hard-wall limit (:class:`tengsim.laws.cohesive.CohesiveLimit`: its traction, energy and
+        curvature beyond a rigid wall at g = 1), or None for a law without one (the constrained solver
+        'ram' asks this, never the class)."""
+        return None
+
     def params(self) -> dict:
         """The law's parameters (its dataclass fields; public attributes otherwise) and its class name."""
         if dataclasses.is_dataclass(self):

@@ -53,6 +53,12 @@ class Exponential(WallLaw):
     def max_softening(self) -> float:
         return self.amplitude / self.range**2
 
+    def hard_wall(self):
+        """Its limit k → ∞: −(W/ρ) e^{−u/ρ} beyond a rigid wall."""
+        from tengsim.laws.cohesive import ExponentialZone
+
+        return ExponentialZone(float(self.work), float(self.range))
+
     def _raw(self, g, need_dp=True, xp=np):
         A, rho, k = self.amplitude, self.range, self.wall_stiffness
         e = xp.exp(-xp.maximum(g - 1.0, 0.0) / rho)

@@ -62,6 +62,12 @@ class MaugisDugdale(WallLaw):
     def max_softening(self) -> float:
         return 1.5 * self.tension / self.smoothing
 
+    def hard_wall(self):
+        """Its limit k → ∞: σ0 over h0 = W/σ0, the step its own smoothstep of width ``smoothing``."""
+        from tengsim.laws.cohesive import DugdaleZone
+
+        return DugdaleZone(float(self.tension), float(self.work), float(self.smoothing))
+
     def _raw(self, g, need_dp=True, xp=np):
         s0, k, s = self.tension, self.wall_stiffness, self.smoothing
         h0 = self.range

@@ -51,6 +51,12 @@ class Repulsive(Law):
     def max_softening(self) -> float:
         return 0.0
 
+    def hard_wall(self):
+        """Its limit k → ∞: the hard wall, no adhesion."""
+        from tengsim.laws.cohesive import NoAdhesion
+
+        return NoAdhesion()
+
     def _raw(self, g, need_dp=True, xp=None):
         k, c = self.exponent, self.scale
         gk = g ** (-k)
