@@ -1,7 +1,7 @@
 """A Prony series fitted to DMA data: storage and loss modulus against frequency.
 
 E'(ω) = E∞ + Σ E_i ω²τ_i²/(1 + ω²τ_i²), E''(ω) = Σ E_i ωτ_i/(1 + ω²τ_i²) are linear in (E∞, E_i): on a
-log-spaced τ grid (``per_decade`` times per decade, one decade beyond the data's 1/ω at each end) the
+log-spaced τ grid (``per_decade`` times per decade from whole decades, one beyond the data's 1/ω at each end) the
 non-negative moduli are the linear least-squares solution (``scipy.optimize.nnls``), each row weighted by
 1/|measured| so that E' and E'' count alike.  The fit's error is stated: the RMS and the largest relative
 residual of E' and of E''.  Branches fitted to zero are dropped.
@@ -50,8 +50,8 @@ def fit_dma(f, storage, loss, per_decade: float = 1.0, source: str = "") -> DMAF
     if not per_decade > 0:
         raise TengsimError(f"per_decade must be > 0, got {per_decade!r}")
     w = 2 * np.pi * f
-    lo, hi = math.log10(1 / w.max()) - 1, math.log10(1 / w.min()) + 1
-    n = max(1, int(math.ceil((hi - lo) * per_decade)) + 1)
+    lo, hi = math.floor(math.log10(1 / w.max())) - 1, math.ceil(math.log10(1 / w.min())) + 1  # whole decades
+    n = max(1, int(round((hi - lo) * per_decade)) + 1)
     tau = np.logspace(lo, hi, n)
     wt = w[:, None] * tau[None, :]
     A_s = np.hstack([np.ones((f.size, 1)), wt**2 / (1 + wt**2)])
