@@ -152,3 +152,21 @@ class GeometricTimeSteps:
 
     def params(self) -> dict:
         return {"time_steps": "geometric", "dt0_s": self.dt0, "growth": self.growth, "dt_max_s": self.dt_max}
+
+
+@dataclass(frozen=True)
+class SegmentSteps:
+    """``n`` equal steps on every segment of the history, whatever its length (a cycle whose parts run at
+    different rates: a slow loading and a fast unloading get the same resolution each)."""
+
+    n: int = 16
+
+    def __post_init__(self):
+        if isinstance(self.n, bool) or not isinstance(self.n, int) or self.n < 1:
+            raise TengsimError(f"steps per segment must be an integer >= 1, got {self.n!r}")
+
+    def times(self, t0: float, t1: float) -> np.ndarray:
+        return t0 + (t1 - t0) * np.arange(1, self.n + 1) / self.n
+
+    def params(self) -> dict:
+        return {"time_steps": "per segment", "steps_per_segment": self.n}
