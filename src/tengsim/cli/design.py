@@ -54,6 +54,9 @@ def register(sub):
     p.add_argument("--out", help="output folder (created; several designs: one subfolder each)")
     p.add_argument("--material", help="a material.toml (tengsim calibrate): its E_star, W, eps, sigma replace the "
                    "design's; with its uncertainty points, also bands.csv, bands.png (95 %% band of A/S, V_OC)")
+    p.add_argument("--relaxation", help="a TOML file with a [relaxation] table: the design also pressed and released "
+                   "at 0.5, 2 and 10 Hz on that viscoelastic material (visco.csv, visco_table.csv, visco.png, a "
+                   "report section)")
     p.add_argument("--quiet", action="store_true", help="no progress lines")
     p.set_defaults(func=run)
 
@@ -238,6 +241,11 @@ def run(args) -> int:
         material = read_material(args.material)
         tables = [(w, {**t, **{k: v for k, v in material["values"].items() if getattr(args, k, None) in (None, "")}})
                   for w, t in tables]
+    relaxation = None
+    if getattr(args, "relaxation", None):  # read before anything runs: a bad file is one line
+        from tengsim.relaxation import read_relaxation
+
+        relaxation = read_relaxation(args.relaxation)
     plans = [plan_design(t, where) for where, t in tables]  # every design checked before anything runs
     out = Path(args.out)
     _check_out(out)
@@ -254,10 +262,10 @@ def run(args) -> int:
         except TengsimError as exc:
             raise TengsimError(f"{where}{exc}") from None
     with folder_lock(out):
-        return _run_locked(args, plans, folders, out, material)
+        return _run_locked(args, plans, folders, out, material, relaxation)
 
 
-def _run_locked(args, plans, folders, out, material=None) -> int:
+def _run_locked(args, plans, folders, out, material=None, relaxation=None) -> int:
     from tengsim.design import run_design, write_comparison, write_design
 
     say = _Say(args.quiet)
@@ -289,6 +297,12 @@ def _run_locked(args, plans, folders, out, material=None) -> int:
         for r in results:
             folder = out if len(results) == 1 else out / _slug(r.plan.name, taken)
             paths += write_bands(predict_bands(r.plan, r, material, say.say), folder, r.plan.name)
+    if relaxation is not None:  # the viscoelastic cycles at the stated frequencies (tengsim.design.visco)
+        from tengsim.design.visco import visco_cycles
+        from tengsim.design.visco_write import write_visco
+
+        for r, f in zip(results, folders):
+            paths += write_visco(visco_cycles(r.plan, relaxation, progress=say.say), out / f)
     for k in range(len(plans)):  # the results are saved: the kept grids are no longer needed
         (out / f".design-{k}.resolve.nc").unlink(missing_ok=True)
     if not args.quiet:
