@@ -28,9 +28,9 @@ SHAPE = Paraboloid(R, 9.0)
 TABOR = KAPPA ** (2 / 3)
 
 
-def run(history, steps, dx=0.2, material=MAT, law=None, maps_at=(), **kw):
+def run(history, steps, dx=0.2, material=MAT, law=None, maps_at=(), solver="fast", **kw):
     return simulate_history(SHAPE, TABOR, dx, material, history, steps, law=law or Repulsive(), tol=1e-5,
-                            maps_at=maps_at, **kw)
+                            maps_at=maps_at, solver=solver, **kw)
 
 
 def apex_indentation(res, dx):
@@ -157,3 +157,16 @@ def test_no_branches_is_the_static_path():
         i = int(np.argmin(np.abs(res["D"] - D)))
         assert res["F"][i] == pytest.approx(ref[D][0], rel=1e-4, abs=1e-6)
         assert res["area_fraction"][i] == pytest.approx(ref[D][1], rel=1e-4)
+
+
+def test_lee_radok_on_the_constrained_solver():
+    """The same creep on 'pk' (its own load control, the hard wall: δ = D): the indentation grows as J(t)^{2/3},
+    and the absolute a(t) = sqrt(R δ) is Lee–Radok's within 1 %."""
+    res = run(ramp_hold(0.0, P_MEAN, 0.0, 4.0, kind="pressure"), GeometricTimeSteps(0.01, 2.0, 1.0), 0.2,
+              solver="pk")
+    assert res.ok
+    t, D = res.t[1:], res["D"][1:]
+    J = sls_creep(t, 1.0, 1.0, TAU)
+    assert np.allclose((D / D[0]) ** 1.5, J / J[0], rtol=0.003)
+    a = np.sqrt(R * D)
+    assert np.allclose(a, lee_radok_radius(P_MEAN * 81.0, R, J / E_STAR), rtol=0.01)
