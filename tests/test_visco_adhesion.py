@@ -43,3 +43,23 @@ def test_pull_off_rises_with_the_unloading_rate():
     assert po[0] == pytest.approx(einf, rel=0.005)
     assert all(b > a for a, b in zip(po, po[1:]))
     assert po[-1] > e0
+
+
+@pytest.mark.slow
+def test_jumps_are_located_in_time_where_the_static_path_has_them():
+    """μ = 2 (the sphere snaps in and out in several jumps): an elastic material driven in D: −1.5 → 1 → −1.5 ε
+    in 1 s each way, steps of 0.1 s bisected at a jump to 0.1/64 s (0.0039 ε of D), has the static path's
+    jumps (d_step 0.25 refined 6 levels: the same resolution in D), each within 4 resolutions."""
+    from tengsim import PathSpec, simulate
+    from tengsim.visco import FixedTimeSteps
+
+    st = simulate(SHAPE, 2.0, 0.25, PathSpec(-1.5, 1.0, 0.25))
+    tab = st.table
+    static = [float(d) for d, j in zip(np.asarray(tab["D"]), np.asarray(tab["jump"])) if j]
+    r = simulate_history(SHAPE, 2.0, 0.25, Prony(1.0), History((0, 1, 2), (-1.5, 1.0, -1.5)), FixedTimeSteps(0.1),
+                         law=LJ93(), tol=1e-6, dt_min=0.1 / 64)
+    found = r.jumps()
+    assert len(found) == len(static) >= 4
+    res = 2.5 * 0.1 / 64
+    for (t, D, _), Ds in zip(found, static):
+        assert abs(D - Ds) <= 4 * res + 1e-12, (t, D, Ds)
