@@ -93,3 +93,15 @@ def test_step_operator_limits_and_exact_update():
 def test_negative_step_is_refused():
     with pytest.raises(TengsimError, match="time step must be >= 0"):
         sls(1, 1, 1).step_factors(-1.0)
+
+
+def test_a_jump_inside_a_history_belongs_to_its_own_instant():
+    """D: 0 → 1 ε in 1 s, a jump to 2 ε at t = 1 s, held: the step ending at 1 s is at D = 1, the jump's at D = 2."""
+    from tengsim.laws import Repulsive
+    from tengsim.shapes import Paraboloid
+    from tengsim.visco import FixedTimeSteps, History, simulate_history
+
+    r = simulate_history(Paraboloid(1.0, 4.0), 1.0, 0.5, sls(1.0, 1.0, 1.0), History((0, 1, 1, 2), (0, 1, 2, 2)),
+                         FixedTimeSteps(0.5), law=Repulsive(), tol=1e-6)
+    assert list(np.round(r.t, 9)) == [0, 0.5, 1, 1, 1.5, 2]
+    assert list(r["D"]) == [0, 0.5, 1, 2, 2, 2]

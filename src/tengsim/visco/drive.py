@@ -163,8 +163,10 @@ class TimeDrive:
                 if dt_min is None:
                     dt_min = (times[0] - ta) / 64
             t_prev = ta
-            for tb_ in times:
-                value_at = (lambda s, k=k: history.value[k + 1]) if tb == ta else history.at
+            va, vb = float(history.value[k]), float(history.value[k + 1])
+            for tb_ in times:  # the control linear on this segment (a jump at its end belongs to the next one)
+                value_at = ((lambda s, vb=vb: vb) if tb == ta else
+                            (lambda s, ta=ta, tb=tb, va=va, vb=vb: va + (s - ta) / (tb - ta) * (vb - va)))
                 out = self._advance(mem, state, ratio, D, eq, t_prev, float(tb_), kind, value_at,
                                     dt_min or 0.0, rows, maps)
                 mem, state, ratio, D, eq = out
