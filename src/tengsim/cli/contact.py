@@ -39,6 +39,9 @@ def register(sub):
     p.add_argument("--plot", help=CLI_ONLY_HELP["plot"])
     p.add_argument("--quiet", action="store_true", help=CLI_ONLY_HELP["quiet"])
     p.add_argument("--resume", action="store_true", help=CLI_ONLY_HELP["resume"])
+    from tengsim.cli import contact_visco
+
+    contact_visco.register_options(p)  # --relaxation FILE: the run on a time axis
     p.set_defaults(func=run)
 
 
@@ -58,6 +61,10 @@ def run(args) -> int:
             raise TengsimError(f"{key} given twice: {args.positional!r} and --{key.replace('_', '-')} {cfg[key]!r}")
         cfg[key] = args.positional
     plan = plan_contact({**cfg, "out": args.out})  # every option checked before anything is written (maps: .nc)
+    if getattr(args, "relaxation", None):
+        from tengsim.cli import contact_visco
+
+        return contact_visco.run(args, plan)
     out = Path(args.out)
     if out.suffix.lower() not in (".csv", ".nc"):
         raise TengsimError(f"--out {args.out}: use a .csv or .nc file")

@@ -54,6 +54,9 @@ def register(sub):
     p.add_argument("--out", help="output folder (created; several designs: one subfolder each)")
     p.add_argument("--material", help="a material.toml (tengsim calibrate): its E_star, W, eps, sigma replace the "
                    "design's; with its uncertainty points, also bands.csv, bands.png (95 %% band of A/S, V_OC)")
+    p.add_argument("--relaxation", help="a TOML file with a [relaxation] table: the design also pressed and released "
+                   "at 0.5, 2 and 10 Hz on that viscoelastic material (visco.csv, visco_table.csv, visco.png, a "
+                   "report section)")
     p.add_argument("--quiet", action="store_true", help="no progress lines")
     p.set_defaults(func=run)
 
@@ -242,12 +245,18 @@ def run(args) -> int:
     if getattr(args, "material", None):  # the fitted material replaces the design's own (options given win)
         material = _read_material(args.material)
         material = material.without(k for k in material.values if getattr(args, k, None) not in (None, ""))
+    relaxation = None
+    if getattr(args, "relaxation", None):  # read before anything runs: a bad file is one line
+        from tengsim.relaxation import read_relaxation
+
+        relaxation = read_relaxation(args.relaxation)
     # every design, and every band point of the material, checked before anything runs
     plans = [plan_design(t, where, material) for where, t in tables]
     out = Path(args.out)
     _check_out(out)
     folders = _folders(plans)
     inputs = [*(x for x in args.inputs if x.lower().endswith(".toml")), *([args.material] if material else []),
+              *([args.relaxation] if relaxation is not None else []),
               *(v for _, t in tables for v in t.values() if isinstance(v, str))]
     _guard(out, folders, inputs)
     from tengsim.design.run import preflight
@@ -265,10 +274,10 @@ def run(args) -> int:
                 point = f"--material {args.material} [[uncertainty.point]] {k}: " if k else ""
                 raise TengsimError(f"{where}{point}{exc}") from None
     with folder_lock(out, holder="tengsim design"):  # the whole run: no second run on this folder meanwhile
-        return _run_locked(args, plans, folders, out)
+        return _run_locked(args, plans, folders, out, relaxation)
 
 
-def _run_locked(args, plans, folders, out) -> int:
+def _run_locked(args, plans, folders, out, relaxation=None) -> int:
     from tengsim.design import predict_bands, run_design, write_bands, write_comparison, write_design
 
     say = _Say(args.quiet)
@@ -296,6 +305,12 @@ def _run_locked(args, plans, folders, out) -> int:
     for r, f in zip(results, folders):  # the prediction's band: the design at each of the material's points
         if r.plan.bands:
             paths += write_bands(predict_bands(r, say.say), out / f, r.plan.name)
+    if relaxation is not None:  # the viscoelastic cycles at the stated frequencies (tengsim.design.visco)
+        from tengsim.design.visco import visco_cycles
+        from tengsim.design.visco_write import write_visco
+
+        for r, f in zip(results, folders):
+            paths += write_visco(visco_cycles(r.plan, relaxation, progress=say.say), out / f)
     for k in range(len(plans)):  # the results are saved: the kept grids are no longer needed
         (out / f".design-{k}.resolve.nc").unlink(missing_ok=True)
     if not args.quiet:

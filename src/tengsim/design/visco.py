@@ -1,0 +1,111 @@
+"""A design on a time axis (``tengsim design ... --relaxation FILE``): the design's contact pressed and released
+at 2–3 frequencies on a viscoelastic material (:mod:`tengsim.visco`), with A/S(t), V_OC(t) (Eq. 12) and the
+nominal pressure over a cycle, and the sensor's numbers at each frequency:
+
+* a triangle cycle 0 → p_max → 0 in one period (load control): the V_OC(P) loop gives the sensitivity, the
+  linear range and the hysteresis (:func:`tengsim.device.sensor.sensor_numbers`, as the static design);
+* a square cycle (press to p_max in 5 % of the period, hold, release, hold): the response and the recovery time
+  to 90 % of V_OC's change, from the start of the press and of the release.
+
+The relaxed elastic solid (E∞, no branch) runs the same cycles once, as the static reference.  The cycles run on
+one coarse grid of ``pixels``² (stated in the report): they show the rate effects, the static design gives the
+converged numbers.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from tengsim.device.formulas import voc_polymer
+from tengsim.device.sensor import sensor_numbers
+from tengsim.relaxation import Prony
+from tengsim.visco import SegmentSteps, History, simulate_history, square_wave
+
+FREQUENCIES = (0.5, 2.0, 10.0)
+"""Hz: the stated frequencies of a design's viscoelastic cycles (a TENG pressed by hand … a fast actuator)."""
+
+
+@dataclass(frozen=True)
+class Cycle:
+    """One cycle at ``frequency`` (Hz; 0: the relaxed elastic reference): t (s), nominal pressure (Pa), A/S, V_OC (V)."""
+
+    frequency: float
+    kind: str
+    t: np.ndarray
+    pressure_Pa: np.ndarray
+    area: np.ndarray
+    voc: np.ndarray
+    force_N: np.ndarray
+
+
+@dataclass(frozen=True)
+class ViscoDesign:
+    """The cycles and the frequency table ({'frequency_Hz', 'sensitivity_V_per_Pa', 'linear_range_Pa',
+    'voc_hysteresis_fraction', 'response_s', 'recovery_s', 'area_max'} per row)."""
+
+    material: Prony
+    grid: str
+    cycles: tuple
+    table: tuple = field(default_factory=tuple)
+
+
+def _t90(t, v, t_start, t_end) -> float:
+    """Time from ``t_start`` until v has made 90 % of its change over [t_start, t_end]."""
+    m = (t >= t_start) & (t <= t_end)
+    tt, vv = t[m], v[m]
+    if tt.size < 2 or vv[-1] == vv[0]:
+        return float("nan")
+    frac = (vv - vv[0]) / (vv[-1] - vv[0])
+    i = int(np.argmax(frac >= 0.9))
+    if i == 0:
+        return float(tt[0] - t_start)
+    t_cross = np.interp(0.9, [frac[i - 1], frac[i]], [tt[i - 1], tt[i]]) if frac[i] != frac[i - 1] else tt[i]
+    return float(t_cross - t_start)
+
+
+def visco_cycles(plan, material: Prony, frequencies=FREQUENCIES, pixels: int = 48, steps: int = 12,
+                 progress=None) -> ViscoDesign:
+    """The design ``plan`` (:class:`tengsim.design.plan.DesignPlan`) cycled at ``frequencies`` (module doc);
+    ``steps`` time steps per segment of each cycle."""
+    cp = plan.contact_plan
+    shape = cp.shape
+    cell = float(getattr(shape, "cell", cp.grid.nx * cp.grid.dx))
+    dx = cell / int(pixels)
+    grid = shape.grid(dx)
+    scale = plan.eps / plan.W                                   # Pa → W/ε
+    lat = plan.contact_plan.scaling.lateral if cp.scaling is not None else 1.0
+    p_max = plan.pressures[-1]
+    cycles, table = [], []
+    for f, mat in [(0.0, Prony(material.E_inf))] + [(float(f), material) for f in frequencies]:
+        period = 1.0 / f if f > 0 else 1.0
+        out = {}
+        for kind in ("triangle", "square"):
+            if kind == "triangle":
+                h = History((0.0, period / 2, period), (0.0, p_max * scale, 0.0), "pressure")
+            else:
+                h = square_wave(0.0, p_max * scale, period, 1, rise=0.05, kind="pressure")
+            if progress is not None:
+                progress(f"viscoelastic cycle: {kind} at {f:g} Hz" if f else f"elastic (E∞) cycle: {kind}")
+            r = simulate_history(shape, cp.tabor, dx, mat, h, SegmentSteps(int(steps)), boundary=cp.boundary,
+                                 law=cp.law, solver=cp.solver, tol=cp.tol, kernel_params=cp.kernel_params,
+                                 E_ref=mat.E_inf, grid=grid)
+            P = r["mean_pressure"] / scale
+            A = r["area_fraction"]
+            V = voc_polymer(A, plan.sigma, plan.eps_r, plan.T)
+            F = r["F"] * 3 * np.pi * plan.W * lat**2 / plan.eps
+            out[kind] = Cycle(f, kind, r.t, P, A, V, F)
+            cycles.append(out[kind])
+        tri = out["triangle"]
+        up = tri.t <= period / 2 + 1e-12
+        down = ~up
+        nums = sensor_numbers(tri.pressure_Pa[up], tri.voc[up],
+                              retraction=(tri.pressure_Pa[down][::-1], tri.voc[down][::-1])).flat()
+        sq = out["square"]
+        table.append({"frequency_Hz": f, "sensitivity_V_per_Pa": nums["sensitivity_V_per_Pa"],
+                      "linear_range_Pa": nums["linear_range_Pa"],
+                      "voc_hysteresis_fraction": nums["voc_hysteresis_fraction"],
+                      "response_s": _t90(sq.t, sq.voc, 0.0, period / 2) if f else float("nan"),
+                      "recovery_s": _t90(sq.t, sq.voc, period / 2, period) if f else float("nan"),
+                      "area_max": float(np.max(sq.area))})
+    return ViscoDesign(material, f"{grid.nx}×{grid.ny} (dx = {dx * lat * 1e9:.0f} nm)", tuple(cycles), tuple(table))

@@ -1,0 +1,92 @@
+"""The files of a design's viscoelastic cycles: OUT/visco.csv (every cycle's rows), OUT/visco_table.csv (the
+frequency table), OUT/visco.png (A/S(t) and V_OC(t) over the square cycle at each frequency, and the V_OC(P)
+loops), and a section appended to OUT/report.md."""
+from __future__ import annotations
+
+import csv
+import math
+from pathlib import Path
+
+import numpy as np
+
+COLS = ("frequency_Hz", "sensitivity_V_per_Pa", "linear_range_Pa", "voc_hysteresis_fraction", "response_s",
+        "recovery_s", "area_max")
+
+
+def _fmt(v, scale=1.0, digits=3) -> str:
+    return "n/a" if v is None or not math.isfinite(v) else f"{v * scale:.{digits}g}"
+
+
+def report_section(vd) -> str:
+    m = vd.material
+    lines = ["", "## Viscoelastic cycles (`--relaxation`)", "",
+             f"Material: E∞ = {m.E_inf / 1e6:.4g} MPa, E0 = {m.E0 / 1e6:.4g} MPa, "
+             + ", ".join(f"{e / 1e6:.3g} MPa at τ = {t:g} s" for e, t in zip(m.E, m.tau))
+             + (f" ({m.source})" if m.source else "") + ".",
+             f"Each frequency: a triangle cycle 0 → p_max → 0 in one period (sensitivity, linear range, hysteresis of "
+             f"V_OC(P)) and a square cycle (press in 5 % of the period, hold, release; response and recovery time to "
+             f"90 % of V_OC's change), load-controlled, on one coarse grid {vd.grid}: rate effects, not converged "
+             f"numbers (the static design above is). 0 Hz: the relaxed elastic solid (E∞).", "",
+             "| f (Hz) | sensitivity (V/kPa) | linear range (kPa) | hysteresis | response (ms) | recovery (ms) | max A/S |",
+             "|---|---|---|---|---|---|---|"]
+    for r in vd.table:
+        lines.append(f"| {_fmt(r['frequency_Hz'])} | {_fmt(r['sensitivity_V_per_Pa'], 1e3)} | "
+                     f"{_fmt(r['linear_range_Pa'], 1e-3)} | {_fmt(r['voc_hysteresis_fraction'], 100)} % | "
+                     f"{_fmt(r['response_s'], 1e3)} | {_fmt(r['recovery_s'], 1e3)} | {_fmt(r['area_max'], 1, 4)} |")
+    lines += ["", "![viscoelastic cycles](visco.png)", ""]
+    return "\n".join(lines)
+
+
+def figure(vd, path: Path) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, 3, figsize=(13, 4.0), constrained_layout=True)
+    colors = plt.cm.viridis(np.linspace(0, 0.85, max(1, len(vd.table))))
+    for c, row in zip(colors, vd.table):
+        f = row["frequency_Hz"]
+        label = f"{f:g} Hz" if f else "elastic (E∞)"
+        for cyc in vd.cycles:
+            if cyc.frequency != f:
+                continue
+            period = 1 / f if f else 1.0
+            ls = "--" if not f else "-"
+            if cyc.kind == "square":
+                axes[0].plot(cyc.t / period, cyc.area, ls, color=c, label=label)
+                axes[1].plot(cyc.t / period, cyc.voc, ls, color=c, label=label)
+            else:
+                axes[2].plot(cyc.pressure_Pa / 1e3, cyc.voc, ls, color=c, label=label)
+    axes[0].set(xlabel="t / period (square cycle)", ylabel="A/S")
+    axes[1].set(xlabel="t / period (square cycle)", ylabel="V_OC (V, Eq. 12)")
+    axes[2].set(xlabel="nominal pressure (kPa, triangle cycle)", ylabel="V_OC (V, Eq. 12)")
+    for ax in axes:
+        ax.grid(alpha=0.3)
+    axes[0].legend(frameon=False)
+    fig.savefig(path, dpi=150)
+    plt.close(fig)
+
+
+def write_visco(vd, folder) -> list:
+    """Write the files (module doc); returns their paths."""
+    folder = Path(folder)
+    rows = folder / "visco.csv"
+    with rows.open("w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(["frequency_Hz", "cycle", "time_s", "pressure_Pa", "area_fraction", "voc_V", "force_N"])
+        for c in vd.cycles:
+            for i in range(c.t.size):
+                w.writerow([c.frequency, c.kind, c.t[i], c.pressure_Pa[i], c.area[i], c.voc[i], c.force_N[i]])
+    table = folder / "visco_table.csv"
+    with table.open("w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(COLS)
+        for r in vd.table:
+            w.writerow([r[k] for k in COLS])
+    png = folder / "visco.png"
+    figure(vd, png)
+    report = folder / "report.md"
+    with report.open("a") as fh:
+        fh.write(report_section(vd))
+    return [rows, table, png]
