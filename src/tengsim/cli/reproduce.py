@@ -17,14 +17,14 @@ def register(sub):
 
 
 def run(args) -> int:
+    from tengsim.outfolder import check_folder, folder_lock
+
+    check_folder(args.out)  # an existing file or an unwritable folder: refused before the numerical imports
     from tengsim.cases.paper.reproduce import reproduce, summary_text
     from tengsim.progress import Progress
 
-    from tengsim.outfolder import output_folder
-
     log = None if args.quiet else (lambda m: print(m, file=sys.stderr, flush=True))
-    # an existing file or an unwritable folder: refused before computing; no other run on it meanwhile
-    with output_folder(args.out, holder="tengsim reproduce"):
+    with folder_lock(args.out, holder="tengsim reproduce"):  # no other run on it meanwhile
         summary = reproduce(args.out, quick=args.quick, log=log,
                             progress_factory=lambda label: Progress(args.quiet))
     if not args.quiet:
