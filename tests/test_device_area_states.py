@@ -72,7 +72,7 @@ def test_device_voc_across_snap_follows_states(tmp_path, capsys):
     snapped_design(tmp_path / "d")
     out = tmp_path / "dev.nc"
     rc = main(["device", "design", "--area-from", str(tmp_path / "d"), "--pressure", "3kPa", "--cycles", "2",
-               "--out", str(out), "--quiet"])
+               "--field", "parallel", "--out", str(out), "--quiet"])  # Eq. 17's plates: the area is what is tested
     assert rc == 0, capsys.readouterr().err
     ds = xr.load_dataset(out)
     charged = float(np.max(ds["area"].values)) / DEFAULTS["area_m2"][0]  # m² of the electrode's area → A/S
