@@ -28,14 +28,14 @@ class Prony:
         object.__setattr__(self, "E", E)
         object.__setattr__(self, "tau", tau)
         if not (math.isfinite(self.E_inf) and self.E_inf > 0):
-            raise TengsimError(f"relaxation E_inf must be a modulus > 0, got {self.E_inf!r} Pa")
+            raise TengsimError(f"relaxation E_inf must be a modulus > 0, got {_modulus(self.E_inf)}")
         if len(E) != len(tau):
             raise TengsimError(f"relaxation: {len(E)} branch moduli but {len(tau)} relaxation times")
         for i, (e, t) in enumerate(zip(E, tau)):
             if not (math.isfinite(e) and e >= 0):
-                raise TengsimError(f"relaxation branch {i + 1}: E must be >= 0, got {e!r} Pa")
+                raise TengsimError(f"relaxation branch {i + 1}: E must be >= 0, got {_modulus(e)}")
             if not (math.isfinite(t) and t > 0):
-                raise TengsimError(f"relaxation branch {i + 1}: tau must be > 0, got {t!r} s")
+                raise TengsimError(f"relaxation branch {i + 1}: tau must be > 0, got {t:g} s")
 
     @property
     def E0(self) -> float:
@@ -120,3 +120,10 @@ def sylgard184() -> Prony:
     curves: use its table, or fit your own DMA data with ``tengsim.relaxation.fit_dma``, for numbers)."""
     return Prony(1.5e6, (0.12e6, 0.08e6, 0.06e6, 0.05e6), (0.01, 0.1, 1.0, 10.0),
                  "representative Sylgard 184 (tengsim.relaxation.sylgard184; see its doc)")
+
+
+def _modulus(pa: float) -> str:
+    """A modulus in the user's units for a message (e.g. '-1 MPa'); a value that is no number as it is."""
+    from tengsim.units import pressure_text
+
+    return pressure_text(pa) if math.isfinite(pa) else repr(pa)
