@@ -2,11 +2,13 @@
 from __future__ import annotations
 
 import csv
+from pathlib import Path
 
 import pytest
 
 from tengsim.cli.main import main
 
+PDMS = str(Path(__file__).resolve().parents[1] / "examples" / "relaxation" / "pdms.toml")
 BASE = ["contact", "sphere", "--radius", "1um", "--pitch", "1.5um", "--E-star", "1MPa", "--W", "50mJ/m2",
         "--tabor", "1.0", "--dx", "100nm", "--quiet"]
 
@@ -15,7 +17,7 @@ def test_history_file_run_writes_a_time_table(tmp_path):
     h = tmp_path / "h.csv"
     h.write_text("time_s,approach_nm\n0,-200\n0.05,150\n0.1,-200\n")
     out = tmp_path / "v.csv"
-    rc = main(BASE + ["--relaxation", "examples/relaxation/pdms.toml", "--history", str(h), "--dt", "10ms",
+    rc = main(BASE + ["--relaxation", PDMS, "--history", str(h), "--dt", "10ms",
                       "--out", str(out)])
     assert rc == 0
     rows = list(csv.DictReader(out.open()))
@@ -32,7 +34,7 @@ def test_history_file_run_writes_a_time_table(tmp_path):
 ])
 def test_bad_history_options_are_one_line_exit_2(tmp_path, capsys, extra, words):
     out = tmp_path / "v.csv"
-    rc = main(BASE + ["--relaxation", "examples/relaxation/pdms.toml", *extra, "--out", str(out)])
+    rc = main(BASE + ["--relaxation", PDMS, *extra, "--out", str(out)])
     assert rc == 2
     err = capsys.readouterr().err.strip()
     assert words in err and len(err.splitlines()) == 1

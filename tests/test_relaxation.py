@@ -1,6 +1,8 @@
 """The material with memory: the Prony series, its TOML table, the DMA fit, the SLS closed forms."""
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 from scipy.integrate import quad
@@ -34,7 +36,7 @@ def test_bad_tables_are_refused_naming_the_value(table, words):
 
 
 def test_the_example_and_the_default_are_the_same_series():
-    m = read_relaxation("examples/relaxation/pdms.toml")
+    m = read_relaxation(Path(__file__).resolve().parents[1] / "examples" / "relaxation" / "pdms.toml")
     d = sylgard184()
     assert (m.E_inf, m.E, m.tau) == (d.E_inf, d.E, pytest.approx(d.tau))
     f = np.logspace(-2, 2, 9)
