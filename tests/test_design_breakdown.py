@@ -27,6 +27,16 @@ def test_design_states_the_breakdown_cap(tmp_path):
     assert a["breakdown_exceeded"] in (0, False)  # 8 uC/m2 x A/S <= 8 uC/m2, far below the cap
     text = (out / "report.md").read_text()
     assert "Air breakdown (Paschen" in text and "below it" in text
+    # V_OC with both field models: Eq. 17's plates, and the finite field of the device design's 4 cm² square,
+    # here against the device layer's own spline table of that field at the rest gap (xb = 1)
+    from tengsim.device.field import bar_field
+
+    square = DeviceParams(mass_kg=0.01, stiffness_N_per_m=5e3, area_m2=AREA_M2, thickness_m=200e-6, gap_m=0.2e-3,
+                          eps_r=3.0, sigma_C_per_m2=8e-6, field="finite", electrode_shape="square")
+    ratio = float(bar_field(square).voc(1.0))
+    assert 0.8 < ratio < 1.0  # fringing: below the parallel plates at a gap of 1 % of the electrode
+    assert a["voc_finite_at_p_max_V"] == pytest.approx(a["voc_eq17_at_p_max_V"] * ratio, rel=2e-3)
+    assert "field: finite" in text and "field: parallel" in text and "voc_finite_at_p_max_V" in a["field_models"]
 
 
 def test_a_charge_above_the_cap_is_flagged():

@@ -10,7 +10,7 @@ COLUMNS = ("status", "tabor", "jump_in_Pa", "pull_off_N", "pull_off_Pa", "full_c
            "sensitivity_above_knee_V_per_Pa", "saturation_Pa", "linear_range_Pa", "linear_r2",
            "voc_hysteresis_fraction",
            "hysteresis_J_m2", "area_at_p_max", "voc_eq12_at_p_max_V",
-           "voc_eq17_at_p_max_V", "grids", "tolerance")
+           "voc_eq17_at_p_max_V", "voc_finite_at_p_max_V", "grids", "tolerance")
 
 
 def _area(r) -> float:

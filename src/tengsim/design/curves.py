@@ -269,6 +269,7 @@ def summarize(res, plan) -> tuple[dict, dict, list]:
         "area_at_p_max": float(app["area"][-1]),
         "voc_eq12_at_p_max_V": float(app["voc_eq12"][-1]),
         "voc_eq17_at_p_max_V": float(app["voc_eq17"][-1]),
+        "voc_finite_at_p_max_V": _finite_voc(plan, float(app["voc_eq17"][-1])),
         "grids": _grids_text(res),
         "tolerance": plan.tol,
         "charged_area_definition": r.definition,
@@ -280,6 +281,15 @@ def summarize(res, plan) -> tuple[dict, dict, list]:
                                                               "hysteresis_bound_J_m2", "area_hysteresis")})
     conv = convergence(res)
     return summary, conv, notes
+
+
+def _finite_voc(plan, voc_eq17: float) -> float:
+    """Eq. 17's V_OC at p_max with the finite field of the design's device (tengsim.design.breakdown)."""
+    if not math.isfinite(voc_eq17):
+        return math.nan
+    from tengsim.design.breakdown import finite_voc_ratio
+
+    return voc_eq17 * finite_voc_ratio(float(plan.eps_r), float(plan.T), float(plan.gap))
 
 
 def na_reasons(summary: dict, numbers, plan, full: float, drawn_in: bool = False) -> dict:
@@ -297,6 +307,7 @@ def na_reasons(summary: dict, numbers, plan, full: float, drawn_in: bool = False
            "area_hysteresis": "the retraction reaches none of the asked pressures",
            "area_at_p_max": f"the approach does not reach {top}", "voc_eq12_at_p_max_V": f"the approach does not "
            f"reach {top}", "voc_eq17_at_p_max_V": f"the approach does not reach {top}",
+           "voc_finite_at_p_max_V": f"the approach does not reach {top}",
            **numbers.reasons}
     out = {}
     for k, text in why.items():

@@ -20,7 +20,8 @@ ROWS = (
                         "asked pressure (absolute)", ""),
     ("area_at_p_max", "charged area A/S at p_max (approach)", ""),
     ("voc_eq12_at_p_max_V", "V_OC at p_max, Eq. 12 (polymer)", "V"),
-    ("voc_eq17_at_p_max_V", "V_OC at p_max, Eq. 17 (rest gap)", "V"),
+    ("voc_eq17_at_p_max_V", "V_OC at p_max, Eq. 17 (rest gap; field: parallel plates)", "V"),
+    ("voc_finite_at_p_max_V", "V_OC at p_max, rest gap, field: finite (4 cm² square electrode, the device's)", "V"),
 )
 
 

@@ -42,7 +42,7 @@ SUMMARY_UNITS = {"jump_in_Pa": "Pa", "pull_off_N": "N per cell", "pull_off_Pa": 
                  "hysteresis_J_m2": "J/m2",
                  "hysteresis_bound_J_m2": "J/m2",
                  "area_hysteresis": "1", "area_at_p_max": "1", "voc_eq12_at_p_max_V": "V",
-                 "voc_eq17_at_p_max_V": "V", "tabor": "1", "seconds": "s",
+                 "voc_eq17_at_p_max_V": "V", "voc_finite_at_p_max_V": "V", "tabor": "1", "seconds": "s",
                  **{k: u for k, (u, _) in NUMBERS.items()}}
 
 
@@ -89,6 +89,9 @@ def to_dataset(res, plan, summary: dict):
         np.isfinite(data["charged_area_fraction"][1][0])) else math.nan
     b = design_breakdown(plan.sigma, plan.eps_r, plan.T, plan.gap, a_max)
     attrs.update({**b, "breakdown_exceeded": int(b["breakdown_exceeded"])})  # 0/1: NetCDF has no booleans
+    from tengsim.design.breakdown import FINITE_FIELD
+
+    attrs["field_models"] = f"voc_eq12, voc_eq17: parallel plates (the paper's); voc_finite_at_p_max_V: {FINITE_FIELD}"
     sensor, reasons = summary.get("sensor"), summary.get("reasons") or {}
     for k, v in summary.items():
         if k in SUMMARY_UNITS and k != "tabor":
