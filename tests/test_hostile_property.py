@@ -401,3 +401,31 @@ def test_generated_calibrate_options(tmp_path_factory, capsys, monkeypatch, opt,
     given_opt = [f"{key}={value}"] if eq else [key, value]
     check_calibrate(d, ["calibrate", d / "d.toml", "--data", d / "m.csv", "--free", "sigma,W", *given_opt,
                         "--quiet", "--out", d / "o"], capsys, monkeypatch)
+
+
+# ---- design --material: a material file (as calibrate writes it, or by hand) with hostile values and points ----
+material_keys = st.one_of(st.sampled_from(["sigma", "W", "eps", "E_star"]), st.text(max_size=8))
+material_value = st.one_of(number_text, st.sampled_from(["-5uC/m2", "1e9C/m2", "abc", "20mJ/m2", "8uC/m2", "50nm",
+                                                         "-1MPa", "0uC/m2"]),
+                           st.integers(-3, 3), st.booleans(), st.lists(st.integers(), max_size=2))
+material_points = st.one_of(st.lists(st.dictionaries(material_keys, material_value, max_size=3), max_size=3),
+                            st.sampled_from([5, "x", ["a"], [5]]))
+
+
+@SETTINGS(30)
+@given(values=st.dictionaries(material_keys, material_value, max_size=3), points=material_points,
+       table=st.sampled_from(["design", "material", "other"]))
+def test_generated_material_files_for_design(tmp_path_factory, capsys, values, points, table):
+    """Every material file is refused in one line (exit 2, nothing written) or planned with all its points and then
+    refused by the 10 ms budget: never exit 70, never a band point found bad after work was done."""
+    d = tmp_path_factory.mktemp("dm")
+    text = toml_table(table, values)
+    if isinstance(points, list) and all(isinstance(p, dict) for p in points):
+        text += "".join(toml_table("uncertainty.point", p).replace("[uncertainty.point]", "[[uncertainty.point]]")
+                        for p in points)
+    else:
+        text += f"[uncertainty]\npoint = {toml_value(points)}\n"
+    f = d / "material.toml"
+    f.write_text(text)
+    rc = check(d, [*DESIGN, "--material", f, "--out", d / "o"], capsys)
+    assert rc == 2  # a bad file in one line, or planned (all its points) and refused by the budget
