@@ -21,6 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from tengsim.backend import fft as _bf
 from tengsim.device.params import EPS0
 from tengsim.errors import positive, require
 
@@ -52,10 +53,10 @@ class PatternField:
 
     def _modes(self):
         n = self.fraction.shape[0]
-        k = np.fft.fftfreq(n, d=1.0 / n)  # integer mode numbers
+        k = _bf.fftfreq(n, d=1.0 / n)  # integer mode numbers
         kx, ky = np.meshgrid(k, k, indexing="ij")
         cell = np.sinc(kx / n) * np.sinc(ky / n)  # piecewise-constant cells
-        s = self.sigma_C_m2 * np.fft.fft2(self.fraction) / (n * n) * cell
+        s = self.sigma_C_m2 * _bf.np_fft2(self.fraction) / (n * n) * cell
         q = 2 * np.pi * np.hypot(kx, ky) / self.pitch_m
         nyq = (np.abs(kx) < n / 2) & (np.abs(ky) < n / 2)
         s = np.where(nyq, s, 0.0)
@@ -70,7 +71,7 @@ class PatternField:
         with np.errstate(divide="ignore", invalid="ignore"):
             phi = s / (EPS0 * q * (1 / np.tanh(q * x) + self.eps_r / np.tanh(q * self.thickness_m)))
         phi[0, 0] = 0.0
-        return np.real(np.fft.ifft2(phi) * n * n)
+        return np.real(_bf.np_ifft2(phi) * n * n)
 
     def field_z(self, gap_m: float, z_m: float) -> np.ndarray:
         """The pattern's part of the normal field (V/m, N x N map, toward the surface positive for a positive
@@ -84,7 +85,7 @@ class PatternField:
             shape = np.exp(-q * z_m) * (1 + np.exp(-2 * q * (x - z_m))) / (1 - np.exp(-2 * q * x))
             e = s / den * shape
         e[0, 0] = 0.0
-        return np.real(np.fft.ifft2(e) * n * n)
+        return np.real(_bf.np_ifft2(e) * n * n)
 
     def uniform_field(self) -> float:
         """The uniform sheet's gap field sigma (A/S)/eps0 (V/m), open circuit, parallel plates."""
