@@ -58,7 +58,7 @@ from tengsim.errors import TengsimError
 from tengsim.registry import SOLVERS
 from tengsim.solvers._pk_core import Convolution, constrained_cg, preconditioner
 from tengsim.solvers._pk_zone import Anderson as _Anderson, zone_inner, zone_residual
-from tengsim.solvers.types import Equilibrium, Problem, State
+from tengsim.solvers.types import Equilibrium, Problem, State, check_settings
 
 #: the largest pixel snap number of a Maugis–Dugdale ramp (PKSolver._ramp)
 RAMP_SNAP = 0.5
@@ -159,16 +159,11 @@ class PKSolver:
     resumes_from_state: ClassVar[bool] = False
 
     def __post_init__(self):
-        if not (isinstance(self.tol, (int, float)) and self.tol > 0 and math.isfinite(self.tol)):
-            raise TengsimError(f"tol must be a finite number > 0, got {self.tol!r}")
+        check_settings(self, ("max_iter", "max_zone", "monitor_every"))
         if self.md_zone not in ("ramp", "sharp"):
             raise TengsimError(f"md_zone must be 'ramp' or 'sharp', got {self.md_zone!r}")
         if self.zone not in ("inner", "outer"):
             raise TengsimError(f"zone must be 'inner' or 'outer', got {self.zone!r}")
-        for key in ("max_iter", "max_zone", "monitor_every"):
-            v = getattr(self, key)
-            if isinstance(v, bool) or not isinstance(v, int) or v < 1:
-                raise TengsimError(f"{key} must be an integer >= 1, got {v!r}")
 
     @staticmethod
     def _convolution(kernel, shape):

@@ -29,7 +29,7 @@ from tengsim import backend
 from tengsim.errors import TengsimError
 from tengsim.registry import SOLVERS
 from tengsim.solvers._ram_core import Compliance, solve_gap
-from tengsim.solvers.types import Equilibrium, Problem, State
+from tengsim.solvers.types import Equilibrium, Problem, State, check_settings
 
 
 def limit_of(law, solver: str = "ram"):
@@ -67,14 +67,9 @@ class RAMSolver:
     resumes_from_state: ClassVar[bool] = False
 
     def __post_init__(self):
-        if not (isinstance(self.tol, (int, float)) and self.tol > 0 and math.isfinite(self.tol)):
-            raise TengsimError(f"tol must be a finite number > 0, got {self.tol!r}")
+        check_settings(self, ("max_iter", "monitor_every"))
         if self.start not in ("scaled", "shifted"):
             raise TengsimError(f"start must be 'scaled' or 'shifted', got {self.start!r}")
-        for key in ("max_iter", "monitor_every"):
-            v = getattr(self, key)
-            if isinstance(v, bool) or not isinstance(v, int) or v < 1:
-                raise TengsimError(f"{key} must be an integer >= 1, got {v!r}")
 
     @staticmethod
     def solves(law) -> bool:

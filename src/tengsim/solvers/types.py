@@ -2,6 +2,7 @@
 :class:`Equilibrium` comes out.  All three are frozen (their arrays are the solver's own)."""
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass
 
@@ -73,3 +74,17 @@ def finish(problem, state, P, r, energy, converged, it, n_conv, t0, msg, capped=
     res = float(np.max(np.abs(r)))
     return Equilibrium(state, H, P, res, converged, it, n_conv, float(energy), time.perf_counter() - t0, msg,
                        capped)
+
+
+def check_settings(solver, counts=("max_iter", "monitor_every")) -> None:
+    """A constrained solver's settings at construction: ``tol`` a finite number > 0, each of ``counts`` an
+    integer >= 1 (one line naming the bad value)."""
+    from tengsim.errors import TengsimError
+
+    tol = solver.tol
+    if isinstance(tol, bool) or not (isinstance(tol, (int, float)) and tol > 0 and math.isfinite(tol)):
+        raise TengsimError(f"tol must be a finite number > 0, got {tol!r}")
+    for key in counts:
+        v = getattr(solver, key)
+        if isinstance(v, bool) or not isinstance(v, int) or v < 1:
+            raise TengsimError(f"{key} must be an integer >= 1, got {v!r}")
