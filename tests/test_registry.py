@@ -25,8 +25,8 @@ def test_builtins_are_registered():
                                    "sinusoid"}
     assert SHAPES.get("sphere") is ts.Paraboloid and SHAPES.get("flat-punch") is ts.FlatPunch
     assert LAWS.get("lj") is LJ93 and LAWS.get("paper") is LJ93 and LAWS.get("repulsive") is Repulsive
-    assert KERNELS.names() == ("free", "periodic") and SOLVERS.names() == ("fast", "vsr", "homotopy", "pk", "pk_jax", "jax", "gpu",
-                                                                           "auto")
+    assert KERNELS.names() == ("free", "periodic") and SOLVERS.names() == ("fast", "vsr", "homotopy", "pk", "pk_jax", "ram", "jax",
+                                                                           "gpu", "auto")
     assert "summary" in OBSERVERS
 
 
