@@ -75,7 +75,7 @@ class Compliance:
             raise TengsimError("solver 'ram': the kernel's compliance is not positive on every mode of its periodic "
                                "domain (no energy in the gap); use solver 'pk' or 'fast'")
         self.spec = spec
-        self.inv_spec = np.divide(1.0, spec, out=np.zeros_like(spec), where=spec > 0)
+        self.inv_spec = np.divide(1.0, spec, out=backend.zeros(spec.shape, spec.dtype), where=spec > 0)
         self.count = 0
 
     def _mul(self, x, mult):
@@ -94,7 +94,8 @@ class Compliance:
         """A cell array on the domain, flat (the block [:nx, :ny]; ``fill`` elsewhere)."""
         if not self.embedded:
             return np.ascontiguousarray(a, dtype=float).ravel().copy()
-        out = np.full(self.domain, fill, dtype=float)
+        out = backend.empty(self.domain)
+        out[...] = fill
         out[:self.shape[0], :self.shape[1]] = a
         return out.ravel()
 
@@ -126,7 +127,7 @@ def solve_gap(op: Compliance, h, cell, law, u, tol: float, max_iter: int, monito
     held).  ``h``: the gap at zero pressure (flat domain layout); ``cell``: the domain's cell pixels (None: all);
     ``law``: a :class:`tengsim.laws.cohesive.CohesiveLimit`; ``monitor(it, residual)``: progress."""
     n = h.size
-    cellm = np.ones(n, bool) if cell is None else cell
+    cellm = cell if cell is not None else ~backend.zeros(n, bool)
     outer = ~cellm
 
     def on_cell(f, v):                     # a law's function on the cell's gaps (0 off the cell)

@@ -92,7 +92,7 @@ class RAMSolver:
             return Equilibrium(State(z, z.copy()), h_cell.copy(), z.copy(), math.inf, False, 0, 0, math.nan,
                                time.perf_counter() - t0, msg)
         h = op.embed(h_cell)
-        cell = op.embed(np.ones(shape, bool), False).astype(bool) if op.embedded else None
+        cell = op.embed(~backend.zeros(shape, bool), False).astype(bool) if op.embedded else None
         q = np.asarray(start.q, dtype=float)
         u = h + op.apply(op.embed(q)) if np.any(q) else h.copy()
         if op.pinned and self.start == "scaled" and np.any(q):
