@@ -129,3 +129,7 @@ def _process_docstring(app, what, name, obj, options, lines):
 
 def setup(app):
     app.connect("autodoc-process-docstring", _process_docstring)
+
+# A short name documented on two classes (e.g. ``table``, ``value``) makes Sphinx warn "more than one target found"
+# where autodoc cross-references it by that name alone; those references are not ours to qualify.
+suppress_warnings = ["ref.python"]

@@ -1,4 +1,4 @@
-"""``tengsim contact ... --relaxation FILE``: the physical run on a time axis (a thin shell over
+"""``tengsim contact … --relaxation FILE``: the physical run on a time axis (a thin shell over
 :mod:`tengsim.visco`).  The history is ``--history FILE.csv`` (time in s, and an approach with a length unit
 in its header, e.g. ``approach_nm``, or a pressure, e.g. ``pressure_kPa``) or a wave by options:
 ``--wave ramp_hold|triangle|square --wave-to VALUE --wave-time T [--cycles N]`` (VALUE a length: approach

@@ -1,4 +1,4 @@
-"""A design on a time axis (``tengsim design ... --relaxation FILE``): the design's contact pressed and released
+"""A design on a time axis (``tengsim design … --relaxation FILE``): the design's contact pressed and released
 at 2–3 frequencies on a viscoelastic material (:mod:`tengsim.visco`), with A/S(t), V_OC(t) (Eq. 12) and the
 nominal pressure over a cycle, and the sensor's numbers at each frequency:
 
@@ -8,7 +8,7 @@ nominal pressure over a cycle, and the sensor's numbers at each frequency:
   to 90 % of V_OC's change, from the start of the press and of the release.
 
 The relaxed elastic solid (E∞, no branch) runs the same cycles once, as the static reference.  The cycles run on
-one coarse grid of ``pixels``² (stated in the report): they show the rate effects, the static design gives the
+one coarse grid of ``pixels`` × ``pixels`` (stated in the report): they show the rate effects, the static design gives the
 converged numbers.
 """
 from __future__ import annotations
