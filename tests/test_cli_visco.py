@@ -48,3 +48,27 @@ def test_bad_relaxation_file_is_refused(tmp_path, capsys):
                       "--out", str(tmp_path / "v.csv")])
     assert rc == 2
     assert "tau must be > 0" in capsys.readouterr().err
+
+
+def test_out_equal_to_the_relaxation_file_is_refused_and_the_file_kept(tmp_path, capsys):
+    """An output path that is an input (the relaxation TOML) is refused before any work: the file is not replaced."""
+    mat = tmp_path / "pdms.toml"
+    mat.write_text(Path(PDMS).read_text())
+    before = mat.read_bytes()
+    rc = main(BASE + ["--relaxation", str(mat), "--wave", "triangle", "--wave-to", "50nm", "--wave-time", "0.1s",
+                      "--out", str(mat)])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert rc == 2 and len(err) == 1 and err[0].startswith("tengsim: error:"), err
+    assert mat.read_bytes() == before
+
+
+@pytest.mark.parametrize("flag", ["--relaxation", "--history"])
+def test_random_bytes_as_relaxation_or_history_is_one_line(tmp_path, capsys, flag):
+    junk = tmp_path / "junk"
+    junk.write_bytes(bytes(range(128, 256)) * 3)
+    extra = (["--relaxation", str(junk), "--wave", "triangle", "--wave-to", "50nm", "--wave-time", "0.1s"]
+             if flag == "--relaxation" else ["--relaxation", PDMS, "--history", str(junk)])
+    rc = main(BASE + extra + ["--out", str(tmp_path / "v.csv")])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert rc == 2 and len(err) == 1 and "not a text" in err[0], err
+    assert not (tmp_path / "v.csv").exists()

@@ -39,6 +39,8 @@ def _history(args, sc):
             head = next(csv.reader(p.read_text().splitlines()))
         except (OSError, StopIteration):
             raise TengsimError(f"cannot read history file {str(p)!r}") from None
+        except (UnicodeDecodeError, csv.Error):
+            raise TengsimError(f"history file {str(p)!r}: not a text (CSV) file") from None
         col = head[1].strip() if len(head) > 1 else ""
         unit = col.split("_", 1)[1] if "_" in col else ""
         h = read_history(p)
@@ -77,10 +79,12 @@ def run(args, plan) -> int:
     sc = plan.scaling
     if sc is None:
         raise TengsimError("--relaxation needs a physical run (--E-star, --W, ... in units)")
+    from tengsim.io import check_output
+
+    out = check_output(args.out, [x for x in (args.relaxation, args.history) if x])  # never an input, before work
     material = read_relaxation(args.relaxation)
     history = _history(args, sc)
     steps = FixedTimeSteps(parse_quantity(args.dt, "time", "--dt")) if args.dt else SegmentSteps(32)
-    out = Path(args.out)
     res = simulate_history(plan.shape, plan.tabor, plan.grid.dx, material, history, steps, boundary=plan.boundary,
                            law=plan.law, solver=plan.solver, tol=plan.tol, kernel_params=plan.kernel_params,
                            grid=plan.grid)

@@ -80,6 +80,8 @@ def read_dma(path, per_decade: float = 1.0) -> DMAFit:
         rows = [r for r in csv.reader(p.read_text().splitlines()) if r and not r[0].lstrip().startswith("#")]
     except OSError as e:
         raise TengsimError(f"cannot read DMA file {str(p)!r}: {e.strerror}") from None
+    except (UnicodeDecodeError, csv.Error):
+        raise TengsimError(f"DMA file {str(p)!r}: not a text (CSV) file") from None
     factor = 1.0
     if rows and not _is_number(rows[0][0]):
         head = ",".join(rows[0])

@@ -59,6 +59,8 @@ def read_relaxation(path) -> Prony:
         doc = tomllib.loads(p.read_text())
     except OSError as e:
         raise TengsimError(f"cannot read relaxation file {str(p)!r}: {e.strerror}") from None
+    except UnicodeDecodeError:
+        raise TengsimError(f"relaxation file {str(p)!r}: not a text (TOML) file") from None
     except tomllib.TOMLDecodeError as e:
         raise TengsimError(f"relaxation file {str(p)!r} is not valid TOML: {e}") from None
     if "relaxation" not in doc:

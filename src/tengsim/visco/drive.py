@@ -12,8 +12,6 @@ in time down to ``dt_min``: a snap-in or a pull-off is located in time to that r
 """
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from tengsim.analysis import apex_index, summarize

@@ -88,6 +88,8 @@ def read_history(path, kind: str | None = None) -> History:
         rows = [r for r in csv.reader(p.read_text().splitlines()) if r and not r[0].lstrip().startswith("#")]
     except OSError as e:
         raise TengsimError(f"cannot read history file {str(p)!r}: {e.strerror}") from None
+    except (UnicodeDecodeError, csv.Error):
+        raise TengsimError(f"history file {str(p)!r}: not a text (CSV) file") from None
     if rows and rows[0] and not _number(rows[0][0]):
         head = rows[0][1].strip().lower() if len(rows[0]) > 1 else ""
         kind = kind or ("pressure" if head.startswith("p") else "approach" if head.startswith(("a", "d")) else None)
