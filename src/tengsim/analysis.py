@@ -121,17 +121,18 @@ def charged_area(H: np.ndarray, grid: Grid, g_c: float, opening: float = 1.0, pe
 
     nx, ny = H.shape
     ax = ay = 0.0
-    for j in range(0, ny, _LINES):  # a few lines at a time: the scan's temporaries stay small beside the maps
-        f = level(H[:, j:j + _LINES])
+    step_y, step_x = max(1, _CHUNK // max(nx, 1)), max(1, _CHUNK // max(ny, 1))
+    for j in range(0, ny, step_y):  # lines in blocks of ~_CHUNK values: the scan's temporaries stay bounded
+        f = level(H[:, j:j + step_y])
         ax += _scan_length(f, periodic) if nx > 1 else float(np.count_nonzero(f < 0))
-    for i in range(0, nx, _LINES):
-        f = level(H[i:i + _LINES, :].T)
+    for i in range(0, nx, step_x):
+        f = level(H[i:i + step_x, :].T)
         ay += _scan_length(f, periodic) if ny > 1 else float(np.count_nonzero(f < 0))
     return float(0.5 * (ax + ay) * grid.area)
 
 
-_LINES = 4
-"""Lines measured at a time by :func:`charged_area`."""
+_CHUNK = 1 << 18
+"""Map values measured at a time by :func:`charged_area` (its temporaries: about 20 such blocks of float64)."""
 
 
 def apex_index(U0: np.ndarray) -> tuple[int, int]:
