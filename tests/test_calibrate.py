@@ -52,6 +52,7 @@ def fitted(tmp_path_factory):
     return d, out, args
 
 
+@pytest.mark.slow  # the shared calibration (two geometries, 36 designs) takes about 3.5 min of CPU
 def test_recovery_two_geometries_intervals_contain_truth(fitted):
     from tengsim.io import read_dataset
 
@@ -80,6 +81,7 @@ def test_recovery_two_geometries_intervals_contain_truth(fitted):
     assert np.all(ds["voc_fitted"].values <= ds["voc_upper"].values + 1e-9)
 
 
+@pytest.mark.slow  # the shared calibration (two geometries, 36 designs) takes about 3.5 min of CPU
 def test_files_report_material_and_cf(fitted):
     _, out, _ = fitted
     for f in ("fit.nc", "fit.csv", "material.toml", "report.md", "fit.png", "residuals.png", "profiles.png"):
@@ -101,6 +103,7 @@ def test_files_report_material_and_cf(fitted):
     assert not bad, [(r.name, r.msgs) for r in bad]
 
 
+@pytest.mark.slow  # the shared calibration (two geometries, 36 designs) takes about 3.5 min of CPU
 def test_rerun_takes_every_design_back(fitted):
     from tengsim.calibrate import calibrate, plan_calibration
 

@@ -121,8 +121,11 @@ def charged_area(H: np.ndarray, grid: Grid, g_c: float, opening: float = 1.0, pe
 
     nx, ny = H.shape
     ax = ay = 0.0
-    step_y, step_x = max(1, _CHUNK // max(nx, 1)), max(1, _CHUNK // max(ny, 1))
-    for j in range(0, ny, step_y):  # lines in blocks of ~_CHUNK values: the scan's temporaries stay bounded
+    # lines in blocks: at most ~_CHUNK values and an eighth of the map, so the scan's temporaries (about ten
+    # blocks) stay below one map's size while its Python overhead is a few blocks, not a block per 4 lines
+    step_y = max(4, min(ny // 8 + 1, _CHUNK // max(nx, 1)))
+    step_x = max(4, min(nx // 8 + 1, _CHUNK // max(ny, 1)))
+    for j in range(0, ny, step_y):
         f = level(H[:, j:j + step_y])
         ax += _scan_length(f, periodic) if nx > 1 else float(np.count_nonzero(f < 0))
     for i in range(0, nx, step_x):
@@ -131,8 +134,8 @@ def charged_area(H: np.ndarray, grid: Grid, g_c: float, opening: float = 1.0, pe
     return float(0.5 * (ax + ay) * grid.area)
 
 
-_CHUNK = 1 << 18
-"""Map values measured at a time by :func:`charged_area` (its temporaries: about 20 such blocks of float64)."""
+_CHUNK = 1 << 16
+"""Most map values measured at a time by :func:`charged_area`."""
 
 
 def apex_index(U0: np.ndarray) -> tuple[int, int]:
