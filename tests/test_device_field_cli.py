@@ -20,6 +20,20 @@ def test_fig7_finite_disk_outputs(tmp_path, capsys):
     assert s["voc_V"] == pytest.approx(v["finite"], rel=1e-3)
     assert s["sigma_breakdown_C_m2"] > s["sigma_times_area_fraction_C_m2"] and s["breakdown_exceeded"] is False
     assert s["sigma_breakdown_short_C_m2"] > s["sigma_breakdown_C_m2"]
+    # the breakdown-limited CMEO to the run's largest gap: below the cap, the cycle is the unlimited one, its
+    # energy the closed form's (tests/test_device_breakdown.py) and its FOM_S of order one at x ~ 1 mm on 7 cm
+    c = s["breakdown_cycle"]
+    assert c["x_max_m"] == pytest.approx(v["gap_m"]) and c["sigma_held_C_m2"] == pytest.approx(
+        s["sigma_times_area_fraction_C_m2"])
+    assert c["energy_J"] == pytest.approx(c["energy_unlimited_J"], rel=1e-12) and 0.1 < c["fom_structural"] < 2.0
+    from tengsim.device import DeviceParams
+    from tengsim.device.breakdown import breakdown_cycle
+
+    p = DeviceParams(**{k: side["params"][k] for k in ("mass_kg", "stiffness_N_per_m", "area_m2", "thickness_m",
+                                                       "gap_m", "eps_r", "sigma_C_per_m2", "field",
+                                                       "electrode_shape")})
+    ref = breakdown_cycle(p, c["x_max_m"], sigma_area_C_m2=c["sigma_held_C_m2"])
+    assert c["energy_J"] == pytest.approx(ref.energy_J, rel=1e-9)
 
 
 @pytest.mark.parametrize("argv, msg", [

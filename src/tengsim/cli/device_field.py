@@ -60,7 +60,7 @@ def field_summary(params, result, pressure_Pa: float | None = None) -> dict:
     sigma_breakdown_C_m2 (open-circuit cap on σ A/S), the short-circuit and the load's, and whether σ A/S exceeds."""
     import numpy as np
 
-    from tengsim.device.breakdown import sigma_breakdown, sigma_breakdown_run
+    from tengsim.device.breakdown import breakdown_cycle, sigma_breakdown, sigma_breakdown_run
     from tengsim.device.field import electrode_size, gap_coefficients
     from tengsim.device.paschen import ATM_PA, SOURCE
     from tengsim.device.params import EPS0
@@ -75,6 +75,7 @@ def field_summary(params, result, pressure_Pa: float | None = None) -> dict:
     ci, v = gap_coefficients(p.electrode_shape, size, p.thickness_m, p.eps_r, [x_max])[:2]
     b = sigma_breakdown(p, x_max_m=x_max, pressure_Pa=pa)
     eff = p.sigma_C_per_m2 * charged
+    cyc = breakdown_cycle(p, x_max, pa, sigma_area_C_m2=eff) if eff > 0 and x_max > 0 else None
     return {
         "field_model": p.field,
         "electrode": {"shape": p.electrode_shape, "size_m": size, "area_m2": p.area_m2},
@@ -88,6 +89,10 @@ def field_summary(params, result, pressure_Pa: float | None = None) -> dict:
         "breakdown_exceeded": bool(eff > b.sigma_breakdown_C_m2),
         "air_pressure_Pa": pa,
         "paschen": SOURCE,
+        # the CMEO to the run's largest gap after the first stroke's breakdown (quasi-static; docs/device.md)
+        "breakdown_cycle": None if cyc is None else {
+            "x_max_m": cyc.x_max_m, "sigma_held_C_m2": cyc.sigma_held_C_m2, "energy_J": cyc.energy_J,
+            "energy_unlimited_J": cyc.energy_unlimited_J, "fom_structural": cyc.fom_structural},
     }
 
 

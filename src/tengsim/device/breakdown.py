@@ -103,13 +103,14 @@ class BreakdownCycle:
     x_max_m: float
 
 
-def breakdown_cycle(params: DeviceParams, x_max_m: float, pressure_Pa: float = ATM_PA, n: int = 100) -> BreakdownCycle:
-    """The CMEO of ``params`` (its field model; σ A/S with A/S = 1 for the flat device, else its initial A/S or 1)
-    to a gap ``x_max_m``, limited by breakdown."""
+def breakdown_cycle(params: DeviceParams, x_max_m: float, pressure_Pa: float = ATM_PA, n: int = 100,
+                    sigma_area_C_m2: float | None = None) -> BreakdownCycle:
+    """The CMEO of ``params`` (its field model) to a gap ``x_max_m``, limited by breakdown, for the charge density
+    ``sigma_area_C_m2`` = σ A/S (default σ times the initial A/S, or σ for a flat device)."""
     x_max = positive("x_max", x_max_m)
     p = params
-    frac = p.area.initial_fraction or 1.0
-    sig = p.sigma_C_per_m2 * frac
+    sig = (p.sigma_C_per_m2 * (p.area.initial_fraction or 1.0) if sigma_area_C_m2 is None
+           else positive("sigma A/S", sigma_area_C_m2))
     cap = sigma_breakdown(p, x_max_m=x_max, pressure_Pa=pressure_Pa).sigma_breakdown_C_m2
     f = bar_field(p, xb_max=max(3.0, x_max / p.gap_m))
     k = p.gap_m / (EPS0 * p.area_m2)
