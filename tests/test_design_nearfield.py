@@ -32,9 +32,9 @@ def test_uniform_map_is_the_uniform_sheet():
 
 def test_one_fourier_mode_against_its_closed_form():
     """f = 1/2 + 1/2 cos(2π x/p) on N pixels: one mode of amplitude σ sinc(1/N)/4 each side (the pixels' cell
-    factor), so E_p(0) = (σ/2) sinc(1/N) coth(qx)/(ε0 (coth qx + ε_r coth qT)) cos(2π x/p) and the surface potential's
-    spread 2 (σ/2) sinc(1/N)/(ε0 q (coth qx + ε_r coth qT)); the decay height solves (σ/2) sinc(1/N) cosh(q(x − z))/
-    (sinh(qx) ε0 (coth qx + ε_r coth qT)) = 1 % of σ/(2ε0)."""
+    factor), so E_p(0) = (σ/2) sinc(1/N) coth(qx)/(ε0 (coth qx + ε_r coth qT)) cos(2π x/p) and the surface
+    potential's spread 2 (σ/2) sinc(1/N)/(ε0 q (coth qx + ε_r coth qT)); the decay height solves
+    (σ/2) sinc(1/N) cosh(q(x − z))/(sinh(qx) ε0 (coth qx + ε_r coth qT)) = 1 % of σ/(2ε0)."""
     n, p = 64, 5e-6
     f = np.repeat((0.5 + 0.5 * np.cos(2 * np.pi * np.arange(n) / n))[:, None], 8, axis=1)
     nf = pattern_nearfield(f, p, p / 8, SIG, T, ER, D0)  # a rectangular cell: 64 x 8 pixels of one size

@@ -190,7 +190,7 @@ def report_line(nf) -> str:
                                                    "electrode")
     return (f"Near field of the charged pattern (the approach map at {nf.pressure_Pa / 1e3:.3g} kPa: A/S "
             f"{nf.area_fraction:.4g} on {nf.pixels[0]}×{nf.pixels[1]} pixels of a {length_text(nf.pitch_x_m)} × "
-            f"{length_text(nf.pitch_y_m)} cell{cell}; uniform sheet σ A/S/ε0 = {nf.uniform_field_V_m / 1e6:.3g} V/µm, "
-            f"open circuit): the largest local field at the charged surface over the uniform one / the gap voltage's "
-            f"spread over the cell over σ A/S x/ε0: {at}; the pattern's field is {dh} (gap "
-            f"{length_text(nf.decay_gap_m)}).")
+            f"{length_text(nf.pitch_y_m)} cell{cell}; uniform sheet σ A/S/ε0 = "
+            f"{nf.uniform_field_V_m / 1e6:.3g} V/µm, open circuit): the largest local field at the charged surface "
+            f"over the uniform one / the gap voltage's spread over the cell over σ A/S x/ε0: {at}; the pattern's "
+            f"field is {dh} (gap {length_text(nf.decay_gap_m)}).")

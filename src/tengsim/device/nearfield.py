@@ -2,10 +2,11 @@
 micrometres of separation, against the uniform sigma A/S the device model uses.
 
 The tribo charge sits on the charged area of a periodic contact map (a fraction map f(x, y) in [0, 1] on an
-Nx x Ny grid of one cell, pitches p_x x p_y (a square cell by default), each pixel a constant). Its mean sigma <f> = sigma A/S is the device model's uniform
-sheet; the rest is a sum of Fourier modes of wavenumber q = 2 pi |(k_x/p_x, k_y/p_y)|, each solved exactly in the layered
-geometry: the grounded back electrode under the dielectric (thickness T, eps_r), the sheet on its surface,
-the air gap x and the moving electrode (held at the sheet's mean potential: modes k != 0 carry no net charge).
+Nx x Ny grid of one cell, pitches p_x x p_y (a square cell by default), each pixel a constant). Its mean
+sigma <f> = sigma A/S is the device model's uniform sheet; the rest is a sum of Fourier modes of wavenumber
+q = 2 pi |(k_x/p_x, k_y/p_y)|, each solved exactly in the layered geometry: the grounded back electrode under
+the dielectric (thickness T, eps_r), the sheet on its surface, the air gap x and the moving electrode (held
+at the sheet's mean potential: modes k != 0 carry no net charge).
 For a mode of amplitude s_k the surface potential is
 
     phi_k = s_k / (eps0 q (coth(q x) + eps_r coth(q T))),
@@ -61,8 +62,8 @@ class PatternField:
 
     @cached_property
     def _spectrum(self):
-        """The map's modes s_k (C/m², half the spectrum along y), their wavenumbers q (1/m) and the pixel count: once per
-        pattern."""
+        """The map's modes s_k (C/m², half the spectrum along y), their wavenumbers q (1/m) and the pixel
+        count: computed once per pattern."""
         nx, ny = self.fraction.shape
         kx, ky = np.meshgrid(_bf.fftfreq(nx, d=1.0 / nx), _bf.fftfreq(ny, d=1.0 / ny), indexing="ij")  # integers
         cell = np.sinc(kx / nx) * np.sinc(ky / ny)  # piecewise-constant pixels
