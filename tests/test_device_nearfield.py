@@ -50,3 +50,17 @@ def test_far_field_is_the_uniform_sheet():
     assert near > 0.5 * pf.uniform_field()  # at the surface the patches' field is of the mean's order
     assert far < 1e-5 * pf.uniform_field()
     assert pf.uniform_field() == pytest.approx(SIG * 0.25 / EPS0)
+
+
+def test_rectangular_cell_strips_along_y_against_the_series():
+    """A cell of 3p x p (48 x 256 pixels), strips of width p/4 varying along y: the same hand series with the pitch
+    along y (ky/pitch_y); the field does not vary along x."""
+    f = np.zeros((48, 256))
+    f[:, :64] = 1.0
+    pf = PatternField(f, 3 * P, SIG, T, ER, pitch_y_m=P)
+    Y = (np.arange(256) + 0.5) / 256 * P
+    e_ref, phi_ref = hand_series(Y, P / 4, 2e-6, 0.5e-6)
+    e = pf.field_z(2e-6, 0.5e-6)
+    np.testing.assert_allclose(e[7], e_ref, atol=1e-6 * np.max(np.abs(e_ref)))
+    assert np.ptp(e, axis=0).max() < 1e-9 * np.max(np.abs(e_ref))
+    assert PatternField(f, P, SIG, T, ER).pitch_y_m == P  # square by default

@@ -71,6 +71,13 @@ def _breakdown_line(result) -> str:
     return report_line(design_breakdown(p.sigma, p.eps_r, p.T, p.gap, a_max))
 
 
+def _nearfield_line(result) -> str:
+    """The charged pattern's near field against the uniform σ A/S (tengsim.design.nearfield)."""
+    from tengsim.design.nearfield import report_line
+
+    return report_line(result.summary.get("nearfield"))
+
+
 def report_text(result, figures) -> str:
     p, s = result.plan, result.summary
     lines = [f"# Design: {p.name}", "",
@@ -84,6 +91,7 @@ def report_text(result, figures) -> str:
              f"T = {length_text(p.T)}, "
              f"rest gap d0 = {length_text(p.gap)} (defaults: the paper's 5.84 µC/m², 2.40, 400 µm, 0.1 mm).",
              _breakdown_line(result),
+             _nearfield_line(result),
              f"Pressures: {pressure_text(p.pressures[0])} to {pressure_text(p.pressures[-1])}, "
              f"{len(p.pressures)} values.",
              "", f"Charged area ({'the default' if p.area == 'contact' else 'area = paper'}): "

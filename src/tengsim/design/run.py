@@ -108,4 +108,7 @@ def run_design(plan, progress=None, keep=None) -> DesignResult:
     maps, depths = (res, maps_asked(res, plan)) if plan.maps and res.maps else (None, {})
     summary, conv, notes = summarize(res, plan)
     summary["map_pressures_asked"] = tuple(depths.items())
+    from tengsim.design.nearfield import design_nearfield  # issue 51: the charged pattern's near field
+
+    summary["nearfield"] = design_nearfield(maps, plan)
     return DesignResult(plan, to_dataset(res, plan, summary), summary, conv, res, tuple(notes), maps)

@@ -9,7 +9,8 @@ load, NaN-padded (a snap is two states at one pressure: the fold and where it la
 exact, not one of the asked pressures); global attributes
 Conventions, title, shape, shape_params (JSON), E_star_Pa, W_J_m2, eps_m, tabor, sigma_C_m2, eps_r, thickness_m,
 gap_m, status, grids, tolerance, charged_area_definition, branches_solved (the retraction is all NaN where only
-the approach was solved), and the per-design numbers (:mod:`tengsim.design.curves`).
+the approach was solved), the per-design numbers (:mod:`tengsim.design.curves`) and the charged pattern's near
+field, ``nearfield_*`` (:func:`tengsim.design.nearfield.attributes`; 'n/a: ...' without maps).
 ``tengsim.device.area_table_from_design`` reads it.
 """
 from __future__ import annotations
@@ -92,6 +93,9 @@ def to_dataset(res, plan, summary: dict):
     from tengsim.design.breakdown import FINITE_FIELD
 
     attrs["field_models"] = f"voc_eq12, voc_eq17: parallel plates (the paper's); voc_finite_at_p_max_V: {FINITE_FIELD}"
+    from tengsim.design.nearfield import attributes as nearfield_attributes
+
+    attrs.update(nearfield_attributes(summary.get("nearfield")))  # the charged pattern's near field (issue 51)
     sensor, reasons = summary.get("sensor"), summary.get("reasons") or {}
     for k, v in summary.items():
         if k in SUMMARY_UNITS and k != "tabor":
