@@ -73,7 +73,8 @@ def _numbers(res):
 @pytest.mark.parametrize("name", ["weak", "fast"])
 def test_a_relaxed_material_gives_the_quasi_static_device(designs, name):
     """E_i -> 0, or every tau far below the working period: the cycle is the relaxed solid's, so the device is the
-    quasi-static one: energy per cycle, peak |V|, V_OC and Q_SC within 0.5 % (measured: < 1e-3 %)."""
+    quasi-static one: energy per cycle, peak |V|, V_OC and Q_SC within 0.5 % (measured: 0.03 % for E_i = 1e-4 E∞,
+    0.003 % for tau = 10 µs; the same 2 Hz device with tau = 0.1 s: -43 % energy, -24 % V_OC)."""
     dq, rq = _device(designs["static"])
     dv, rv = _device(designs[name])
     assert dq.area_model == "quasi-static A(P)" and dv.area_model == "viscoelastic cycle at 2 Hz"
