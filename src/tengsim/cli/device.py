@@ -38,7 +38,9 @@ DESIGN_HELP = ("The device a design describes, in one step: `tengsim device desi
                "design does not know (mass, stiffness, electrode area, load, waveform) comes from the options, the "
                "config's [device] and [waveform], or the paper's Fig. 8 device, and the run says which values were "
                "defaults. The waveform (default: a 2 Hz square wave pressing to the design's p_max) must stay inside "
-               "the design's pressures. " + CONFIG_HELP)
+               "the design's pressures. A design with viscoelastic cycles (`tengsim design ... --relaxation FILE`) "
+               "drives the device with the contact's own A/S(t) at the waveform's frequency (within the cycles'; "
+               "the summary's area_model says which A was used). " + CONFIG_HELP)
 AREA_FROM_HELP = ("charged-area model from a result on file: a design result DIR/design.nc (or DIR) of "
                   "`tengsim design`, or a physical load-controlled `tengsim contact` result (.nc/.csv); the "
                   "approach branch (overrides [device] area)")
@@ -169,6 +171,8 @@ def execute(case: str, cfg: dict, cli: dict | None = None, quiet: bool = False, 
         if designed is not None and not quiet:  # after every check: an error stays one line
             for line in designed.lines():
                 print(f"tengsim: {line}", file=sys.stderr)
+        for line in (designed.warnings() if designed is not None else []):
+            print(f"tengsim: warning: {line}", file=sys.stderr)
         _note_paper_device(case, cfg, dev_cli, quiet)
         res = simulate(params, wf, t_end, dt_out=run.get("dt_out"), options=solver, progress=not quiet)
         skip = 1 if (wf.period and t_end >= 2 * wf.period - 1e-12) else 0
@@ -176,8 +180,8 @@ def execute(case: str, cfg: dict, cli: dict | None = None, quiet: bool = False, 
             from tengsim.design.device import rest_gap_voltage
             from tengsim.io import jsonable
 
-            summary = jsonable({**res.summary(skip), **rest_gap_voltage(designed, res),
-                                "designed_device": designed.provenance()})
+            summary = jsonable({"area_model": designed.area_model, **res.summary(skip),
+                                **rest_gap_voltage(designed, res), "designed_device": designed.provenance()})
         elif case == "fig7":
             from tengsim.cases.paper import fig7_summary
 

@@ -8,6 +8,11 @@ defaults) unless given: the plate's mass, the spring, the electrode area, the lo
 (a square wave pressing to the design's highest pressure).  :class:`DesignedDevice` says which values came from
 where.  A waveform that presses outside the area table's pressures is refused
 (:func:`tengsim.device.config.check_pressures`): the table is never held at its ends in silence.
+
+A design with viscoelastic cycles (``tengsim design … --relaxation``) drives the device with the contact's own
+A/S(t) over its square cycle at the waveform's frequency (:func:`tengsim.device.areas.area_cycle_from_design`;
+docs/viscoelastic.md, "The device"): the waveform must be that cycle (a square wave from 0 to the cycles' p_max,
+pressed for half the period) at a frequency within the cycles'; ``area_model`` says which A the device used.
 """
 from __future__ import annotations
 
@@ -27,6 +32,8 @@ DEFAULTS = {
     "frequency_Hz": (2.0, "square wave at 2 Hz"),
 }
 """What a design does not know, the paper's Fig. 8 device; ``amplitude_Pa`` defaults to the design's p_max."""
+QUASI_STATIC = "quasi-static A(P)"
+"""``area_model`` of a device driven by the design's static A/S(P) (no viscoelastic cycles in the design)."""
 FROM_DESIGN = {"sigma_C_per_m2": "sigma_C_m2", "eps_r": "eps_r", "thickness_m": "thickness_m", "gap_m": "gap_m"}
 """DeviceParams field: the design.nc attribute it is read from."""
 
@@ -43,10 +50,28 @@ class DesignedDevice:
     from_design: dict = field(default_factory=dict)
     defaults: dict = field(default_factory=dict)
     pressure_range: tuple = (math.nan, math.nan)
+    unused: tuple = ()
+
+    @property
+    def area_model(self) -> str:
+        """'quasi-static A(P)', or the viscoelastic cycle's label ('viscoelastic cycle at 2 Hz')."""
+        area = self.params.area
+        return str(area.label) if getattr(area, "carries_history", False) else QUASI_STATIC
 
     def provenance(self) -> dict:
-        return {"design": self.source, "from_design": dict(self.from_design), "defaults": dict(self.defaults),
-                "design_pressure_range_Pa": list(self.pressure_range)}
+        out = {"design": self.source, "from_design": dict(self.from_design), "defaults": dict(self.defaults),
+               "design_pressure_range_Pa": list(self.pressure_range), "area_model": self.area_model}
+        if getattr(self.params.area, "carries_history", False):
+            d = self.params.area.details
+            out["area_cycle"] = {k: d[k] for k in ("cycle", "cycle_frequencies_Hz", "cycle_weights",
+                                                   "design_cycle_frequencies_Hz", "grid_correction", "cycle_grid")
+                                 if k in d}
+        return out
+
+    def warnings(self) -> list:
+        """One line per value given that this device does not use (area_memory with a viscoelastic cycle)."""
+        return [f"{u} is not used: the viscoelastic contact carries its own history (A/S in flight is the cycle's "
+                "at the release)" for u in self.unused]
 
     def lines(self) -> list:
         """Two lines for the user: what came from the design, and which values are defaults."""
@@ -139,8 +164,40 @@ def designed_device(path, device: dict | None = None, waveform: dict | None = No
         if "frequency_Hz" not in named:
             defaults["frequency_Hz"] = DEFAULTS["frequency_Hz"][1]
     waveform = wave
-    designed = DesignedDevice(params, waveform, str(p), from_design, defaults, (lo, hi))
-    return designed
+    unused = ()
+    if "area" not in device:  # the design's viscoelastic cycles, if it has them, carry the device's A/S
+        cycle = _viscoelastic_area(p, waveform, table)
+        if cycle is not None:
+            params = params.replace(area=cycle)
+            from_design["area"] = f"A/S(t) of the {cycle.label} ({cycle.details['cycle']})"
+            if "area_memory" in device:
+                unused = (f"area_memory = {device['area_memory']!r}",)
+    return DesignedDevice(params, waveform, str(p), from_design, defaults, (lo, hi), unused)
+
+
+def _viscoelastic_area(path, wave, table):
+    """The :class:`tengsim.device.params.AreaCycle` of the design's viscoelastic cycles at the waveform's
+    frequency (None: the design has none); the waveform must be the cycles' square press (one line if not)."""
+    from tengsim.device import SquareWave
+    from tengsim.device.areas import area_cycle_from_design, visco_record
+
+    rec = visco_record(path)
+    if rec is None:
+        return None
+    pm = rec["p_max_Pa"]
+    what = (f"the design's viscoelastic cycles ({path}) are square presses from 0 to {pm / 1e3:.4g} kPa, pressed "
+            "for half of each period")
+    if not isinstance(wave, SquareWave):
+        raise TengsimError(f"device design: {what}; a [waveform] of kind {wave.to_dict()['kind']!r} is not one of "
+                           "them: give a square wave (the default)")
+    if abs(wave.amplitude_Pa - pm) > 1e-6 * pm:
+        raise TengsimError(f"device design: {what}; --pressure {wave.amplitude_Pa / 1e3:.4g} kPa is not that "
+                           f"cycle: press to {pm / 1e3:.4g} kPa (the default), or design with --p-max "
+                           f"{wave.amplitude_Pa / 1e3:.4g}kPa")
+    if abs(wave.duty - 0.5) > 1e-9 or wave.low_Pa != 0:
+        raise TengsimError(f"device design: {what}; a square wave of duty {wave.duty:g} from {wave.low_Pa:g} Pa is "
+                           "not that cycle: give duty 0.5 and low_Pa 0 (the defaults)")
+    return area_cycle_from_design(path, wave.frequency_Hz, float(table(pm)))
 
 
 def _size(values) -> float:
@@ -158,12 +215,15 @@ def rest_gap_voltage(designed: DesignedDevice, result) -> dict:
 
     p = designed.params
     peak = waveform_peak(designed.waveform, float(result.t[-1]))
-    a = float(np.interp(peak, p.area.pressure_Pa, p.area.area_fraction)) if hasattr(p.area, "pressure_Pa") \
-        else math.nan
+    if getattr(p.area, "carries_history", False):  # the cycle's A/S at the release (end of the press)
+        a = float(p.area.at_phase(0.5))
+    else:
+        a = float(np.interp(peak, p.area.pressure_Pa, p.area.area_fraction)) if hasattr(p.area, "pressure_Pa") \
+            else math.nan
     rest = np.flatnonzero(np.asarray(result.series["P_a"]) <= 0)  # released: the last row before the next press
     i = int(rest[-1]) if rest.size else -1
     return {"voc_at_rest_gap_V": float(result.series["V_oc"][i]), "gap_at_rest_m": float(result.series["gap"][i]),
             "design_voc_eq17_V": float(voc_apart(p.sigma_C_per_m2, a, p.gap_m, 1.0)), "pressed_to_Pa": peak}
 
 
-__all__ = ["DEFAULTS", "FROM_DESIGN", "DesignedDevice", "designed_device", "rest_gap_voltage"]
+__all__ = ["DEFAULTS", "FROM_DESIGN", "QUASI_STATIC", "DesignedDevice", "designed_device", "rest_gap_voltage"]

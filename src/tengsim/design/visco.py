@@ -24,6 +24,8 @@ from tengsim.visco import SegmentSteps, History, simulate_history, square_wave
 
 FREQUENCIES = (0.5, 2.0, 10.0)
 """Hz: the stated frequencies of a design's viscoelastic cycles (a TENG pressed by hand … a fast actuator)."""
+RISE = 0.05
+"""The square cycle's press and release ramps, a fraction of the period (pressed for half the period)."""
 
 
 @dataclass(frozen=True)
@@ -42,12 +44,14 @@ class Cycle:
 @dataclass(frozen=True)
 class ViscoDesign:
     """The cycles and the frequency table ({'frequency_Hz', 'sensitivity_V_per_Pa', 'linear_range_Pa',
-    'voc_hysteresis_fraction', 'response_s', 'recovery_s', 'area_max'} per row)."""
+    'voc_hysteresis_fraction', 'response_s', 'recovery_s', 'area_max'} per row); ``p_max_Pa``: the pressure every
+    cycle presses to."""
 
     material: Prony
     grid: str
     cycles: tuple
     table: tuple = field(default_factory=tuple)
+    p_max_Pa: float = float("nan")
 
 
 def _t90(t, v, t_start, t_end) -> float:
@@ -84,7 +88,7 @@ def visco_cycles(plan, material: Prony, frequencies=FREQUENCIES, pixels: int = 4
             if kind == "triangle":
                 h = History((0.0, period / 2, period), (0.0, p_max * scale, 0.0), "pressure")
             else:
-                h = square_wave(0.0, p_max * scale, period, 1, rise=0.05, kind="pressure")
+                h = square_wave(0.0, p_max * scale, period, 1, rise=RISE, kind="pressure")
             if progress is not None:
                 progress(f"viscoelastic cycle: {kind} at {f:g} Hz" if f else f"elastic (E∞) cycle: {kind}")
             r = simulate_history(shape, cp.tabor, dx, mat, h, SegmentSteps(int(steps)), boundary=cp.boundary,
@@ -108,4 +112,5 @@ def visco_cycles(plan, material: Prony, frequencies=FREQUENCIES, pixels: int = 4
                       "response_s": _t90(sq.t, sq.voc, 0.0, period / 2) if f else float("nan"),
                       "recovery_s": _t90(sq.t, sq.voc, period / 2, period) if f else float("nan"),
                       "area_max": float(np.max(sq.area))})
-    return ViscoDesign(material, f"{grid.nx}×{grid.ny} (dx = {dx * lat * 1e9:.0f} nm)", tuple(cycles), tuple(table))
+    return ViscoDesign(material, f"{grid.nx}×{grid.ny} (dx = {dx * lat * 1e9:.0f} nm)", tuple(cycles), tuple(table),
+                       float(p_max))

@@ -1,6 +1,8 @@
 """The files of a design's viscoelastic cycles: OUT/visco.csv (every cycle's rows), OUT/visco_table.csv (the
 frequency table), OUT/visco.png (A/S(t) and V_OC(t) over the square cycle at each frequency, and the V_OC(P)
-loops), and a section appended to OUT/report.md."""
+loops), a section appended to OUT/report.md, and the cycles recorded in OUT/design.nc (:func:`record_in_design`),
+so that the design result carries its material's history: ``tengsim device design`` drives the device with it
+(:func:`tengsim.device.areas.area_cycle_from_design`)."""
 from __future__ import annotations
 
 import csv
@@ -68,6 +70,54 @@ def figure(vd, path: Path) -> None:
     plt.close(fig)
 
 
+RECORD = {  # design.nc variable (along VISCO_DIM): (units, long_name)
+    "visco_frequency": ("Hz", "frequency of the cycle the row belongs to (0: the relaxed elastic solid, E_inf, "
+                              "period 1 s)"),
+    "visco_time": ("s", "time from the start of the cycle"),
+    "visco_pressure": ("Pa", "nominal pressure (load control)"),
+    "visco_charged_area_fraction": ("1", "charged contact area over cell area (A/S) on the cycles' coarse grid"),
+}
+VISCO_DIM = "visco_row"
+
+
+def record_in_design(vd, folder) -> Path | None:
+    """Add the cycles to ``folder``/design.nc (none there: None): the variables :data:`RECORD` and ``visco_cycle``
+    (triangle or square) along :data:`VISCO_DIM`, one row per time of each cycle as in visco.csv, and the
+    attributes ``relaxation`` (JSON: E_inf_Pa, E_Pa, tau_s, source), ``visco_frequencies_Hz``, ``visco_p_max_Pa``
+    (every cycle presses to it), ``visco_rise`` (the square cycle's ramps, a fraction of its period; pressed for
+    half the period), ``visco_grid``.  Rewritten whole (atomically): the design's own variables unchanged."""
+    import json
+
+    from tengsim.design.visco import RISE
+    from tengsim.io import read_dataset, write_dataset
+
+    path = Path(folder) / "design.nc"
+    if not path.is_file():
+        return None
+    ds = read_dataset(path)
+    cols = {"visco_frequency": [], "visco_time": [], "visco_pressure": [], "visco_charged_area_fraction": []}
+    kinds = []
+    for c in vd.cycles:
+        cols["visco_frequency"].append(np.full(c.t.size, float(c.frequency)))
+        cols["visco_time"].append(np.asarray(c.t, float))
+        cols["visco_pressure"].append(np.asarray(c.pressure_Pa, float))
+        cols["visco_charged_area_fraction"].append(np.asarray(c.area, float))
+        kinds += [c.kind] * c.t.size
+    for name, parts in cols.items():
+        units, long_name = RECORD[name]
+        ds[name] = ((VISCO_DIM,), np.concatenate(parts), {"units": units, "long_name": long_name})
+    ds["visco_cycle"] = ((VISCO_DIM,), np.array(kinds, dtype=object), {"long_name": "triangle or square cycle"})
+    m = vd.material
+    ds.attrs["relaxation"] = json.dumps({"E_inf_Pa": m.E_inf, "E_Pa": list(m.E), "tau_s": list(m.tau),
+                                         "source": m.source})
+    ds.attrs["visco_frequencies_Hz"] = np.array(sorted({float(r["frequency_Hz"]) for r in vd.table} - {0.0}))
+    ds.attrs["visco_p_max_Pa"] = float(vd.p_max_Pa)
+    ds.attrs["visco_rise"] = float(RISE)
+    ds.attrs["visco_grid"] = str(vd.grid)
+    write_dataset(ds, path)
+    return path
+
+
 def write_visco(vd, folder) -> list:
     """Write the files (module doc); returns their paths."""
     folder = Path(folder)
@@ -89,4 +139,5 @@ def write_visco(vd, folder) -> list:
     report = folder / "report.md"
     with report.open("a") as fh:
         fh.write(report_section(vd))
+    record_in_design(vd, folder)
     return [rows, table, png]

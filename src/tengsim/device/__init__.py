@@ -6,7 +6,7 @@ live in :mod:`tengsim.cases.paper`.
 """
 from tengsim.device.dynamics import simulate
 from tengsim.constants import EPS0
-from tengsim.device.params import (AreaFunction, AreaTable, ConstantArea, DeviceParams, SolverOptions,
+from tengsim.device.params import (AreaCycle, AreaFunction, AreaTable, ConstantArea, DeviceParams, SolverOptions,
                                    area_model)
 from tengsim.device.result import DeviceResult
 from tengsim.device.waveforms import WAVEFORMS, Sine, SquareWave, Staircase, TableWaveform

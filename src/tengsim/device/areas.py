@@ -13,6 +13,7 @@ that pressure kept, so the pressures increase strictly.
 """
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numpy as np
@@ -133,6 +134,102 @@ def _landing_after(P):
     return P
 
 
+def visco_record(path) -> dict | None:
+    """The viscoelastic cycles a design result holds (``tengsim design … --relaxation``,
+    :func:`tengsim.design.visco_write.record_in_design`), None for a design without: {'frequencies_Hz' (the
+    cycles', increasing, without the relaxed 0), 'p_max_Pa', 'rise', 'grid', 'relaxation' (dict), 'square':
+    {frequency: (t s, P Pa, A/S)} (0: the relaxed elastic solid, period 1 s)}."""
+    import json
+
+    import xarray as xr
+
+    p = design_path(path)
+    try:
+        with xr.open_dataset(p) as ds:
+            if "relaxation" not in ds.attrs:
+                return None
+            need = ("visco_frequency", "visco_cycle", "visco_time", "visco_charged_area_fraction")
+            missing = [v for v in need if v not in ds]
+            if missing or "visco_p_max_Pa" not in ds.attrs:
+                raise TengsimError(f"area: {str(p)!r} names a relaxation but holds no viscoelastic cycles (no "
+                                   f"{', '.join(missing) or 'visco_p_max_Pa'}): write it again with `tengsim design "
+                                   "… --relaxation FILE`")
+            f = np.asarray(ds["visco_frequency"].values, float)
+            kind = np.asarray(ds["visco_cycle"].values).astype(str)
+            t = np.asarray(ds["visco_time"].values, float)
+            P = np.asarray(ds["visco_pressure"].values, float) if "visco_pressure" in ds else np.full(t.size, np.nan)
+            a = np.asarray(ds["visco_charged_area_fraction"].values, float)
+            attrs = dict(ds.attrs)
+    except (OSError, ValueError) as exc:
+        raise TengsimError(f"area: cannot read {str(p)!r} as a design result ({str(exc).splitlines()[0][:80]})") \
+            from None
+    square = {}
+    for fr in np.unique(f):
+        m = (f == fr) & (kind == "square") & np.isfinite(t) & np.isfinite(a)
+        if np.count_nonzero(m) >= 2:
+            order = np.argsort(t[m], kind="stable")
+            square[float(fr)] = (t[m][order], P[m][order], np.clip(a[m][order], 0.0, 1.0))
+    freqs = np.array(sorted(k for k in square if k > 0))
+    if freqs.size == 0 or 0.0 not in square:
+        raise TengsimError(f"area: {str(p)!r}: its viscoelastic record holds no square cycle "
+                           f"{'of the relaxed solid (0 Hz)' if freqs.size else 'at a frequency > 0'}")
+    try:
+        relax = json.loads(str(attrs["relaxation"]))
+    except ValueError:
+        relax = {"text": str(attrs["relaxation"])}
+    return {"frequencies_Hz": freqs, "p_max_Pa": float(attrs["visco_p_max_Pa"]),
+            "rise": float(attrs.get("visco_rise", math.nan)), "grid": str(attrs.get("visco_grid", "")),
+            "relaxation": relax, "square": square, "source": str(p)}
+
+
+def area_cycle_from_design(path, frequency_Hz: float, static_fraction: float | None = None):
+    """The :class:`AreaCycle` of a design result's viscoelastic square cycles (:func:`visco_record`; None for a
+    design without) at the waveform's ``frequency_Hz``: the design's cycle at that frequency, or between two of
+    its frequencies the two nearest interpolated linearly in log f at each phase; outside them refused (the
+    contact's rate response is not extrapolated).  ``static_fraction``: the converged static design's A/S at
+    p_max; the cycles (on one coarse grid) are scaled by it over the relaxed (E∞) cycle's A/S at the end of its
+    hold, the same state on the coarse grid (the factor is ``details['grid_correction']``)."""
+    from tengsim.device.params import AreaCycle
+
+    rec = visco_record(path)
+    if rec is None:
+        return None
+    f = float(frequency_Hz)
+    fs = rec["frequencies_Hz"]
+    span = f"{fs[0]:g} to {fs[-1]:g} Hz" if fs.size > 1 else f"{fs[0]:g} Hz only"
+    if not (fs[0] * (1 - 1e-9) <= f <= fs[-1] * (1 + 1e-9)):
+        raise TengsimError(f"device design: the waveform's frequency {f:g} Hz is outside the design's viscoelastic "
+                           f"cycles ({span}; {rec['source']}): give --frequency within them (the contact's rate "
+                           "response is not extrapolated)")
+
+    def cycle(fr):
+        t, _, a = rec["square"][fr]
+        return np.clip(t * (fr if fr > 0 else 1.0), 0.0, 1.0), a
+
+    near = np.flatnonzero(np.abs(np.log(fs / f)) <= 1e-9)
+    if near.size:
+        used, weights = [float(fs[near[0]])], [1.0]
+        phase, area = cycle(used[0])
+        how = f"the design's cycle at {used[0]:g} Hz"
+    else:
+        j = int(np.searchsorted(fs, f))
+        f1, f2 = float(fs[j - 1]), float(fs[j])
+        w = math.log(f / f1) / math.log(f2 / f1)
+        (p1, a1), (p2, a2) = cycle(f1), cycle(f2)
+        phase = np.union1d(p1, p2)
+        area = (1 - w) * np.interp(phase, p1, a1) + w * np.interp(phase, p2, a2)
+        used, weights = [f1, f2], [1 - w, w]
+        how = f"interpolated in log f between the design's cycles at {f1:g} and {f2:g} Hz (weights {1 - w:.3g}, {w:.3g})"
+    rel_t, _, rel_a = rec["square"][0.0]
+    held = float(np.interp(0.5, rel_t, rel_a))  # the relaxed cycle at the end of its hold (period 1 s)
+    corr = float(static_fraction) / held if static_fraction is not None and held > 0 else 1.0
+    area = np.clip(corr * np.asarray(area, float), 0.0, 1.0)
+    details = {"cycle": how, "cycle_frequencies_Hz": used, "cycle_weights": weights,
+               "design_cycle_frequencies_Hz": fs.tolist(), "cycle_p_max_Pa": rec["p_max_Pa"],
+               "grid_correction": corr, "cycle_grid": rec["grid"], "relaxation": rec["relaxation"]}
+    return AreaCycle(f, phase, area, f"viscoelastic cycle at {f:g} Hz", details)
+
+
 def _approach_states(ds):
     """(P, A/S) of the approach states a design result holds (None: a file written without them)."""
     if "state_pressure" not in ds or "state_charged_area_fraction" not in ds:
@@ -222,5 +319,5 @@ def area_table_from_file(path) -> AreaTable:
     return area_table_from_design(p)
 
 
-__all__ = ["area_table_from_contact", "area_table_from_design", "area_table_from_file", "design_path",
+__all__ = ["area_cycle_from_design", "visco_record", "area_table_from_contact", "area_table_from_design", "area_table_from_file", "design_path",
            "passed_curve", "stable_branch", "DESIGN_FILE"]

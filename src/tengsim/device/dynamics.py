@@ -12,7 +12,9 @@ Rules the paper leaves open (see docs/device.md):
   through R with V = -Q T/(eps_r eps0 S) (Eq. 22), solved exactly. Release when the force the
   plate would feel at y = d0, P_a S - k_e d0 + F_e, turns negative (the reaction would have to pull).
 * Charged area: while in contact A follows A(P); the polymer keeps its charge, so in flight A is
-  the largest area reached so far ("max") or the area at release ("release").
+  the largest area reached so far ("max") or the area at release ("release").  An area that carries its own
+  history (:class:`tengsim.device.params.AreaCycle`, a viscoelastic contact's cycle) is read at the time, not
+  the pressure, and in flight is the area at release: no ``area_memory`` rule.
 """
 from __future__ import annotations
 
@@ -105,8 +107,11 @@ class _Core:
 
 
 def _area_fraction(core: _Core, tb):
-    """A/S demanded by the pressure at tbar (in contact), per ``area_pressure``."""
+    """A/S demanded by the pressure at tbar (in contact), per ``area_pressure``; an area that carries its own
+    history: its value at that time."""
     p = core.p
+    if getattr(p.area, "carries_history", False):
+        return p.area.at_time(np.asarray(tb) * core.tau)
     pa = core.pbar(np.asarray(tb)) / core.pscale
     if p.area_pressure == "contact":
         pa = np.maximum(pa - p.stiffness_N_per_m * p.gap_m / p.area_m2, 0.0)
@@ -129,6 +134,7 @@ def simulate(params: DeviceParams, waveform, t_end: float, *, dt_out: float | No
     require(t_end / dt_out <= 5e6, f"t_end / dt_out = {t_end / dt_out:.3g} output rows is too many")
     opts = options or SolverOptions()
     core = _Core(params, waveform)
+    history = bool(getattr(params.area, "carries_history", False))
     tau = core.tau
     tb_end = t_end / tau
     n_grid = int(math.floor(t_end / dt_out + 1e-9)) + 1
@@ -202,7 +208,7 @@ def simulate(params: DeviceParams, waveform, t_end: float, *, dt_out: float | No
                 if tg.size:
                     demand = _area_fraction(core, tg)
                     gs = (np.maximum.accumulate(np.maximum(demand, g1)) if params.area_memory == "max"
-                          else demand)
+                          and not history else demand)
                     emit(tg, st, True, gs, e_impact)
                 dec = math.exp(-lam * (t_rel - a)) if lam < math.inf else 0.0
                 if core.mode == "finite":
@@ -268,9 +274,10 @@ def _contact_charge(q0: float, lam: float, a: float):
 
 
 def _contact_area(core: _Core, g1: float, a: float, b: float) -> float:
-    """Charged-area fraction after a contact interval [a, b] (tbar), per ``area_memory``."""
+    """Charged-area fraction after a contact interval [a, b] (tbar), per ``area_memory`` (an area that carries
+    its own history: the area at b, the release)."""
     tt = np.linspace(a, b, 33) if b > a else np.array([a])
     demand = _area_fraction(core, tt)
-    if core.p.area_memory == "release":
+    if core.p.area_memory == "release" or getattr(core.p.area, "carries_history", False):
         return float(demand[-1])
     return float(max(g1, demand.max()))

@@ -137,10 +137,61 @@ class AreaFunction:
         return {"kind": "function", "name": self.name, "initial_fraction": self.initial_fraction}
 
 
+@dataclass(frozen=True, eq=False)
+class AreaCycle:
+    """A charged area that carries its own history: A/S over one period of a periodic press, at the phase
+    ``phase`` (t f mod 1, increasing over [0, 1]) of a waveform at ``frequency_Hz`` (a viscoelastic contact's
+    cycle, :func:`tengsim.device.areas.area_cycle_from_design`).  In contact the device's A/S is the cycle's at
+    the waveform's phase; in flight the value at the release (the contact's own area when it separated).  No
+    ``area_memory`` rule applies: the history is in the cycle.  ``label`` says which cycle it is."""
+
+    frequency_Hz: float
+    phase: np.ndarray
+    area_fraction: np.ndarray
+    label: str = "viscoelastic cycle"
+    details: dict = field(default_factory=dict)
+
+    carries_history = True
+
+    def __post_init__(self):
+        object.__setattr__(self, "frequency_Hz", positive("frequency_Hz", self.frequency_Hz))
+        try:
+            ph = np.array(self.phase, dtype=float).ravel()
+            a = np.array(self.area_fraction, dtype=float).ravel()
+        except (TypeError, ValueError):
+            raise TengsimError("area cycle must hold numbers") from None
+        require(ph.size >= 2 and ph.size == a.size, f"area cycle: {ph.size} phases but {a.size} area fractions")
+        require(bool(np.all(np.isfinite(ph)) and np.all(np.isfinite(a))), "area cycle holds non-finite values")
+        require(bool(np.all(np.diff(ph) >= 0)) and ph[0] >= 0 and ph[-1] <= 1,
+                "area cycle phases must increase within [0, 1]")
+        require(bool(np.all((a >= 0) & (a <= 1))), f"area fractions must be in [0, 1], got {a[(a < 0) | (a > 1)][:3]}")
+        ph.setflags(write=False)
+        a.setflags(write=False)
+        object.__setattr__(self, "phase", ph)
+        object.__setattr__(self, "area_fraction", a)
+
+    @property
+    def initial_fraction(self) -> float:
+        """Uncharged until the first contact."""
+        return 0.0
+
+    def at_time(self, t_s):
+        """A/S at time ``t_s`` (s) of the waveform: the cycle's value at its phase."""
+        phase = np.mod(np.asarray(t_s, dtype=float) * self.frequency_Hz, 1.0)
+        return np.interp(phase, self.phase, self.area_fraction)
+
+    def at_phase(self, phase):
+        return np.interp(np.asarray(phase, dtype=float), self.phase, self.area_fraction)
+
+    def to_dict(self) -> dict:
+        return {"kind": "cycle", "label": self.label, "frequency_Hz": self.frequency_Hz,
+                "phase": self.phase.tolist(), "area_fraction": self.area_fraction.tolist(), **self.details}
+
+
 def area_model(area):
     """The charged-area model for ``area``: a number (constant fraction), an area model, or any callable
     pressure (Pa) -> A/S (wrapped in :class:`AreaFunction`)."""
-    if isinstance(area, (ConstantArea, AreaTable, AreaFunction)):
+    if isinstance(area, (ConstantArea, AreaTable, AreaFunction, AreaCycle)):
         return area
     if isinstance(area, (int, float)) and not isinstance(area, bool):
         return ConstantArea(area)
@@ -177,13 +228,14 @@ class DeviceParams:
     sigma_C_per_m2: float = _f("tribo-charge density sigma")
     load_ohm: float = _f("load R; 0 = short circuit, 'inf' = open circuit", 1.0e6)
     damping_ratio: float = _f("damping ratio zeta, c = 2 zeta sqrt(M k_e)", 0.7)
-    area: ConstantArea | AreaTable | AreaFunction = _f(
+    area: ConstantArea | AreaTable | AreaFunction | AreaCycle = _f(
         "charged-area model: a fraction, or a table {pressure_Pa = [...], area_fraction = [...]}", ConstantArea)
     force_model: str = _f("electrostatic force on the plate", "field", choices=FORCE_MODELS)
     eq20_reg: float = _f("eq20 only: the 1/d term uses d + eq20_reg d0", 1.0e-3)
     area_pressure: str = _f("pressure that sets A in contact: applied P_a, or contact P_a - k_e d0/S",
                             "applied", choices=AREA_PRESSURES)
-    area_memory: str = _f("charged area in flight: largest reached, or the area at release", "max",
+    area_memory: str = _f("charged area in flight: largest reached, or the area at release (not used by an "
+                          "area that carries its own history, a viscoelastic cycle)", "max",
                           choices=AREA_MEMORIES)
     initial_charge: str = _f("Q(0): zero (paper), or rest (V = 0, no start spike)", "zero",
                              choices=INITIAL_CHARGES)
