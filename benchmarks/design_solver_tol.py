@@ -28,15 +28,16 @@ SMALL = {"shape": "pyramid", "pitch": "1um", "base": "0.5um", "height": "0.2um",
 def one(table, grid_index, tol):
     from tengsim.continuation import walker
     from tengsim.design import plan_design
-    from tengsim.design import run as R
+    from tengsim.design import walk as _walk
+    from tengsim.run import grids as _grids
     from tengsim.design.curves import branch_curves
     from tengsim.run.plan import plan_contact
 
     plan = plan_design(table)
     cplan = dataclasses.replace(plan_contact(plan.contact_table), tol=tol)
-    dx = R.start_dx(plan, cplan)
-    d_max, _ = R.find_d_max(plan, cplan, dx)
-    g = R.refinement_grids(cplan.shape, dx, grid_index + 1)[grid_index]
+    dx = _walk.start_dx(plan, cplan)
+    d_max, _ = _walk.find_d_max(plan, cplan, dx)
+    g = _grids.refinement_grids(cplan.shape, dx, grid_index + 1)[grid_index]
     spent = []
     solve = walker.Walker.solve
 
@@ -48,7 +49,7 @@ def one(table, grid_index, tol):
     walker.Walker.solve = counting
     try:
         t0 = time.perf_counter()
-        res = R._simulate(cplan, g.dx, d_max)
+        res = _walk._simulate(cplan, g.dx, d_max)
         wall = time.perf_counter() - t0
     finally:
         walker.Walker.solve = solve

@@ -192,7 +192,8 @@ def test_first_grid_is_the_default_refinements_first_fine_enough_one():
     for the issue's pyramid)."""
     from tengsim import status
     from tengsim.run.plan import plan_contact
-    from tengsim.design.walk import START_ZONE_PIXELS, start_dx
+    from tengsim.design.walk import start_dx
+    from tengsim.run.refine import START_ZONE_PIXELS
     from tengsim.run.grids import default_dx, refinement_grids
 
     from tengsim.cli.design import _read_toml
@@ -349,7 +350,8 @@ def test_budget_cap_is_the_last_refinement_grid_the_budget_pays_for():
 
     from tengsim.cli.design import _read_toml
     from tengsim.run.budget import budget_pixels, run_cost
-    from tengsim.design.walk import height_eps, start_dx
+    from tengsim.design.walk import start_dx
+    from tengsim.run.reach import height_eps
     from tengsim.run.grids import GridSequence, refinement_grids
 
     plan = plan_design(_read_toml(str(Path(__file__).parent.parent / "examples" / "own_design" / "pyramid.toml")))
@@ -375,7 +377,8 @@ def test_estimate_uses_the_backends_cost_and_names_it(monkeypatch):
     from pathlib import Path
 
     from tengsim.cli.design import _read_toml
-    from tengsim.design import run as dr
+    from tengsim.design import walk as _walk
+    from tengsim.run import budget as _budget
     from tengsim.resources import CPU_COST, GPU_COST
     from tengsim.run.plan import plan_contact
     from tengsim.solvers import choice
@@ -385,21 +388,21 @@ def test_estimate_uses_the_backends_cost_and_names_it(monkeypatch):
     assert cp.solver == "fast" and "no GPU" in cp.solver_note  # auto, on this machine
     from tengsim.run.grids import GridSequence
 
-    dx = dr.start_dx(plan, cp)
+    dx = _walk.start_dx(plan, cp)
     seq = GridSequence(cp.shape, dx)
-    cpu = dr.estimate(plan, cp, seq, 25.0, dr.run_cost(cp, 25.0))
+    cpu = _budget.estimate(plan, cp, seq, 25.0, _budget.run_cost(cp, 25.0))
     assert cpu.backend == CPU_COST.backend and "CPU" in cpu.lines()[1]
     monkeypatch.setattr(choice, "gpu_visible", lambda: True)
     cp_gpu = dataclasses.replace(cp, solver="gpu")
-    gpu = dr.estimate(plan, cp_gpu, seq, 25.0, dr.run_cost(cp_gpu, 25.0))
+    gpu = _budget.estimate(plan, cp_gpu, seq, 25.0, _budget.run_cost(cp_gpu, 25.0))
     assert gpu.backend == GPU_COST.backend and "GPU" in gpu.lines()[1]
     g = cp.shape.grid(dx)
     rows_its = gpu.cost.rows * gpu.cost.iterations
     per_iteration = GPU_COST.floor + GPU_COST.per_point * g.nx * g.ny
     assert gpu.cost.grid_seconds(cp.shape, g) == pytest.approx(rows_its * per_iteration)
     assert gpu.seconds < cpu.seconds
-    assert (dr.budget_pixels(plan, cp.shape, seq, dr.run_cost(cp_gpu, 25.0))
-            > dr.budget_pixels(plan, cp.shape, seq, dr.run_cost(cp, 25.0)))
+    assert (_budget.budget_pixels(plan, cp.shape, seq, _budget.run_cost(cp_gpu, 25.0))
+            > _budget.budget_pixels(plan, cp.shape, seq, _budget.run_cost(cp, 25.0)))
 
 
 def test_auto_picks_the_gpu_where_jax_sees_one(monkeypatch):
@@ -443,17 +446,17 @@ def test_the_designs_solver_tolerance_moves_its_numbers_far_less_than_tol():
     force and the hysteresis move by less than tol/20 against the 1e-6 solve (measured 2e-4 for A/S)."""
     import dataclasses
 
-    from tengsim.design import run as R
+    from tengsim.design import plan as _dplan, walk as _walk
     from tengsim.design.curves import branch_curves
     from tengsim.run.plan import plan_contact
 
     plan = plan_design(SMALL)
-    assert R.solver_tol(plan) == pytest.approx(1e-4)
+    assert _dplan.solver_tol(plan) == pytest.approx(1e-4)
     out = []
-    for tol in (R.solver_tol(plan), 1e-6):
+    for tol in (_dplan.solver_tol(plan), 1e-6):
         cplan = dataclasses.replace(plan_contact(plan.contact_table), tol=tol)
-        dx = R.start_dx(plan, cplan)
-        res = R._simulate(cplan, dx, R.find_d_max(plan, cplan, dx)[0])
+        dx = _walk.start_dx(plan, cplan)
+        res = _walk._simulate(cplan, dx, _walk.find_d_max(plan, cplan, dx)[0])
         assert res.params["tol"] == tol and res.status == "ok"
         c = branch_curves(res, plan)
         out.append((np.concatenate([c["approach"]["area"], c["retraction"]["area"]]), res.pull_off_force,

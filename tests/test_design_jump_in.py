@@ -101,7 +101,8 @@ def test_a_second_pass_walks_every_grid_to_the_extended_path():
     reached p_max (plus a margin) and may fall short; the run's second pass must not cut the finer grids' paths
     again at the same D, or it fails the same way and blames p_max."""
     from tengsim.design import plan_design, run_design
-    from tengsim.design.walk import _reach, grid_path
+    from tengsim.design.walk import grid_path
+    from tengsim.run.reach import reach as _reach
 
     plan = plan_design({"shape": "pyramid", "pitch": "1um", "base": "0.5um", "height": "0.2um", "E_star": "5MPa",
                         "W": "20mJ/m2", "eps": "50nm", "p_max": "20kPa", "p_step": "10kPa", "tol": 0.05,

@@ -12,7 +12,7 @@ import math
 import numpy as np
 import pytest
 
-from tengsim.run import resolve
+from tengsim.run import judge, resolve
 from tengsim.cli.main import main
 from tengsim.errors import TengsimError
 from tengsim.results.read import load_result
@@ -28,27 +28,27 @@ PYR_CFG = {"shape": "pyramid", "N": 0.946, "cell": 3.78, "tabor": 0.5, "d_min": 
 def test_richardson_recovers_a_known_order_on_uneven_grids(p):
     h = [0.42, 0.29, 0.18]  # ratios 1.45, 1.61: as the FFT-friendly pixel counts give them
     f = [2.0 + 0.7 * x**p for x in h]
-    r = resolve.richardson(h, f)
+    r = judge.richardson(h, f)
     assert r["observed"] and r["order"] == pytest.approx(p, rel=1e-8)
     assert r["extrapolated"] == pytest.approx(2.0, abs=1e-10)
     assert r["error"] == pytest.approx(2.0 - f[-1], rel=1e-8)
 
 
 def test_richardson_two_grids_assume_first_order_and_odd_cases():
-    r = resolve.richardson([0.2, 0.1], [1.2, 1.1])  # order 1 assumed: error = Δ/(r − 1)
+    r = judge.richardson([0.2, 0.1], [1.2, 1.1])  # order 1 assumed: error = Δ/(r − 1)
     assert not r["observed"] and r["order"] == 1.0 and r["error"] == pytest.approx(-0.1)
-    r = resolve.richardson([0.4, 0.2, 0.1], [1.0, 1.2, 1.1])  # not monotone: order 1, not measured
+    r = judge.richardson([0.4, 0.2, 0.1], [1.0, 1.2, 1.1])  # not monotone: order 1, not measured
     assert not r["observed"] and r["order"] == 1.0
-    r = resolve.richardson([0.4, 0.2, 0.1], [1 + 0.4**6, 1 + 0.2**6, 1 + 0.1**6])  # clipped to P_MAX
-    assert r["observed"] and r["order"] == resolve.P_MAX
-    assert math.isnan(resolve.richardson([0.2], [1.0])["error"])
-    assert math.isnan(resolve.richardson([0.2, 0.1], [1.0, math.nan])["error"])
+    r = judge.richardson([0.4, 0.2, 0.1], [1 + 0.4**6, 1 + 0.2**6, 1 + 0.1**6])  # clipped to P_MAX
+    assert r["observed"] and r["order"] == judge.P_MAX
+    assert math.isnan(judge.richardson([0.2], [1.0])["error"])
+    assert math.isnan(judge.richardson([0.2, 0.1], [1.0, math.nan])["error"])
 
 
 def test_relative_change_has_an_absolute_floor():
-    assert resolve.relative("jump_in_D", 0.005, 0.0) == pytest.approx(0.005)  # floor 1 ε
-    assert resolve.relative("pull_off_F", 1e-4, 0.0) == pytest.approx(0.01)  # floor 0.01
-    assert resolve.relative("pull_off_F", -0.05, -5.0) == pytest.approx(0.01)
+    assert judge.relative("jump_in_D", 0.005, 0.0) == pytest.approx(0.005)  # floor 1 ε
+    assert judge.relative("pull_off_F", 1e-4, 0.0) == pytest.approx(0.01)  # floor 0.01
+    assert judge.relative("pull_off_F", -0.05, -5.0) == pytest.approx(0.01)
 
 
 # ---- a cheap refinement -----------------------------------------------------------------------------

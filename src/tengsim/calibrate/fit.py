@@ -186,7 +186,6 @@ def fit(model: Model, box=None, polish: bool = True, model_error: float = 0.0) -
     d = len(names)
     thr = threshold(prob)
     lb = log_bounds(prob)
-    s_est = None
     box = lb.copy() if box is None else np.asarray(box, float)
     if d:
         axes, pts = _grid(box, GRID[d])

@@ -203,7 +203,7 @@ def _calibrate(prob, out_dir, n_nodes, zooms, progress, refine, expected_noise) 
     from tengsim.calibrate.fit import Model, band, fit, residual_text
     from tengsim.calibrate.surrogate import (POINTS_PER_CURVE, Surrogate, geometry_key, grid_points, node_table,
                                              solve_node)
-    from tengsim.design.units import time_text
+    from tengsim.units import time_text
     from tengsim.design.write import to_dataset  # noqa: F401 - its imports (xarray) before the first design is timed
 
     t0 = time.perf_counter()

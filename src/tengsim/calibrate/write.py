@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from tengsim.calibrate.problem import KINDS, UNITS, label, text
+from tengsim.calibrate.problem import UNITS, label, text
 
 SI_UNITS = {"sigma": "C m-2", "W": "J m-2", "eps": "m", "E_star": "Pa"}
 
@@ -131,7 +131,7 @@ def material_text(cal) -> str:
     for k in ("E_star", "W", "eps", "sigma"):
         if k in vals:
             lines.append(f'{k} = "{vals[k] / UNITS[k][1]:.8g}{UNITS[k][2]}"')
-    lines += ["", "[uncertainty]", f'method = "profile likelihood, 95 %"', f"free = {json.dumps(list(prob.free))}"]
+    lines += ["", "[uncertainty]", 'method = "profile likelihood, 95 %"', f"free = {json.dumps(list(prob.free))}"]
     for k in prob.free:
         lo, hi, olo, ohi = f.interval[k]
         lines.append(f'{k}_95 = ["{lo / UNITS[k][1]:.6g}{UNITS[k][2]}", "{hi / UNITS[k][1]:.6g}{UNITS[k][2]}"]'

@@ -216,7 +216,7 @@ def snap_in(P, area, p_range) -> float:
 
 
 def _grids_text(res) -> str:
-    from tengsim.design.units import length_text
+    from tengsim.units import length_text
 
     lat = res.scaling.lateral
     tab = res.params.get("resolution") or {}
@@ -227,7 +227,7 @@ def _grids_text(res) -> str:
 
 def summarize(res, plan) -> tuple[dict, dict, list]:
     """(summary {name: value}, convergence {number: relative change between the last two grids}, notes)."""
-    from tengsim.design.units import pressure_text
+    from tengsim.units import pressure_text
 
     from tengsim.run.area import CHARGED_COLUMN
 
@@ -295,7 +295,7 @@ def _finite_voc(plan, voc_eq17: float) -> float:
 def na_reasons(summary: dict, numbers, plan, full: float, drawn_in: bool = False) -> dict:
     """{number: why it is n/a} for the per-design numbers that are NaN (the sensor's from its own reasons);
     ``drawn_in``: the approach starts attracted (an adhesive apex drawn into contact at zero load)."""
-    from tengsim.design.units import pressure_text
+    from tengsim.units import pressure_text
 
     top = pressure_text(plan.pressures[-1])
     start = "the apex is drawn in at zero load, then " if drawn_in else ""
@@ -321,7 +321,7 @@ def physical_message(text: str, lateral: float) -> str:
     """The refinement's message in the user's units: dx values (X units) as lengths, A/S observables named."""
     import re
 
-    from tengsim.design.units import length_text
+    from tengsim.units import length_text
 
     def dx(m):
         return f"dx {m.group(1)} {length_text(float(m.group(2)) * lateral)}"

@@ -178,7 +178,7 @@ def report_line(nf) -> str:
     """The report's line: the pattern's peak field and gap-voltage spread at each gap, its decay height."""
     if nf is None:
         return f"Near field of the charged pattern: n/a ({NO_MAPS})."
-    from tengsim.design.units import length_text
+    from tengsim.units import length_text
 
     cell = "" if nf.boundary == "periodic" else "; the free cell taken as one cell of a periodic array of its size"
     rows = list(zip(nf.peak_over_uniform, nf.voltage_spread_over_uniform, nf.gaps_m))

@@ -162,7 +162,7 @@ class DesignPlan:
 
     def shape_text(self) -> str:
         """'pitch 10 µm, base 5 µm, height 3.5 µm' (lengths in their unit, other numbers plain)."""
-        from tengsim.design.units import length_text, pressure_text
+        from tengsim.units import length_text, pressure_text
 
         def each(v, text):  # a size may be a pair (a topography's physical_size): 'a × b'
             if isinstance(v, (tuple, list)):

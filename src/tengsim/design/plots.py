@@ -22,7 +22,7 @@ def _plt():
 
 
 def title(plan, status: str | None = None) -> str:
-    from tengsim.design.units import length_text
+    from tengsim.units import length_text
 
     sizes = plan.shape_text()
     mat = (f"E* {plan.E_star / 1e6:.3g} MPa, W {plan.W * 1e3:.3g} mJ/m², ε {length_text(plan.eps)}, "

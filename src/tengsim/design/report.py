@@ -4,7 +4,7 @@ from __future__ import annotations
 import math
 
 from tengsim.design.plan import BOUNDARY_WHY
-from tengsim.design.units import length_text, pressure_text
+from tengsim.units import length_text, pressure_text
 
 ROWS = (
     ("jump_in_Pa", "jump-in pressure (approach under load, just before the first snap into contact in the asked "

@@ -32,14 +32,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from tengsim.design.plan import SOLVER_TOL_PER_TOL, constrained_solver, solver_tol  # noqa: F401
-from tengsim.design.keep import checkpoint, identity, kept_path  # noqa: F401
-from tengsim.design.walk import (D_MIN, D_STEP, _reach, _say, _simulate,  # noqa: F401
-                                 find_d_max, grid_path, height_eps, map_pressures, maps_asked, observers, path_to,
-                                 start_dx)
-from tengsim.run.budget import (BudgetSpent, budget_pixels, cap_line, check_budget, deadline,  # noqa: F401
-                                estimate, run_cost)
-from tengsim.run.grids import refinement_grids  # noqa: F401
+from tengsim.design.plan import constrained_solver
+from tengsim.design.keep import identity, kept_path
+from tengsim.design.walk import map_pressures, maps_asked, observers
+from tengsim.run.refine import say_to as _say
 
 
 @dataclass(frozen=True)

@@ -1,7 +1,7 @@
 """A design's walk: the first grid, the path's D range and each grid's path, the maps kept on the way.
 
 The first dx is the user's (a length) or :func:`start_dx`: the first grid of the refinement's sequence
-(:mod:`tengsim.run.grids`) whose dx is at most the law's process zone over :data:`START_ZONE_PIXELS`.
+(:mod:`tengsim.run.grids`) whose dx is at most the law's process zone over :data:`tengsim.run.refine.START_ZONE_PIXELS`.
 The path to p_max is the run layer's (:mod:`tengsim.run.reach`): an adaptive D walk from D = -1 ε to a d_max found on
 a grid twice as coarse as the default first grid (:func:`find_d_max`), each finer grid's walk ending a little past
 the D at which the grid before it reached p_max (:func:`grid_path`).  The design chooses where the pressure and gap
@@ -9,17 +9,12 @@ maps are kept: at the asked pressures nearest 10 %, 50 % and 100 % of p_max (:fu
 """
 from __future__ import annotations
 
-import numpy as np
-
-from tengsim.run.reach import D_MIN, D_STEP, EXTEND_TRIES, path_to, reach as _reach  # noqa: F401
-from tengsim.run.reach import D_MARGIN, find_d_max as reach_d_max, grid_path as reach_grid_path, height_eps  # noqa: F401
-from tengsim.run.reach import map_depths as reach_depths
-from tengsim.run.refine import START_ZONE_PIXELS, say_to as _say  # noqa: F401
+from tengsim.run.reach import grid_path as reach_grid_path, map_depths as reach_depths, path_to
 
 
 def start_dx(plan, cplan) -> float:
     """The design's first dx in X units (:func:`tengsim.run.refine.first_dx`: the plan's, or the refinement's first
-    grid whose dx is at most the law's process zone over :data:`START_ZONE_PIXELS`)."""
+    grid whose dx is at most the law's process zone over :data:`tengsim.run.refine.START_ZONE_PIXELS`)."""
     from tengsim.run.refine import first_dx
 
     return first_dx(cplan, plan)

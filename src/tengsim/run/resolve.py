@@ -56,12 +56,10 @@ import numpy as np
 
 from tengsim.errors import TengsimError
 from tengsim.run.checkpoint import Checkpoint
-from tengsim.run.grids import (FACTOR, MIN_SIDE, PHASE_SPAN, PHASE_TOL, aligned, default_dx,  # noqa: F401
-                                edge_phases, next_grid)
+from tengsim.run.grids import FACTOR, MIN_SIDE, default_dx, edge_phases, next_grid
 from tengsim.run.memory import default_max_pixels
 from tengsim.run.tolerance import DEFAULT_TOL
-from tengsim.run.judge import (FLOORS, NEED_FLOOR, P_MAX, P_MIN, _dx_needed, _judge, _levels_table,  # noqa: F401
-                               _why, contact_observables, floor_of, relative, richardson)
+from tengsim.run.judge import NEED_FLOOR, _dx_needed, _judge, _levels_table, _why, contact_observables
 
 def resolve_plan(plan, observe=None, full_length: float | None = None, progress=None, checkpoint=None, start=None,
                  watch=None, path_for=None, settings=None):

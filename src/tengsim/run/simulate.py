@@ -12,7 +12,7 @@ from tengsim.shapes import Pyramid, Shape
 from tengsim.laws import Law
 from tengsim.kernels import make_kernel
 from tengsim.kernels.distributed import SlabPeriodicKernel, check_split
-from tengsim.kernels.mirror import SYMMETRY_CHOICES, MirrorKernel, choose_symmetry  # noqa: F401
+from tengsim.kernels.mirror import MirrorKernel, choose_symmetry
 from tengsim.continuation import LoadPathSpec, run_load_path
 from tengsim.continuation import PathSpec, run_path
 from tengsim.run.memory import MAP_WORK, check_memory

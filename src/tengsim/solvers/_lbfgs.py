@@ -125,7 +125,7 @@ class KMetricLBFGS:
         else :meth:`rollback`, which leaves the memory as if the pair had never been stored.
         Returns the slot.
         """
-        k, m = len(self.order), self.m
+        k = len(self.order)
         if k:
             xs, xy = x[0::2], x[1::2]          # <s_i, y>, <y_i, y>
             gamma, cS, cY = self._last
