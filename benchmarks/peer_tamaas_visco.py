@@ -1,0 +1,291 @@
+"""Peer benchmark: tengsim's viscoelastic time drive (``tengsim.visco.TimeDrive`` with the hard-wall constrained
+solver 'pk' under load control) against Tamaas 2.9's ``MaxwellViscoelastic`` (PyPI ``tamaas``) on the same
+non-adhesive periodic rough surface and load history, side by side in one run.  Not part of tengsim or its
+test suite.
+
+Install the peer in its own environment (it runs in a subprocess; the two exchange .npz/.json files):
+
+    python3 -m venv /work/venvs/tamaas && /work/venvs/tamaas/bin/pip install tamaas numpy scipy
+
+Tamaas' conventions (settled by the child's ``convention`` check, run each time and recorded): its solver is
+pressure (load) controlled, one ``solve(p̄)`` a time step of ``time_step`` (backward Euler on each branch:
+G̃ = Σ G_i τ_i/(τ_i + Δt)); ``model.E`` is the relaxed Young's modulus E∞ and ``shear_moduli`` the branches'
+shear moduli G_i, so a branch adds E*_i = 2 G_i/(1 − ν) to E*∞ = E∞/(1 − ν²) (a glassy branch, τ → ∞, gives
+the elastic solve at E*∞ + 2G/(1 − ν) to round-off; τ → 0 the one at E*∞).  Here ν = 0: G_i = E*_i/2.
+
+Problem (both codes): benchmarks/peer_aspher.py's periodic self-affine surface (Hurst 0.8, seed 1) on n×n,
+heights ×200 (rms 3.67 ε at 256²), cell L = 256 (dx = 2 at 128², 1 at 256²), hard wall, no adhesion, a
+standard linear solid E*(t) = E*∞ + E*_1 e^{−t/τ} with E*∞ = 1, E*_1 = 2 (E*0 = 3), τ = 1, under the mean
+pressure p̄(t): 0 → ``--p-max`` over [0, τ] (linear), held to 3τ, down to p_max/4 at 4τ, held to 5τ, in fixed
+steps Δt = ``--dt`` (and Δt/2 with ``--halve``).  tengsim: its exact internal-variable update (w linear over a
+step, tengsim.visco.memory; the surface at rest at t = 0), ``pk`` tolerance ``--tol`` (ε); Tamaas: its
+relative tolerance ``--tamaas-tol``, one solve per step from t = Δt (at rest at t = 0).
+
+Reported per step: the contact area fraction (pixels with p > 0) and the mean gap (ε; tengsim: −D, the
+surface's mean at zero; Tamaas: mean(displacement − surface)), their largest differences over the history,
+the CPU time (time.process_time of each process) and its ratio.  One thread each.
+
+    OPENBLAS_NUM_THREADS=1 python benchmarks/peer_tamaas_visco.py --sizes 128 256 --halve \
+        --out benchmarks/results/peer_tamaas_visco.json
+"""
+from __future__ import annotations
+
+import argparse
+import importlib
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+L, SCALE = 256.0, 200.0
+E_INF, E1, TAU, NU = 1.0, 2.0, 1.0, 0.0          # E* (tengsim's units of W/ε per ε/ℓ: only ratios and κ = 1/E*)
+T_KNOTS = (0.0, 1.0, 3.0, 4.0, 5.0)                # × τ
+P_FRACTIONS = (0.0, 1.0, 1.0, 0.25, 0.25)          # × p_max
+
+
+def heights(n: int) -> np.ndarray:
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    from peer_aspher import surface
+
+    return SCALE * surface(n)
+
+
+LIMIT_KNOTS = ((0.0, 0.5, 40.0), (0.0, 1.0, 1.0))  # the long hold (× τ, × p_max; run at Δt = τ/2): the relaxed limit
+
+
+def schedule(dt: float, p_max: float, knots=(T_KNOTS, P_FRACTIONS)):
+    """(times, loads): the fixed steps of every segment, t = 0 first (the surface at rest, p̄ = 0)."""
+    t, p = [0.0], [0.0]
+    tk, pk_ = knots
+    for (ta, tb), (pa, pb) in zip(zip(tk, tk[1:]), zip(pk_, pk_[1:])):
+        k = int(round((tb - ta) * TAU / dt))
+        for i in range(1, k + 1):
+            t.append(ta * TAU + i * dt)
+            p.append(p_max * (pa + (pb - pa) * i / k))
+    return np.array(t), np.array(p)
+
+
+# ---- tengsim -------------------------------------------------------------------------------------------------
+def run_tengsim(h, dt, p_max, tol, knots=(T_KNOTS, P_FRACTIONS)):
+    from tengsim.grid import Grid
+    from tengsim.kernels import PeriodicKernel
+    from tengsim.laws import Repulsive
+    from tengsim.relaxation import Prony
+    from tengsim.solvers import make_solver
+    from tengsim.visco import FixedTimeSteps, History, TimeDrive
+
+    importlib.import_module("tengsim.plugins")                          # the registries filled ('pk')
+
+    n = h.shape[0]
+    grid = Grid(n, n, L / n, L / n)
+    t, p = schedule(dt, p_max, knots)
+    hist = History(tuple(x * TAU for x in knots[0]), tuple(f * p_max for f in knots[1]), "pressure")
+    drive = TimeDrive(-(h - h.mean()), Repulsive(), lambda kappa: PeriodicKernel(grid, kappa), 1.0 / E_INF,
+                      make_solver("pk", tol=tol), Prony(E_INF, (E1,), (TAU,)), jump_h=np.inf, maps_at=(t[-1],))
+    c0, w0 = time.process_time(), time.perf_counter()
+    res = drive.run(hist, FixedTimeSteps(dt))
+    cpu, wall = time.process_time() - c0, time.perf_counter() - w0
+    if len(res.t) != len(t) or not np.allclose(res.t, t):
+        raise RuntimeError(f"tengsim's steps ({len(res.t)}) differ from the schedule ({len(t)})")
+    P_last = res.maps[t[-1]][1]
+    area = res["area_repulsive"] / (L * L)
+    check = abs(float(np.mean(P_last > 0)) - float(area[-1]))            # the column is the map's fraction
+    return {"cpu": cpu, "wall": wall, "t": res.t.tolist(), "p": res["mean_pressure"].tolist(),
+            "area": area.tolist(), "mean_gap": (-res["D"]).tolist(), "converged": int(res.converged.sum()),
+            "n_conv": int(res["n_conv"].sum()), "area_column_vs_map": check}
+
+
+# ---- Tamaas (child process) ----------------------------------------------------------------------------------
+def _tamaas_model(tm, n):
+    model = tm.ModelFactory.createModel(tm.model_type.basic_2d, [L, L], [n, n])
+    model.E, model.nu = E_INF * (1 - NU ** 2), NU                       # E* = E/(1 − ν²) = E∞*
+    return model
+
+
+def _convention(tm, surf, p_bar, tol):
+    """Tamaas' moduli convention by test: a glassy branch (τ ≫ Δt) and a relaxed one (τ ≪ Δt) against the
+    elastic solves at E*0 = E*∞ + 2G/(1 − ν) and E*∞ (largest traction difference, area of each)."""
+    n = surf.shape[0]
+    G = E1 * (1 - NU) / 2
+
+    def elastic(E_star):
+        m = _tamaas_model(tm, n)
+        m.E = E_star * (1 - NU ** 2)
+        s = tm.PolonskyKeerRey(m, surf, tol, tm.PolonskyKeerRey.pressure, tm.PolonskyKeerRey.pressure)
+        s.max_iter = 20000
+        s.solve(p_bar)
+        return np.array(m.traction, copy=True), float(np.mean(np.asarray(m.displacement) - surf))
+
+    def visco(tau, dt):
+        m = _tamaas_model(tm, n)
+        s = tm.MaxwellViscoelastic(m, surf, tol, dt, [G], [tau])
+        s.max_iter = 20000
+        s.solve(p_bar)
+        return np.array(m.traction, copy=True)
+
+    out = {}
+    for name, tau, E_star in (("glassy", 1e12, E_INF + E1), ("relaxed", 1e-12, E_INF)):
+        pv, (pe, gap) = visco(tau, 1.0), elastic(E_star)
+        out[name] = {"E_star": E_star, "max_dp": float(np.abs(pv - pe).max()), "max_p": float(pe.max()),
+                     "area_visco": float(np.mean(pv > 0)), "area_elastic": float(np.mean(pe > 0)), "gap_elastic": gap}
+    return out
+
+
+def tamaas_child(npz, out, tol, dt, p_max, knots):
+    import tamaas as tm
+
+    tm.set_log_level(tm.LogLevel.error)
+    h = np.load(npz)["h"]
+    n = h.shape[0]
+    surf = np.ascontiguousarray(h - h.mean())
+    t, p = schedule(dt, p_max, knots)
+    conv = _convention(tm, surf, p_max, tol)
+    model = _tamaas_model(tm, n)
+    solver = tm.MaxwellViscoelastic(model, surf, tol, dt, [E1 * (1 - NU) / 2], [TAU])
+    solver.max_iter = 20000
+    area, gap, err = [0.0], [float("nan")], [0.0]
+    c0, w0 = time.process_time(), time.perf_counter()
+    for pk in p[1:]:
+        err.append(float(solver.solve(float(pk))))
+        tr, u = np.asarray(model.traction), np.asarray(model.displacement)
+        area.append(float(np.mean(tr > 0)))
+        gap.append(float(np.mean(u - surf)))
+    cpu, wall = time.process_time() - c0, time.perf_counter() - w0
+    with open(out, "w") as f:
+        json.dump({"cpu": cpu, "wall": wall, "t": t.tolist(), "area": area, "mean_gap": gap, "solve_error": err,
+                   "convention": conv, "version": tm.__version__}, f)
+
+
+def run_tamaas(h, python, tol, dt, p_max, knots=(T_KNOTS, P_FRACTIONS)):
+    with tempfile.TemporaryDirectory() as tmp:
+        npz, out = os.path.join(tmp, "h.npz"), os.path.join(tmp, "out.json")
+        np.savez(npz, h=h)
+        env = dict(os.environ, OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1")
+        got = subprocess.run([python, "-W", "ignore", os.path.abspath(__file__), "--tamaas-child", npz, out,
+                              str(tol), str(dt), str(p_max), json.dumps(knots)],
+                             env=env, capture_output=True, text=True)
+        if got.returncode:
+            return {"error": got.stderr.strip().splitlines()[-1] if got.stderr.strip() else "failed"}
+        with open(out) as f:
+            return json.load(f)
+
+
+# ---- comparison ----------------------------------------------------------------------------------------------
+def compare(a, b):
+    """Largest |Δ area| and |Δ mean gap| of two runs over their common times (t > 0)."""
+    ta, tb = np.round(np.asarray(a["t"]), 9), np.round(np.asarray(b["t"]), 9)
+    common, ia, ib = np.intersect1d(ta, tb, return_indices=True)
+    keep = common > 0
+    ia, ib = ia[keep], ib[keep]
+    da = np.abs(np.asarray(a["area"])[ia] - np.asarray(b["area"])[ib])
+    dg = np.abs(np.asarray(a["mean_gap"])[ia] - np.asarray(b["mean_gap"])[ib])
+    return {"max_area": float(da.max()), "t_max_area": float(common[keep][da.argmax()]),
+            "max_gap": float(dg.max()), "t_max_gap": float(common[keep][dg.argmax()])}
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--sizes", type=int, nargs="+", default=[128, 256])
+    ap.add_argument("--dt", type=float, default=0.05, help="time step (s, τ = 1 s)")
+    ap.add_argument("--halve", action="store_true", help="also run both codes at dt/2 (time-step convergence)")
+    ap.add_argument("--p-max", type=float, default=0.1, help="the held mean pressure (W/ε; E*∞ = 1)")
+    ap.add_argument("--tol", type=float, default=1e-8, help="tengsim pk's gap residual (ε)")
+    ap.add_argument("--tamaas-tol", type=float, default=1e-10, help="Tamaas' relative tolerance")
+    ap.add_argument("--tamaas-python", default="/work/venvs/tamaas/bin/python")
+    ap.add_argument("--out", default=None, help="a JSON file for the rows")
+    ap.add_argument("--no-limit", action="store_true", help="skip the long hold (the relaxed limit)")
+    ap.add_argument("--tamaas-child", nargs=6, help=argparse.SUPPRESS)
+    args = ap.parse_args(argv)
+    if args.tamaas_child:
+        npz, out, tol, dt, p_max, knots = args.tamaas_child
+        tamaas_child(npz, out, float(tol), float(dt), float(p_max), json.loads(knots))
+        return 0
+    for name, v in (("--dt", args.dt), ("--p-max", args.p_max)):
+        if not v > 0:
+            print(f"{name} must be > 0, got {v:g}", file=sys.stderr)
+            return 2
+    os.environ.setdefault("TENGSIM_FFT_WORKERS", "1")
+    rows = []
+    load = os.getloadavg()
+    dts = [args.dt, args.dt / 2] if args.halve else [args.dt]
+    for n in args.sizes:
+        h = heights(n)
+        row = {"n": n, "rms": float(h.std()), "load": load, "p_max": args.p_max, "runs": {}}
+        for dt in dts:
+            tam = run_tamaas(h, args.tamaas_python, args.tamaas_tol, dt, args.p_max)
+            ten = run_tengsim(h, dt, args.p_max, args.tol)
+            row["runs"][f"{dt:g}"] = {"dt": dt, "tamaas": tam, "tengsim": ten,
+                                      "diff": compare(ten, tam) if "error" not in tam else None}
+        if not args.no_limit:  # the long hold: both against the elastic solves at E*∞ and E*0 (Tamaas' PKR)
+            tam = run_tamaas(h, args.tamaas_python, args.tamaas_tol, 0.5 * TAU, args.p_max, LIMIT_KNOTS)
+            ten = run_tengsim(h, 0.5 * TAU, args.p_max, args.tol, LIMIT_KNOTS)
+            row["limit"] = {"dt": 0.5 * TAU, "t_end": LIMIT_KNOTS[0][-1] * TAU, "tengsim_area": ten["area"][-1],
+                            "tamaas_area": tam.get("area", [float("nan")])[-1],
+                            "tengsim_gap": ten["mean_gap"][-1], "tamaas_gap": tam.get("mean_gap", [float("nan")])[-1],
+                            "elastic": tam.get("convention"), "tengsim_cpu": ten["cpu"], "tamaas_cpu": tam.get("cpu")}
+        if len(dts) == 2:
+            a, b = (row["runs"][f"{d:g}"] for d in dts)
+            row["halving"] = {"tengsim": compare(a["tengsim"], b["tengsim"])}
+            if a["diff"] and b["diff"]:
+                row["halving"]["tamaas"] = compare(a["tamaas"], b["tamaas"])
+        rows.append(row)
+        print(json.dumps({"n": n, **{k: (v["diff"], v["tengsim"]["cpu"], v["tamaas"].get("cpu"))
+                                     for k, v in row["runs"].items()}}), flush=True)
+    if args.out:
+        with open(args.out, "w") as f:
+            json.dump(rows, f, indent=1)
+    report(rows)
+    return 0
+
+
+def report(rows):
+    print("| grid | Δt (τ) | steps | tengsim CPU s | Tamaas CPU s | CPU ratio tengsim/Tamaas | max Δ area | "
+          "max Δ mean gap (ε) |")
+    print("|---|---|---|---|---|---|---|---|")
+    for r in rows:
+        for v in r["runs"].values():
+            t, m, d = v["tamaas"], v["tengsim"], v["diff"]
+            if d is None:
+                print(f"| {r['n']}² | {v['dt']:g} | | {m['cpu']:.3g} | {t['error']} | | | |")
+                continue
+            print(f"| {r['n']}² | {v['dt']:g} | {len(m['t']) - 1} | {m['cpu']:.3g} | {t['cpu']:.3g} | "
+                  f"{m['cpu'] / t['cpu']:.2f} | {d['max_area']:.1e} (t = {d['t_max_area']:g}) | "
+                  f"{d['max_gap']:.1e} (t = {d['t_max_gap']:g}) |")
+        if "halving" in r:
+            hv = r["halving"]
+            print(f"| {r['n']}² | Δt → Δt/2 | | area {hv['tengsim']['max_area']:.1e}, "
+                  f"gap {hv['tengsim']['max_gap']:.1e} "
+                  f"| area {hv.get('tamaas', {}).get('max_area', float('nan')):.1e}, gap "
+                  f"{hv.get('tamaas', {}).get('max_gap', float('nan')):.1e} | | | |")
+    for r in rows:
+        if r.get("limit") and r["limit"]["elastic"]:
+            lm, c = r["limit"], r["limit"]["elastic"]
+            print(f"{r['n']}² held p̄ to t = {lm['t_end']:g} τ (Δt = {lm['dt']:g}): "
+                  f"area tengsim {lm['tengsim_area']:.5f}, "
+                  f"Tamaas {lm['tamaas_area']:.5f}; elastic (Tamaas PKR) at E*∞ {c['relaxed']['area_elastic']:.5f}, "
+                  f"at E*0 {c['glassy']['area_elastic']:.5f}; mean gap tengsim {lm['tengsim_gap']:.4f}, "
+                  f"Tamaas {lm['tamaas_gap']:.4f}, elastic at E*∞ {c['relaxed']['gap_elastic']:.4f}")
+        v = next(iter(r["runs"].values()))
+        if "convention" in v["tamaas"]:
+            c = v["tamaas"]["convention"]
+            print(f"{r['n']}² Tamaas convention: glassy vs elastic E*={c['glassy']['E_star']:g}: max|Δp| "
+                  f"{c['glassy']['max_dp']:.1e} (p max {c['glassy']['max_p']:.3g}); "
+                  f"relaxed vs E*={c['relaxed']['E_star']:g}:"
+                  f" {c['relaxed']['max_dp']:.1e}")
+        for key, v in r["runs"].items():
+            m, t = v["tengsim"], v["tamaas"]
+            if "area" not in t:
+                continue
+            idx = [i for i, s in enumerate(m["t"]) if any(abs(s - k * TAU) < 1e-9 for k in T_KNOTS[1:])
+                   or abs(s - 0.5 * TAU) < 1e-9 or abs(s - 2 * TAU) < 1e-9]
+            print(f"{r['n']}² Δt={key}: t: area tengsim / Tamaas, mean gap tengsim / Tamaas: " + "; ".join(
+                f"{m['t'][i]:g}: {m['area'][i]:.5f} / {t['area'][i]:.5f}, {m['mean_gap'][i]:.4f} / "
+                f"{t['mean_gap'][i]:.4f}" for i in idx))
+
+
+if __name__ == "__main__":
+    sys.exit(main())
