@@ -52,6 +52,7 @@ def fitted(tmp_path_factory):
     return d, out, args
 
 
+@pytest.mark.xdist_group("calibration")  # one worker sets the shared calibration up once
 @pytest.mark.slow  # the shared calibration (two geometries, 36 designs) takes about 3.5 min of CPU
 def test_recovery_two_geometries_intervals_contain_truth(fitted):
     from tengsim.io import read_dataset
@@ -81,6 +82,7 @@ def test_recovery_two_geometries_intervals_contain_truth(fitted):
     assert np.all(ds["voc_fitted"].values <= ds["voc_upper"].values + 1e-9)
 
 
+@pytest.mark.xdist_group("calibration")  # one worker sets the shared calibration up once
 @pytest.mark.slow  # the shared calibration (two geometries, 36 designs) takes about 3.5 min of CPU
 def test_files_report_material_and_cf(fitted):
     _, out, _ = fitted
@@ -103,6 +105,7 @@ def test_files_report_material_and_cf(fitted):
     assert not bad, [(r.name, r.msgs) for r in bad]
 
 
+@pytest.mark.xdist_group("calibration")  # one worker sets the shared calibration up once
 @pytest.mark.slow  # the shared calibration (two geometries, 36 designs) takes about 3.5 min of CPU
 def test_rerun_takes_every_design_back(fitted):
     from tengsim.calibrate import calibrate, plan_calibration
@@ -241,6 +244,7 @@ def test_expected_noise_reaches_the_warning():
     assert _expected_noise(None, "relative") is None
 
 
+@pytest.mark.xdist_group("calibration")  # one worker sets the shared calibration up once
 @pytest.mark.slow
 def test_exact_data_give_back_the_truth(fitted, tmp_path):
     """Curves without noise (tengsim's own at the truth): the fit is as exact as the interpolation, no bias left
@@ -260,6 +264,7 @@ def test_exact_data_give_back_the_truth(fitted, tmp_path):
         assert abs(cal.fit.best[k] / TRUE[k] - 1) < 1e-3 and lo <= TRUE[k] <= hi, (k, cal.fit.best[k], lo, hi)
 
 
+@pytest.mark.xdist_group("calibration")  # one worker sets the shared calibration up once
 @pytest.mark.slow
 def test_design_with_the_fitted_material_writes_bands(fitted, tmp_path):
     """tengsim design --material: the design at the fitted material, and a band from the material's uncertainty
