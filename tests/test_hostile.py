@@ -459,6 +459,32 @@ def test_c12_a_second_sweep_on_a_held_folder_is_refused(tmp_path, study_client):
     assert s["ok"] + s.get("under_resolved", 0) == 1
 
 
+def test_c12_a_sweep_and_a_design_on_one_folder_refuse_each_other(tmp_path):
+    """The one output-folder lock (tengsim.outfolder) is held by a sweep too: a design, calibration or
+    reproduction on the sweep's folder is refused in one line naming the sweep, and a sweep on a folder a
+    design holds is refused; each folder is free again after its holder ends."""
+    from tengsim.errors import TengsimError
+    from tengsim.outfolder import folder_lock
+    from tengsim.study.layout import StudyDir
+
+    sd = StudyDir(tmp_path / "out")
+    with sd.lock("sweep"):
+        with pytest.raises(TengsimError, match=r"in use by another tengsim run \(pid \d+, tengsim sweep"):
+            with folder_lock(sd.root, holder="tengsim design"):
+                pass
+    with folder_lock(sd.root, holder="tengsim design"):
+        with pytest.raises(TengsimError, match=r"in use by another tengsim run \(pid \d+, tengsim design"):
+            with sd.lock("optimize"):
+                pass
+    with sd.lock("sweep"), pytest.raises(TengsimError, match="in use by another sweep"):
+        with sd.lock("sweep"):
+            pass
+    with folder_lock(sd.root, holder="tengsim calibrate"), StudyDir(tmp_path / "other").lock("sweep"):
+        pass  # two folders: no interference
+    with sd.lock("sweep"):  # free again
+        pass
+
+
 def test_c12_a_child_forked_while_the_folder_is_held_does_not_keep_it(tmp_path):
     """A process forked while a sweep holds its folder (a worker a Dask nanny restarts) does not hold the
     folder after the sweep ends (a flock kept by the child's copy made the next sweep refuse, by chance);

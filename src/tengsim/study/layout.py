@@ -91,7 +91,12 @@ class StudyDir:
             os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
             _HELD[key] = fd
             try:
-                yield path
+                # and the one lock of every command's output folder (tengsim.outfolder): a design, calibration
+                # or reproduction on this folder meanwhile is refused too, and this sweep if one holds it
+                from tengsim.outfolder import folder_lock
+
+                with folder_lock(self.root, holder=f"tengsim {who}"):
+                    yield path
             finally:
                 _HELD.pop(key, None)
         finally:
