@@ -95,7 +95,7 @@ def test_design_report_and_dataset_carry_the_near_field(tiny, tmp_path):
 
     from tengsim.design import write_design
     from tengsim.design.nearfield import _released_map, charged_fraction
-    from tengsim.design.plots import _peak_separation
+    from tengsim.design.walk import peak_separation
 
     nf = tiny.summary["nearfield"]
     m, p_pa = _released_map(tiny.maps)
@@ -106,7 +106,7 @@ def test_design_report_and_dataset_carry_the_near_field(tiny, tmp_path):
     assert nf.pitch_x_m == pytest.approx(1e-6) and nf.pitch_y_m == pytest.approx(1e-6)
     assert nf.gaps_m == (*GAPS_M, pytest.approx(1e-6))
     assert all(v > 1.0 for v in nf.peak_over_uniform) and 0 < nf.decay_height_m < 1e-6
-    pf = PatternField(charged_fraction(m["H"], _peak_separation(tiny.plan)), nf.pitch_x_m, SIG, T, ER)
+    pf = PatternField(charged_fraction(m["H"], peak_separation(tiny.plan)), nf.pitch_x_m, SIG, T, ER)
     far = nf.uniform_field_V_m + pf.field_z(50e-6, 3e-6)
     assert np.max(np.abs(far / (SIG * nf.area_fraction / EPS0) - 1)) < 1e-3
     write_design(tiny, tmp_path, figures=False)

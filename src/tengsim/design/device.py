@@ -56,12 +56,12 @@ class DesignedDevice:
     def area_model(self) -> str:
         """'quasi-static A(P)', or the viscoelastic cycle's label ('viscoelastic cycle at 2 Hz')."""
         area = self.params.area
-        return str(area.label) if getattr(area, "carries_history", False) else QUASI_STATIC
+        return str(area.label) if area.carries_history else QUASI_STATIC
 
     def provenance(self) -> dict:
         out = {"design": self.source, "from_design": dict(self.from_design), "defaults": dict(self.defaults),
                "design_pressure_range_Pa": list(self.pressure_range), "area_model": self.area_model}
-        if getattr(self.params.area, "carries_history", False):
+        if self.params.area.carries_history:
             d = self.params.area.details
             out["area_cycle"] = {k: d[k] for k in ("cycle", "cycle_frequencies_Hz", "cycle_weights",
                                                    "design_cycle_frequencies_Hz", "grid_correction", "cycle_grid")
@@ -215,7 +215,7 @@ def rest_gap_voltage(designed: DesignedDevice, result) -> dict:
 
     p = designed.params
     peak = waveform_peak(designed.waveform, float(result.t[-1]))
-    if getattr(p.area, "carries_history", False):  # the cycle's A/S at the release (end of the press)
+    if p.area.carries_history:  # the cycle's A/S at the release (end of the press)
         a = float(p.area.at_phase(0.5))
     else:
         a = float(np.interp(peak, p.area.pressure_Pa, p.area.area_fraction)) if hasattr(p.area, "pressure_Pa") \

@@ -131,12 +131,12 @@ def _released_map(res):
 def design_nearfield(res, plan):
     """The :class:`NearField` of a design's run ``res`` (holding its kept maps) and ``plan``: the charge of the
     approach map at the largest pressure kept; None where no maps were kept (``plan.maps`` false)."""
-    from tengsim.design.plots import _peak_separation
+    from tengsim.design.walk import peak_separation
 
     if res is None or not getattr(plan, "maps", True):
         return None
     m, p_pa = _released_map(res)
-    g_c = _peak_separation(plan)
+    g_c = peak_separation(plan)
     if m is None or g_c is None:
         return None
     f = charged_fraction(m["H"], g_c)

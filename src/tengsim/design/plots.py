@@ -87,7 +87,9 @@ def maps_figure(result):
     lat = sc.lateral * 1e6
     a = res.branch("approach")
     asked = dict(result.summary.get("map_pressures_asked", {}))
-    g_c = _peak_separation(result.plan)
+    from tengsim.design.walk import peak_separation
+
+    g_c = peak_separation(result.plan)
     fig, axes = plt.subplots(1, len(maps), figsize=(4.3 * len(maps), 4.1), constrained_layout=True, squeeze=False)
     for ax, m in zip(axes[0], maps):
         Pmap = np.asarray(m["P"], float) * unit / 1e3
@@ -109,14 +111,6 @@ def maps_figure(result):
                       "separation; the 2-D charged area lies inside)", fontsize=8)
     fig.suptitle(title(result.plan, result.status), fontsize=10)
     return fig
-
-
-def _peak_separation(plan):
-    """The law's peak-tension separation g_c (ε) of a plan, None if it cannot be had."""
-    from tengsim.analysis import law_edge
-
-    law = getattr(getattr(plan, "contact_plan", None), "law", None)
-    return None if law is None else law_edge(law)[0]
 
 
 def _edge_contour(ax, m, g_c, hx, hy):

@@ -92,3 +92,12 @@ def observers(plan):
         return out
 
     return observe, watch
+
+
+def peak_separation(plan):
+    """The law's peak-tension separation g_c (ε) of a design plan, the charged area's edge on its kept gap maps;
+    None if it cannot be had."""
+    from tengsim.analysis import law_edge
+
+    law = getattr(getattr(plan, "contact_plan", None), "law", None)
+    return None if law is None else law_edge(law)[0]

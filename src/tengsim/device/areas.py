@@ -319,5 +319,5 @@ def area_table_from_file(path) -> AreaTable:
     return area_table_from_design(p)
 
 
-__all__ = ["area_cycle_from_design", "visco_record", "area_table_from_contact", "area_table_from_design", "area_table_from_file", "design_path",
-           "passed_curve", "stable_branch", "DESIGN_FILE"]
+__all__ = ["area_cycle_from_design", "visco_record", "area_table_from_contact", "area_table_from_design",
+           "area_table_from_file", "design_path", "passed_curve", "stable_branch", "DESIGN_FILE"]

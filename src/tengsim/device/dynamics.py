@@ -41,6 +41,7 @@ class _Core:
         self.p = p
         self.wf = waveform
         self.tau = p.time_scale
+        self.history = p.area.carries_history  # an area with its own history: read by time, no area_memory
         self.pscale = p.area_m2 / (p.gap_m * p.stiffness_N_per_m)  # Pbar = P_a S/(d0 k_e)
         self.g2 = p.gamma2
         self.g3 = p.gamma3
@@ -110,7 +111,7 @@ def _area_fraction(core: _Core, tb):
     """A/S demanded by the pressure at tbar (in contact), per ``area_pressure``; an area that carries its own
     history: its value at that time."""
     p = core.p
-    if getattr(p.area, "carries_history", False):
+    if core.history:
         return p.area.at_time(np.asarray(tb) * core.tau)
     pa = core.pbar(np.asarray(tb)) / core.pscale
     if p.area_pressure == "contact":
@@ -134,7 +135,6 @@ def simulate(params: DeviceParams, waveform, t_end: float, *, dt_out: float | No
     require(t_end / dt_out <= 5e6, f"t_end / dt_out = {t_end / dt_out:.3g} output rows is too many")
     opts = options or SolverOptions()
     core = _Core(params, waveform)
-    history = bool(getattr(params.area, "carries_history", False))
     tau = core.tau
     tb_end = t_end / tau
     n_grid = int(math.floor(t_end / dt_out + 1e-9)) + 1
@@ -208,7 +208,7 @@ def simulate(params: DeviceParams, waveform, t_end: float, *, dt_out: float | No
                 if tg.size:
                     demand = _area_fraction(core, tg)
                     gs = (np.maximum.accumulate(np.maximum(demand, g1)) if params.area_memory == "max"
-                          and not history else demand)
+                          and not core.history else demand)
                     emit(tg, st, True, gs, e_impact)
                 dec = math.exp(-lam * (t_rel - a)) if lam < math.inf else 0.0
                 if core.mode == "finite":
@@ -278,6 +278,6 @@ def _contact_area(core: _Core, g1: float, a: float, b: float) -> float:
     its own history: the area at b, the release)."""
     tt = np.linspace(a, b, 33) if b > a else np.array([a])
     demand = _area_fraction(core, tt)
-    if core.p.area_memory == "release" or getattr(core.p.area, "carries_history", False):
+    if core.p.area_memory == "release" or core.history:
         return float(demand[-1])
     return float(max(g1, demand.max()))

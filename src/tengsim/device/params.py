@@ -39,6 +39,7 @@ class ConstantArea:
     """Charged area A = fraction * S, independent of pressure (flat interface, Fig. 7)."""
 
     fraction: float = 1.0
+    carries_history = False  # A follows the pressure; the device's area_memory patches the gap (AreaCycle: True)
 
     def __post_init__(self):
         f = finite("area fraction", self.fraction)
@@ -63,6 +64,8 @@ class AreaTable:
 
     Outside the table the end values are held. The polymer is uncharged until first contact.
     """
+
+    carries_history = False
 
     pressure_Pa: np.ndarray
     area_fraction: np.ndarray
@@ -111,6 +114,8 @@ class AreaFunction:
 
     ``initial_fraction`` is the charged fraction before the first contact (0: a patterned polymer).
     """
+
+    carries_history = False
 
     function: object
     initial_fraction: float = 0.0
