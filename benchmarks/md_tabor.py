@@ -7,7 +7,7 @@ section "Interaction laws").  One case per call:
 
 prints pull-off P̄* = −∬P/π and radius a* (vertex of F(a), tengsim.analysis.quadratic_vertex, on the
 sub-pixel edge radius tengsim.analysis.edge_radius), the fine rows' best P̄, the zero-load radius,
-their deviations from Maugis (tengsim.axisym.maugis_sphere) and the wall time.  The walks are
+their deviations from Maugis (tengsim.references.axisym.maugis_sphere) and the wall time.  The walks are
 tests/test_laws.py's md_branch / md_measure.
 """
 import argparse
@@ -18,7 +18,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
-from tengsim.axisym import maugis_sphere  # noqa: E402
+from tengsim.references.axisym import maugis_sphere  # noqa: E402
 from test_laws import md_measure  # noqa: E402
 
 

@@ -1,4 +1,4 @@
-"""The independent axisymmetric reference (tengsim.axisym) and the 2-D engine's LJ93 sphere against it.
+"""The independent axisymmetric reference (tengsim.references.axisym) and the 2-D engine's LJ93 sphere against it.
 
 Reference: rings with closed-form influence coefficients (Johnson 1985 Eq. 3.41), Newton plus
 pseudo-arclength continuation through the turning points.  Measured (docs/validation.md):
@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
-from tengsim.axisym import AxisymSphere, disc_integral, walk
+from tengsim.references.axisym import AxisymSphere, disc_integral, walk
 from tengsim.shapes import Paraboloid
 from tengsim.laws import LJ93
 from tengsim.kernels import FreeKernel
@@ -120,7 +120,7 @@ def _zero_load_radius(c):
 
 def test_axisym_md_vs_maugis_mu03():
     """λ = 0.347, dr = 0.04: pull-off +0.14 % (asserted 0.3 %), zero-load radius −0.3 % (asserted 1 %)."""
-    from tengsim.axisym import maugis_sphere, pull_off_state
+    from tengsim.references.axisym import maugis_sphere, pull_off_state
     m = maugis_sphere(0.3)
     c = axisym_md(0.3, 0.04)
     assert -pull_off_state(c)[0] / np.pi == pytest.approx(m.pull_off, rel=3e-3)
@@ -129,7 +129,7 @@ def test_axisym_md_vs_maugis_mu03():
 
 def test_md_smoothing_default_is_converged():
     """Doubling the default ramp width (0.2 → 0.4) moves the pull-off by 0.045 % (asserted 0.1 %)."""
-    from tengsim.axisym import pull_off_state
+    from tengsim.references.axisym import pull_off_state
     a = pull_off_state(axisym_md(0.3, 0.04, 0.2))[0]
     b = pull_off_state(axisym_md(0.3, 0.04, 0.4))[0]
     assert a == pytest.approx(b, rel=1e-3)
@@ -138,7 +138,7 @@ def test_md_smoothing_default_is_converged():
 @pytest.mark.slow
 def test_axisym_md_vs_maugis_mu1():
     """λ = 1.157, dr = 0.02: pull-off +0.15 %, radius at pull-off −0.16 %, at zero load +0.03 % (asserted 1 %)."""
-    from tengsim.axisym import maugis_sphere, pull_off_state
+    from tengsim.references.axisym import maugis_sphere, pull_off_state
     m = maugis_sphere(1.0)
     c = axisym_md(1.0, 0.02)
     f, _, a = pull_off_state(c)
@@ -154,7 +154,7 @@ def test_axisym_md_vs_maugis_mu3():
     0.01: +0.07 / −0.33 %); asserted 1 %; 26–34 s.  With the default smoothing 0.2 (and 0.4) each ring
     snaps on its own at this coupling (κ = 5.2): dr 0.04 takes 15152 steps and gives +23 %, dr 0.02 with
     smoothing 0.4 +2.3 % (why the default did not finish in 500 s at dr 0.02)."""
-    from tengsim.axisym import maugis_sphere, pull_off_state
+    from tengsim.references.axisym import maugis_sphere, pull_off_state
     from tengsim.laws import MaugisDugdale
     m = maugis_sphere(3.0)
     c = AxisymSphere(3.0, MaugisDugdale(smoothing=0.6), dr=0.02, r_fine=4.7, r_max=9.0).trace(d_end=6.3)

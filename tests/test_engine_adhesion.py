@@ -9,7 +9,7 @@ Measured (docs/validation.md): the LJ sphere's |pull-off| exceeds MD by +1.4 % (
 +5.6 % (μ = 0.5), +5.4 % (μ = 1), +1.6 % (μ = 3); converged in dx, cell and D step to < 0.1 %.
 That difference is the LJ law's, not an error, so Maugis–Dugdale is no reference for these runs: the
 pull-off is checked against the independent axisymmetric solution of the same LJ problem
-(tengsim.axisym; tests/test_axisym.py for μ = 0.5 and 1 at 0.3 %, here μ = 1 and 3 on fine grids), and
+(tengsim.references.axisym; tests/test_axisym.py for μ = 0.5 and 1 at 0.3 %, here μ = 1 and 3 on fine grids), and
 against the DMT/JKR limits and grid convergence.
 """
 from __future__ import annotations
@@ -32,7 +32,7 @@ AXISYM_TOL = 3e-3  # the 2-D engine at dx 0.1–0.2 against the rings (dr 0.04, 
 @lru_cache(maxsize=None)
 def axisym_pulloff(mu: float) -> float:
     """|∬P|/π at pull-off of the axisymmetric reference (rings, dr 0.04)."""
-    from tengsim.axisym import AxisymSphere, walk
+    from tengsim.references.axisym import AxisymSphere, walk
 
     c = AxisymSphere(mu, LJ93(), dr=0.04).trace(d_start=-2.0 * mu)
     return -walk(c).pull_off / np.pi

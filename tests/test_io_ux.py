@@ -77,10 +77,10 @@ def test_overwrite_keeps_the_files_mode(tmp_path, umask):
 def test_netcdf_and_figures_follow_the_umask(tmp_path, umask):
     import xarray as xr
 
-    from tengsim.plots import _plt, save
+    from tengsim.plots import pyplot, save
 
     io.write_dataset(xr.Dataset({"a": ("x", [1.0, 2.0])}), tmp_path / "d.nc")
-    fig = _plt().figure()
+    fig = pyplot().figure()
     save(fig, tmp_path / "f.png")
     assert _mode(tmp_path / "d.nc") == 0o644 and _mode(tmp_path / "f.png") == 0o644
 

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from tengsim import references as ref
-from tengsim.axisym import maugis_sphere
+from tengsim.references.axisym import maugis_sphere
 from tengsim.cli.main import main
 from tengsim.errors import TengsimError
 from tengsim.laws import LJ93, LJ_PEAK_TENSION, Exponential, MaugisDugdale, make_law

@@ -1,6 +1,6 @@
 """The adhesive constrained solver 'ram' (tengsim.solvers.ram): the law's hard-wall limit asked of the law, and
 its states against Hertz, Maugis–Dugdale (pull-off, the DMT and JKR sides), the axisymmetric reference
-(tengsim.axisym) for the exponential law, an independent residual with the kernel's own convolution for a
+(tengsim.references.axisym) for the exponential law, an independent residual with the kernel's own convolution for a
 user's cohesive law, the 'pk' solver on the sharp Dugdale zone, and Tamaas on the adhesive rough path
 (tests/data/ram_rough_tamaas.npz, made by tests/data/make_ram_rough_tamaas.py).  Measured values:
 docs/validation.md, "The adhesive constrained solver 'ram'"."""
@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from tengsim import references as ref
-from tengsim.axisym import AxisymSphere, maugis_sphere
+from tengsim.references.axisym import AxisymSphere, maugis_sphere
 from tengsim.errors import TengsimError
 from tengsim.grid import Grid
 from tengsim.kernels import FreeKernel, PeriodicKernel
@@ -128,7 +128,7 @@ def test_sharp_dugdale_zone_equilibrium():
 
 def test_exponential_sphere_against_axisymmetric_reference():
     """Exponential law (ρ = 0.5 ε), μ = 1, dx 0.1: ∬P at D = 0.5 ε (cold) and 0 ε (retracting) within 1 % of
-    tengsim.axisym's ring solution (its curve traced with the law's wall k = 10⁴ W/ε², compliance 2e-4 ε;
+    tengsim.references.axisym's ring solution (its curve traced with the law's wall k = 10⁴ W/ε², compliance 2e-4 ε;
     the branch in contact; measured 0.13 %, 0.20 %)."""
     law = Exponential(range=0.5, wall_stiffness=1e4)
     cur = AxisymSphere(1.0, law, dr=0.02, r_fine=4.0, r_max=16.0).trace(d_end=0.6)

@@ -1,33 +1,33 @@
-"""Contact figures: paper Figs. 3, 4, 5 and a generic approach–retraction plot.  Agg backend."""
+"""Contact figures: the approach–retraction curves, maps, sweeps and time series, and the one figure writer.
+
+Agg backend.  The paper's Figs. 3–5 are in :mod:`tengsim.cases.paper.figures`."""
 from __future__ import annotations
 
 import numpy as np
 
-from tengsim.io import atomic_path
-
-COLORS = {"A": "tab:blue", "B": "tab:orange", "C": "tab:green"}
+from tengsim.io import save_figure
 
 
-def _plt():
+def pyplot():
+    """matplotlib.pyplot on the Agg backend (files only): the one import of pyplot in tengsim."""
     import matplotlib
 
-    matplotlib.use("Agg")
+    matplotlib.use("Agg", force=False)
     import matplotlib.pyplot as plt
 
     return plt
 
 
 def save(fig, path) -> None:
-    """Save a figure atomically (format from the suffix) and close it: the one figure writer of tengsim."""
-    from pathlib import Path
-
-    plt = _plt()
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, format=Path(path).suffix.lstrip(".") or "png", dpi=150, bbox_inches="tight")
-    plt.close(fig)
+    """Save a figure atomically (format from the suffix; 150 dpi, tight box) and close it."""
+    try:
+        save_figure(fig, path, dpi=150, bbox_inches="tight")
+    finally:
+        pyplot().close(fig)
 
 
-def _branches(ax, res, x, y, color, label, jumps=True):
+def draw_branches(ax, res, x, y, color, label, jumps=True):
+    """Approach solid and retraction dashed, broken at jumps (dots: filled after, open before)."""
     for b, ls in (("approach", "-"), ("retraction", "--")):
         t = res.branch(b)
         if len(t["D"]) == 0:
@@ -83,7 +83,7 @@ def plot_curves(res, path, title: str = "", keys=None) -> None:
     (kPa) on a right-hand axis, the last panel against the pressure; titled with its shape, sizes and
     materials.  A dimensionless one in the units of Eq. (7), titled with its shape's numbers.
     """
-    plt = _plt()
+    plt = pyplot()
     t = res.table
     params = res.params or {}
     eps = params.get("eps_m")
@@ -105,9 +105,9 @@ def plot_curves(res, path, title: str = "", keys=None) -> None:
         dl, fl, ll = "rigid approach D (ε)", "force per cell F (3π W ℓ²/ε)", f"contact length Λc ({unit})"
     labels = [(dl, fl), (dl, ll), (pl if pressure else fl, ll)]
     fig, axs = plt.subplots(1, 3, figsize=(12.5, 3.9), constrained_layout=True)
-    _branches(axs[0], view, "D", "F", "k", "")
-    _branches(axs[1], view, "D", "contact_length", "k", "")
-    _branches(axs[2], pview if pressure else view, "F", "contact_length", "k", "")
+    draw_branches(axs[0], view, "D", "F", "k", "")
+    draw_branches(axs[1], view, "D", "contact_length", "k", "")
+    draw_branches(axs[2], pview if pressure else view, "F", "contact_length", "k", "")
     for ax, (xl, yl) in zip(axs, labels):
         ax.set_xlabel(xl)
         ax.set_ylabel(yl)
@@ -124,74 +124,6 @@ def plot_curves(res, path, title: str = "", keys=None) -> None:
     save(fig, path)
 
 
-def plot_fig3(results: dict, path, d_values=(1.0, 3.0, 6.0, 14.0)) -> None:
-    """Fig. 3: pressure maps P(X, Y) on approach, rows = groups, columns = D."""
-    plt = _plt()
-    groups = list(results)
-    fig, axs = plt.subplots(len(groups), len(d_values), figsize=(3.4 * len(d_values), 2.9 * len(groups)),
-                            squeeze=False, constrained_layout=True)
-    for i, g in enumerate(groups):
-        res = results[g]
-        maps = {round(m["D"], 9): m for m in res.maps if m["branch"] == "approach"}
-        for j, D in enumerate(d_values):
-            ax = axs[i, j]
-            m = maps.get(round(D, 9))
-            if m is None:
-                ax.set_axis_off()
-                continue
-            P = m["P"]
-            lim = max(1e-9, float(np.percentile(np.abs(P), 99.5)))
-            ext = [res.grid.x[0], res.grid.x[-1], res.grid.y[0], res.grid.y[-1]]
-            im = ax.imshow(P.T, origin="lower", extent=ext, cmap="RdBu_r", vmin=-lim, vmax=lim)
-            ax.set_title(f"group {g}, D = {D:g}", fontsize=9)
-            ax.set_xlabel("X")
-            if j == 0:
-                ax.set_ylabel("Y")
-            fig.colorbar(im, ax=ax, shrink=0.8)
-    fig.suptitle("Pressure P (Eq. 8; positive = compressive, colour scale symmetric), approach")
-    save(fig, path)
-
-
-def plot_fig4(results: dict, path, paper_transition: dict | None = None) -> None:
-    """Fig. 4: (a) Λc(D), (b) Λc(F), (c) F(D) for the groups; approach solid, retraction dashed."""
-    plt = _plt()
-    fig, axs = plt.subplots(1, 3, figsize=(13, 3.8))
-    for g, res in results.items():
-        c = COLORS.get(g, None)
-        _branches(axs[0], res, "D", "contact_length", c, g)
-        _branches(axs[1], res, "F", "contact_length", c, g)
-        _branches(axs[2], res, "D", "F", c, g)
-        if paper_transition and g in paper_transition:
-            axs[0].axvline(paper_transition[g], color=c, lw=0.8, ls=":")
-    labels = [("D", r"$\Lambda_c$", "(a)"), ("F", r"$\Lambda_c$", "(b)"), ("D", "F", "(c)")]
-    for ax, (xl, yl, tag) in zip(axs, labels):
-        ax.set_xlabel(xl)
-        ax.set_ylabel(yl)
-        ax.set_title(tag, loc="left")
-        ax.grid(alpha=0.3)
-    axs[0].legend(fontsize=7, ncol=1)
-    if paper_transition:
-        axs[0].text(0.98, 0.02, "dotted: paper's transition D", transform=axs[0].transAxes,
-                    ha="right", fontsize=7)
-    save(fig, path)
-
-
-def plot_fig5(curves: dict, path) -> None:
-    """Fig. 5: V_OC (Eq. 12) against pressure f/L² (kPa), one curve per group.
-
-    ``curves`` maps group → (pressure_Pa, voc_V)."""
-    plt = _plt()
-    fig, ax = plt.subplots(figsize=(5.2, 3.8))
-    for g, (p, v) in curves.items():
-        ax.plot(np.asarray(p) / 1e3, v, "-", color=COLORS.get(g), label=f"group {g}")
-    ax.set_xlabel("pressure $f/L^2$ (kPa)")
-    ax.set_ylabel("$V_{OC}$ (V), Eq. (12)")
-    ax.set_xscale("log")
-    ax.grid(alpha=0.3, which="both")
-    ax.legend()
-    save(fig, path)
-
-
 _SERIES = (("y", "displacement y", "m"), ("Q", "charge Q", "C"), ("I", "current I", "A"), ("V", "voltage V", "V"),
            ("power", "power into the load", "W"), ("V_oc", "open-circuit voltage $V_{OC}$", "V"),
            ("I_sc", "short-circuit current $I_{SC}$", "A"))
@@ -202,7 +134,7 @@ def plot_timeseries(data, path, title: str = "", period: float | None = None) ->
     series in engineering-prefixed units (mm, nC, µA, V, µW), no axis offsets; the power panel from
     V·I where the file has no power column.  With the waveform's ``period`` (s), each panel is scaled to
     the settled cycles and the first period (the start transient of Q(0) = 0) is shaded, clipped."""
-    plt = _plt()
+    plt = pyplot()
     data = {k: np.asarray(data[k]) for k in ("t", *(k for k, _, _ in _SERIES)) if k in data}  # a Dataset too
     if "power" not in data and "V" in data and "I" in data:
         data["power"] = np.asarray(data["V"], float) * np.asarray(data["I"], float)
@@ -261,7 +193,7 @@ def plot_maps(res, path, title: str = "", keys=None) -> None:
         raise TengsimError("the result holds no maps (run with --maps D1,D2,...)")
     if res.grid is None:
         raise TengsimError("the result has no grid, so its maps cannot be placed")
-    plt = _plt()
+    plt = pyplot()
     g, p = res.grid, res.params or {}
     eps, lat = p.get("eps_m"), p.get("lateral_m")
     physical = bool(eps and lat and p.get("W_J_m2"))
@@ -305,7 +237,7 @@ def plot_sweep(data, path, title: str = "") -> None:
     engineering prefixes), the best load marked."""
     from tengsim.units import format_si, si_prefix
 
-    plt = _plt()
+    plt = pyplot()
     R = np.asarray(data["R"], float)
     p = np.asarray(data["average_power"], float)
     e = np.asarray(data["energy_per_cycle"], float)
@@ -360,7 +292,7 @@ def plot_resolution(res, path, title: str = "") -> None:
     names = [k for k in tab if k not in fixed and np.isfinite(num(tab[k])).any()]
     if not names:
         raise TengsimError("the resolution table has no finite observable")
-    plt = _plt()
+    plt = pyplot()
     dx = num(tab["dx"])
     st = [str(s) for s in tab.get("status", ["?"] * len(dx))]
     ncol = min(len(names), 4)  # at most four panels a row: a page's width

@@ -207,9 +207,9 @@ def report_text(cal, figures) -> str:
 
 
 def figures(cal, out: Path) -> list:
-    from tengsim.plots import _plt, save
+    from tengsim.plots import pyplot, save
 
-    plt = _plt()
+    plt = pyplot()
     f, prob = cal.fit, cal.problem
     o = _obs(cal)
     paths = []

@@ -69,7 +69,7 @@ BAND_FILES = ("bands.csv", "bands.png")
 def write_bands(bands: dict, out_dir, name: str = "") -> list:
     """DIR/bands.csv and DIR/bands.png of a prediction's bands."""
     from tengsim.io import csv_text, write_text
-    from tengsim.plots import _plt, save
+    from tengsim.plots import pyplot, save
 
     out = Path(out_dir)
     ok = all(s == "ok" for s in bands["statuses"])
@@ -79,7 +79,7 @@ def write_bands(bands: dict, out_dir, name: str = "") -> list:
             "area_fraction_lower": bands["area_lower"], "area_fraction_upper": bands["area_upper"],
             "voc_eq12_V": bands["voc"], "voc_eq12_lower_V": bands["voc_lower"], "voc_eq12_upper_V": bands["voc_upper"]}
     write_text(out / "bands.csv", csv_text(cols, header, missing=""))
-    plt = _plt()
+    plt = pyplot()
     fig, axes = plt.subplots(1, 2, figsize=(9, 3.4))
     P = bands["pressure"] / 1e3
     for ax, k, lab in ((axes[0], "area", "charged area A/S"), (axes[1], "voc", "V_OC, Eq. 12 (V)")):

@@ -61,7 +61,8 @@ def compare_table(results) -> dict:
 
 def write_comparison(results, out_dir) -> list:
     """compare.csv and compare.png in ``out_dir`` (each design's own files in a folder of its own)."""
-    from tengsim.design.plots import _plt, compare_figure
+    from tengsim.design.plots import compare_figure
+    from tengsim.plots import pyplot
     from tengsim.io import csv_text, write_text
 
     out = Path(out_dir)
@@ -73,5 +74,5 @@ def write_comparison(results, out_dir) -> list:
     try:
         save_figure(fig, out / "compare.png", dpi=110)  # atomic, as every figure
     finally:
-        _plt().close(fig)
+        pyplot().close(fig)
     return [out / "compare.csv", out / "compare.png"]

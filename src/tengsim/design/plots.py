@@ -9,16 +9,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from tengsim.plots import pyplot
+
 BRANCH_STYLE = {"approach": "-", "retraction": "--"}
-
-
-def _plt():
-    import matplotlib
-
-    matplotlib.use("Agg", force=False)
-    import matplotlib.pyplot as plt
-
-    return plt
 
 
 def title(plan, status: str | None = None) -> str:
@@ -33,7 +26,7 @@ def title(plan, status: str | None = None) -> str:
 
 def design_figure(result):
     """A/S (and the repulsive area), V_OC (Eq. 12, Eq. 17) and dV_OC/dP against pressure (kPa)."""
-    plt = _plt()
+    plt = pyplot()
     ds = result.dataset
     P = ds["pressure"].values / 1e3
     fig, axes = plt.subplots(1, 3, figsize=(13, 4.2), constrained_layout=True)
@@ -75,7 +68,7 @@ def design_figure(result):
 
 def maps_figure(result):
     """Contact pressure maps (kPa) on the approach at the pressures the run kept maps for; None if none."""
-    plt = _plt()
+    plt = pyplot()
     res = result.maps
     if res is None:
         return None
@@ -130,7 +123,7 @@ def _edge_contour(ax, m, g_c, hx, hy):
 def compare_figure(results):
     """A/S and V_OC (Eq. 12) on the approach against pressure for several designs (DesignResults or design.nc
     Datasets): one colour per design, a filled marker where its status is ok, an open one where it is not."""
-    plt = _plt()
+    plt = pyplot()
     fig, axes = plt.subplots(1, 2, figsize=(12, 4.5), constrained_layout=True)
     for i, r in enumerate(results):
         ds = getattr(r, "dataset", r)  # a DesignResult or a design.nc Dataset
@@ -154,7 +147,7 @@ def save_design_figures(result, out_dir) -> list:
     """Write design.png (and maps.png when the run kept maps) into ``out_dir``; returns the paths."""
     from pathlib import Path
 
-    plt = _plt()
+    plt = pyplot()
     out = []
     for name, make in (("design.png", design_figure), ("maps.png", maps_figure)):
         fig = make(result)

@@ -40,10 +40,9 @@ def report_section(vd) -> str:
 
 
 def figure(vd, path: Path) -> None:
-    import matplotlib
+    from tengsim.plots import pyplot
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     fig, axes = plt.subplots(1, 3, figsize=(13, 4.0), constrained_layout=True)
     colors = plt.cm.viridis(np.linspace(0, 0.85, max(1, len(vd.table))))

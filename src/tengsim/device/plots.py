@@ -9,10 +9,9 @@ from tengsim.errors import require
 
 
 def _figure(nrows, ncols, size):
-    import matplotlib
+    from tengsim.plots import pyplot
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     return plt, *plt.subplots(nrows, ncols, figsize=size, squeeze=False)
 

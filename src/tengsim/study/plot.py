@@ -83,10 +83,9 @@ def _data(ds, var):
 def plot_study(root, out, vars=MAP_VARS) -> list:
     """Draw the design maps of study directory ``root`` to ``out`` (and ``<out stem>_voc<suffix>`` for the
     V_OC(P) curves).  Returns the files written."""
-    import matplotlib
+    from tengsim.plots import pyplot
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     root, out = Path(root), Path(out)
     from tengsim.study.layout import StudyDir

@@ -36,7 +36,7 @@ def reproduce(out_dir, quick: bool = False, progress_factory=None, log=None,
     """
     from tengsim.device import plots as dplots
     from tengsim.device.formulas import voc_polymer
-    from tengsim.plots import plot_fig3, plot_fig4, plot_fig5
+    from tengsim.cases.paper.figures import plot_fig3, plot_fig4, plot_fig5
 
     out_dir = Path(out_dir)
     io.check_writable(out_dir)  # the staging folder goes beside it

@@ -320,7 +320,7 @@ def maugis_sphere(mu: float, sigma0: float | None = None) -> MaugisSphere:
     With these values the references' SI-like formulas return the engine's units directly: forces in
     W R (so P̄ = |F|/(πWR) = −∬P/π), lengths in ℓ = sqrt(Rε) = 1, indentation in ε.  λ from the
     Dugdale stress ``sigma0`` (default the LJ93 peak 16/(9√3), giving λ = 1.157 μ)."""
-    from tengsim import references as ref
+    from tengsim import references as ref  # the package's closed forms (this module sits above them)
     from tengsim.laws import LJ_PEAK_TENSION
 
     R, E_star, W = 1.0, positive("mu", mu) ** -1.5, 1.0
