@@ -14,10 +14,10 @@ EXAMPLES = sorted((Path(__file__).parent.parent / "examples" / "own_design").glo
 
 @pytest.mark.parametrize("path", EXAMPLES, ids=[p.stem for p in EXAMPLES])
 def test_the_shape_and_its_parameters_give_the_same_a_s(path):
-    from tengsim.cli.design import _read_toml
+    from tengsim.design import read_design
     from tengsim.design import plan_design
 
-    shape = plan_design(_read_toml(str(path))).contact_plan.shape
+    shape = plan_design(read_design(str(path))).contact_plan.shape
     params = shape.params()
     res = types.SimpleNamespace(params=params)
     lam = np.linspace(0.0, 1.5 * patch(shape, params)[0], 7)

@@ -156,10 +156,10 @@ def test_shipped_design_examples_plan():
     cube, grating and hemisphere arrays (docs/own_design.md), periodic by default."""
     from pathlib import Path
 
-    from tengsim.cli.design import _read_toml
+    from tengsim.design import read_design
 
     files = sorted((Path(__file__).parent.parent / "examples" / "own_design").glob("*.toml"))
-    plans = [plan_design(_read_toml(str(f))) for f in files]
+    plans = [plan_design(read_design(str(f))) for f in files]
     assert {p.shape for p in plans} == {"pyramid", "cone", "cube", "line", "hemisphere"}
     for p in plans:
         pitch = 10e-6 if p.shape in ("pyramid", "cone") else 20e-6
@@ -196,10 +196,10 @@ def test_first_grid_is_the_default_refinements_first_fine_enough_one():
     from tengsim.run.refine import START_ZONE_PIXELS
     from tengsim.run.grids import default_dx, refinement_grids
 
-    from tengsim.cli.design import _read_toml
+    from tengsim.design import read_design
     from pathlib import Path
 
-    plan = plan_design(_read_toml(str(Path(__file__).parent.parent / "examples" / "own_design" / "pyramid.toml")))
+    plan = plan_design(read_design(str(Path(__file__).parent.parent / "examples" / "own_design" / "pyramid.toml")))
     cp = plan_contact(plan.contact_table)
     zone = status.process_zone_estimate(cp.law, cp.tabor**1.5)
     dx0 = default_dx(cp.shape, cp.law, cp.tabor**1.5, cp.boundary)
@@ -208,7 +208,7 @@ def test_first_grid_is_the_default_refinements_first_fine_enough_one():
     k = [g.nx for g in seq].index(cp.shape.grid(dx).nx)
     assert k > 0 and seq[k].dx <= zone / START_ZONE_PIXELS < seq[k - 1].dx
     assert [g.nx for g in seq[k:k + 3]] == [245, 385, 585]  # the last grids the pyramid converged on before
-    given = plan_design(dict(_read_toml(str(Path(__file__).parent.parent / "examples" / "own_design" / "pyramid.toml")),
+    given = plan_design(dict(read_design(str(Path(__file__).parent.parent / "examples" / "own_design" / "pyramid.toml")),
                              dx="100nm"))
     assert start_dx(given, cp) * cp.scaling.lateral == pytest.approx(100e-9)  # a dx given is the first grid's
 
@@ -348,13 +348,13 @@ def test_budget_cap_is_the_last_refinement_grid_the_budget_pays_for():
     first grid within the default 10 min."""
     from pathlib import Path
 
-    from tengsim.cli.design import _read_toml
+    from tengsim.design import read_design
     from tengsim.run.budget import budget_pixels, run_cost
     from tengsim.design.walk import start_dx
     from tengsim.run.reach import height_eps
     from tengsim.run.grids import GridSequence, refinement_grids
 
-    plan = plan_design(_read_toml(str(Path(__file__).parent.parent / "examples" / "own_design" / "pyramid.toml")))
+    plan = plan_design(read_design(str(Path(__file__).parent.parent / "examples" / "own_design" / "pyramid.toml")))
     cp = plan.contact_plan
     dx = start_dx(plan, cp)
     d_max = 1.2 * height_eps(cp, dx) + 2.0
@@ -376,14 +376,14 @@ def test_estimate_uses_the_backends_cost_and_names_it(monkeypatch):
     same design is expected faster at these sizes (the GPU solves the whole grid, the CPU a mirrored quarter)."""
     from pathlib import Path
 
-    from tengsim.cli.design import _read_toml
+    from tengsim.design import read_design
     from tengsim.design import walk as _walk
     from tengsim.run import budget as _budget
     from tengsim.resources import CPU_COST, GPU_COST
     from tengsim.run.plan import plan_contact
     from tengsim.solvers import choice
 
-    plan = plan_design(_read_toml(str(Path(__file__).parent.parent / "examples" / "own_design" / "pyramid.toml")))
+    plan = plan_design(read_design(str(Path(__file__).parent.parent / "examples" / "own_design" / "pyramid.toml")))
     cp = plan_contact(plan.contact_table)
     assert cp.solver == "fast" and "no GPU" in cp.solver_note  # auto, on this machine
     from tengsim.run.grids import GridSequence

@@ -48,7 +48,7 @@ def test_calibrate_honours_the_law_in_design_as_design_does(tmp_path):
     """A law given in [design] (where the design's contact keys belong) is the one both plan."""
     from tengsim.calibrate import plan_calibration
     from tengsim.calibrate.data import Curve
-    from tengsim.cli.design import _read_toml
+    from tengsim.design import read_design
     from tengsim.design import plan_design
 
     f = tmp_path / "d.toml"
@@ -57,7 +57,7 @@ def test_calibrate_honours_the_law_in_design_as_design_does(tmp_path):
     curve = Curve("m", P, np.array([10.0, 12.0, 13.0, 14.0]), ("approach",) * 4)
     prob = plan_calibration([f], [curve], "sigma,W", "W=10mJ/m2:60mJ/m2")
     law = type(prob.plans[0].contact_plan.law).__name__
-    assert law == type(plan_design(_read_toml(str(f))).contact_plan.law).__name__ == "MaugisDugdale"
+    assert law == type(plan_design(read_design(str(f))).contact_plan.law).__name__ == "MaugisDugdale"
 
 
 def test_a_design_table_given_to_the_api_is_read_by_the_same_rules(tmp_path):

@@ -64,18 +64,6 @@ def _say(progress, text):
         progress(text)
 
 
-def _read_design_file(path) -> dict:
-    """The design table of a design file: read by :func:`tengsim.schema.read_config` and taken by the one reading of
-    a design's tables, :func:`tengsim.design.design_table` (``tengsim design``'s: a table it refuses, calibrate
-    refuses the same way)."""
-    from tengsim.design import design_table
-    from tengsim.schema import read_config
-
-    if not Path(path).is_file():
-        raise TengsimError(f"{path}: no such file (give a design TOML that tengsim design accepts)")
-    return design_table(read_config(path), str(path))
-
-
 def plan_calibration(designs, data, free=None, bounds=None, noise="relative", voc="eq12", solver=None):
     """The checked :class:`tengsim.calibrate.problem.Problem`.  ``designs``: one per curve (or one for all), each a
     design's table, a (label, table) pair (the CLI's: the file read at the edge, named by its path) or a design TOML
@@ -85,7 +73,7 @@ def plan_calibration(designs, data, free=None, bounds=None, noise="relative", vo
     from tengsim.calibrate.data import Curve, read_curve
     from tengsim.calibrate.problem import (DEFAULT_BOUNDS, NOISES, PARAMS, VOC_MODELS, Problem, check_reachable,
                                            count_check, parse_bounds, parse_free, text)
-    from tengsim.design import plan_design
+    from tengsim.design import plan_design, read_design
     from tengsim.run.refine import check_solver
 
     designs, data = list(designs), list(data)
@@ -113,7 +101,7 @@ def plan_calibration(designs, data, free=None, bounds=None, noise="relative", vo
             t = design_table(d)
             name = t.get("name", t.get("shape"))
         else:
-            name, t = str(d), _read_design_file(d)
+            name, t = str(d), read_design(d)
         if solver is not None:
             t["solver"] = solver
         tables.append(t)

@@ -108,34 +108,9 @@ def help_text(shape: str | None = None) -> str:
     return "\n".join(out) + "\n"
 
 
-def _read_toml(path: str) -> dict:
-    """The design table of a TOML file, read at the edge (:func:`tengsim.schema.read_config`) and taken by the one
-    reading of a design's tables (:func:`tengsim.design.design_table`, which calibrate uses too)."""
-    from tengsim.design import design_table
-    from tengsim.errors import shown
-    from tengsim.schema import read_config
-
-    if not Path(path).is_file():
-        raise TengsimError(f"{shown(path, 200)[1:-1]}: no such file (give a registered shape or a TOML file)")
-    return design_table(read_config(path), path)
-
-
-def _read_material(path: str):
-    """The fitted material of ``--material`` (:func:`tengsim.design.material_table` of the file's tables)."""
-    from tengsim.design import material_table
-    from tengsim.schema import read_config
-
-    if not Path(path).is_file():
-        raise TengsimError(f"--material {path}: no such file (give the material.toml tengsim calibrate wrote)")
-    try:
-        cfg = read_config(path)
-    except TengsimError as exc:
-        raise TengsimError(f"--material {path}: {exc}") from None
-    return material_table(cfg, path)
-
-
 def _tables(args) -> list:
     """[(label, table)] of the designs the command line names."""
+    from tengsim.design import read_design
     from tengsim.errors import shown
     from tengsim.registry import SHAPES
 
@@ -153,7 +128,7 @@ def _tables(args) -> list:
     bad = [x for x in args.inputs if not x.lower().endswith(".toml")]
     if bad:
         raise TengsimError(f"{shown(bad[0])}: several inputs must all be TOML files")
-    return [(f"{x}: ", {**_read_toml(x), **opts}) for x in args.inputs]
+    return [(f"{x}: ", {**read_design(x), **opts}) for x in args.inputs]
 
 
 def _check_out(out: Path) -> None:
@@ -229,7 +204,7 @@ class _Say:
 
 
 def run(args) -> int:
-    from tengsim.design import plan_design
+    from tengsim.design import plan_design, read_material
     from tengsim.registry import SHAPES
 
     if args.help:
@@ -243,7 +218,7 @@ def run(args) -> int:
     tables = _tables(args)
     material = None
     if getattr(args, "material", None):  # the fitted material replaces the design's own (options given win)
-        material = _read_material(args.material)
+        material = read_material(args.material)
         material = material.without(k for k in material.values if getattr(args, k, None) not in (None, ""))
     relaxation = None
     if getattr(args, "relaxation", None):  # read before anything runs: a bad file is one line

@@ -8,25 +8,24 @@ linear range and hysteresis, on a grid chosen and refined to a stated tolerance:
     result = run_design(plan)          # a frozen DesignResult: .dataset (xarray), .summary, .status
     write_design(result, "d1")         # d1/design.nc, design.csv, design.png, maps.png, report.md
 
-A file's tables (read at the edge, :func:`tengsim.schema.read_config`) become a design's table through
-:func:`design_table`; a fitted material (``tengsim calibrate``'s material.toml) through :func:`material_table`, and
+A design file becomes a design's table through :func:`read_design` (tables already read: :func:`design_table`); a
+fitted material (``tengsim calibrate``'s material.toml) through :func:`read_material` (:func:`material_table`), and
 ``plan_design(table, material=material)`` plans the design at it and its uncertainty points, whose band
 :func:`predict_bands` runs after the design (:func:`write_bands`: bands.csv, bands.png)::
 
-    from tengsim.schema import read_config
-    mat = material_table(read_config("fit/material.toml"), "fit/material.toml")
-    plan = plan_design(design_table(read_config("new.toml"), "new.toml"), material=mat)
+    mat = read_material("fit/material.toml")
+    plan = plan_design(read_design("new.toml"), material=mat)
     result = run_design(plan)
     write_bands(predict_bands(result), "new")
 """
 from tengsim.design.bands import predict_bands, write_bands
 from tengsim.design.compare import compare_table, write_comparison
-from tengsim.design.material import Material, material_table
+from tengsim.design.material import Material, material_table, read_material
 from tengsim.design.plan import PAPER_DEVICE, DesignPlan, plan_design
 from tengsim.design.run import DesignResult, run_design
-from tengsim.design.tables import design_table
+from tengsim.design.tables import design_table, read_design
 from tengsim.design.write import write_design
 
 __all__ = ["PAPER_DEVICE", "DesignPlan", "DesignResult", "Material", "compare_table", "design_table",
-           "material_table", "plan_design", "predict_bands", "run_design", "write_bands", "write_comparison",
-           "write_design"]
+           "material_table", "plan_design", "predict_bands", "read_design", "read_material", "run_design",
+           "write_bands", "write_comparison", "write_design"]

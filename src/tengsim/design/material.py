@@ -80,3 +80,20 @@ def material_table(cfg: dict, source: str = "") -> Material:
 
 
 __all__ = ["MATERIAL_KEYS", "Material", "material_table"]
+
+
+def read_material(path) -> Material:
+    """The fitted material of the file ``path`` (``tengsim calibrate``'s material.toml), taken by
+    :func:`material_table`; the one reader of a material file."""
+    from pathlib import Path
+
+    from tengsim.errors import TengsimError
+    from tengsim.schema import read_config
+
+    if not Path(path).is_file():
+        raise TengsimError(f"--material {path}: no such file (give the material.toml tengsim calibrate wrote)")
+    try:
+        cfg = read_config(path)
+    except TengsimError as exc:
+        raise TengsimError(f"--material {path}: {exc}") from None
+    return material_table(cfg, str(path))

@@ -10,7 +10,9 @@ not read is never read differently by another command.  The keys and their bound
 """
 from __future__ import annotations
 
-from tengsim.errors import ConfigValueError, listed, shown
+from pathlib import Path
+
+from tengsim.errors import ConfigValueError, TengsimError, listed, shown
 
 
 def design_table(cfg: dict, source: str = "") -> dict:
@@ -35,3 +37,13 @@ def design_table(cfg: dict, source: str = "") -> dict:
 
 
 __all__ = ["design_table"]
+
+
+def read_design(path) -> dict:
+    """The design's table of the design file ``path``: read by :func:`tengsim.schema.read_config` and taken by
+    :func:`design_table`; the one reader of a design file (``tengsim design``, ``tengsim calibrate``, the API)."""
+    from tengsim.schema import read_config
+
+    if not Path(path).is_file():
+        raise TengsimError(f"{shown(str(path), 200)[1:-1]}: no such file (give a design TOML file)")
+    return design_table(read_config(path), str(path))
