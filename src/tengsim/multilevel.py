@@ -8,6 +8,12 @@ larger, heights Fourier-truncated) from the undeformed state, then each finer le
 Fourier-interpolated elastic pressure q of the level below (w = K q: one convolution), up to the
 given grid.
 
+Two prolongations of the pressure: ``"fourier"`` (the default; a smooth adhesive pressure) and ``"block"``
+(each coarse pixel's pressure on its 2×2 fine pixels): a hard-wall pressure ends at the contact's edge, where a
+Fourier series rings and its clipped start costs the fine level more iterations than a cold start (measured with
+``pk`` on the benchmark surface in docs/benchmarks.md).  Under load control (``load``: the mean pressure) each level
+solves to the same load (``solver.solve_load``) and the block start is rescaled to it.
+
 Only the finest level's answer is returned, and it is judged like any other: by the Eq. (9) residual
 on the given grid, so it is a stable equilibrium of the fine problem.  With adhesion a problem can
 have several; the nested start may settle in a different one from a cold start (both are local
@@ -45,6 +51,8 @@ class NestedSolve:
 
     equilibrium: Equilibrium
     levels: list = field(default_factory=list)
+    approach: float = 0.0
+    """Load control: the finest level's rigid approach beyond the problem's g0 (ε; ``solve_load``'s dD)."""
 
     @property
     def seconds(self) -> float:
@@ -59,6 +67,18 @@ class NestedSolve:
         """Convolutions weighted by their grid size relative to the finest grid."""
         nf = np.prod(self.levels[-1].shape)
         return float(sum(s.n_conv * np.prod(s.shape) / nf for s in self.levels))
+
+
+def block_prolong(q: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
+    """``q`` on a grid ``shape`` = an integer multiple of its own: each pixel's value on its block of fine pixels."""
+    fx, fy = shape[0] // q.shape[0], shape[1] // q.shape[1]
+    if (fx * q.shape[0], fy * q.shape[1]) != tuple(shape):
+        raise TengsimError(f"block prolongation needs a multiple of {q.shape}, got {tuple(shape)}")
+    return np.repeat(np.repeat(np.asarray(q, dtype=float), fx, axis=0), fy, axis=1)
+
+
+PROLONGATIONS = {"fourier": fourier_resample, "block": block_prolong}
+"""The pressure's prolongation from one level to the next, by name."""
 
 
 def coarse_levels(shape: tuple[int, int], min_size: int = 128, levels: int | None = None,
@@ -77,7 +97,8 @@ def coarse_levels(shape: tuple[int, int], min_size: int = 128, levels: int | Non
 
 def nested_solve(solver, g0: np.ndarray, law, kernel: PeriodicKernel, min_size: int = 128,
                  levels: int | None = None, max_dx: float = 0.5, coarse_tol: float | None = 1e-3,
-                 coarse_max_iter: int | None = 1000, on_level=None) -> NestedSolve:
+                 coarse_max_iter: int | None = 1000, on_level=None, load: float | None = None,
+                 prolong: str = "fourier") -> NestedSolve:
     """Solve the periodic problem (g0 = U0 − D + 1, law, kernel) by nested grids; see the module doc.
 
     Grids are halved down to ``min_size`` pixels, at most ``levels`` times, and never to a pixel
@@ -91,7 +112,13 @@ def nested_solve(solver, g0: np.ndarray, law, kernel: PeriodicKernel, min_size: 
     keeps the solver's own); the finest level always to the solver's tolerance.  Measured on the
     scaling study's 4096² surface: its 2048² level, solved to 1e-6, ran past 3000 iterations (~20 min).
     ``on_level(stat)`` is called with each level's :class:`LevelStat` as it finishes (progress).
+    ``load``: load control at that mean pressure (W/ε; the solver's ``solve_load``), None: displacement control.
+    ``prolong``: ``"fourier"`` or ``"block"`` (module doc).
     """
+    if prolong not in PROLONGATIONS:
+        raise TengsimError(f"prolong must be one of {', '.join(PROLONGATIONS)}, got {prolong!r}")
+    if load is not None and not hasattr(solver, "solve_load"):
+        raise TengsimError(f"load control needs a solver with solve_load; {type(solver).__name__} has none")
     if not isinstance(kernel, PeriodicKernel):
         raise TengsimError("nested_solve needs a periodic kernel (the coarse grids resample the cell "
                            "by Fourier series)")
@@ -115,7 +142,9 @@ def nested_solve(solver, g0: np.ndarray, law, kernel: PeriodicKernel, min_size: 
         if q is None:
             start = State.zero(shape)
         else:
-            qf = fourier_resample(q, shape)
+            qf = PROLONGATIONS[prolong](q, shape)
+            if load is not None and prolong == "block" and qf.mean() > 0:
+                qf *= load / qf.mean()
             start = State(qf, k.apply(qf))
             n_conv = 1
         lvl = solver
@@ -126,11 +155,14 @@ def nested_solve(solver, g0: np.ndarray, law, kernel: PeriodicKernel, min_size: 
             if coarse_max_iter is not None and hasattr(solver, "max_iter"):
                 kw["max_iter"] = min(int(coarse_max_iter), solver.max_iter)
             lvl = dataclasses.replace(solver, **kw) if kw and dataclasses.is_dataclass(solver) else solver
-        eq = lvl.solve(Problem(g, law, k), start)
+        if load is None:
+            eq = lvl.solve(Problem(g, law, k), start)
+        else:
+            eq, approach = lvl.solve_load(Problem(g, law, k), float(load), start)
         n_conv += eq.n_conv
         stats.append(LevelStat(shape, n_conv, eq.iterations, time.perf_counter() - t0, eq.residual))
         if on_level is not None:
             on_level(stats[-1])
         q = eq.state.q
     eq = dataclasses.replace(eq, n_conv=stats[-1].n_conv)
-    return NestedSolve(eq, stats)
+    return NestedSolve(eq, stats, approach if load is not None else 0.0)
