@@ -105,7 +105,7 @@ class Field:
             try:
                 v = self.check(v, label) if _arity(self.check) == 2 else self.check(v)
             except TengsimError as e:  # the check sees the number in SI: name the value as the user wrote it
-                if self.dim is None or not isinstance(value, str) or shown(value) in str(e):
+                if self.dim is None or not isinstance(value, str):
                     raise
                 raise type(e)(f"{e} (given as {shown(value)})") from None
         return v

@@ -63,7 +63,7 @@ def field_summary(params, result, pressure_Pa: float | None = None) -> dict:
     from tengsim.device.breakdown import breakdown_cycle, sigma_breakdown, sigma_breakdown_run
     from tengsim.device.field import electrode_size, gap_coefficients
     from tengsim.device.paschen import ATM_PA, SOURCE
-    from tengsim.device.params import EPS0
+    from tengsim.constants import EPS0
 
     p = params
     pa = ATM_PA if pressure_Pa is None else pressure_Pa

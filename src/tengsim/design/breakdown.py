@@ -21,11 +21,11 @@ FINITE_FIELD = "finite: a 4 cm² square electrode (tengsim device design's defau
 def finite_voc_ratio(eps_r: float, thickness_m: float, gap_m: float) -> float:
     """V_OC at the rest gap d0 with the finite field of the design's device (a square of :data:`AREA_M2`, the
     electrode ``tengsim device design`` defaults to) over Eq. 17's parallel plates: σ A v(d0) / (σ (A/S) d0/ε0)."""
-    from tengsim.constants import EPS0
     from tengsim.device.field import electrode_size, gap_coefficients
+    from tengsim.device.formulas import eq17_volts_per_charge
 
     v = gap_coefficients("square", electrode_size("square", AREA_M2), thickness_m, eps_r, np.array([gap_m]))[1]
-    return float(v[0] * EPS0 * AREA_M2 / gap_m)
+    return float(v[0] * AREA_M2 / eq17_volts_per_charge(gap_m))
 
 
 @lru_cache(maxsize=64)

@@ -47,14 +47,13 @@ solver's share of a reported number is then far below tol (docs/validation.md, "
 def constrained_solver(law):
     """The constrained solver a design runs ``law`` on unless it names its solver, asked of the law: one that
     declares an adhesive hard-wall limit (``Law.hard_wall()`` with a tension: ``md``, ``exp``, a plugin's) runs
-    on 'pk' where 'pk' solves it, else on 'ram' (tengsim.solvers.ram); None for any other law (LJ93; the wall
-    without adhesion): the design's default solver."""
-    from tengsim.solvers import pk, ram
-
+    on the solver its limit prefers (``CohesiveLimit.solver``: 'pk' for ``md`` and ``exp``, 'ram' unless a
+    plugin's limit says otherwise); None for any other law (LJ93; the wall without adhesion): the design's
+    default solver."""
     lim = law.hard_wall() if hasattr(law, "hard_wall") else None
     if lim is None or not float(lim.tension) > 0:
         return None
-    return "pk" if pk.supports(law) else "ram"
+    return lim.solver
 
 
 TOL_FLOOR = 1e-4

@@ -8,6 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.integrate import trapezoid
 
+from tengsim.constants import EPS0
 from tengsim.device import formulas as fm
 from tengsim.device.dynamics import simulate
 from tengsim.device.params import DeviceParams, SolverOptions
@@ -229,7 +230,7 @@ def figure_of_merit(params: DeviceParams, x_max: float | None = None) -> FigureO
     """FOM_S = 2 eps0 E_m / (sigma^2 S x_max) (Zi et al. 2015); x_max defaults to d0."""
     x = params.gap_m if x_max is None else positive("x_max", x_max)
     cm = fm.cmeo_cycle(params.sigma_C_per_m2, params.area_m2, params.thickness_m, params.eps_r, x)
-    fom_num = 2 * fm.EPS0 * cm.energy_J / (params.sigma_C_per_m2 ** 2 * params.area_m2 * x)
+    fom_num = 2 * EPS0 * cm.energy_J / (params.sigma_C_per_m2 ** 2 * params.area_m2 * x)
     return FigureOfMerit(float(fm.fom_structural(x, params.thickness_m, params.eps_r)), float(fom_num),
                          cm.energy_J, float(x))
 

@@ -19,9 +19,10 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from tengsim.constants import EPS0
 from tengsim.device.field import bar_field
 from tengsim.device.paschen import ATM_PA, SOURCE, breakdown_voltage
-from tengsim.device.params import EPS0, DeviceParams
+from tengsim.device.params import DeviceParams
 from tengsim.errors import positive, require
 
 

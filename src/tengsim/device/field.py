@@ -23,8 +23,8 @@ from functools import lru_cache
 import numpy as np
 from scipy.interpolate import CubicSpline
 
+from tengsim.constants import EPS0
 from tengsim.device import field_bem
-from tengsim.device.params import EPS0
 from tengsim.errors import require
 
 FIELD_MODELS = ("parallel", "finite")

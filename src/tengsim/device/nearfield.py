@@ -24,7 +24,7 @@ from functools import cached_property
 import numpy as np
 
 from tengsim.backend import fft as _bf
-from tengsim.device.params import EPS0
+from tengsim.constants import EPS0
 from tengsim.errors import positive, require
 
 

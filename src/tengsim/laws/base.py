@@ -143,8 +143,8 @@ class Law:
 
     def hard_wall(self):
         """The law's hard-wall limit (:class:`tengsim.laws.cohesive.CohesiveLimit`: its traction, energy and
-        curvature beyond a rigid wall at g = 1), or None for a law without one (the constrained solver
-        'ram' asks this, never the class)."""
+        curvature beyond a rigid wall at g = 1, and which constrained solver it prefers), or None for a law without
+        one (the constrained solvers 'pk' and 'ram' and the design ask this, never the class)."""
         return None
 
     def params(self) -> dict:

@@ -16,7 +16,8 @@ user's law gives its own by overriding ``hard_wall`` with a subclass of :class:`
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
+from typing import ClassVar
 
 import numpy as np
 
@@ -31,6 +32,12 @@ class CohesiveLimit:
     work: float = 0.0
     length: float = 1.0
     smooth: bool = True
+    #: a Dugdale zone (module doc): 'pk' solves it as a zone of pixels at −σ0, its step ``ramp`` wide
+    plateau: ClassVar[bool] = False
+    #: the width (ε) of a plateau's step at u = ``length`` (0: a sharp step)
+    ramp: float = 0.0
+    #: the constrained solver this limit is best solved by ('ram' solves any limit; 'pk' the ones it says)
+    solver: ClassVar[str] = "ram"
 
     def traction(self, u, xp=np):  # pragma: no cover - abstract
         raise NotImplementedError
@@ -45,10 +52,20 @@ class CohesiveLimit:
         """Which side of a jump of t each gap lies on (a non-smooth law; None for a smooth one)."""
         return None
 
+    def with_ramp(self, ramp: float) -> "CohesiveLimit":  # pragma: no cover - a plateau's
+        """The same plateau with its step ``ramp`` wide (ε; 0: sharp)."""
+        raise NotImplementedError
+
+    def step_gap(self, p, xp=np):  # pragma: no cover - a plateau's
+        """The gap u (ε) on a plateau's step where the traction is ``p`` (−σ0 < p < 0): t's inverse there."""
+        raise NotImplementedError
+
 
 @dataclass(frozen=True)
 class NoAdhesion(CohesiveLimit):
     """The hard wall alone (t = φ = 0)."""
+
+    solver: ClassVar[str] = "pk"
 
     def traction(self, u, xp=np):
         return xp.zeros_like(u)
@@ -62,13 +79,15 @@ class NoAdhesion(CohesiveLimit):
 
 @dataclass(frozen=True)
 class DugdaleZone(CohesiveLimit):
-    """Maugis' Dugdale zone: t = −σ0 for 0 <= u < h0 = W/σ0, 0 beyond; φ = −σ0 (h0 − u)⁺.  ``ramp`` > 0: the
+    """Maugis' Dugdale zone: t = −σ0 for 0 <= u <= h0 = W/σ0, 0 beyond; φ = −σ0 (h0 − u)⁺.  ``ramp`` > 0: the
     step is the smoothstep 3s² − 2s³ of that width centred on h0 (``MaugisDugdale``'s formula, its
-    ``smoothing``; W unchanged); 0: the sharp step."""
+    ``smoothing``; W unchanged); 0: the sharp step.  A plateau (module doc), best solved by 'pk'."""
 
     tension: float = 1.0
     work: float = 1.0
     ramp: float = 0.0
+    plateau: ClassVar[bool] = True
+    solver: ClassVar[str] = "pk"
 
     @property
     def length(self) -> float:
@@ -78,14 +97,18 @@ class DugdaleZone(CohesiveLimit):
     def smooth(self) -> bool:
         return self.ramp > 0
 
+    def with_ramp(self, ramp: float) -> "DugdaleZone":
+        return replace(self, ramp=float(ramp))
+
     def _s(self, u, xp):
-        return xp.clip((self.length + 0.5 * self.ramp - u) / self.ramp, 0.0, 1.0)
+        """s = 1 inside the zone, 0 beyond, the step's linear coordinate between."""
+        return xp.clip((self.length + 0.5 * self.ramp - u) * (1.0 / self.ramp), 0.0, 1.0)
 
     def traction(self, u, xp=np):
         if not self.ramp > 0:
-            return xp.where(u < self.length, -self.tension, 0.0)
+            return xp.where(u <= self.length, -self.tension, 0.0)
         s = self._s(u, xp)
-        return -self.tension * s * s * (3.0 - 2.0 * s)
+        return s * (s * (3.0 - 2.0 * s)) * -self.tension
 
     def energy(self, u, xp=np):
         if not self.ramp > 0:
@@ -101,28 +124,38 @@ class DugdaleZone(CohesiveLimit):
         return -6.0 * self.tension / self.ramp * s * (1.0 - s)
 
     def side(self, u, xp=np):
-        return u < self.length if not self.ramp > 0 else None
+        return u <= self.length if not self.ramp > 0 else None
+
+    def step_gap(self, p, xp=np):
+        y = -p / self.tension
+        s = 0.5 - xp.sin(xp.arcsin(1.0 - 2.0 * y) / 3.0)         # the smoothstep's inverse
+        return self.length + 0.5 * self.ramp - self.ramp * s
 
 
 @dataclass(frozen=True)
 class ExponentialZone(CohesiveLimit):
-    """t = −(W/ρ) e^{−u/ρ}, φ = −W e^{−u/ρ}, φ'' = −(W/ρ²) e^{−u/ρ}; ρ = ``length``."""
+    """t = −(W/ρ) e^{−u/ρ}, φ = −W e^{−u/ρ}, φ'' = −(W/ρ²) e^{−u/ρ}; ρ = ``length`` (u < 0: as u = 0).  Best
+    solved by 'pk' (its outer fixed point)."""
 
     work: float = 1.0
     length: float = 1.0
+    solver: ClassVar[str] = "pk"
 
     @property
     def tension(self) -> float:
         return self.work / self.length
 
+    def _decay(self, u, xp):
+        return xp.exp(xp.maximum(u, 0.0) * (-1.0 / self.length))
+
     def traction(self, u, xp=np):
-        return -self.tension * xp.exp(-u / self.length)
+        return self._decay(u, xp) * -self.tension
 
     def energy(self, u, xp=np):
-        return -self.work * xp.exp(-u / self.length)
+        return self._decay(u, xp) * -self.work
 
     def curvature(self, u, xp=np):
-        return -(self.work / self.length**2) * xp.exp(-u / self.length)
+        return self._decay(u, xp) * -(self.work / self.length**2)
 
 
 @dataclass(frozen=True)

@@ -17,6 +17,13 @@ from tengsim.results import write
 from tengsim.results.hysteresis import LoopEnergy, loop_energy
 from tengsim.results.columns import CURVE_COLUMNS
 
+TRANSITION_LENGTH_FRACTION = 0.95
+"""The partial-to-full contact transition of paper Fig. 4(a) (:meth:`ContactResult.transition_D`, a study's
+``transition_D``): the approach D where the contact length Λc reaches this fraction of its full-contact value.
+Not the design's full contact (tengsim.run.area.FULL_CONTACT_AREA_FRACTION, the same 0.95 of another measure:
+the charged area A/S, where it saturates under the load) nor a study's adhesive full contact (0.9 of Λc at zero
+load): three questions, each with its own name; the values are those their results were published with."""
+
 
 @dataclass(frozen=True)
 class Jump:
@@ -155,7 +162,7 @@ class ContactResult:
         (:attr:`loop_energy`'s bound), never a negative energy that is only quadrature error."""
         return self.loop_energy.value
 
-    def transition_D(self, full_length: float, fraction: float = 0.95) -> float:
+    def transition_D(self, full_length: float, fraction: float = TRANSITION_LENGTH_FRACTION) -> float:
         """First approach D at which Λc reaches ``fraction`` × ``full_length`` (linear interpolation):
         the partial-to-full contact transition of paper Fig. 4(a).  NaN if never reached."""
         a = self.branch("approach")

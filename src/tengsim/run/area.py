@@ -164,7 +164,9 @@ CHARGED_COLUMN = "charged_fraction"
 
 FULL_CONTACT_AREA_FRACTION = 0.95
 """Full contact as a design reports it (``full_contact_Pa``): the approach pressure at which the charged area A/S
-reaches this fraction of its full-contact value (the footprint's): where the area saturates under the load."""
+reaches this fraction of its full-contact value (the footprint's): where the area saturates under the load.  (A
+study's ``transition_D`` asks 0.95 of another measure, the contact length Λc:
+tengsim.results.result.TRANSITION_LENGTH_FRACTION.)"""
 ADHESIVE_FULL_CONTACT_LENGTH_FRACTION = 0.9
 """A study's ``adhesive_full_contact`` flag (its default ``full_contact_fraction``): the contact length Λc at zero
 load at least this fraction of the full-contact length, a pattern that adhesion alone pulls (nearly) shut.  A

@@ -141,10 +141,10 @@ def check_solver(cplan) -> None:
 
     solver = make_solver(cplan.solver, tol=cplan.tol)
     if hasattr(solver, "solves") and not solver.solves(cplan.law):
-        from tengsim.solvers.pk import PKSolver, wall_model
+        from tengsim.solvers.pk import PKSolver, limit_of
 
         if isinstance(solver, PKSolver):
-            wall_model(cplan.law)  # raises the solver's own line, naming the solvers that can
+            limit_of(cplan.law, solver.name)  # raises the solver's own line, naming the solvers that can
         raise TengsimError(f"solver {cplan.solver!r} cannot solve law {type(cplan.law).__name__}")
 
 

@@ -7,7 +7,7 @@ The unknown is the total pressure p (W/ε) and a contact mask.  Every pixel is, 
 
 * contact: the gap above the wall u = 0, p >= −σ0 free (p + σ0 the contact pressure of the hard-wall problem);
 * off the contact: the law's tension at its gap, p = p_a(u) (−σ0 in the zone, 0 beyond it, the smoothstep
-  between where the zone has a ramp; tengsim.solvers.pk.WallModel.adhesive).
+  between where the zone has a ramp: the law's hard-wall limit's traction, tengsim.laws.cohesive).
 
 One iteration: u = h + K p (one convolution); on the contact Polonsky & Keer's step along the preconditioned
 gradient t = P_S M⁻¹ P_S u (tengsim.solvers._pk_core's |q| preconditioner M⁻¹ ≈ K⁻¹: one FFT pair), a fixed
@@ -58,9 +58,10 @@ class ZoneResult:
     changes: int
 
 
-def zone_residual(model, u, p, contact, work) -> float:
-    """The largest distance (ε) of a pixel's gap from the gaps its pressure allows (module doc)."""
-    s0, h0, r = model.tension, model.length, model.ramp
+def zone_residual(zone, u, p, contact, work) -> float:
+    """The largest distance (ε) of a pixel's gap from the gaps its pressure allows (module doc); ``zone`` a
+    plateau (tengsim.laws.cohesive.CohesiveLimit: its tension, length, ramp and step_gap)."""
+    s0, h0, r = zone.tension, zone.length, zone.ramp
     lo, hi = h0 - 0.5 * r, h0 + 0.5 * r
     full, none = p <= -s0, p >= 0.0
     np.abs(u, out=work)                                          # the contact: u = 0
@@ -71,9 +72,7 @@ def zone_residual(model, u, p, contact, work) -> float:
     work[m] = np.maximum(hi - u[m], 0.0)
     m = off & ~full & ~none                                      # the ramp: u = its inverse at p
     if m.any():
-        y = -p[m] / s0
-        t = 0.5 - np.sin(np.arcsin(1.0 - 2.0 * y) / 3.0)         # smoothstep⁻¹
-        work[m] = np.abs(u[m] - (hi - r * t))
+        work[m] = np.abs(u[m] - zone.step_gap(p[m], np))
     return float(work.max()) if work.size else 0.0
 
 
@@ -155,15 +154,15 @@ class _Mix:
         gx -= F @ gamma
 
 
-def zone_inner(conv, h, model, p, contact, tol: float, max_iter: int, monitor=None, precond=None,
+def zone_inner(conv, h, zone, p, contact, tol: float, max_iter: int, monitor=None, precond=None,
             anderson: int = 0, stall: int = 100) -> ZoneResult:
     """The cohesive zone in the contact's loop (module doc), displacement control, from the total
     pressure ``p`` and ``contact`` mask (both the solve's own: overwritten).  ``h``: the gap above the wall at
-    p = 0 (flat, ε); ``model``: a Maugis–Dugdale :class:`tengsim.solvers.pk.WallModel` (sharp or with a ramp);
+    p = 0 (flat, ε); ``zone``: a plateau's hard-wall limit (tengsim.laws.cohesive; sharp or with a ramp);
     ``anderson``: the memory of the iterates' mixing (0: none); ``stall``: iterations without a new lowest
     residual after which it stops unconverged (a set update cycling, a mixing stagnating)."""
     n = h.size
-    s0 = model.tension
+    s0 = zone.tension
     Kp, u, r = backend.empty(n), backend.empty(n), backend.empty(n)
     work, target, p_old = backend.empty(n), backend.empty(n), backend.empty(n)
     t = backend.empty(n) if precond is not None else work
@@ -173,7 +172,7 @@ def zone_inner(conv, h, model, p, contact, tol: float, max_iter: int, monitor=No
     for it in range(max_iter + 1):
         conv(p, Kp)
         np.add(h, Kp, out=u)
-        res = zone_residual(model, u, p, contact, work)
+        res = zone_residual(zone, u, p, contact, work)
         if monitor is not None:
             monitor(it, res)
         if res <= tol or it == max_iter:
@@ -212,7 +211,7 @@ def zone_inner(conv, h, model, p, contact, tol: float, max_iter: int, monitor=No
         # every other pixel off the contact: to its law's tension at its gap
         np.greater(p, -0.5 * s0, out=beyond)                     # which side of the zone's end it was on
         np.maximum(u, 0.0, out=work)
-        model.adhesive(work, target)
+        target[...] = zone.traction(work, np)
         target -= p
         target *= off
         p += target

@@ -2,19 +2,21 @@
 pressures for a hard wall, and its cohesive extension (Rey, Anciaux & Molinari, Comput. Mech. 2017) for
 Maugis–Dugdale and exponential adhesion outside the contact.
 
-Laws.  The solver solves the hard-wall limit of a law with a wall, the wall at g = 1 (h = 0):
+Laws.  The solver solves the hard-wall limit of a law with a wall, the wall at g = 1 (h = 0), asking the law
+for it (``law.hard_wall()``, a :class:`tengsim.laws.cohesive.CohesiveLimit`; its doc says what 'pk' reads), never
+its class:
 
-* ``repulsive`` (:class:`~tengsim.laws.Repulsive`, P = c g^-k) as its limit k → ∞: no pressure for
-  g > 1, any pressure >= 0 at g = 1, no overlap g < 1 (a hard wall; the penalty law's own wall is soft
-  on the scale ε, a few ε of compression at the loads of a Hertz check);
-* ``md`` (:class:`~tengsim.laws.MaugisDugdale`) as its limits wall_stiffness → ∞, smoothing → 0: the
-  Dugdale tension σ0 = ``tension`` wherever 1 <= g <= 1 + h0 (h0 = W/σ0 = ``law.work``/σ0, so the
-  work of adhesion is the law's W), nothing beyond, and at g = 1 any pressure >= −σ0;
-* ``exp`` (:class:`~tengsim.laws.Exponential`) as its limit wall_stiffness → ∞: the attraction
-  −(W/ρ) exp(−(g − 1)/ρ) for g >= 1, ρ = ``range``, W = ``law.work``, any pressure >= −W/ρ at g = 1.
+* no tension (``repulsive``, P = c g^-k, as its limit k → ∞): no pressure for g > 1, any pressure >= 0 at
+  g = 1, no overlap g < 1 (a hard wall; the penalty law's own wall is soft on the scale ε, a few ε of
+  compression at the loads of a Hertz check);
+* a plateau (``md``, :class:`~tengsim.laws.MaugisDugdale`, as its limits wall_stiffness → ∞, smoothing → 0):
+  the Dugdale tension σ0 wherever 1 <= g <= 1 + h0 (h0 = W/σ0, so the work of adhesion is the law's W),
+  nothing beyond, and at g = 1 any pressure >= −σ0;
+* a smooth traction (``exp``, :class:`~tengsim.laws.Exponential`, as its limit wall_stiffness → ∞: the
+  attraction −(W/ρ) exp(−(g − 1)/ρ) for g >= 1; a plugin's smooth limit), any pressure >= t(0) at g = 1.
 
-Any other law (LJ93's smooth repulsion, a plugin's law) is refused with one line naming the solvers
-that can ('fast', or 'homotopy' where the law is stiff at the pixel scale).
+A law without a hard-wall limit (LJ93's smooth repulsion) or whose limit is none of these is refused with one
+line naming the solvers that can ('fast', or 'homotopy' where the law is stiff at the pixel scale; 'ram').
 
 Cohesive laws (Rey et al. 2017: the adhesive tractions outside the contact are a load of the
 non-adhesive problem).  ``zone='inner'`` (the default of 'pk'; the Maugis–Dugdale ramp under displacement
@@ -28,7 +30,7 @@ pressure is p = p_c + p_a, p_a the law's tension where the gap is within its ran
 initial gap g0 − 1 + K p_a; the zone is then updated from the new gap and the contact solve repeated until
 the zone no longer changes (the sharp Dugdale zone: a set of pixels), or, for a ramp, the gap moves by less
 than ``tol`` and every gap is within ``tol`` of the law's graph (tengsim.solvers._pk_zone.zone_residual);
-for the exponential law until the gap moves by less than ``tol`` (a damped fixed point; it converges where
+for a smooth traction (the exponential law) until the gap moves by less than ``tol`` (a damped fixed point; it converges where
 the law is softer than a pixel, pixel snap number < 1, and says so when it does not).  The start state's gap
 gives the first zone, so a path's warm starts keep its branch (jumps are the walker's).
 
@@ -71,71 +73,66 @@ SHARP_TOL = 1e-3
 #: iterations without a new lowest residual after which the zone in the contact's loop stops, mixed and unmixed
 ZONE_STALL = (10, 100)
 
-#: the laws 'pk' solves, by class name (their hard-wall limits, module doc)
-SUPPORTED = ("Repulsive", "MaugisDugdale", "Exponential")
+def _solvable(lim) -> bool:
+    """Is ``lim`` (a law's hard-wall limit, or None) one 'pk' solves: the wall alone, a plateau or smooth?"""
+    return lim is not None and (not float(lim.tension) > 0 or lim.plateau or lim.smooth)
 
 
-@dataclass(frozen=True)
-class WallModel:
-    """The hard-wall limit of a law: ``kind`` 'wall', 'md' or 'exp'; σ0 (W/ε), h0 or ρ (ε), W (W)."""
-
-    kind: str
-    tension: float = 0.0
-    length: float = 0.0
-    work: float = 0.0
-    ramp: float = 0.0          # md: the width (ε) of the smoothstep at the zone's end; 0: a sharp step
-
-    @property
-    def sharp(self) -> bool:
-        """A zone that is a set of pixels (sharp Maugis–Dugdale): updated until it no longer changes."""
-        return self.kind == "md" and self.ramp == 0.0
-
-    def adhesive(self, u, out):
-        """p_a at the gap above the wall u >= 0 (in contact u = 0: −σ0), into ``out``."""
-        if self.sharp:
-            np.less_equal(u, self.length, out=out)
-            out *= -self.tension
-        elif self.kind == "md":                      # the law's smoothstep, t = 1 inside, 0 beyond
-            np.subtract(self.length + 0.5 * self.ramp, u, out=out)
-            out *= 1.0 / self.ramp
-            np.clip(out, 0.0, 1.0, out=out)
-            out *= out * (3.0 - 2.0 * out)
-            out *= -self.tension
-        else:
-            np.maximum(u, 0.0, out=out)
-            out *= -1.0 / self.length
-            np.exp(out, out=out)
-            out *= -self.tension
-        return out
-
-    def energy(self, u) -> float:
-        """ΣΦ over the pixels (W per pixel area) at gaps above the wall u."""
-        if self.kind == "wall":
-            return 0.0
-        if self.kind == "md":                        # (the ramp's energy as the sharp step's: O(ramp²))
-            z = u <= self.length
-            return float(-self.tension * np.sum(self.length - np.maximum(u, 0.0), where=z))
-        return float(-self.work * np.exp(-np.maximum(u, 0.0) / self.length).sum())
-
-
-def wall_model(law, solver: str = "pk") -> WallModel:
+def limit_of(law, solver: str = "pk"):
     """The hard-wall limit of ``law`` (module doc), or one line naming the solvers that can solve it."""
+    lim = law.hard_wall() if hasattr(law, "hard_wall") else None
+    if _solvable(lim):
+        return lim
     name = type(law).__name__
-    if name == "Repulsive":
-        return WallModel("wall")
-    if name == "MaugisDugdale":
-        s0 = float(law.tension)
-        return WallModel("md", s0, float(law.work) / s0, float(law.work))  # the ramp: PKSolver
-    if name == "Exponential":
-        W, rho = float(law.work), float(law.range)
-        return WallModel("exp", W / rho, rho, W)
-    raise TengsimError(f"solver '{solver}' solves hard walls only (laws repulsive, md, exp); law {name} has a "
-                       "smooth repulsion: use solver 'fast' (or 'homotopy' for a law stiff at the pixel scale)")
+    if lim is None:
+        raise TengsimError(f"solver '{solver}' solves hard walls only (laws repulsive, md, exp); law {name} has a "
+                           "smooth repulsion: use solver 'fast' (or 'homotopy' for a law stiff at the pixel scale)")
+    raise TengsimError(f"solver '{solver}' solves a hard-wall limit without adhesion, with a Dugdale zone or with a "
+                       f"smooth traction; law {name}'s traction jumps: use solver 'ram'")
 
 
 def supports(law) -> bool:
     """Can 'pk' solve ``law`` (its hard-wall limit)?"""
-    return type(law).__name__ in SUPPORTED
+    return _solvable(law.hard_wall() if hasattr(law, "hard_wall") else None)
+
+
+def _ramped(lim) -> bool:
+    """A plateau whose step has a width (the zone's ramp): solved after the sharp zone's solve, or in the loop."""
+    return lim.plateau and lim.smooth
+
+
+def _traction(lim, u, out):
+    """p_a = t(u) at the gaps above the wall u (in contact u <= 0: t(0)), into ``out``."""
+    out[...] = lim.traction(u, backend.xp)
+    return out
+
+
+def _energy(lim, u) -> float:
+    """ΣΦ over the pixels (W per pixel area) at gaps above the wall u (a plateau's ramp: as its sharp step's,
+    O(ramp²))."""
+    if not float(lim.tension) > 0:
+        return 0.0
+    if lim.plateau:
+        lim = lim.with_ramp(0.0)
+    return float(lim.energy(np.maximum(u, 0.0), backend.xp).sum())
+
+
+@dataclass(frozen=True)
+class Solved:
+    """One contact or cohesive solve of :class:`PKSolver`: the pressure ``p``, ``Kp`` = K p, the gap above the
+    wall ``u``, the load-control correction ``c`` (ε), the contact solves' iterations, whether it converged, its
+    residual (ε), the cohesive-zone updates, its message and the contact mask."""
+
+    p: np.ndarray
+    Kp: np.ndarray
+    u: np.ndarray
+    c: float
+    iterations: int
+    converged: bool
+    residual: float
+    zones: int
+    message: str
+    contact: np.ndarray
 
 
 @dataclass(frozen=True)
@@ -205,22 +202,22 @@ class PKSolver:
         return float(conv(unit, backend.empty(unit.size))[i])
 
     @staticmethod
-    def _ramp(law, kii) -> float:
-        """The zone's ramp (ε): the law's smoothing, widened where a pixel would be stiffer than it
+    def _ramp(lim, kii) -> float:
+        """The zone's ramp (ε): the law's own step, widened where a pixel would be stiffer than it
         (pixel snap number 1.5 σ0 K_ii / ramp above ``RAMP_SNAP``)."""
-        return max(float(law.smoothing), 1.5 * float(law.tension) * kii / RAMP_SNAP)
+        return max(float(lim.ramp), 1.5 * float(lim.tension) * kii / RAMP_SNAP)
 
     def _solve(self, problem: Problem, start: State, load):
         t0 = time.perf_counter()
         if problem.weights is not None:
             raise TengsimError(f"solver '{self.name}' does not solve weighted (mirror-block) problems; "
                                "use solver 'fast' for a mirror-symmetric cell")
-        model = wall_model(problem.law, self.name)
+        lim = limit_of(problem.law, self.name)
         shape = np.shape(problem.g0)
         conv = self._convolution(problem.kernel, shape)
         pre = preconditioner(problem.kernel, shape) if self.precondition else None
-        if model.kind == "md" and self.md_zone == "ramp":
-            model = replace(model, ramp=self._ramp(problem.law, self._kii(conv, shape)))
+        if lim.plateau and float(lim.tension) > 0:      # md_zone: the step widened to the pixel, or sharp
+            lim = lim.with_ramp(self._ramp(lim, self._kii(conv, shape)) if self.md_zone == "ramp" else 0.0)
         g0 = backend.xp.ascontiguousarray(problem.g0, dtype=float).ravel()
         q0 = backend.xp.asarray(start.q, dtype=float).ravel()
         w0 = backend.xp.asarray(start.w, dtype=float).ravel()
@@ -236,91 +233,94 @@ class PKSolver:
         every = self.monitor_every
         mon = None if self.monitor is None else (
             lambda it, res: self.monitor(it, res, math.nan) if it % every == 0 else None)
-        if model.kind == "wall":
+        if not float(lim.tension) > 0:
             core = self._core(conv, h0, np.maximum(q0, 0.0), self.tol, self.max_iter, load, mon, pre)
-            p, Kp, u, c = core.p, core.Kp, core.u, core.c
-            touching = p > 0
-            its, ok, res, zones = core.iterations, core.converged, core.residual, 0
-            msg = "converged" if ok else f"not converged in {self.max_iter} iterations (residual {res:.3g} ε)"
-        elif model.kind == "md" and model.ramp > 0 and self.zone == "inner" and load is None:
-            p, Kp, u, c, its, ok, res, zones, msg, touching = self._zone_inner(model, conv, h0, q0, w0, mon, pre)
+            ok, res = core.converged, core.residual
+            out = Solved(core.p, core.Kp, core.u, core.c, core.iterations, ok, res, 0,
+                         "converged" if ok else f"not converged in {self.max_iter} iterations (residual {res:.3g} ε)",
+                         core.p > 0)
+        elif _ramped(lim) and self.zone == "inner" and load is None:
+            out = self._zone_inner(lim, conv, h0, q0, w0, mon, pre)
         else:
             out = None
-            if model.ramp > 0 and RAMP_WARM and bool(np.any(q0)):   # warm: the ramp from the start, if quick
-                out = self._cohesive(model, conv, h0, q0, w0, load, mon, pre, RAMP_WARM)
-                spent = (out[4], out[7])
-                out = out if out[5] else None
+            if _ramped(lim) and RAMP_WARM and bool(np.any(q0)):   # warm: the ramp from the start, if quick
+                warm = self._cohesive(lim, conv, h0, q0, w0, load, mon, pre, RAMP_WARM)
+                out = warm if warm.converged else None
+                spent = (warm.iterations, warm.zones) if out is None else (0, 0)
             else:
                 spent = (0, 0)
             if out is None:
-                out = self._ramp_after_sharp(model, conv, h0, q0, w0, load, mon, pre)
-            p, Kp, u, c, its, ok, res, zones, msg, touching = out
-            its, zones = its + spent[0], zones + spent[1]
-        w = Kp
+                out = self._ramp_after_sharp(lim, conv, h0, q0, w0, load, mon, pre)
+            out = replace(out, iterations=out.iterations + spent[0], zones=out.zones + spent[1])
+        p, w, c = out.p, out.Kp, out.c
         H = (g0 + c) + w - 1.0
-        H[touching] = 0.0          # on the wall where it presses (the hard wall's u = 0; off by <= tol before)
-        E = problem.dA * (0.5 * float(np.dot(p, w)) + model.energy(u))
+        H[out.contact] = 0.0       # on the wall where it presses (the hard wall's u = 0; off by <= tol before)
+        E = problem.dA * (0.5 * float(np.dot(p, w)) + _energy(lim, out.u))
+        msg = out.message if out.zones == 0 else f"{out.message} ({out.zones} cohesive-zone updates)"
         eq = Equilibrium(State(p.reshape(shape), w.reshape(shape)), H.reshape(shape), p.reshape(shape).copy(),
-                         float(res), bool(ok), int(its), int(conv.count), E, time.perf_counter() - t0,
-                         msg if zones == 0 else f"{msg} ({zones} cohesive-zone updates)")
+                         float(out.residual), bool(out.converged), int(out.iterations), int(conv.count), E,
+                         time.perf_counter() - t0, msg)
         return eq, float(c)
 
-    def _zone_inner(self, model, conv, h0, q0, w0, mon, pre):
+    def _zone_inner(self, lim, conv, h0, q0, w0, mon, pre) -> Solved:
         """The Maugis–Dugdale zone in the contact's loop (tengsim.solvers._pk_zone), from the start state's gap:
         mixed (``anderson``), then, where that stalls, unmixed from the same start, then the outer fixed point
         (the message says which)."""
         u0 = h0 + w0
-        p0 = model.adhesive(np.maximum(u0, 0.0), backend.empty(h0.size))
+        p0 = _traction(lim, np.maximum(u0, 0.0), backend.empty(h0.size))
         pc = np.maximum(q0 - p0, 0.0)
         pc[u0 > self.tol] = 0.0
         p0 += pc
         its, tried = 0, []
         for m, stall in ((self.anderson, ZONE_STALL[0]), (0, ZONE_STALL[1])):
-            z = zone_inner(conv, h0, model, p0.copy(), pc > 0, self.tol, self.max_iter, mon, pre, m, stall)
+            z = zone_inner(conv, h0, lim, p0.copy(), pc > 0, self.tol, self.max_iter, mon, pre, m, stall)
             its += z.iterations
             if z.converged:
                 how = "zone in the contact's loop" + (", unmixed" if tried else "")
-                return z.p, z.Kp, z.u, 0.0, its, True, z.residual, 0, f"converged ({how})", z.contact
+                return Solved(z.p, z.Kp, z.u, 0.0, its, True, z.residual, 0, f"converged ({how})", z.contact)
             tried.append(f"{z.iterations} iterations (residual {z.residual:.3g} ε, {z.changes} set changes)")
             if not m:
                 break
-        out = self._ramp_after_sharp(model, conv, h0, q0, w0, None, mon, pre)
-        why = f"{out[8]} (outer fixed point: the zone in the contact's loop did not settle in {' + '.join(tried)})"
-        return out[:4] + (out[4] + its, out[5], out[6], out[7], why, out[9])
+        out = self._ramp_after_sharp(lim, conv, h0, q0, w0, None, mon, pre)
+        why = f"{out.message} (outer fixed point: the zone in the contact's loop did not settle in {' + '.join(tried)})"
+        return replace(out, iterations=out.iterations + its, message=why)
 
-    def _ramp_after_sharp(self, model, conv, h0, q0, w0, load, mon, pre):
-        """A cohesive solve; with a ramp (md), the sharp zone's solve first (it jumps in few updates) as its
-        start, and the sharp state if the ramp does not settle in RAMP_UPDATES updates."""
-        if model.ramp == 0:
-            return self._cohesive(model, conv, h0, q0, w0, load, mon, pre, self.max_zone)
+    def _ramp_after_sharp(self, lim, conv, h0, q0, w0, load, mon, pre) -> Solved:
+        """A cohesive solve; with a ramp (a plateau's step), the sharp zone's solve first (it jumps in few
+        updates) as its start, and the sharp state if the ramp does not settle in RAMP_UPDATES updates."""
+        if not _ramped(lim):
+            return self._cohesive(lim, conv, h0, q0, w0, load, mon, pre, self.max_zone)
         its = zones = 0
-        sharp = self._cohesive(replace(model, ramp=0.0), conv, h0, q0, w0, load, mon, pre, self.max_zone,
+        sharp = self._cohesive(lim.with_ramp(0.0), conv, h0, q0, w0, load, mon, pre, self.max_zone,
                                max(self.tol, SHARP_TOL))     # only a start: loosely
-        if sharp[5]:
-            q0, w0, its, zones = sharp[0], sharp[1], sharp[4], sharp[7]
-        out = self._cohesive(model, conv, h0, q0, w0, load, mon, pre, RAMP_UPDATES if sharp[5] else self.max_zone)
-        its, zones = its + out[4], zones + out[7]
-        if not out[5] and sharp[5]:  # the ramp's fixed point cycles: the sharp zone's state, to tol
-            out = self._cohesive(replace(model, ramp=0.0), conv, h0, sharp[0], sharp[1], load, mon, pre,
-                                 self.max_zone)
-            its, zones = its + out[4], zones + out[7]
-            why = f"{out[8]} (sharp Dugdale zone: the ramp did not settle in {RAMP_UPDATES} updates)"
-            out = out[:8] + (why,) + out[9:]
-        return out[:4] + (its,) + out[5:7] + (zones,) + out[8:]
+        if sharp.converged:
+            q0, w0, its, zones = sharp.p, sharp.Kp, sharp.iterations, sharp.zones
+        out = self._cohesive(lim, conv, h0, q0, w0, load, mon, pre,
+                             RAMP_UPDATES if sharp.converged else self.max_zone)
+        its, zones = its + out.iterations, zones + out.zones
+        if not out.converged and sharp.converged:  # the ramp's fixed point cycles: the sharp zone's state, to tol
+            out = self._cohesive(lim.with_ramp(0.0), conv, h0, sharp.p, sharp.Kp, load, mon, pre, self.max_zone)
+            its, zones = its + out.iterations, zones + out.zones
+            out = replace(out, message=f"{out.message} (sharp Dugdale zone: the ramp did not settle in "
+                                       f"{RAMP_UPDATES} updates)")
+        return replace(out, iterations=its, zones=zones)
 
-    def _cohesive(self, model: WallModel, conv, h0, q0, w0, load, mon, pre, limit, tol=None):
+    def _cohesive(self, lim, conv, h0, q0, w0, load, mon, pre, limit, tol=None) -> Solved:
+        """The outer fixed point (module doc): the contact solved with the zone's tractions p_a as a load, the
+        zone updated from the new gap, until it no longer changes (a sharp step) or the gap stops moving."""
         tol = self.tol if tol is None else tol
         n = h0.size
-        s0 = model.tension
+        s0 = lim.tension
+        sharp = not lim.smooth                        # a zone that is a set of pixels: until it no longer changes
         Ka, pa, pa_new, hh, u_prev, used = (backend.empty(n) for _ in range(6))
         # the first zone from the start state's gap; its contact pressure from its pressure
-        model.adhesive(h0 + w0, pa)
+        _traction(lim, h0 + w0, pa)
         pc = np.maximum(q0 - pa, 0.0)
         pc[(h0 + w0) > tol] = 0.0
         last_move = math.inf
         its, zones, ok, res, c = 0, 0, False, math.inf, 0.0
         core = None
-        mix = None if model.sharp else _Anderson(n, self.anderson)
+        mix = None if sharp else _Anderson(n, self.anderson)
         for zones in range(1, limit + 1):
             used[:] = pa                              # the zone this contact solve carries
             conv(used, Ka)
@@ -330,7 +330,7 @@ class PKSolver:
                 raise TengsimError(f"load control needs a compressive contact: the mean pressure {load:.6g} W/ε "
                                    f"is below the cohesive zone's tension {float(pa.mean()):.6g} W/ε")
             # the contact solve to a tolerance the zone's last move allows (inexact early updates)
-            tol_in = tol if model.sharp else max(tol, min(1e-2 * last_move, 1e-2))
+            tol_in = tol if sharp else max(tol, min(1e-2 * last_move, 1e-2))
             core = self._core(conv, hh, pc, tol_in, self.max_iter, core_load, mon, pre,
                                   None if core is None else core.Kp)   # K p_c: the last solve's
             its += core.iterations
@@ -338,9 +338,9 @@ class PKSolver:
             if not core.converged:
                 res = core.residual
                 break
-            model.adhesive(u, pa_new)
+            _traction(lim, u, pa_new)
             pa_new[pc > 0] = -s0
-            if model.sharp:
+            if sharp:
                 moved = int(np.count_nonzero(pa_new != pa))
                 res = core.residual
                 if moved == 0:
@@ -352,12 +352,12 @@ class PKSolver:
                 u_prev[:] = u
                 res = max(core.residual, move if math.isfinite(move) else 0.0)
                 if zones > 1 and move <= tol and tol_in <= tol:
-                    if model.kind != "md":
+                    if not lim.plateau:
                         ok = True
                         break
                     # two updates can agree on a zone that is not the law's (Anderson's clipped iterates): the
                     # state is judged by its gaps against the law's graph (tengsim.solvers._pk_zone), as the CG's is
-                    law = zone_residual(model, u, pc + used, pc > 0, backend.empty(n))
+                    law = zone_residual(lim, u, pc + used, pc > 0, backend.empty(n))
                     res = max(res, law)
                     if law <= tol:
                         ok = True
@@ -374,7 +374,7 @@ class PKSolver:
             msg = f"contact solve not converged in {self.max_iter} iterations (residual {res:.3g} ε)"
         else:
             msg = f"cohesive zone not settled in {limit} updates (last move {res:.3g} ε)"
-        return p, Kp, u, c, its, ok, res, zones, msg, pc > 0
+        return Solved(p, Kp, u, c, its, ok, res, zones, msg, pc > 0)
 
 
 @dataclass(frozen=True)

@@ -12,6 +12,7 @@ import math
 import numpy as np
 
 from tengsim.errors import TengsimError
+from tengsim.results.result import TRANSITION_LENGTH_FRACTION
 from tengsim.run.area import (ADHESIVE_FULL_CONTACT_LENGTH_FRACTION, cell_side, full_length, loaded_area,
                                physical_scale)
 
@@ -20,7 +21,7 @@ OBSERVABLE_DEFAULTS = {
     "fit_range": None,
     "grid_max": "150kPa",
     "grid_num": 61,
-    "transition_fraction": 0.95,
+    "transition_fraction": TRANSITION_LENGTH_FRACTION,
     "full_contact_fraction": ADHESIVE_FULL_CONTACT_LENGTH_FRACTION,
 }
 
@@ -62,7 +63,7 @@ def parse_observables(table: dict, where: str = "study") -> dict:
         Field("grid_max", "float", OBSERVABLE_DEFAULTS["grid_max"], dim="pressure",
               help="top of the common pressure grid (from 0)"),
         Field("grid_num", "int", 61, help="points of the common pressure grid"),
-        Field("transition_fraction", "float", 0.95, help="Λc fraction of full contact for transition_D"),
+        Field("transition_fraction", "float", OBSERVABLE_DEFAULTS["transition_fraction"], help="Λc fraction of full contact for transition_D"),
         Field("full_contact_fraction", "float", OBSERVABLE_DEFAULTS["full_contact_fraction"], help="Λc fraction of full contact at zero load flagged"),
     ])
     raw = dict(table)
