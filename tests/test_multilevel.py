@@ -79,3 +79,46 @@ def test_nested_solve_rejects_free_kernel_and_bad_shape():
         nested_solve(FastSolver(), g0, LJ93(), FreeKernel(Grid(64, 64, 0.25, 0.25), 0.35))
     with pytest.raises(TengsimError, match="shape"):
         nested_solve(FastSolver(), g0[:32, :32], LJ93(), K)
+
+
+def _rough_periodic(n, seed=3):
+    """A smooth random periodic surface (a few long wavelengths), heights in ε."""
+    rng = np.random.default_rng(seed)
+    k = np.fft.fftfreq(n, 1.0 / n)
+    K = np.hypot(*np.meshgrid(k, k, indexing="ij"))
+    c = np.where((K >= 1) & (K <= 6), np.maximum(K, 1.0) ** -1.8, 0.0) * np.exp(2j * np.pi * rng.random((n, n)))
+    h = np.real(np.fft.ifft2(c))
+    return 3.0 * h / h.std()
+
+
+@pytest.mark.parametrize("prolong", ["block", "fourier"])
+def test_nested_pk_under_load_lands_on_the_cold_equilibrium(prolong):
+    """Hard wall, load control: the nested start (block or Fourier prolongation) ends on the fine grid's own
+    equilibrium: the same contact set to a pixel in 10⁴, pressures to the solver's tolerance."""
+    from tengsim.laws import Repulsive
+    from tengsim.solvers.pk import PKSolver
+
+    n, load = 128, 0.05
+    h = _rough_periodic(n)
+    k = PeriodicKernel(Grid(n, n, 0.5, 0.5), 1.0)
+    g0 = 1.0 + h.max() - h
+    solver = PKSolver(tol=1e-8, max_iter=2000)
+    cold, dD = solver.solve_load(Problem(g0, Repulsive(), k), load)
+    ns = nested_solve(solver, g0, Repulsive(), k, min_size=32, max_dx=4.0, coarse_tol=None, load=load,
+                      prolong=prolong)
+    eq = ns.equilibrium
+    assert cold.converged and eq.converged
+    assert [s.shape for s in ns.levels] == [(32, 32), (64, 64), (128, 128)]
+    assert eq.P.mean() == pytest.approx(load, rel=1e-9)
+    assert np.mean((eq.P > 0) != (cold.P > 0)) < 1e-4
+    assert np.max(np.abs(eq.P - cold.P)) < 1e-5 * np.max(cold.P)
+    assert ns.approach == pytest.approx(dD, abs=1e-6)
+
+
+def test_nested_refuses_an_unknown_prolongation_and_load_without_solve_load():
+    n = 32
+    k = PeriodicKernel(Grid(n, n, 0.5, 0.5), 1.0)
+    with pytest.raises(TengsimError, match="prolong"):
+        nested_solve(FastSolver(), np.ones((n, n)) * 2, LJ93(), k, prolong="cubic")
+    with pytest.raises(TengsimError, match="solve_load"):
+        nested_solve(FastSolver(), np.ones((n, n)) * 2, LJ93(), k, load=0.1)
