@@ -17,6 +17,7 @@ from tengsim.schema import Field, Table, dataclass_fields, signature_fields
 from tengsim.shapes.base import dimensionless_fields, physical_fields
 from tengsim.shapes.roughened import LENGTH_KEYS as _ROUGHNESS_LENGTHS, roughness_fields
 from tengsim.units import number_or_text
+from tengsim.solvers.types import SOLVER_TOL
 
 
 PHYSICAL_KEYS = ("E_star", "W", "eps")
@@ -134,7 +135,7 @@ def common_fields() -> list:
         Field("poisson", default=0.5, help="Poisson ratio ν of the film, -1 < ν <= 0.5; E* keeps its meaning, "
               "E = E*(1 - ν²) (needs thickness)"),
         Field("solver", "str", "auto", choices=SOLVERS.names, help="solver: " + SOLVERS.help()),
-        Field("tol", default=1e-6, help="max residual of Eq. (9) in ε"),
+        Field("tol", default=SOLVER_TOL, help="max residual of Eq. (9) in ε"),
         Field("symmetry", "str", "auto", choices=("auto", "off"),
               help="auto: solve on the irreducible quarter (half) of the cell when the shape and its grid are "
               "mirror symmetric (same answer, less time and memory); off: always the full grid"),

@@ -20,6 +20,7 @@ from tengsim.run.keys import (ADAPTIVE_KEYS, LOAD_KEYS, common_fields, common_na
 from tengsim.shapes.base import dimensionless_fields, physical_fields
 from tengsim.shapes.roughened import roughen
 from tengsim.units import Scaling, parse_quantity
+from tengsim.solvers.types import SOLVER_TOL
 
 
 _SUFFIX = {"length": "_m", "pressure": "_Pa", "energy/area": "_J_m2"}
@@ -193,7 +194,7 @@ class ContactPlan:
     path: object  # PathSpec or tengsim.continuation.load.LoadPathSpec
     boundary: str = "free"
     solver: object = "fast"
-    tol: float = 1e-6
+    tol: float = SOLVER_TOL
     law: object = None
     extra: dict = field(default_factory=dict)
     scaling: Scaling | None = None

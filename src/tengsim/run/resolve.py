@@ -60,6 +60,8 @@ from tengsim.run.grids import FACTOR, MIN_SIDE, default_dx, edge_phases, next_gr
 from tengsim.run.memory import default_max_pixels
 from tengsim.run.tolerance import DEFAULT_TOL
 from tengsim.run.judge import NEED_FLOOR, _dx_needed, _judge, _levels_table, _why, contact_observables
+from tengsim.solvers.types import SOLVER_TOL
+
 
 def resolve_plan(plan, observe=None, full_length: float | None = None, progress=None, checkpoint=None, start=None,
                  watch=None, path_for=None, settings=None):
@@ -191,7 +193,7 @@ def _stop_message(levels, rich, changes, tol, max_pixels, stop, lateral) -> str:
 def resolve_contact(shape, tabor: float, path, dx: float | None = None, law=None, boundary: str = "free",
                     resolve_tol: float = DEFAULT_TOL, max_pixels: int | None = None, observe=None,
                     full_length: float | None = None, progress=None, checkpoint=None, start=None,
-                    watch=None, path_for=None, solver="fast", tol: float = 1e-6, extra_params: dict | None = None,
+                    watch=None, path_for=None, solver="fast", tol: float = SOLVER_TOL, extra_params: dict | None = None,
                     observers=(), scaling=None, kernel_params: dict | None = None, symmetry: str = "auto"):
     """The API form of :func:`resolve_plan`, as :func:`tengsim.run.simulate.simulate` is of ``simulate_plan``:
     builds the :class:`tengsim.run.plan.ContactPlan` of these pieces (``resolve_tol``, ``max_pixels`` and

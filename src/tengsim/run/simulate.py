@@ -20,6 +20,7 @@ from tengsim.solvers import make_solver
 from tengsim.solvers.mirror import MirrorSolver
 from tengsim.solvers.distributed import SlabSolver
 from tengsim import parallel
+from tengsim.solvers.types import SOLVER_TOL
 
 MONITOR_MIN_POINTS = 1024**2  # grids from this size on report progress inside each solve
 #: full-grid arrays a block run still holds beside the block's workspace (U0, g0, the unfolded H and P the
@@ -28,7 +29,7 @@ MIRROR_FULL_ARRAYS = 12
 
 
 def simulate(shape: Shape, tabor: float, dx: float, path: PathSpec, boundary: str = "free",
-             solver="fast", tol: float = 1e-6, law: Law | str | None = None, progress=None,
+             solver="fast", tol: float = SOLVER_TOL, law: Law | str | None = None, progress=None,
              grid=None, extra_params: dict | None = None, observers=(), scaling=None,
              kernel_params: dict | None = None, throw: bool = False, check_memory_first: bool = True,
              sink=None, symmetry: str = "auto"):
@@ -148,7 +149,7 @@ def simulate_plan(plan: ContactPlan, progress=None, sink=None, throw: bool = Fal
 
 def simulate_pyramid(N: float, cell: float, tabor: float = 0.5, dx: float = 0.05,
                      d_min: float = -1.0, d_max: float = 4.0, d_step: float = 0.05,
-                     boundary: str = "free", solver="fast", tol: float = 1e-6,
+                     boundary: str = "free", solver="fast", tol: float = SOLVER_TOL,
                      maps_at=(), progress=None, symmetry: str = "auto", **path_kw):
     """The paper's pyramid unit cell (Eq. 11) with N = n/(2ε) and L̄ = ``cell`` (``symmetry`` as in :func:`simulate`)."""
     shape = Pyramid(N, cell)

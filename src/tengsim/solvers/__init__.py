@@ -16,11 +16,11 @@ from __future__ import annotations
 
 from tengsim.registry import SOLVERS
 from tengsim.solvers.fast import FastSolver
-from tengsim.solvers.types import Equilibrium, Problem, State
+from tengsim.solvers.types import SOLVER_TOL, Equilibrium, Problem, State
 from tengsim.solvers.vsr import VSRSolver
 
 
-def make_solver(name: str, tol: float = 1e-6, **kw):
+def make_solver(name: str, tol: float = SOLVER_TOL, **kw):
     """Solver by registered name (see ``tengsim.registry.SOLVERS``): 'fast' (L-BFGS) or 'vsr' (the paper's
     relaxation).  A registered solver is a factory ``(tol=..., **kw) -> solver``."""
     return SOLVERS.get(name)(tol=tol, **kw)
@@ -30,4 +30,4 @@ SOLVERS.register("fast", FastSolver, summary="L-BFGS in the kernel metric")
 SOLVERS.register("vsr", VSRSolver, summary="the paper's relaxation")
 
 
-__all__ = ["Equilibrium", "FastSolver", "Problem", "State", "VSRSolver", "make_solver"]
+__all__ = ["SOLVER_TOL", "Equilibrium", "FastSolver", "Problem", "State", "VSRSolver", "make_solver"]

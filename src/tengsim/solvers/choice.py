@@ -12,6 +12,7 @@ import functools
 import importlib.util
 
 from tengsim.registry import SOLVERS
+from tengsim.solvers.types import SOLVER_TOL
 
 #: the distributions that give JAX a GPU backend (CUDA or ROCm plugins; old jaxlib CUDA builds)
 GPU_PLUGINS = ("jax_cuda12_plugin", "jax_cuda13_plugin", "jax_cuda11_plugin", "jax_rocm60_plugin",
@@ -65,7 +66,7 @@ def choose(name, points=None) -> tuple:
     return "fast", "solver: fast (auto: JAX sees no GPU; the NumPy fast solver on the CPU)"
 
 
-def auto_solver(tol: float = 1e-6, **kw):
+def auto_solver(tol: float = SOLVER_TOL, **kw):
     """The solver :func:`choose` picks for 'auto', made with ``tol`` (API: ``make_solver('auto')``)."""
     return SOLVERS.get(choose("auto")[0])(tol=tol, **kw)
 

@@ -42,7 +42,7 @@ from tengsim.laws.safe import safe
 from tengsim.grid import Grid
 from tengsim.registry import SOLVERS
 from tengsim.solvers.fast import FastSolver
-from tengsim.solvers.types import Equilibrium, Problem, State
+from tengsim.solvers.types import SOLVER_TOL, Equilibrium, Problem, State
 from tengsim.solvers._reduce import for_kernel
 
 
@@ -173,7 +173,7 @@ class HomotopySolver:
     a plain fast solve.  ``iterations`` and ``n_conv`` of a cold solve add every stage's (a coarse
     grid's convolutions are cheaper: the message gives their fine-grid worth)."""
 
-    tol: float = 1e-6
+    tol: float = SOLVER_TOL
     max_iter: int = 3000
     memory: int = 10
     resync: int = 25

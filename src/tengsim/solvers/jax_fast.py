@@ -47,7 +47,7 @@ import numpy as np
 from tengsim.errors import MemoryRefused, SolverUnavailable, TengsimError
 from tengsim.laws.safe import SafeLaw
 from tengsim.registry import SOLVERS
-from tengsim.solvers.types import Equilibrium, Problem, State
+from tengsim.solvers.types import SOLVER_TOL, Equilibrium, Problem, State
 
 F32_TOL = 2e-5  # float32 fields: the smallest tolerance it can reach reliably (max|r| in ε)
 DEVICES = ("auto", "cpu", "gpu")
@@ -173,7 +173,7 @@ class JaxSolver:
     ``device``: 'auto' (JAX's default), 'cpu' or 'gpu'; ``dtype``: 'float64' or 'float32' (the fields;
     scalars stay float64).  Same interface and result (host NumPy arrays) as FastSolver."""
 
-    tol: float = 1e-6
+    tol: float = SOLVER_TOL
     max_iter: int = 3000
     memory: int = 10
     resync: int = 25
@@ -318,7 +318,7 @@ def _result(problem, out, shape, max_iter, compile_s, t0):
 
 
 SOLVERS.register("jax", JaxSolver, summary="the fast solver compiled with JAX (GPU if JAX has one, else CPU)")
-def gpu_solver(tol: float = 1e-6, **kw) -> JaxSolver:
+def gpu_solver(tol: float = SOLVER_TOL, **kw) -> JaxSolver:
     """The JAX solver on a GPU (TengsimError, one line, when JAX has none)."""
     return JaxSolver(tol=tol, **{"device": "gpu", "name": "gpu", **kw})
 

@@ -60,7 +60,7 @@ from tengsim.errors import TengsimError
 from tengsim.registry import SOLVERS
 from tengsim.solvers._pk_core import Convolution, constrained_cg, preconditioner
 from tengsim.solvers._pk_zone import Anderson as _Anderson, zone_inner, zone_residual
-from tengsim.solvers.types import Equilibrium, Problem, State, check_settings
+from tengsim.solvers.types import SOLVER_TOL, Equilibrium, Problem, State, check_settings
 
 #: the largest pixel snap number of a Maugis–Dugdale ramp (PKSolver._ramp)
 RAMP_SNAP = 0.5
@@ -141,7 +141,7 @@ class PKSolver:
     zones (module doc).  ``tol``: the gap residual (ε); ``max_iter``: iterations of one contact solve;
     ``max_zone``: zone updates of a cohesive solve; ``monitor(iteration, residual)``: progress."""
 
-    tol: float = 1e-6
+    tol: float = SOLVER_TOL
     max_iter: int = 1000
     max_zone: int = 500
     precondition: bool = True

@@ -29,7 +29,7 @@ from tengsim import backend
 from tengsim.errors import TengsimError
 from tengsim.registry import SOLVERS
 from tengsim.solvers._ram_core import Compliance, solve_gap
-from tengsim.solvers.types import Equilibrium, Problem, State, check_settings
+from tengsim.solvers.types import SOLVER_TOL, Equilibrium, Problem, State, check_settings
 
 
 def limit_of(law, solver: str = "ram"):
@@ -56,7 +56,7 @@ class RAMSolver:
     Tamaas' states at every step, 'scaled' keeps more contact on a retraction); elsewhere always h + w;
     ``monitor(iteration, residual, nan)``: progress every ``monitor_every`` iterations."""
 
-    tol: float = 1e-6
+    tol: float = SOLVER_TOL
     max_iter: int = 20000
     name: str = "ram"
     start: str = "shifted"

@@ -10,6 +10,10 @@ import numpy as np
 
 from tengsim import backend
 
+SOLVER_TOL = 1e-6
+"""The default tolerance of every solver: the largest residual of Eq. (9) (or of the gap, for the constrained
+solvers) an equilibrium may keep, in ε; the [contact] table's ``tol``.  Defined here only."""
+
 
 @dataclass(frozen=True)
 class Problem:

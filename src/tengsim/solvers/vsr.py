@@ -11,7 +11,7 @@ import numpy as np
 from tengsim import backend
 from tengsim.errors import TengsimError
 from tengsim.laws.safe import safe
-from tengsim.solvers.types import Equilibrium, Problem, State, finish
+from tengsim.solvers.types import SOLVER_TOL, Equilibrium, Problem, State, finish
 
 
 @dataclass(frozen=True)
@@ -28,7 +28,7 @@ class VSRSolver:
     stable equilibrium.  One convolution per pseudo-time step.
     """
 
-    tol: float = 1e-6
+    tol: float = SOLVER_TOL
     max_iter: int = 200000
     dt0: float = 0.5
     growth: float = 1.2

@@ -16,6 +16,7 @@ from tengsim.io import jsonable
 from tengsim.shapes import Pyramid
 from tengsim.continuation import LoadPathSpec, PathSpec
 from tengsim.cases.paper.units import PAPER_GROUPS, paper_scaling
+from tengsim.solvers.types import SOLVER_TOL
 
 # The paper's reported partial-to-full contact transitions (Fig. 4a), for comparison only.
 PAPER_TRANSITION_D = {"A": 1.75, "B": 5.20, "C": 10.95}
@@ -33,7 +34,7 @@ class RunSettings:
     d_max: float = 14.0
     boundary: str = "free"
     solver: str = "fast"
-    tol: float = 1e-6
+    tol: float = SOLVER_TOL
     n_loads: int = 80  # load steps of the load-controlled A(P) (Figs. 5 and 8), at least …
     p_step_Pa: float = 10e3  # … so many that a step is at most this nominal pressure (Fig. 8 starts at 10 kPa)
 
