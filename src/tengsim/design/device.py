@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from tengsim.device.params import QUASI_STATIC
 from tengsim.errors import TengsimError
 
 DEFAULTS = {
@@ -33,8 +34,6 @@ DEFAULTS = {
     "frequency_Hz": (2.0, "square wave at 2 Hz"),
 }
 """What a design does not know, the paper's Fig. 8 device; ``amplitude_Pa`` defaults to the design's p_max."""
-QUASI_STATIC = "quasi-static A(P)"
-"""``area_model`` of a device driven by the design's static A/S(P) (no viscoelastic cycles in the design)."""
 FROM_DESIGN = {"sigma_C_per_m2": "sigma_C_m2", "eps_r": "eps_r", "thickness_m": "thickness_m", "gap_m": "gap_m"}
 """DeviceParams field: the design.nc attribute it is read from."""
 

@@ -382,6 +382,24 @@ def _one_line(read):
 
 
 @_one_line
+def design_visco_record(path) -> dict | None:
+    """The viscoelastic record (:func:`visco_record`) of ``path`` if it is a design result (DIR, DIR/design.nc)
+    with cycles; None for a design without, a contact result or no file (whose own readers say what is wrong)."""
+    p = Path(path)
+    if p.is_dir():
+        return visco_record(p) if (p / DESIGN_FILE).is_file() else None
+    if not p.is_file() or p.suffix.lower() == ".csv":
+        return None
+    import xarray as xr
+
+    try:
+        with xr.open_dataset(p) as ds:
+            design = AREA_VARIABLE in ds
+    except (OSError, ValueError):
+        return None
+    return visco_record(p) if design else None
+
+
 def area_table_from_file(path) -> AreaTable:
     """The area model of a result on file: a design result (DIR, DIR/design.nc) or a contact result."""
     p = Path(path)
@@ -400,5 +418,5 @@ def area_table_from_file(path) -> AreaTable:
     return area_table_from_design(p)
 
 
-__all__ = ["area_cycle_from_design", "visco_record", "area_table_from_contact", "area_table_from_design",
+__all__ = ["area_cycle_from_design", "area_cycle_for_waveform", "design_visco_record", "visco_record", "area_table_from_contact", "area_table_from_design",
            "area_table_from_file", "design_path", "passed_curve", "stable_branch", "DESIGN_FILE"]

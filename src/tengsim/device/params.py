@@ -238,6 +238,19 @@ class AreaCycle:
         return d
 
 
+QUASI_STATIC = "quasi-static A(P)"
+"""The label of an area read from the pressure (an A/S(P) table or function, a constant): the ``area_model`` a
+device summary states; an area that carries its own history states its ``label``."""
+
+
+def area_model_label(area) -> str:
+    """Which A a device used: the cycle's label ('viscoelastic cycle at 2 Hz') or :data:`QUASI_STATIC`
+    ('constant A/S' for a constant fraction)."""
+    if area.carries_history:
+        return str(area.label)
+    return "constant A/S" if isinstance(area, ConstantArea) else QUASI_STATIC
+
+
 def area_model(area):
     """The charged-area model for ``area``: a number (constant fraction), an area model, or any callable
     pressure (Pa) -> A/S (wrapped in :class:`AreaFunction`)."""

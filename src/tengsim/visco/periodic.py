@@ -37,7 +37,8 @@ class PeriodicCycles:
     """The presses of a periodic history: ``periods`` (the first :data:`PLAIN` periods from rest, each a
     :class:`TimeResult` with t from 0 to the period), ``steady`` (the periodic cycle), ``change`` (max |ΔA/S| of
     the last two periods driven one after the other, over the largest A/S), ``tol``, ``converged`` and
-    ``evaluations`` (the periods driven in all)."""
+    ``evaluations`` (the periods driven in all).  Two periods are compared at the times both visit
+    (:func:`schedule`)."""
 
     periods: tuple
     steady: TimeResult
@@ -65,8 +66,19 @@ def _unpack(x: np.ndarray, like: MaxwellMemory) -> MaxwellMemory:
     return MaxwellMemory(q, np.array(x[len(like.q) * n:]).reshape(like.w.shape))
 
 
+def schedule(history: History, steps) -> np.ndarray:
+    """The times every run of ``history`` with ``steps`` visits (a jump's bisection adds its own, which differ
+    from one period to the next): where two periods' cycles are compared."""
+    out = [float(history.t[0])]
+    for ta, tb in zip(history.t, history.t[1:]):
+        out += [float(tb)] if tb == ta else [float(x) for x in steps.times(float(ta), float(tb))]
+    return np.asarray(out)
+
+
 def _area_on(res: TimeResult, t: np.ndarray) -> np.ndarray:
-    return np.interp(t, res.t, res["area_fraction"])
+    """A/S of ``res`` at the times ``t`` it visited (at a repeated time, the last row: after the jump)."""
+    i = np.clip(np.searchsorted(res.t, t * (1 + 1e-12) + 1e-300, side="right") - 1, 0, res.t.size - 1)
+    return np.asarray(res["area_fraction"])[i]
 
 
 def periodic_cycles(drive: TimeDrive, history: History, steps, tol: float = TOL, max_periods: int = MAX_PERIODS,
@@ -76,7 +88,7 @@ def periodic_cycles(drive: TimeDrive, history: History, steps, tol: float = TOL,
     plain, max_periods = max(1, int(plain)), max(int(plain) + 1, int(max_periods))
     res, end = drive.run_from(history, steps)
     periods = [res]
-    t_ref = res.t
+    t_ref = schedule(history, steps)
     scale = max(float(np.max(res["area_fraction"])), 1e-12)
     like = end.memory
     xs, gs = [np.zeros_like(_pack(like))], [_pack(end.memory)]  # x: a period's start memory, g = G(x) its end
