@@ -206,9 +206,10 @@ def rest_gap_voltage(designed: DesignedDevice, result) -> dict:
     peak = waveform_peak(designed.waveform, float(result.t[-1]))
     rest = np.flatnonzero(np.asarray(result.series["P_a"]) <= 0)  # released: the last row before the next press
     i = int(rest[-1]) if rest.size else -1
-    if p.area.carries_history:  # the last press's A/S at its release (the end of the press: phase 1/2)
-        last = math.floor(float(result.t[i]) * p.area.frequency_Hz - 1e-9)
-        a = float(p.area.at_time((max(last, 0) + 0.5) / p.area.frequency_Hz))
+    if p.area.carries_history:  # the largest A/S of the last press (the square press's at its release)
+        f = p.area.frequency_Hz
+        last = max(math.floor(float(result.t[i]) * f - 1e-9), 0)
+        a = p.area.largest(last / f, (last + 1) / f)
     else:
         a = float(np.interp(peak, p.area.pressure_Pa, p.area.area_fraction)) if hasattr(p.area, "pressure_Pa") \
             else math.nan

@@ -82,9 +82,14 @@ def _t90(t, v, t_start, t_end) -> float:
 
 
 def visco_cycles(plan, material: Prony, frequencies=FREQUENCIES, pixels: int = 48, steps: int = 12,
-                 progress=None) -> ViscoDesign:
+                 progress=None, presses=PRESSES) -> ViscoDesign:
     """The design ``plan`` (:class:`tengsim.design.plan.DesignPlan`) cycled at ``frequencies`` (module doc);
-    ``steps`` time steps per segment of each cycle."""
+    ``steps`` time steps per segment of each cycle; ``presses``: the repeated presses recorded (the square one
+    always: the sensor's response and recovery are read off its first press)."""
+    presses = ("square",) + tuple(k for k in presses if k != "square")
+    bad = [k for k in presses if k not in PRESSES]
+    if bad:
+        raise ValueError(f"no press {bad[0]!r} (presses: {', '.join(PRESSES)})")
     cp = plan.contact_plan
     shape = cp.shape
     cell = float(getattr(shape, "cell", cp.grid.nx * cp.grid.dx))
@@ -107,7 +112,7 @@ def visco_cycles(plan, material: Prony, frequencies=FREQUENCIES, pixels: int = 4
     for f, mat in [(0.0, Prony(material.E_inf))] + [(float(f), material) for f in frequencies]:
         period = 1.0 / f if f > 0 else 1.0
         out = {}
-        for kind in ("triangle", "square") if f == 0 else ("triangle",) + PRESSES:
+        for kind in ("triangle", "square") if f == 0 else ("triangle",) + presses:
             h = (History((0.0, period / 2, period), (0.0, p_max * scale, 0.0), "pressure") if kind == "triangle"
                  else press_history(kind, p_max * scale, period, int(steps)))
             st = SegmentSteps(int(steps)) if kind != "sine" else SegmentSteps(1)

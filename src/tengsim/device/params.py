@@ -152,8 +152,8 @@ class AreaCycle:
     ones is the steady state plus the last recorded press's difference from it times ``decay``^(n − recorded),
     ``decay`` the ratio of the last two recorded presses' differences from the steady state (a geometric approach,
     the slowest branch's).  In contact the device's A/S is its press's at the waveform's phase; in flight the value
-    at the release (the contact's own area when it separated).  No ``area_memory`` rule applies: the history is in
-    the cycles.  ``label`` says which cycle it is."""
+    the largest of the press just ended (the area that press charged, :meth:`largest`; the square press's at its
+    release).  No ``area_memory`` rule applies: the history is in the cycles.  ``label`` says which cycle it is."""
 
     frequency_Hz: float
     phase: np.ndarray
@@ -222,6 +222,16 @@ class AreaCycle:
             m = k == n
             out[m] = np.interp(phase[m], self.phase, self.press(int(n) + 1))
         return out
+
+    def largest(self, t0_s: float, t1_s: float) -> float:
+        """The largest A/S over the times [t0_s, t1_s] (s) of the waveform, at its ends and every node of the cycles
+        between: the area a press in contact over that interval charged."""
+        f = self.frequency_Hz
+        t = [float(t0_s), float(t1_s)]
+        for k in range(math.floor(t0_s * f), math.floor(t1_s * f) + 1):
+            nodes = (k + self.phase) / f
+            t += nodes[(nodes > t0_s) & (nodes < t1_s)].tolist()
+        return float(np.max(self.at_time(np.asarray(t))))
 
     def at_phase(self, phase, press: int = 1):
         """A/S at ``phase`` of press ``press`` (1: the first)."""
