@@ -262,3 +262,53 @@ def test_design_with_relaxation_then_device_end_to_end(tmp_path, capsys):
     assert s["designed_device"]["area_cycle"]["cycle_frequencies_Hz"] == [2.0, 10.0]
     w = math.log(5 / 2) / math.log(5)
     assert s["designed_device"]["area_cycle"]["cycle_weights"] == pytest.approx([1 - w, w])
+
+
+def _config(tmp_path, waveform: str):
+    from tengsim.cases.paper import fig8_params
+    from tengsim.device import ConstantArea
+
+    dev = {k: v for k, v in fig8_params(ConstantArea(1.0)).to_dict().items() if not isinstance(v, dict)}
+    dev["field"] = "parallel"
+    lines = ["[device]"] + [f"{k} = {json.dumps(v)}" for k, v in dev.items()] + ["[waveform]", waveform]
+    cfg = tmp_path / "dev.toml"
+    cfg.write_text("\n".join(lines) + "\n")
+    return cfg
+
+
+@pytest.mark.parametrize("waveform, model", [
+    ('kind = "square"\namplitude_Pa = 1e4\nfrequency_Hz = 2.0', "viscoelastic cycle at 2 Hz"),
+    ('kind = "sine"\namplitude_Pa = 5e3\noffset_Pa = 5e3\nphase_rad = -1.5707963267948966\nfrequency_Hz = 2.0',
+     "viscoelastic sine cycle at 2 Hz")])
+def test_device_run_area_from_a_viscoelastic_design_uses_its_cycles(designs, tmp_path, waveform, model):
+    """`device run --area-from` a design with cycles: the viscoelastic A(t) of the press the waveform is, as `device
+    design` takes it (the summary's area_model says so); the same design without cycles: the quasi-static A(P)."""
+    cfg = _config(tmp_path, waveform)
+    for which, want in (("fast", model), ("static", "quasi-static A(P)")):
+        out = tmp_path / f"{which}.csv"
+        assert main(["device", "run", "--config", str(cfg), "--area-from", str(designs[which] / "design.nc"),
+                     "--out", str(out), "--quiet", "--cycles", "2"]) == 0
+        side = json.loads(out.with_suffix(".json").read_text())
+        assert side["summary"]["area_model"] == want
+        assert side["params"]["area"]["kind"] == ("cycle" if which != "static" else "table")
+
+
+@pytest.mark.parametrize("case, extra, said", [
+    ("run", 'kind = "square"\namplitude_Pa = 5e3\nfrequency_Hz = 2.0', "--pressure 5 kPa is not that cycle"),
+    ("run", 'kind = "sine"\namplitude_Pa = 1e4\nfrequency_Hz = 2.0', "a sine of amplitude 10 kPa, offset 0 kPa"),
+    ("run", 'kind = "table"\nt_s = [0, 0.25, 0.5]\npressure_Pa = [0, 1e4, 0]\nperiodic = true',
+     "a [waveform] of kind 'table' is not one of them"),
+    ("fig8", None, "the staircase to 15 pressures"),
+    ("fig7", None, "is not that cycle")])
+def test_device_cases_refuse_a_waveform_the_viscoelastic_design_has_no_cycle_for(designs, tmp_path, capsys, case,
+                                                                               extra, said):
+    """No silent quasi-static use of a viscoelastic design: a waveform that is none of its recorded presses is one
+    line (exit 2, nothing written) naming the presses it has."""
+    out = tmp_path / "x.csv"
+    args = ["device", case, "--area-from", str(designs["fast"] / "design.nc"), "--out", str(out)]
+    if extra is not None:
+        args += ["--config", str(_config(tmp_path, extra))]
+    assert main(args) == 2
+    err = capsys.readouterr().err.strip()
+    assert said in err and "viscoelastic cycles" in err and len(err.splitlines()) == 1, err
+    assert not out.exists() and not out.with_suffix(".json").exists()

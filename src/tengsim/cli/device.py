@@ -247,6 +247,11 @@ def _viscoelastic(case, cfg, cli, params, wf):
     if not isinstance(raw, (str, Path)) or design_visco_record(raw) is None:
         return params
     rec = design_visco_record(raw)
+    if case == "fig8":  # its staircase is no press a design records
+        raise TengsimError(f"device fig8 --area-from {raw}: the design's viscoelastic cycles press to "
+                           f"{rec['p_max_Pa'] / 1e3:.4g} kPa only, the staircase to {len(wf.amplitudes_Pa)} pressures: "
+                           "run its square or sine press with `tengsim device design --area-from` (or `device run`), or "
+                           "give a design without --relaxation for the quasi-static A(P)")
     cycle = area_cycle_for_waveform(raw, wf, float(params.area(rec["p_max_Pa"])),
                                     where=f"device {case} --area-from {raw}")
     return params.replace(area=cycle)

@@ -381,7 +381,6 @@ def _one_line(read):
     return wrapped
 
 
-@_one_line
 def design_visco_record(path) -> dict | None:
     """The viscoelastic record (:func:`visco_record`) of ``path`` if it is a design result (DIR, DIR/design.nc)
     with cycles; None for a design without, a contact result or no file (whose own readers say what is wrong)."""
@@ -400,6 +399,7 @@ def design_visco_record(path) -> dict | None:
     return visco_record(p) if design else None
 
 
+@_one_line
 def area_table_from_file(path) -> AreaTable:
     """The area model of a result on file: a design result (DIR, DIR/design.nc) or a contact result."""
     p = Path(path)
