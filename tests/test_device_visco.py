@@ -23,7 +23,7 @@ MATERIALS = {"slow": sls(E, E, 0.1),                     # relaxes at 0.1 s: ins
              "fast": Prony(E, (E,), (1e-5,)),            # tau far below every period: relaxed at every step
              "long": sls(E, E, 5.0)}                     # tau = 10 periods at 2 Hz: no recovery between presses
 FREQUENCIES = {"long": (2.0,), "weak": (2.0,), "fast": (2.0,)}  # (slow: 0.5, 2 and 10 Hz)
-PRESSES = {"slow": ("square",)}                          # (the others: the square and the sine press)
+PRESSES = {"slow": ("square",)}                          # (the others: the square and the sine press, --visco-sine)
 
 
 @pytest.fixture(scope="module")

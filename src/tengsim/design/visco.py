@@ -8,7 +8,8 @@ nominal pressure over a cycle, and the sensor's numbers at each frequency:
   to 90 % of V_OC's change, from the start of the press and of the release.
 
 * the presses the device is driven by, repeated from one period to the next with the material's memory carried
-  (:func:`tengsim.visco.simulate_periodic`): the square cycle and a sine press P = (p_max/2)(1 − cos 2π f t), each
+  (:func:`tengsim.visco.simulate_periodic`): the square cycle and, asked (``presses``; ``tengsim design
+  --visco-sine``), a sine press P = (p_max/2)(1 − cos 2π f t), each
   as its first :data:`tengsim.visco.periodic.PLAIN` periods from rest and its periodic steady state (the cycle
   repeating to :data:`tengsim.visco.periodic.TOL` of its largest A/S).
 
@@ -82,10 +83,11 @@ def _t90(t, v, t_start, t_end) -> float:
 
 
 def visco_cycles(plan, material: Prony, frequencies=FREQUENCIES, pixels: int = 48, steps: int = 12,
-                 progress=None, presses=PRESSES) -> ViscoDesign:
+                 progress=None, presses=("square",)) -> ViscoDesign:
     """The design ``plan`` (:class:`tengsim.design.plan.DesignPlan`) cycled at ``frequencies`` (module doc);
-    ``steps`` time steps per segment of each cycle; ``presses``: the repeated presses recorded (the square one
-    always: the sensor's response and recovery are read off its first press)."""
+    ``steps`` time steps per segment of each cycle; ``presses``: the repeated presses recorded, of
+    :data:`PRESSES` (the square one always: the sensor's response and recovery are read off its first press; the
+    sine as many periods again: ``tengsim design --visco-sine``)."""
     presses = ("square",) + tuple(k for k in presses if k != "square")
     bad = [k for k in presses if k not in PRESSES]
     if bad:
