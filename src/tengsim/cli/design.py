@@ -57,6 +57,9 @@ def register(sub):
     p.add_argument("--relaxation", help="a TOML file with a [relaxation] table: the design also pressed and released "
                    "at 0.5, 2 and 10 Hz on that viscoelastic material (visco.csv, visco_table.csv, visco.png, a "
                    "report section)")
+    p.add_argument("--visco-sine", action="store_true", help="with --relaxation: also record the sine press "
+                   "(p_max/2)(1 - cos 2 pi f t) with its memory, for `tengsim device design` with that sine (as many "
+                   "periods again as the square press)")
     p.add_argument("--quiet", action="store_true", help="no progress lines")
     p.set_defaults(func=run)
 
@@ -225,6 +228,8 @@ def run(args) -> int:
         from tengsim.relaxation import read_relaxation
 
         relaxation = read_relaxation(args.relaxation)
+    elif getattr(args, "visco_sine", False):
+        raise TengsimError("--visco-sine records the sine press of the viscoelastic cycles: give --relaxation FILE")
     # every design, and every band point of the material, checked before anything runs
     plans = [plan_design(t, where, material) for where, t in tables]
     out = Path(args.out)
@@ -285,7 +290,8 @@ def _run_locked(args, plans, folders, out, relaxation=None) -> int:
         from tengsim.design.visco_write import write_visco
 
         for r, f in zip(results, folders):
-            paths += write_visco(visco_cycles(r.plan, relaxation, progress=say.say), out / f)
+            presses = ("square", "sine") if getattr(args, "visco_sine", False) else ("square",)
+            paths += write_visco(visco_cycles(r.plan, relaxation, progress=say.say, presses=presses), out / f)
     for k in range(len(plans)):  # the results are saved: the kept grids are no longer needed
         (out / f".design-{k}.resolve.nc").unlink(missing_ok=True)
     if not args.quiet:

@@ -144,6 +144,7 @@ def execute(case: str, cfg: dict, cli: dict | None = None, quiet: bool = False, 
         params, wf = designed.params, designed.waveform
     else:
         params, wf = _device_and_waveform(case, cfg, dev_cli)
+        params = _viscoelastic(case, cfg, cli, params, wf)
     from tengsim.device import simulate
     from tengsim.device.config import check_pressures
 
@@ -159,7 +160,7 @@ def execute(case: str, cfg: dict, cli: dict | None = None, quiet: bool = False, 
         if "area" not in cfg.get("device", {}) and "area" not in dev_cli:  # the slow engine: after every check
             params = params.replace(area=fig8_area_table(bool(run.get("quick", False))))
         res = simulate(params, wf, wf.duration, dt_out=run.get("dt_out", 1e-4), options=solver, progress=not quiet)
-        summary = fig8_summary(res)
+        summary = {"area_model": _area_model(params), **fig8_summary(res)}
     else:
         t_end = run.get("t_end")
         if t_end is None:
@@ -185,11 +186,11 @@ def execute(case: str, cfg: dict, cli: dict | None = None, quiet: bool = False, 
         elif case == "fig7":
             from tengsim.cases.paper import fig7_summary
 
-            summary = fig7_summary(res, skip)
+            summary = {"area_model": _area_model(params), **fig7_summary(res, skip)}
         else:
             from tengsim.io import jsonable
 
-            summary = jsonable(res.summary(skip))
+            summary = jsonable({"area_model": _area_model(params), **res.summary(skip)})
     from tengsim.cli import device_field
 
     summary = {**summary, **device_field.field_summary(params, res, cli.get("air_pressure_Pa"))}
@@ -227,6 +228,33 @@ def _device_and_waveform(case, cfg, dev_cli):
     if case == "sweep":
         require(getattr(wf, "period", None) is not None, "a load sweep needs a periodic waveform")
     return params, wf
+
+
+def _area_model(params) -> str:
+    """The summary's ``area_model``: which A the device used (:func:`tengsim.device.params.area_model_label`)."""
+    from tengsim.device.params import area_model_label
+
+    return area_model_label(params.area)
+
+
+def _viscoelastic(case, cfg, cli, params, wf):
+    """``params`` with the viscoelastic A(t) of a design result with cycles given as the area (--area-from, [device]
+    area), as `device design` takes it (:func:`tengsim.device.areas.area_cycle_for_waveform`): never its quasi-static
+    A(P) in silence; a waveform that is none of its recorded presses is one line."""
+    from tengsim.device.areas import area_cycle_for_waveform, design_visco_record
+
+    raw = (cli or {}).get("device", {}).get("area") or (cfg.get("device") or {}).get("area")
+    if not isinstance(raw, (str, Path)) or design_visco_record(raw) is None:
+        return params
+    rec = design_visco_record(raw)
+    if case == "fig8":  # its staircase is no press a design records
+        raise TengsimError(f"device fig8 --area-from {raw}: the design's viscoelastic cycles press to "
+                           f"{rec['p_max_Pa'] / 1e3:.4g} kPa only, the staircase to {len(wf.amplitudes_Pa)} pressures: "
+                           "run its square or sine press with `tengsim device design --area-from` (or `device run`), or "
+                           "give a design without --relaxation for the quasi-static A(P)")
+    cycle = area_cycle_for_waveform(raw, wf, float(params.area(rec["p_max_Pa"])),
+                                    where=f"device {case} --area-from {raw}")
+    return params.replace(area=cycle)
 
 
 def _area_source(cfg, cli) -> str:
@@ -340,6 +368,7 @@ def _sweep(cfg, cli, run, dev_cli, solver, out, quiet, source) -> int:
     cycles = run.get("cycles", DEFAULT_CYCLES["sweep"])
     require(cycles >= 2, f"cycles must be >= 2 for a sweep (the first is dropped), got {cycles!r}")
     params, wf = _device_and_waveform("sweep", cfg, dev_cli)
+    params = _viscoelastic("sweep", cfg, cli, params, wf)
     loads = np.logspace(np.log10(r_min), np.log10(r_max), points)
     from tengsim.device.config import check_pressures
 
@@ -350,7 +379,8 @@ def _sweep(cfg, cli, run, dev_cli, solver, out, quiet, source) -> int:
     from tengsim.io import jsonable
 
     k_opt = int(np.nanargmax(sw.average_power_W))  # the optimum's row
-    head = jsonable({"params": params.to_dict(), "waveform": wf.to_dict(), "optimum_ohm": sw.optimum_ohm,
+    head = jsonable({"area_model": _area_model(params), "params": params.to_dict(), "waveform": wf.to_dict(),
+                     "optimum_ohm": sw.optimum_ohm,
                     "optimum_power_W": sw.optimum_power_W,
                     "optimum_peak_power_W": float(sw.peak_power_W[k_opt]), "optimum_at_edge": sw.optimum_at_edge,
                     "run": {"case": "sweep", "cycles": cycles, "config": cfg, "config_file": source}})

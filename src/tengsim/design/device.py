@@ -10,9 +10,10 @@ where.  A waveform that presses outside the area table's pressures is refused
 (:func:`tengsim.device.config.check_pressures`): the table is never held at its ends in silence.
 
 A design with viscoelastic cycles (``tengsim design … --relaxation``) drives the device with the contact's own
-A/S(t) over its square cycle at the waveform's frequency (:func:`tengsim.device.areas.area_cycle_from_design`;
-docs/viscoelastic.md, "The device"): the waveform must be that cycle (a square wave from 0 to the cycles' p_max,
-pressed for half the period) at a frequency within the cycles'; ``area_model`` says which A the device used.
+A/S(t) over its presses at the waveform's frequency, press by press with the memory carried
+(:func:`tengsim.device.areas.area_cycle_for_waveform`; docs/viscoelastic.md, "The device"): the waveform must be
+one of the recorded presses (a square wave from 0 to the cycles' p_max pressed for half the period, or the sine
+press (p_max/2)(1 − cos 2πft)) at a frequency within the cycles'; ``area_model`` says which A the device used.
 """
 from __future__ import annotations
 
@@ -21,6 +22,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from tengsim.device.params import QUASI_STATIC
 from tengsim.errors import TengsimError
 
 DEFAULTS = {
@@ -32,8 +34,6 @@ DEFAULTS = {
     "frequency_Hz": (2.0, "square wave at 2 Hz"),
 }
 """What a design does not know, the paper's Fig. 8 device; ``amplitude_Pa`` defaults to the design's p_max."""
-QUASI_STATIC = "quasi-static A(P)"
-"""``area_model`` of a device driven by the design's static A/S(P) (no viscoelastic cycles in the design)."""
 FROM_DESIGN = {"sigma_C_per_m2": "sigma_C_m2", "eps_r": "eps_r", "thickness_m": "thickness_m", "gap_m": "gap_m"}
 """DeviceParams field: the design.nc attribute it is read from."""
 
@@ -63,9 +63,11 @@ class DesignedDevice:
                "design_pressure_range_Pa": list(self.pressure_range), "area_model": self.area_model}
         if self.params.area.carries_history:
             d = self.params.area.details
-            out["area_cycle"] = {k: d[k] for k in ("cycle", "cycle_frequencies_Hz", "cycle_weights",
-                                                   "design_cycle_frequencies_Hz", "grid_correction", "cycle_grid")
+            out["area_cycle"] = {k: d[k] for k in ("cycle", "press", "cycle_frequencies_Hz", "cycle_weights",
+                                                   "design_cycle_frequencies_Hz", "grid_correction", "cycle_grid",
+                                                   "presses_recorded", "steady_state")
                                  if k in d}
+            out["area_cycle"]["decay"] = self.params.area.decay
         return out
 
     def warnings(self) -> list:
@@ -176,28 +178,15 @@ def designed_device(path, device: dict | None = None, waveform: dict | None = No
 
 
 def _viscoelastic_area(path, wave, table):
-    """The :class:`tengsim.device.params.AreaCycle` of the design's viscoelastic cycles at the waveform's
-    frequency (None: the design has none); the waveform must be the cycles' square press (one line if not)."""
-    from tengsim.device import SquareWave
-    from tengsim.device.areas import area_cycle_from_design, visco_record
+    """The :class:`tengsim.device.params.AreaCycle` of the design's viscoelastic presses for the waveform (None: the
+    design has none); the waveform must be one of the recorded presses (one line if not;
+    :func:`tengsim.device.areas.area_cycle_for_waveform`)."""
+    from tengsim.device.areas import area_cycle_for_waveform, visco_record
 
     rec = visco_record(path)
     if rec is None:
         return None
-    pm = rec["p_max_Pa"]
-    what = (f"the design's viscoelastic cycles ({path}) are square presses from 0 to {pm / 1e3:.4g} kPa, pressed "
-            "for half of each period")
-    if not isinstance(wave, SquareWave):
-        raise TengsimError(f"device design: {what}; a [waveform] of kind {wave.to_dict()['kind']!r} is not one of "
-                           "them: give a square wave (the default)")
-    if abs(wave.amplitude_Pa - pm) > 1e-6 * pm:
-        raise TengsimError(f"device design: {what}; --pressure {wave.amplitude_Pa / 1e3:.4g} kPa is not that "
-                           f"cycle: press to {pm / 1e3:.4g} kPa (the default), or design with --p-max "
-                           f"{wave.amplitude_Pa / 1e3:.4g}kPa")
-    if abs(wave.duty - 0.5) > 1e-9 or wave.low_Pa != 0:
-        raise TengsimError(f"device design: {what}; a square wave of duty {wave.duty:g} from {wave.low_Pa:g} Pa is "
-                           "not that cycle: give duty 0.5 and low_Pa 0 (the defaults)")
-    return area_cycle_from_design(path, wave.frequency_Hz, float(table(pm)))
+    return area_cycle_for_waveform(path, wave, float(table(rec["p_max_Pa"])), where="device design")
 
 
 def _size(values) -> float:
@@ -215,13 +204,15 @@ def rest_gap_voltage(designed: DesignedDevice, result) -> dict:
 
     p = designed.params
     peak = waveform_peak(designed.waveform, float(result.t[-1]))
-    if p.area.carries_history:  # the cycle's A/S at the release (end of the press)
-        a = float(p.area.at_phase(0.5))
+    rest = np.flatnonzero(np.asarray(result.series["P_a"]) <= 0)  # released: the last row before the next press
+    i = int(rest[-1]) if rest.size else -1
+    if p.area.carries_history:  # the largest A/S of the last press (the square press's at its release)
+        f = p.area.frequency_Hz
+        last = max(math.floor(float(result.t[i]) * f - 1e-9), 0)
+        a = p.area.largest(last / f, (last + 1) / f)
     else:
         a = float(np.interp(peak, p.area.pressure_Pa, p.area.area_fraction)) if hasattr(p.area, "pressure_Pa") \
             else math.nan
-    rest = np.flatnonzero(np.asarray(result.series["P_a"]) <= 0)  # released: the last row before the next press
-    i = int(rest[-1]) if rest.size else -1
     return {"voc_at_rest_gap_V": float(result.series["V_oc"][i]), "gap_at_rest_m": float(result.series["gap"][i]),
             "design_voc_eq17_V": float(voc_apart(p.sigma_C_per_m2, a, p.gap_m, 1.0)), "pressed_to_Pa": peak}
 

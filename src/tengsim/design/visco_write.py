@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 
 COLS = ("frequency_Hz", "sensitivity_V_per_Pa", "linear_range_Pa", "voc_hysteresis_fraction", "response_s",
-        "recovery_s", "area_max")
+        "recovery_s", "area_max", "area_max_steady")
 
 
 def _fmt(v, scale=1.0, digits=3) -> str:
@@ -29,12 +29,21 @@ def report_section(vd) -> str:
              f"V_OC(P)) and a square cycle (press in 5 % of the period, hold, release; response and recovery time to "
              f"90 % of V_OC's change), load-controlled, on one coarse grid {vd.grid}: rate effects, not converged "
              f"numbers (the static design above is). 0 Hz: the relaxed elastic solid (E∞).", "",
-             "| f (Hz) | sensitivity (V/kPa) | linear range (kPa) | hysteresis | response (ms) | recovery (ms) | max A/S |",
-             "|---|---|---|---|---|---|---|"]
+             "| f (Hz) | sensitivity (V/kPa) | linear range (kPa) | hysteresis | response (ms) | recovery (ms) | max A/S "
+             "| max A/S, steady |",
+             "|---|---|---|---|---|---|---|---|"]
     for r in vd.table:
         lines.append(f"| {_fmt(r['frequency_Hz'])} | {_fmt(r['sensitivity_V_per_Pa'], 1e3)} | "
                      f"{_fmt(r['linear_range_Pa'], 1e-3)} | {_fmt(r['voc_hysteresis_fraction'], 100)} % | "
-                     f"{_fmt(r['response_s'], 1e3)} | {_fmt(r['recovery_s'], 1e3)} | {_fmt(r['area_max'], 1, 4)} |")
+                     f"{_fmt(r['response_s'], 1e3)} | {_fmt(r['recovery_s'], 1e3)} | {_fmt(r['area_max'], 1, 4)} | "
+                     f"{_fmt(r.get('area_max_steady', math.nan), 1, 4)} |")
+    if vd.steady:
+        lines += ["", "The device's presses repeated with the material's memory carried from one period to the next "
+                  "(max A/S, steady: the square press's periodic steady state; the first press starts from rest): "
+                  + "; ".join(f"{s['cycle']} at {s['frequency_Hz']:g} Hz "
+                              f"{'repeats' if s['converged'] else 'does NOT repeat'} to "
+                              f"{_fmt(s['change'], 100, 2)} % after {s['evaluations']} periods" for s in vd.steady)
+                  + "."]
     lines += ["", "![viscoelastic cycles](visco.png)", ""]
     return "\n".join(lines)
 
@@ -53,13 +62,15 @@ def figure(vd, path: Path) -> None:
             if cyc.frequency != f:
                 continue
             period = 1 / f if f else 1.0
-            ls = "--" if not f else "-"
+            ls = "--" if not f else "-" if cyc.press == 1 else ":"
+            if cyc.press not in (0, 1):
+                continue
             if cyc.kind == "square":
                 axes[0].plot(cyc.t / period, cyc.area, ls, color=c, label=label)
                 axes[1].plot(cyc.t / period, cyc.voc, ls, color=c, label=label)
-            else:
+            elif cyc.kind == "triangle":
                 axes[2].plot(cyc.pressure_Pa / 1e3, cyc.voc, ls, color=c, label=label)
-    axes[0].set(xlabel="t / period (square cycle)", ylabel="A/S")
+    axes[0].set(xlabel="t / period (square cycle; dotted: its periodic steady state)", ylabel="A/S")
     axes[1].set(xlabel="t / period (square cycle)", ylabel="V_OC (V, Eq. 12)")
     axes[2].set(xlabel="nominal pressure (kPa, triangle cycle)", ylabel="V_OC (V, Eq. 12)")
     for ax in axes:
@@ -75,6 +86,7 @@ RECORD = {  # design.nc variable (along VISCO_DIM): (units, long_name)
     "visco_time": ("s", "time from the start of the cycle"),
     "visco_pressure": ("Pa", "nominal pressure (load control)"),
     "visco_charged_area_fraction": ("1", "charged contact area over cell area (A/S) on the cycles' coarse grid"),
+    "visco_press": ("1", "which press of the repeated cycle (1, 2, ... from rest; 0: its periodic steady state)"),
 }
 VISCO_DIM = "visco_row"
 
@@ -84,7 +96,9 @@ def record_in_design(vd, folder) -> Path | None:
     (triangle or square) along :data:`VISCO_DIM`, one row per time of each cycle as in visco.csv, and the
     attributes ``relaxation`` (JSON: E_inf_Pa, E_Pa, tau_s, source), ``visco_frequencies_Hz``, ``visco_p_max_Pa``
     (every cycle presses to it), ``visco_rise`` (the square cycle's ramps, a fraction of its period; pressed for
-    half the period), ``visco_grid``.  Rewritten whole (atomically): the design's own variables unchanged."""
+    half the period), ``visco_grid``, ``visco_steady`` (JSON: per frequency and press, how its periodic steady state
+    converged).  A square or sine press has rows for its presses 1, 2, … from rest and for its steady state
+    (``visco_press`` 0).  Rewritten whole (atomically): the design's own variables unchanged."""
     import json
 
     from tengsim.design.visco import RISE
@@ -94,18 +108,21 @@ def record_in_design(vd, folder) -> Path | None:
     if not path.is_file():
         return None
     ds = read_dataset(path)
-    cols = {"visco_frequency": [], "visco_time": [], "visco_pressure": [], "visco_charged_area_fraction": []}
+    cols = {"visco_frequency": [], "visco_time": [], "visco_pressure": [], "visco_charged_area_fraction": [],
+            "visco_press": []}
     kinds = []
     for c in vd.cycles:
         cols["visco_frequency"].append(np.full(c.t.size, float(c.frequency)))
         cols["visco_time"].append(np.asarray(c.t, float))
         cols["visco_pressure"].append(np.asarray(c.pressure_Pa, float))
         cols["visco_charged_area_fraction"].append(np.asarray(c.area, float))
+        cols["visco_press"].append(np.full(c.t.size, int(c.press)))
         kinds += [c.kind] * c.t.size
     for name, parts in cols.items():
         units, long_name = RECORD[name]
         ds[name] = ((VISCO_DIM,), np.concatenate(parts), {"units": units, "long_name": long_name})
-    ds["visco_cycle"] = ((VISCO_DIM,), np.array(kinds, dtype=object), {"long_name": "triangle or square cycle"})
+    ds["visco_cycle"] = ((VISCO_DIM,), np.array(kinds, dtype=object),
+                         {"long_name": "triangle, square or sine cycle"})
     m = vd.material
     ds.attrs["relaxation"] = json.dumps({"E_inf_Pa": m.E_inf, "E_Pa": list(m.E), "tau_s": list(m.tau),
                                          "source": m.source})
@@ -113,6 +130,8 @@ def record_in_design(vd, folder) -> Path | None:
     ds.attrs["visco_p_max_Pa"] = float(vd.p_max_Pa)
     ds.attrs["visco_rise"] = float(RISE)
     ds.attrs["visco_grid"] = str(vd.grid)
+    ds.attrs["visco_steady"] = json.dumps([{k: (bool(v) if isinstance(v, (bool, np.bool_)) else v)
+                                            for k, v in s.items()} for s in vd.steady])
     write_dataset(ds, path)
     return path
 
@@ -123,10 +142,11 @@ def write_visco(vd, folder) -> list:
     rows = folder / "visco.csv"
     with rows.open("w", newline="") as fh:
         w = csv.writer(fh)
-        w.writerow(["frequency_Hz", "cycle", "time_s", "pressure_Pa", "area_fraction", "voc_V", "force_N"])
+        w.writerow(["frequency_Hz", "cycle", "press", "time_s", "pressure_Pa", "area_fraction", "voc_V", "force_N"])
         for c in vd.cycles:
             for i in range(c.t.size):
-                w.writerow([c.frequency, c.kind, c.t[i], c.pressure_Pa[i], c.area[i], c.voc[i], c.force_N[i]])
+                w.writerow([c.frequency, c.kind, c.press, c.t[i], c.pressure_Pa[i], c.area[i], c.voc[i],
+                            c.force_N[i]])
     table = folder / "visco_table.csv"
     with table.open("w", newline="") as fh:
         w = csv.writer(fh)

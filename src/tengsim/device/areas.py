@@ -134,11 +134,18 @@ def _landing_after(P):
     return P
 
 
+PRESS_KINDS = ("square", "sine")
+"""The presses a design records with their memory (:data:`tengsim.design.visco.PRESSES`; the device layer's copy of
+the names its records hold)."""
+
+
 def visco_record(path) -> dict | None:
     """The viscoelastic cycles a design result holds (``tengsim design … --relaxation``,
     :func:`tengsim.design.visco_write.record_in_design`), None for a design without: {'frequencies_Hz' (the
-    cycles', increasing, without the relaxed 0), 'p_max_Pa', 'rise', 'grid', 'relaxation' (dict), 'square':
-    {frequency: (t s, P Pa, A/S)} (0: the relaxed elastic solid, period 1 s)}."""
+    square cycles', increasing, without the relaxed 0), 'p_max_Pa', 'rise', 'grid', 'relaxation' (dict),
+    'square': {frequency: (t s, P Pa, A/S)} (the first press; 0: the relaxed elastic solid, period 1 s),
+    'presses': {kind: {frequency: {'periods': [(t, P, A/S) of press 1, 2, …], 'steady': (t, P, A/S) or None}}},
+    'steady': the record's list of how each steady state converged}."""
     import json
 
     import xarray as xr
@@ -159,16 +166,27 @@ def visco_record(path) -> dict | None:
             t = np.asarray(ds["visco_time"].values, float)
             P = np.asarray(ds["visco_pressure"].values, float) if "visco_pressure" in ds else np.full(t.size, np.nan)
             a = np.asarray(ds["visco_charged_area_fraction"].values, float)
+            press = (np.asarray(ds["visco_press"].values, int) if "visco_press" in ds
+                     else np.ones(t.size, int))  # a record written before the presses were repeated: press 1 only
             attrs = dict(ds.attrs)
     except (OSError, ValueError) as exc:
         raise TengsimError(f"area: cannot read {str(p)!r} as a design result ({str(exc).splitlines()[0][:80]})") \
             from None
-    square = {}
-    for fr in np.unique(f):
-        m = (f == fr) & (kind == "square") & np.isfinite(t) & np.isfinite(a)
-        if np.count_nonzero(m) >= 2:
-            order = np.argsort(t[m], kind="stable")
-            square[float(fr)] = (t[m][order], P[m][order], np.clip(a[m][order], 0.0, 1.0))
+    presses = {}
+    for k in PRESS_KINDS:
+        for fr in np.unique(f[kind == k]):
+            rows = {}
+            for n in np.unique(press[(kind == k) & (f == fr)]):
+                m = (f == fr) & (kind == k) & (press == n) & np.isfinite(t) & np.isfinite(a)
+                if np.count_nonzero(m) >= 2:
+                    order = np.argsort(t[m], kind="stable")
+                    rows[int(n)] = (t[m][order], P[m][order], np.clip(a[m][order], 0.0, 1.0))
+            periods = []
+            while len(periods) + 1 in rows:
+                periods.append(rows[len(periods) + 1])
+            if periods:
+                presses.setdefault(k, {})[float(fr)] = {"periods": periods, "steady": rows.get(0)}
+    square = {fr: v["periods"][0] for fr, v in presses.get("square", {}).items()}
     freqs = np.array(sorted(k for k in square if k > 0))
     if freqs.size == 0 or 0.0 not in square:
         raise TengsimError(f"area: {str(p)!r}: its viscoelastic record holds no square cycle "
@@ -177,57 +195,120 @@ def visco_record(path) -> dict | None:
         relax = json.loads(str(attrs["relaxation"]))
     except ValueError:
         relax = {"text": str(attrs["relaxation"])}
+    try:
+        steady = json.loads(str(attrs.get("visco_steady", "[]")))
+    except ValueError:
+        steady = []
     return {"frequencies_Hz": freqs, "p_max_Pa": float(attrs["visco_p_max_Pa"]),
             "rise": float(attrs.get("visco_rise", math.nan)), "grid": str(attrs.get("visco_grid", "")),
-            "relaxation": relax, "square": square, "source": str(p)}
+            "relaxation": relax, "square": square, "presses": presses, "steady": steady, "source": str(p)}
 
 
-def area_cycle_from_design(path, frequency_Hz: float, static_fraction: float | None = None):
-    """The :class:`AreaCycle` of a design result's viscoelastic square cycles (:func:`visco_record`; None for a
-    design without) at the waveform's ``frequency_Hz``: the design's cycle at that frequency, or between two of
-    its frequencies the two nearest interpolated linearly in log f at each phase; outside them refused (the
-    contact's rate response is not extrapolated).  ``static_fraction``: the converged static design's A/S at
-    p_max; the cycles (on one coarse grid) are scaled by it over the relaxed (E∞) cycle's A/S at the end of its
-    hold, the same state on the coarse grid (the factor is ``details['grid_correction']``)."""
+def area_cycle_from_design(path, frequency_Hz: float, static_fraction: float | None = None, press: str = "square",
+                           record: dict | None = None):
+    """The :class:`AreaCycle` of a design result's viscoelastic presses ``press`` (square or sine;
+    :func:`visco_record`; None for a design without) at the waveform's ``frequency_Hz``: the design's cycles at that
+    frequency, or between two of its frequencies the two nearest interpolated linearly in log f at each phase;
+    outside them refused (the contact's rate response is not extrapolated).  Each of the press's recorded periods
+    (1, 2, … from rest) and its periodic steady state is carried (:class:`AreaCycle`: press n of the device reads
+    its own).  ``static_fraction``: the converged static design's A/S at p_max; the cycles (on one coarse grid) are
+    scaled by it over the relaxed (E∞) cycle's A/S at the end of its hold, the same state on the coarse grid (the
+    factor is ``details['grid_correction']``)."""
     from tengsim.device.params import AreaCycle
 
-    rec = visco_record(path)
+    rec = visco_record(path) if record is None else record
     if rec is None:
         return None
     f = float(frequency_Hz)
-    fs = rec["frequencies_Hz"]
+    table = rec["presses"].get(press, {})
+    fs = np.array(sorted(k for k in table if k > 0))
+    if fs.size == 0:
+        raise TengsimError(f"device: the design's viscoelastic record ({rec['source']}) holds no {press} press: "
+                           "write it again with `tengsim design … --relaxation FILE` (which records the square and "
+                           "the sine press)")
     span = f"{fs[0]:g} to {fs[-1]:g} Hz" if fs.size > 1 else f"{fs[0]:g} Hz only"
     if not (fs[0] * (1 - 1e-9) <= f <= fs[-1] * (1 + 1e-9)):
         raise TengsimError(f"device design: the waveform's frequency {f:g} Hz is outside the design's viscoelastic "
                            f"cycles ({span}; {rec['source']}): give --frequency within them (the contact's rate "
                            "response is not extrapolated)")
 
-    def cycle(fr):
-        t, _, a = rec["square"][fr]
-        return np.clip(t * (fr if fr > 0 else 1.0), 0.0, 1.0), a
+    def presses(fr):
+        """[(phase, A/S) of press 1, 2, …], (phase, A/S) of the steady state (the last press if none)."""
+        rows = table[fr]
+        ph = [(np.clip(t * fr, 0.0, 1.0), a) for t, _, a in rows["periods"]]
+        st = rows["steady"]
+        return ph, ((np.clip(st[0] * fr, 0.0, 1.0), st[2]) if st is not None else ph[-1])
 
     near = np.flatnonzero(np.abs(np.log(fs / f)) <= 1e-9)
     if near.size:
         used, weights = [float(fs[near[0]])], [1.0]
-        phase, area = cycle(used[0])
         how = f"the design's cycle at {used[0]:g} Hz"
     else:
         j = int(np.searchsorted(fs, f))
         f1, f2 = float(fs[j - 1]), float(fs[j])
         w = math.log(f / f1) / math.log(f2 / f1)
-        (p1, a1), (p2, a2) = cycle(f1), cycle(f2)
-        phase = np.union1d(p1, p2)
-        area = (1 - w) * np.interp(phase, p1, a1) + w * np.interp(phase, p2, a2)
         used, weights = [f1, f2], [1 - w, w]
         how = f"interpolated in log f between the design's cycles at {f1:g} and {f2:g} Hz (weights {1 - w:.3g}, {w:.3g})"
+    per = [presses(fr) for fr in used]
+    phase = np.unique(np.concatenate([c[0] for pp, st in per for c in pp + [st]]))
+    n = min(len(pp) for pp, _ in per)
+
+    def mix(pick):
+        return sum(wt * np.interp(phase, *pick(pp, st)) for wt, (pp, st) in zip(weights, per))
+
     rel_t, _, rel_a = rec["square"][0.0]
     held = float(np.interp(0.5, rel_t, rel_a))  # the relaxed cycle at the end of its hold (period 1 s)
     corr = float(static_fraction) / held if static_fraction is not None and held > 0 else 1.0
-    area = np.clip(corr * np.asarray(area, float), 0.0, 1.0)
-    details = {"cycle": how, "cycle_frequencies_Hz": used, "cycle_weights": weights,
+    cycles = [np.clip(corr * mix(lambda pp, st, i=i: pp[i]), 0.0, 1.0) for i in range(n)]
+    steady = np.clip(corr * mix(lambda pp, st: st), 0.0, 1.0)
+    conv = [s for s in rec.get("steady", []) if s.get("cycle") == press and float(s.get("frequency_Hz", -1)) in used]
+    details = {"cycle": how, "press": press, "cycle_frequencies_Hz": used, "cycle_weights": weights,
                "design_cycle_frequencies_Hz": fs.tolist(), "cycle_p_max_Pa": rec["p_max_Pa"],
-               "grid_correction": corr, "cycle_grid": rec["grid"], "relaxation": rec["relaxation"]}
-    return AreaCycle(f, phase, area, f"viscoelastic cycle at {f:g} Hz", details)
+               "grid_correction": corr, "cycle_grid": rec["grid"], "relaxation": rec["relaxation"],
+               "presses_recorded": n, "steady_state": conv}
+    return AreaCycle(f, phase, cycles[0], f"viscoelastic {press} cycle at {f:g} Hz" if press != "square"
+                     else f"viscoelastic cycle at {f:g} Hz", details, tuple(cycles[1:]), steady)
+
+
+def area_cycle_for_waveform(path, wave, static_fraction: float | None = None, where: str = "device"):
+    """The :class:`AreaCycle` of a design result's viscoelastic presses for the waveform ``wave`` (None: the design
+    has none); a waveform that is none of the recorded presses is refused in one line saying which ones are: a
+    square wave from 0 to the cycles' p_max pressed for half the period, or the sine press
+    (p_max/2)(1 − cos 2π f t) (a Sine with amplitude = offset = p_max/2, phase −π/2)."""
+    from tengsim.device.waveforms import Sine, SquareWave
+
+    rec = visco_record(path)
+    if rec is None:
+        return None
+    pm = rec["p_max_Pa"]
+    kinds = set(rec["presses"]) & set(PRESS_KINDS)
+    sine = "sine" in kinds
+    what = (f"the design's viscoelastic cycles ({rec['source']}) are a square press from 0 to {pm / 1e3:.4g} kPa, "
+            "pressed for half of each period" + (f", and the sine press {pm / 2e3:.4g} kPa × (1 − cos 2πft) "
+                                                 "(amplitude = offset = p_max/2, phase −π/2)" if sine else ""))
+    kind = wave.to_dict()["kind"]
+    if isinstance(wave, Sine):
+        if not sine:
+            raise TengsimError(f"{where}: {what}; this record holds no sine press: write the design again with "
+                               "`tengsim design … --relaxation FILE`, or give a square wave")
+        ph = math.remainder(wave.phase_rad + math.pi / 2, 2 * math.pi)
+        if (abs(wave.amplitude_Pa - pm / 2) > 1e-6 * pm or abs(wave.offset_Pa - pm / 2) > 1e-6 * pm
+                or abs(ph) > 1e-9):
+            raise TengsimError(f"{where}: {what}; a sine of amplitude {wave.amplitude_Pa / 1e3:.4g} kPa, offset "
+                               f"{wave.offset_Pa / 1e3:.4g} kPa, phase {wave.phase_rad:.4g} rad is not that press: give "
+                               f"amplitude_Pa = offset_Pa = {pm / 2:.6g} and phase_rad = {-math.pi / 2:.6g}")
+        return area_cycle_from_design(path, wave.frequency_Hz, static_fraction, "sine", rec)
+    if not isinstance(wave, SquareWave):
+        raise TengsimError(f"{where}: {what}; a [waveform] of kind {kind!r} is not one of them (its own presses are "
+                           "not recorded): give a square wave" + (" or that sine" if sine else ""))
+    if abs(wave.amplitude_Pa - pm) > 1e-6 * pm:
+        raise TengsimError(f"{where}: {what}; --pressure {wave.amplitude_Pa / 1e3:.4g} kPa is not that "
+                           f"cycle: press to {pm / 1e3:.4g} kPa (the default), or design with --p-max "
+                           f"{wave.amplitude_Pa / 1e3:.4g}kPa")
+    if abs(wave.duty - 0.5) > 1e-9 or wave.low_Pa != 0:
+        raise TengsimError(f"{where}: {what}; a square wave of duty {wave.duty:g} from {wave.low_Pa:g} Pa is "
+                           "not that cycle: give duty 0.5 and low_Pa 0 (the defaults)")
+    return area_cycle_from_design(path, wave.frequency_Hz, static_fraction, "square", rec)
 
 
 def _approach_states(ds):
@@ -300,6 +381,24 @@ def _one_line(read):
     return wrapped
 
 
+def design_visco_record(path) -> dict | None:
+    """The viscoelastic record (:func:`visco_record`) of ``path`` if it is a design result (DIR, DIR/design.nc)
+    with cycles; None for a design without, a contact result or no file (whose own readers say what is wrong)."""
+    p = Path(path)
+    if p.is_dir():
+        return visco_record(p) if (p / DESIGN_FILE).is_file() else None
+    if not p.is_file() or p.suffix.lower() == ".csv":
+        return None
+    import xarray as xr
+
+    try:
+        with xr.open_dataset(p) as ds:
+            design = AREA_VARIABLE in ds
+    except (OSError, ValueError):
+        return None
+    return visco_record(p) if design else None
+
+
 @_one_line
 def area_table_from_file(path) -> AreaTable:
     """The area model of a result on file: a design result (DIR, DIR/design.nc) or a contact result."""
@@ -319,5 +418,5 @@ def area_table_from_file(path) -> AreaTable:
     return area_table_from_design(p)
 
 
-__all__ = ["area_cycle_from_design", "visco_record", "area_table_from_contact", "area_table_from_design",
+__all__ = ["area_cycle_from_design", "area_cycle_for_waveform", "design_visco_record", "visco_record", "area_table_from_contact", "area_table_from_design",
            "area_table_from_file", "design_path", "passed_curve", "stable_branch", "DESIGN_FILE"]

@@ -14,7 +14,8 @@ Rules the paper leaves open (see docs/device.md):
 * Charged area: while in contact A follows A(P); the polymer keeps its charge, so in flight A is
   the largest area reached so far ("max") or the area at release ("release").  An area that carries its own
   history (:class:`tengsim.device.params.AreaCycle`, a viscoelastic contact's cycle) is read at the time, not
-  the pressure, and in flight is the area at release: no ``area_memory`` rule.
+  the pressure, and in flight is the largest area of the press just ended (the area it charged; the square
+  press's at its release, where the held contact has crept to): no ``area_memory`` rule.
 """
 from __future__ import annotations
 
@@ -275,9 +276,11 @@ def _contact_charge(q0: float, lam: float, a: float):
 
 def _contact_area(core: _Core, g1: float, a: float, b: float) -> float:
     """Charged-area fraction after a contact interval [a, b] (tbar), per ``area_memory`` (an area that carries
-    its own history: the area at b, the release)."""
+    its own history: the largest A/S of that press, :meth:`tengsim.device.params.AreaCycle.largest`)."""
+    if core.history:
+        return float(core.p.area.largest(a * core.tau, b * core.tau))
     tt = np.linspace(a, b, 33) if b > a else np.array([a])
     demand = _area_fraction(core, tt)
-    if core.p.area_memory == "release" or core.history:
+    if core.p.area_memory == "release":
         return float(demand[-1])
     return float(max(g1, demand.max()))

@@ -144,17 +144,24 @@ class AreaFunction:
 
 @dataclass(frozen=True, eq=False)
 class AreaCycle:
-    """A charged area that carries its own history: A/S over one period of a periodic press, at the phase
+    """A charged area that carries its own history: A/S over each period of a periodic press, at the phase
     ``phase`` (t f mod 1, increasing over [0, 1]) of a waveform at ``frequency_Hz`` (a viscoelastic contact's
-    cycle, :func:`tengsim.device.areas.area_cycle_from_design`).  In contact the device's A/S is the cycle's at
-    the waveform's phase; in flight the value at the release (the contact's own area when it separated).  No
-    ``area_memory`` rule applies: the history is in the cycle.  ``label`` says which cycle it is."""
+    cycles, :func:`tengsim.device.areas.area_cycle_from_design`).  ``area_fraction``: the first press, from rest;
+    ``later``: presses 2, 3, … as the contact passed them, each from the memory the one before left; ``steady``:
+    the periodic steady state the presses tend to (None: every press is the first).  Press n beyond the recorded
+    ones is the steady state plus the last recorded press's difference from it times ``decay``^(n − recorded),
+    ``decay`` the ratio of the last two recorded presses' differences from the steady state (a geometric approach,
+    the slowest branch's).  In contact the device's A/S is its press's at the waveform's phase; in flight the value
+    the largest of the press just ended (the area that press charged, :meth:`largest`; the square press's at its
+    release).  No ``area_memory`` rule applies: the history is in the cycles.  ``label`` says which cycle it is."""
 
     frequency_Hz: float
     phase: np.ndarray
     area_fraction: np.ndarray
     label: str = "viscoelastic cycle"
     details: dict = field(default_factory=dict)
+    later: tuple = ()
+    steady: np.ndarray | None = None
 
     carries_history = True
 
@@ -162,35 +169,96 @@ class AreaCycle:
         object.__setattr__(self, "frequency_Hz", positive("frequency_Hz", self.frequency_Hz))
         try:
             ph = np.array(self.phase, dtype=float).ravel()
-            a = np.array(self.area_fraction, dtype=float).ravel()
+            rows = [np.array(a, dtype=float).ravel() for a in (self.area_fraction, *self.later)]
+            st = None if self.steady is None else np.array(self.steady, dtype=float).ravel()
         except (TypeError, ValueError):
             raise TengsimError("area cycle must hold numbers") from None
-        require(ph.size >= 2 and ph.size == a.size, f"area cycle: {ph.size} phases but {a.size} area fractions")
-        require(bool(np.all(np.isfinite(ph)) and np.all(np.isfinite(a))), "area cycle holds non-finite values")
+        require(ph.size >= 2, f"area cycle: {ph.size} phases, needs at least 2")
+        for a in rows + ([st] if st is not None else []):
+            require(a.size == ph.size, f"area cycle: {ph.size} phases but {a.size} area fractions")
+            require(bool(np.all(np.isfinite(a))), "area cycle holds non-finite values")
+            require(bool(np.all((a >= 0) & (a <= 1))), f"area fractions must be in [0, 1], got {a[(a < 0) | (a > 1)][:3]}")
+        require(bool(np.all(np.isfinite(ph))), "area cycle holds non-finite values")
         require(bool(np.all(np.diff(ph) >= 0)) and ph[0] >= 0 and ph[-1] <= 1,
                 "area cycle phases must increase within [0, 1]")
-        require(bool(np.all((a >= 0) & (a <= 1))), f"area fractions must be in [0, 1], got {a[(a < 0) | (a > 1)][:3]}")
-        ph.setflags(write=False)
-        a.setflags(write=False)
+        for a in [ph] + rows + ([st] if st is not None else []):
+            a.setflags(write=False)
         object.__setattr__(self, "phase", ph)
-        object.__setattr__(self, "area_fraction", a)
+        object.__setattr__(self, "area_fraction", rows[0])
+        object.__setattr__(self, "later", tuple(rows[1:]))
+        object.__setattr__(self, "steady", st)
+        decay = 0.0
+        if st is not None and len(rows) >= 2:
+            d1, d2 = rows[-2] - st, rows[-1] - st
+            den = float(np.dot(d1, d1))
+            decay = float(np.clip(np.dot(d2, d1) / den, 0.0, 1.0 - 1e-12)) if den > 0 else 0.0
+        object.__setattr__(self, "_decay", decay)
+
+    @property
+    def decay(self) -> float:
+        """The presses' geometric approach to the steady state beyond the recorded ones (class doc)."""
+        return self._decay
 
     @property
     def initial_fraction(self) -> float:
         """Uncharged until the first contact."""
         return 0.0
 
-    def at_time(self, t_s):
-        """A/S at time ``t_s`` (s) of the waveform: the cycle's value at its phase."""
-        phase = np.mod(np.asarray(t_s, dtype=float) * self.frequency_Hz, 1.0)
-        return np.interp(phase, self.phase, self.area_fraction)
+    def press(self, n: int) -> np.ndarray:
+        """A/S on ``phase`` of press ``n`` (1: the first, from rest)."""
+        rows = (self.area_fraction, *self.later)
+        n = max(int(n), 1)
+        if n <= len(rows) or self.steady is None:
+            return rows[min(n, len(rows)) - 1]
+        return np.clip(self.steady + (rows[-1] - self.steady) * self._decay ** (n - len(rows)), 0.0, 1.0)
 
-    def at_phase(self, phase):
-        return np.interp(np.asarray(phase, dtype=float), self.phase, self.area_fraction)
+    def at_time(self, t_s):
+        """A/S at time ``t_s`` (s) of the waveform: its press's value at its phase."""
+        x = np.asarray(t_s, dtype=float) * self.frequency_Hz
+        k = np.floor(x)
+        phase = x - k
+        out = np.empty_like(phase)
+        for n in np.unique(k):
+            m = k == n
+            out[m] = np.interp(phase[m], self.phase, self.press(int(n) + 1))
+        return out
+
+    def largest(self, t0_s: float, t1_s: float) -> float:
+        """The largest A/S over the times [t0_s, t1_s] (s) of the waveform, at its ends and every node of the cycles
+        between: the area a press in contact over that interval charged."""
+        f = self.frequency_Hz
+        t = [float(t0_s), float(t1_s)]
+        for k in range(math.floor(t0_s * f), math.floor(t1_s * f) + 1):
+            nodes = (k + self.phase) / f
+            t += nodes[(nodes > t0_s) & (nodes < t1_s)].tolist()
+        return float(np.max(self.at_time(np.asarray(t))))
+
+    def at_phase(self, phase, press: int = 1):
+        """A/S at ``phase`` of press ``press`` (1: the first)."""
+        return np.interp(np.asarray(phase, dtype=float), self.phase, self.press(press))
 
     def to_dict(self) -> dict:
-        return {"kind": "cycle", "label": self.label, "frequency_Hz": self.frequency_Hz,
-                "phase": self.phase.tolist(), "area_fraction": self.area_fraction.tolist(), **self.details}
+        d = {"kind": "cycle", "label": self.label, "frequency_Hz": self.frequency_Hz,
+             "phase": self.phase.tolist(), "area_fraction": self.area_fraction.tolist(), **self.details}
+        if self.later:
+            d["later_presses"] = [a.tolist() for a in self.later]
+        if self.steady is not None:
+            d["steady_area_fraction"] = self.steady.tolist()
+            d["decay"] = self._decay
+        return d
+
+
+QUASI_STATIC = "quasi-static A(P)"
+"""The label of an area read from the pressure (an A/S(P) table or function, a constant): the ``area_model`` a
+device summary states; an area that carries its own history states its ``label``."""
+
+
+def area_model_label(area) -> str:
+    """Which A a device used: the cycle's label ('viscoelastic cycle at 2 Hz') or :data:`QUASI_STATIC`
+    ('constant A/S' for a constant fraction)."""
+    if area.carries_history:
+        return str(area.label)
+    return "constant A/S" if isinstance(area, ConstantArea) else QUASI_STATIC
 
 
 def area_model(area):

@@ -4,8 +4,10 @@ from tengsim.visco.history import (FixedTimeSteps, GeometricTimeSteps, History, 
                                    square_wave, triangle)
 from tengsim.visco.memory import MaxwellMemory, StepOperator
 from tengsim.visco.result import TimeResult
-from tengsim.visco.drive import TimeDrive
-from tengsim.visco.simulate import simulate_history
+from tengsim.visco.drive import DriveEnd, TimeDrive
+from tengsim.visco.periodic import PeriodicCycles, periodic_cycles
+from tengsim.visco.simulate import build_drive, simulate_history, simulate_periodic
 
 __all__ = ["FixedTimeSteps", "GeometricTimeSteps", "History", "SegmentSteps", "ramp_hold", "read_history", "square_wave",
-           "triangle", "MaxwellMemory", "StepOperator", "TimeResult", "TimeDrive", "simulate_history"]
+           "triangle", "MaxwellMemory", "StepOperator", "TimeResult", "DriveEnd", "TimeDrive",
+           "PeriodicCycles", "periodic_cycles", "build_drive", "simulate_history", "simulate_periodic"]

@@ -12,6 +12,8 @@ in time down to ``dt_min``: a snap-in or a pull-off is located in time to that r
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from tengsim.analysis import apex_index, summarize
@@ -24,6 +26,17 @@ from tengsim.visco.memory import MaxwellMemory, StepOperator
 from tengsim.visco.result import COLUMNS, TimeResult
 
 MAX_ROOT = 60  # regula-falsi steps of one load-controlled step
+
+
+@dataclass(frozen=True)
+class DriveEnd:
+    """Where a run ended: the material's ``memory``, the solver's last ``state`` (a warm start), the kernel's
+    coupling ratio E_ref/E_eff of its last step and the approach ``D`` (ε): what a run that goes on from it needs."""
+
+    memory: MaxwellMemory
+    state: State | None
+    ratio: float
+    D: float
 
 
 class TimeDrive:
@@ -140,11 +153,23 @@ class TimeDrive:
     # ---- the run ----------------------------------------------------------------------------------------------
     def run(self, history: History, steps, start_D: float | None = None) -> TimeResult:
         """The run of ``history`` with the step control ``steps``; the surface at rest before the first time."""
+        return self.run_from(history, steps, start_D=start_D)[0]
+
+    def run_from(self, history: History, steps, start: DriveEnd | None = None,
+                 start_D: float | None = None) -> tuple:
+        """(TimeResult, DriveEnd): the run of ``history`` from ``start`` (the :class:`DriveEnd` of an earlier run:
+        its memory, warm start and approach; None: the surface at rest), and where it ended.  The first point is
+        the instantaneous step from the start's memory to the control at the history's first time (from a
+        memory that run ended with at that control, the same state again)."""
         kind = history.kind
-        mem = MaxwellMemory.rest(self.U0.shape, self.material.branches)
-        state, ratio = None, 1.0
-        D = float(history.value[0]) if kind == "approach" else (float(start_D) if start_D is not None
-                                                                 else float(self.U0.min()) - 2.0)
+        if start is None:
+            mem = MaxwellMemory.rest(self.U0.shape, self.material.branches)
+            state, ratio = None, 1.0
+            D = float(history.value[0]) if kind == "approach" else (float(start_D) if start_D is not None
+                                                                     else float(self.U0.min()) - 2.0)
+        else:
+            mem, state, ratio = start.memory, start.state, start.ratio
+            D = float(history.value[0]) if kind == "approach" else float(start.D)
         rows, maps = [], {}
         t0 = float(history.t[0])
         # the first point: the surface at rest meets the control at t0 (an instantaneous step)
@@ -175,7 +200,8 @@ class TimeDrive:
                   "E_ref_Pa": self.E_ref, "coupling_ref": self.coupling, "jump_h": self.jump_h,
                   "dt_min_s": dt_min or 0.0, "solver": getattr(self.solver, "name", ""),
                   **getattr(self.law, "params", dict)()}
-        return TimeResult(t, cols, np.array([r[2] for r in rows]), np.array([r[3] for r in rows]), params, maps)
+        res = TimeResult(t, cols, np.array([r[2] for r in rows]), np.array([r[3] for r in rows]), params, maps)
+        return res, DriveEnd(mem, state, ratio, D)
 
     def _advance(self, mem, state, ratio, D, eq, ta, tb, kind, value_at, dt_min, rows, maps, depth=0):
         """The step ta → tb, bisected at a jump down to dt_min; rows appended; returns the new (mem, state, ratio, D, eq)."""
