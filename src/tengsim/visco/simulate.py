@@ -8,14 +8,14 @@ from tengsim.kernels import make_kernel
 from tengsim.laws import Law
 from tengsim.registry import LAWS
 from tengsim.relaxation import Prony
-from tengsim.solvers import make_solver
+from tengsim.solvers import SOLVER_TOL, make_solver
 from tengsim.visco.drive import TimeDrive
 from tengsim.visco.history import History
 from tengsim.visco.periodic import MAX_PERIODS, PLAIN, TOL, PeriodicCycles, periodic_cycles
 
 
 def build_drive(shape, tabor: float, dx: float, material: Prony, boundary: str = "free", law: Law | str | None = None,
-                solver="fast", tol: float = 1e-6, kernel_params: dict | None = None, E_ref: float | None = None,
+                solver="fast", tol: float = SOLVER_TOL, kernel_params: dict | None = None, E_ref: float | None = None,
                 jump_h: float = 0.3, dt_min: float | None = None, maps_at=(), grid=None, **drive_kw):
     """(TimeDrive, params): the drive of ``shape`` with Tabor's μ = ``tabor`` at the reference modulus ``E_ref``
     (Pa, default the material's E∞: the static run's μ is the relaxed solid's), and the shape's and grid's
