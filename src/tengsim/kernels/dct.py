@@ -264,6 +264,40 @@ class MirrorConvolver(_IntoConvolver):
                 np.multiply(zm.imag[_ix(o, slice(0, w - wa))], spec[b], out=dst[b])
         return dst
 
+    def _even_spec_even(self, a, k, t):
+        """a ← the even transform along k of (the even transform along k of a) × spectrum, in place: the two
+        passes of :meth:`_even` along one axis fused per line chunk (the chunk's transform stays in the buffer
+        between them: the same values as the two passes, without storing and packing them again)."""
+        Z, _ = self._buffers()
+        spec = self.spectrum
+        o, m = 1 - k, a.shape[k]
+        n, ch = 2 * m - 1, self._lines
+        for s0 in range(0, a.shape[o], ch):
+            w = min(ch, a.shape[o] - s0)
+            wa = (w + 1) // 2
+            nb = w - wa
+            sa, sb = _ix(o, slice(s0, s0 + wa)), _ix(o, slice(s0 + wa, s0 + w))
+            z = Z[: n * wa].reshape((n, wa) if k == 0 else (wa, n))
+            zm = z[_ix(k, slice(0, m))]
+            zr, zi = zm.real, zm.imag
+            ib = zi[_ix(o, slice(0, nb))]
+            zr[...] = a[sa]
+            if nb < wa:
+                zi[_ix(o, slice(nb, wa))] = 0.0
+            ib[...] = a[sb]
+            head, tail = z[_ix(k, slice(m, n))], z[_ix(k, slice(m - 1, 0, -1))]
+            head[...] = tail
+            _bf.c2c(z, k, True, 0, z, t)
+            np.multiply(zr, spec[sa], out=zr)
+            np.multiply(ib, spec[sb], out=ib)
+            if nb < wa:
+                zi[_ix(o, slice(nb, wa))] = 0.0
+            head[...] = tail
+            _bf.c2c(z, k, True, 0, z, t)
+            a[sa] = zr
+            a[sb] = ib
+        return a
+
     def _periodic_lines(self, a, j, t):
         """a ← irfft(rfft(a) · spectrum) along the periodic axis j, in place, line chunk by chunk."""
         _, E = self._buffers()
@@ -312,8 +346,7 @@ class MirrorConvolver(_IntoConvolver):
             return self._even(out, k, out, t)
         out = np.empty(self.shape) if out is None else out
         self._even(p, 1, out, t)
-        self._even(out, 0, out, t, self.spectrum)
-        self._even(out, 0, out, t)
+        self._even_spec_even(out, 0, t)
         return self._even(out, 1, out, t)
 
 
