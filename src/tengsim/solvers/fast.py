@@ -13,7 +13,7 @@ from tengsim.solvers._reduce import for_kernel
 from tengsim.solvers._weights import Weights
 from tengsim.solvers._descent import _Descent
 from tengsim.solvers._workspace import Spare
-from tengsim.solvers.types import Equilibrium, Problem, State
+from tengsim.solvers.types import SOLVER_TOL, Equilibrium, Problem, State
 
 
 @dataclass(frozen=True)
@@ -45,7 +45,7 @@ class FastSolver:
     that same sync.
     """
 
-    tol: float = 1e-6
+    tol: float = SOLVER_TOL
     max_iter: int = 3000
     memory: int = 10
     resync: int = 25
