@@ -74,3 +74,18 @@ def test_contact_help_lists_the_shapes_and_says_how_to_see_one(capsys):
     for name in SHAPES.names():
         assert any(ln.split()[:1] == [name] for ln in page.splitlines()), name
     assert len(page.splitlines()) < 316 // 2
+
+
+@pytest.mark.parametrize("given,expected", [(None, "1"), ("3", "3")])
+def test_the_command_line_runs_one_blas_thread_unless_told(given, expected):
+    """The entry point sets OPENBLAS_NUM_THREADS (and MKL's) to 1 before NumPy loads, so NumPy's OpenBLAS runs
+    one thread; a value the user set is kept."""
+    import os
+
+    env = {k: v for k, v in os.environ.items() if k not in ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")}
+    if given is not None:
+        env["OPENBLAS_NUM_THREADS"] = given
+    code = ("import sys, os\nfrom tengsim.cli import main\nassert 'numpy' not in sys.modules\n"
+            "print(os.environ['OPENBLAS_NUM_THREADS'], os.environ['MKL_NUM_THREADS'])")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, env=env).stdout
+    assert out.split() == [expected, "1"]

@@ -10,10 +10,18 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import re
 import sys
 
-from tengsim.errors import TengsimError
+# One BLAS thread unless the user says otherwise, set before NumPy loads: tengsim's BLAS calls are the L-BFGS
+# products over a few stored rows and dot products, where OpenBLAS' threads double the CPU time and gain no wall
+# time (the README pyramid at tol 0.05: 116 s of CPU against 56 s, 65 s of wall against 57 s; docs/benchmarks.md).
+# The FFTs' threads are set apart (TENGSIM_FFT_WORKERS).
+for _name in ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_name, "1")
+
+from tengsim.errors import TengsimError  # noqa: E402  (after the BLAS threads are set)
 
 SUBCOMMANDS = ["design", "calibrate", "contact", "device", "reproduce", "run", "plot", "sweep", "optimize"]
 
