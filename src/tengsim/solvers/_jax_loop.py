@@ -23,7 +23,6 @@ spectrum, the law's parameters, tol, max_iter) is a traced argument.
 """
 from __future__ import annotations
 
-import jax
 import jax.numpy as jnp
 from jax import lax
 from jax.scipy.linalg import solve_triangular
