@@ -17,14 +17,15 @@ from tengsim.references.axisym import AxisymSphere, maugis_sphere
 from tengsim.errors import TengsimError
 from tengsim.grid import Grid
 from tengsim.kernels import FreeKernel, PeriodicKernel
-from tengsim.laws import LJ93, Exponential, Law, MaugisDugdale, Repulsive
-from tengsim.laws.cohesive import CohesiveFunctions, DugdaleZone
+from tengsim.laws import LJ93, Exponential, MaugisDugdale, Repulsive
+from tengsim.laws.cohesive import DugdaleZone
 from tengsim.shapes import Paraboloid
 from tengsim.solvers import Problem, State, make_solver
 from tengsim.solvers.pk import PKSolver
 from tengsim.solvers.ram import RAMSolver
 
 import tengsim.plugins  # noqa: F401  (registers 'ram')
+from _user_laws import LinearSoftening
 
 DATA = os.path.join(os.path.dirname(__file__), "data")
 
@@ -50,26 +51,6 @@ def test_hertz_sphere():
     assert eq.P.sum() * grid.area == pytest.approx(ref.hertz_force(60.0, 0.1, 0.1), rel=3e-3)
     assert eq.H.min() >= 0.0
     assert np.abs(eq.P[eq.H > 0]).max() < 1e-6 * eq.P.max()
-
-
-@dataclass(frozen=True)
-class LinearSoftening(Law):
-    """A user's law that declares its hard-wall limit: t = −σ0 (1 − u/δ) for u < δ (W = σ0 δ / 2)."""
-
-    sigma0: float = 0.5
-    delta: float = 2.0
-    g_safe: float = 0.6
-
-    def _raw(self, g, need_dp=True, xp=np):      # a soft-wall form, for the soft solvers (not used here)
-        u = g - 1.0
-        p = xp.where(u < 0, -self.sigma0 - 1000.0 * u, -self.sigma0 * xp.clip(1.0 - u / self.delta, 0.0, 1.0))
-        return -self.sigma0 * self.delta / 2.0 * xp.clip(1.0 - u / self.delta, 0.0, 1.0) ** 2, p, None
-
-    def hard_wall(self):
-        s, d = self.sigma0, self.delta
-        return CohesiveFunctions(t=lambda u, xp: -s * xp.clip(1.0 - u / d, 0.0, 1.0),
-                                 phi=lambda u, xp: -0.5 * s * d * xp.clip(1.0 - u / d, 0.0, 1.0) ** 2,
-                                 d2phi=lambda u, xp: xp.where(u < d, -s / d, 0.0), length=d)
 
 
 @pytest.mark.parametrize("kernel", ["free", "periodic"])
