@@ -49,7 +49,7 @@ def report_section(vd) -> str:
 
 
 def figure(vd, path: Path) -> None:
-    from tengsim.plots import pyplot
+    from tengsim.plots import pyplot, save
 
     plt = pyplot()
 
@@ -66,18 +66,18 @@ def figure(vd, path: Path) -> None:
             if cyc.press not in (0, 1):
                 continue
             if cyc.kind == "square":
-                axes[0].plot(cyc.t / period, cyc.area, ls, color=c, label=label)
-                axes[1].plot(cyc.t / period, cyc.voc, ls, color=c, label=label)
+                which = label if not f else f"{label}, {'first press' if cyc.press == 1 else 'steady state'}"
+                axes[0].plot(cyc.t / period, cyc.area, ls, color=c, label=which)
+                axes[1].plot(cyc.t / period, cyc.voc, ls, color=c, label=which)
             elif cyc.kind == "triangle":
                 axes[2].plot(cyc.pressure_Pa / 1e3, cyc.voc, ls, color=c, label=label)
     axes[0].set(xlabel="t / period (square cycle; dotted: its periodic steady state)", ylabel="A/S")
-    axes[1].set(xlabel="t / period (square cycle)", ylabel="V_OC (V, Eq. 12)")
+    axes[1].set(xlabel="t / period (square cycle; dotted: its periodic steady state)", ylabel="V_OC (V, Eq. 12)")
     axes[2].set(xlabel="nominal pressure (kPa, triangle cycle)", ylabel="V_OC (V, Eq. 12)")
     for ax in axes:
         ax.grid(alpha=0.3)
-    axes[0].legend(frameon=False)
-    fig.savefig(path, dpi=150)
-    plt.close(fig)
+    axes[0].legend(frameon=False, fontsize=8)
+    save(fig, path)  # atomic, as every figure
 
 
 RECORD = {  # design.nc variable (along VISCO_DIM): (units, long_name)
