@@ -294,7 +294,8 @@ def test_device_run_area_from_a_viscoelastic_design_uses_its_cycles(designs, tmp
 
 
 @pytest.mark.parametrize("case, extra, said", [
-    ("run", 'kind = "square"\namplitude_Pa = 5e3\nfrequency_Hz = 2.0', "--pressure 5 kPa is not that cycle"),
+    ("run", 'kind = "square"\namplitude_Pa = 5e3\nfrequency_Hz = 2.0',
+     "the [waveform]'s square wave to 5 kPa (--config, or the command's default waveform) is not that cycle"),
     ("run", 'kind = "sine"\namplitude_Pa = 1e4\nfrequency_Hz = 2.0', "a sine of amplitude 10 kPa, offset 0 kPa"),
     ("run", 'kind = "table"\nt_s = [0, 0.25, 0.5]\npressure_Pa = [0, 1e4, 0]\nperiodic = true',
      "a [waveform] of kind 'table' is not one of them"),

@@ -302,8 +302,11 @@ def area_cycle_for_waveform(path, wave, static_fraction: float | None = None, wh
         raise TengsimError(f"{where}: {what}; a [waveform] of kind {kind!r} is not one of them (its own presses are "
                            "not recorded): give a square wave" + (" or that sine" if sine else ""))
     if abs(wave.amplitude_Pa - pm) > 1e-6 * pm:
-        raise TengsimError(f"{where}: {what}; --pressure {wave.amplitude_Pa / 1e3:.4g} kPa is not that "
-                           f"cycle: press to {pm / 1e3:.4g} kPa (the default), or design with --p-max "
+        given, fix = ((f"--pressure {wave.amplitude_Pa / 1e3:.4g} kPa", f"press to {pm / 1e3:.4g} kPa (the default)")
+                      if where == "device design" else
+                      (f"the [waveform]'s square wave to {wave.amplitude_Pa / 1e3:.4g} kPa (--config, or the command's "
+                       "default waveform)", f"give a [waveform] table with kind = 'square', amplitude_Pa = {pm:.6g}"))
+        raise TengsimError(f"{where}: {what}; {given} is not that cycle: {fix}, or design with --p-max "
                            f"{wave.amplitude_Pa / 1e3:.4g}kPa")
     if abs(wave.duty - 0.5) > 1e-9 or wave.low_Pa != 0:
         raise TengsimError(f"{where}: {what}; a square wave of duty {wave.duty:g} from {wave.low_Pa:g} Pa is "
