@@ -8,8 +8,9 @@ pixels out of contact entering (the conjugacy restarted), the load control's cor
 preconditioner's safeguard (after ``STALL`` iterations without a new lowest residual, on from the best pressure
 without it).  What differs is only the bookkeeping JAX needs: ``if`` becomes a select, the safeguard's restart a
 branch of the loop's body, Python's early ``break`` a flag.  The kernel is taken through what
-:class:`tengsim.registry.FourierKernelLike` declares (spectrum, padded shape, periodic) and the convolution is
-the JAX solver's (tengsim.solvers._jax_fft).  Fields and scalars are float64.
+:class:`tengsim.registry.FourierKernelLike` declares (spectrum, padded shape, periodic); the convolution and
+the preconditioner's product go through the JAX FFT seam (tengsim.solvers._jax_fft).  Fields and scalars are
+float64.
 
 The cohesive zones (Maugis–Dugdale, exponential) stay the NumPy solver's outer loop on the host
 (:class:`tengsim.solvers.pk.PKSolver`): each zone update calls this compiled contact solve.
@@ -41,12 +42,13 @@ def _build(shape, padded, periodic: bool, load_control: bool, pre: bool):
 
     f64 = jnp.float64
     conv_ = _jax_fft.convolution(shape, padded, periodic, jnp.dtype(f64))
+    pre_ = _jax_fft.convolution(shape, shape, True, jnp.dtype(f64))   # M⁻¹ x: the periodic product with mult
 
     def solve(h, p0, Kp0, use_Kp0, spec, mult, diag, tol, max_iter, load):
         conv = lambda x: conv_(x, spec)                                  # noqa: E731
 
         def precond(x):
-            return jnp.fft.irfft2(jnp.fft.rfft2(x.reshape(shape)) * mult, s=shape).ravel()
+            return pre_(x, mult)
 
         def evaluate(p, Kp):
             """u, S (the direction's set), nS, c, residual at p with K p."""
