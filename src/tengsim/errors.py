@@ -12,6 +12,26 @@ class ConfigValueError(TengsimError):
     combination that cannot be built, e.g. a pyramid wider than its cell)."""
 
 
+class NumberError(ConfigValueError):
+    """A number refused where text becomes a number (:func:`tengsim.units.read_number`): too long, an underscore,
+    not finite, out of range.  It carries its parts (``name``, the ``text`` as given, the ``reason``), so that a
+    caller that reads the number under another label (an option, a number inside a quantity) names it in its own
+    words with :meth:`named`, never by rewriting this message's text."""
+
+    def __init__(self, name: str, text, reason: str, finite: bool = False):
+        self.name, self.text, self.reason, self.finite = name, text, reason, finite
+        super().__init__(self.named(name))
+
+    def named(self, label: str | None, value: bool = True) -> str:
+        """The message under ``label``: "label = 'text'<reason>" (``value`` false: "label<reason>", for a label that
+        already shows the text); ``label`` None: "'text'<reason>" (argparse names the option itself)."""
+        if self.finite:
+            return f"{label or 'value'} must be finite, got {shown(self.text)}"
+        if label is None:
+            return f"{shown(self.text)}{self.reason}"
+        return f"{label} = {shown(self.text)}{self.reason}" if value else f"{label}{self.reason}"
+
+
 class MachineError(TengsimError):
     """What this machine cannot give a run, not a property of its input: a solver or extra not installed
     (:class:`SolverUnavailable`), too little memory (:class:`MemoryRefused`), the time budget spent or expected

@@ -13,20 +13,34 @@ import importlib
 import os
 import re
 
-import tengsim.kernels  # noqa: F401  (registers 'free', 'periodic')
-import tengsim.laws  # noqa: F401  (registers 'lj93', 'repulsive', 'md', 'exp')
-import tengsim.observers  # noqa: F401  (registers 'summary', 'array_area')
-import tengsim.shapes  # noqa: F401  (registers every built-in shape)
-import tengsim.solvers  # noqa: F401  (registers 'fast', 'vsr')
-import tengsim.solvers.homotopy  # noqa: F401  (registers 'homotopy')
-import tengsim.solvers.pk  # noqa: F401  (registers 'pk')
-import tengsim.solvers.ram  # noqa: F401  (registers 'ram')
-import tengsim.solvers.jax_fast  # noqa: F401  (registers 'jax', 'gpu'; imports JAX only when one is made)
-import tengsim.solvers.choice  # noqa: F401  (registers 'auto': gpu where JAX sees one, else fast)
+import tengsim.kernels
+import tengsim.laws
+import tengsim.observers
+import tengsim.shapes
+import tengsim.solvers
+import tengsim.solvers.homotopy
+import tengsim.solvers.pk
+import tengsim.solvers.ram
+import tengsim.solvers.jax_fast
+import tengsim.solvers.choice
 from tengsim.errors import TengsimError
 from tengsim.registry import KERNELS, LAWS, OBSERVERS, SHAPES, SOLVERS
 
-__all__ = ["KERNELS", "LAWS", "OBSERVERS", "SHAPES", "SOLVERS", "load_plugins"]
+BUILT_IN = (
+    tengsim.kernels,  # registers 'free', 'periodic'
+    tengsim.laws,  # registers 'lj93', 'repulsive', 'md', 'exp'
+    tengsim.observers,  # registers 'summary', 'array_area'
+    tengsim.shapes,  # registers every built-in shape
+    tengsim.solvers,  # registers 'fast', 'vsr'
+    tengsim.solvers.homotopy,  # registers 'homotopy'
+    tengsim.solvers.pk,  # registers 'pk'
+    tengsim.solvers.ram,  # registers 'ram'
+    tengsim.solvers.jax_fast,  # registers 'jax', 'gpu'; imports JAX only when one is made
+    tengsim.solvers.choice,  # registers 'auto': gpu where JAX sees one, else fast
+)
+"""The built-in modules whose import fills the registries (each registers its pieces when imported)."""
+
+__all__ = ["BUILT_IN", "KERNELS", "LAWS", "OBSERVERS", "SHAPES", "SOLVERS", "load_plugins"]
 
 _LOADED: set = set()
 

@@ -5,7 +5,7 @@ import math
 import re
 from dataclasses import dataclass
 
-from tengsim.errors import ConfigValueError, TengsimError, positive, shown
+from tengsim.errors import ConfigValueError, NumberError, TengsimError, positive, shown
 
 _PREFIX = {"": 1.0, "k": 1e3, "M": 1e6, "G": 1e9, "m": 1e-3, "u": 1e-6, "µ": 1e-6, "μ": 1e-6,
            "n": 1e-9, "p": 1e-12, "c": 1e-2}
@@ -47,15 +47,17 @@ MAX_MAGNITUDE = 1e100
 """The largest |value| (SI) any input may have; the smallest non-zero one is its inverse.  Every
 physical input lies far inside (a Planck length is 1.6e-35 m); past it, grids and scalings overflow."""
 
+_OUT_OF_RANGE = (f" is out of range: a value's magnitude must lie between {1 / MAX_MAGNITUDE:g} and {MAX_MAGNITUDE:g} "
+                 "(or be 0)")
+
 
 def bounded(x: float, text, name: str = "value") -> float:
     """``x`` if finite and 0 or within [1/MAX_MAGNITUDE, MAX_MAGNITUDE] in magnitude, else a
     ConfigValueError naming ``name`` and (cut) ``text``."""
     if not math.isfinite(x):
-        raise ConfigValueError(f"{name} must be finite, got {shown(text)}")
+        raise NumberError(name, text, "", finite=True)
     if x != 0 and not (1.0 / MAX_MAGNITUDE <= abs(x) <= MAX_MAGNITUDE):
-        raise ConfigValueError(f"{name} = {shown(text)} is out of range: a value's magnitude must lie "
-                               f"between {1 / MAX_MAGNITUDE:g} and {MAX_MAGNITUDE:g} (or be 0)")
+        raise NumberError(name, text, _OUT_OF_RANGE)
     return x
 
 
@@ -70,17 +72,15 @@ def read_number(text, name: str = "value") -> float:
         raise ValueError(f"{text!r} is not a number")
     if isinstance(text, int):
         if abs(text) > MAX_MAGNITUDE:
-            raise ConfigValueError(f"{name} = {shown(text)} is out of range: a value's magnitude must lie "
-                                   f"between {1 / MAX_MAGNITUDE:g} and {MAX_MAGNITUDE:g} (or be 0)")
+            raise NumberError(name, text, _OUT_OF_RANGE)
         return bounded(float(text), text, name)
     if isinstance(text, float):
         return bounded(text, text, name)
     s = str(text).strip()
     if len(s) > MAX_TEXT:
-        raise ConfigValueError(f"{name} = {shown(text)} is not a number (a number or quantity is at most "
-                               f"{MAX_TEXT} characters)")
+        raise NumberError(name, text, f" is not a number (a number or quantity is at most {MAX_TEXT} characters)")
     if "_" in s:
-        raise ConfigValueError(f"{name} = {shown(text)}: no underscores in numbers (write 0.5, not 0_5)")
+        raise NumberError(name, text, ": no underscores in numbers (write 0.5, not 0_5)")
     x = float(s)  # a ValueError for anything else
     if math.isnan(x):
         return x  # NaN is left to each key's own check (finite, positive), which names it

@@ -119,13 +119,13 @@ def _whole(text) -> int:
     '0_4' is refused, not read as 4); argparse names the option."""
     import argparse
 
-    from tengsim.errors import ConfigValueError, shown
+    from tengsim.errors import NumberError, shown
     from tengsim.units import read_number
 
     try:
         n = read_number(text, "value")
-    except ConfigValueError as exc:
-        raise argparse.ArgumentTypeError(str(exc).replace("value = ", "", 1)) from None
+    except NumberError as exc:
+        raise argparse.ArgumentTypeError(exc.named(None)) from None
     except ValueError:
         n = float("nan")
     if not (n == n and n == int(n)):
@@ -142,7 +142,7 @@ def _expected_noise(text, noise):
     refused, not read as 5 %)."""
     import re
 
-    from tengsim.errors import ConfigValueError
+    from tengsim.errors import NumberError
     from tengsim.units import read_number
 
     if text is None:
@@ -154,9 +154,8 @@ def _expected_noise(text, noise):
         if not m or m.group(2) not in units:
             raise ValueError
         value = read_number(m.group(1), f"--expected-noise {t}") * units[m.group(2)]
-    except ConfigValueError as exc:
-        raise TengsimError(str(exc).replace(f"--expected-noise {t} = {m.group(1)!r}", f"--expected-noise {t}")
-                           ) from None
+    except NumberError as exc:
+        raise TengsimError(exc.named(f"--expected-noise {t}", value=False)) from None
     except ValueError:
         raise TengsimError(f"--expected-noise {text}: give it with its unit, e.g. "
                            f"{'2%' if noise == 'relative' else '0.5V'} ({noise} noise)") from None

@@ -232,7 +232,9 @@ def write_contact(res, out, plot=None, quiet=False, stream=None) -> int:
         lat = res.scaling.lateral if res.scaling is not None else None
         grids = ", ".join(format_si(d * lat, "m", 4) if lat else f"{d:.4g}" for d in res.params.get("resolve_grids", ()))
         print(f"tengsim: resolved: dx {grids}; status {res.params.get('resolve_status')}", file=sys.stderr)
-    missed = [m for m in str(res.params.get("load_not_met") or "").split("; ") if m]
+    from tengsim.continuation.load import misses_in
+
+    missed = misses_in(res.params)
     if missed:  # load control: which loads, and where the search for each ended
         print(f"tengsim: warning: {len(missed)} load(s) not met, first {missed[0]} (all: parameter "
               "'load_not_met')", file=sys.stderr)

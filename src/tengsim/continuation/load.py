@@ -222,6 +222,21 @@ def _not_reached(spec: LoadPathSpec, branch: _LoadBranch, Ft: float) -> str:
             f"{how}")
 
 
+MISS_SEPARATOR = "; "
+"""Between the loads a load-controlled run missed in its ``params['load_not_met']`` (one text, so that it is written
+to a file's attributes as it is); :func:`misses_in` reads it back."""
+
+
+def joined_misses(misses) -> str:
+    """The missed loads (each 'branch F = …: D bracket …', no separator inside) as one ``load_not_met`` text."""
+    return MISS_SEPARATOR.join(misses)
+
+
+def misses_in(params: dict) -> list:
+    """The missed loads of a result's ``params`` (:func:`joined_misses` inverted; [] where every load was met)."""
+    return [m for m in str(params.get("load_not_met") or "").split(MISS_SEPARATOR) if m]
+
+
 def run_load_path(U0, law, kernel, solver, spec: LoadPathSpec, start: State | None = None,
                   progress=None, keep_states: bool = False, observers=(), sink=None):
     """Solve the load-controlled approach–retraction path; returns a ContactResult (same columns as
@@ -262,7 +277,7 @@ def run_load_path(U0, law, kernel, solver, spec: LoadPathSpec, start: State | No
     misses = [m for b in branches for m in b.misses]
     more = {}
     if misses:
-        more["load_not_met"] = "; ".join(misses)
+        more["load_not_met"] = joined_misses(misses)
     if up.d_max > spec.d_max:
         more["d_max_reached"] = up.d_max  # the search range the approach extended itself to
     absent = rec.maps_missing([b.name for b in branches])

@@ -19,6 +19,14 @@ from tengsim.device.analysis import (FigureOfMerit, ResistanceSweep, StaticVolta
                                      resistance_sweep, staircase_summary, steady_charge, steady_start, voc_from_area,
                                      vq_cycle)
 
+__all__ = ["simulate", "EPS0", "AreaCycle", "AreaFunction", "AreaTable", "ConstantArea", "DeviceParams",
+           "SolverOptions", "area_model", "DeviceResult", "WAVEFORMS", "Sine", "SquareWave", "Staircase",
+           "TableWaveform", "area_table_from_design", "parse_device", "parse_waveform", "CMEOCycle", "cmeo_cycle",
+           "eq20_force", "electrostatic_energy", "field_force", "fom_structural", "isc_apart", "qsc_apart",
+           "voc_apart", "voc_from_contact_length", "voc_polymer", "voltage", "FigureOfMerit", "ResistanceSweep",
+           "StaticVoltageCurve", "VQCycle", "figure_of_merit", "resistance_sweep", "staircase_summary",
+           "steady_charge", "steady_start", "voc_from_area", "vq_cycle"]
+
 _MOVED = {"fig7_params", "fig7_summary", "fig7_waveform", "fig8_params", "fig8_summary", "fig8_waveform",
           "run_fig7", "run_fig8"}
 _RENAMED = {"waveform_from_dict": "tengsim.device.parse_waveform (tengsim.device.config, the one parser)",

@@ -2,6 +2,7 @@
 [contact] table, never raising (a failure is a failed point with its message)."""
 from __future__ import annotations
 
+import importlib
 import json
 import os
 import socket
@@ -79,8 +80,7 @@ def warm_up(plugins: str = "") -> int:
         _worker_setup(plugins)
     except TengsimError:
         pass  # the points report it, each as a failed point with the message
-    import tengsim.run.plan  # noqa: F401
-    import tengsim.run.simulate  # noqa: F401
-    import xarray  # noqa: F401
+    for module in ("tengsim.run.plan", "tengsim.run.simulate", "xarray"):
+        importlib.import_module(module)
 
     return os.getpid()

@@ -3,10 +3,9 @@
 (:func:`simulate_periodic`, :mod:`tengsim.visco.periodic`)."""
 from __future__ import annotations
 
-from tengsim import plugins  # noqa: F401  (the registries filled)
 from tengsim.kernels import make_kernel
 from tengsim.laws import Law
-from tengsim.registry import LAWS
+from tengsim.plugins import LAWS  # the registries filled
 from tengsim.relaxation import Prony
 from tengsim.solvers import SOLVER_TOL, make_solver
 from tengsim.visco.drive import TimeDrive
