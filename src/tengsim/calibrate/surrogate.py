@@ -40,6 +40,7 @@ from pathlib import Path
 import numpy as np
 
 from tengsim.errors import MachineError, SolverUnavailable, TengsimError
+from tengsim.status.levels import Status
 
 POINTS_PER_CURVE = 21
 """Pressures of a node's design, 0 to p_max (A/S is linear between them; more make the refinement judge more)."""
@@ -163,7 +164,7 @@ def solve_node(table: dict, folder: Path, u: float, v: float, progress=None) -> 
     nc, bad = folder / f"{key}.nc", folder / f"{key}.failed.txt"
     if nc.is_file():
         P, A, st, status, secs = _load(nc)
-        return Node(u, v, status == "ok", P, A, "" if status == "ok" else f"status {status}", secs, True, st)
+        return Node(u, v, status == Status.OK, P, A, "" if status == Status.OK else f"status {status}", secs, True, st)
     if bad.is_file():
         return Node(u, v, False, message=bad.read_text(encoding="utf-8").strip(), cached=True)
     folder.mkdir(parents=True, exist_ok=True)
@@ -183,7 +184,7 @@ def solve_node(table: dict, folder: Path, u: float, v: float, progress=None) -> 
     write_dataset(res.dataset, nc)
     (folder / f"{key}.resolve.nc").unlink(missing_ok=True)
     P, A, st = _read(res.dataset)
-    ok = res.status == "ok"
+    ok = res.status == Status.OK
     return Node(u, v, ok, P, A, "" if ok else f"status {res.status}", time.perf_counter() - t0, states=st)
 
 

@@ -302,7 +302,9 @@ def _run_locked(args, plans, folders, out, relaxation=None) -> int:
                   f"{s['seconds']:.0f} s", file=sys.stderr)
         print(f"tengsim: wrote {len(paths)} files in {out} (report: {out / 'report.md' if len(results) == 1 else out})",
               file=sys.stderr)
+    from tengsim.status.levels import Status
+
     for r in results:
-        if r.status != "ok":
+        if r.status != Status.OK:
             print(f"tengsim: warning: {r.plan.name}: status {r.status} (see its report.md)", file=sys.stderr)
     return 0

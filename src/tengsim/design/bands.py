@@ -13,6 +13,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+from tengsim.status.levels import Status
 
 
 def _key(plan) -> tuple:
@@ -72,7 +73,7 @@ def write_bands(bands: dict, out_dir, name: str = "") -> list:
     from tengsim.plots import pyplot, save
 
     out = Path(out_dir)
-    ok = all(s == "ok" for s in bands["statuses"])
+    ok = all(s == Status.OK for s in bands["statuses"])
     header = {"band": "95 % (envelope over the material's uncertainty points, profile likelihood)",
               "designs": len(bands["statuses"]), "all_ok": ok}
     cols = {"pressure_kPa": bands["pressure"] / 1e3, "area_fraction": bands["area"],

@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from tengsim.plots import pyplot
+from tengsim.status.levels import Status
 
 BRANCH_STYLE = {"approach": "-", "retraction": "--"}
 
@@ -129,7 +130,7 @@ def compare_figure(results):
         ds = getattr(r, "dataset", r)  # a DesignResult or a design.nc Dataset
         P = ds["pressure"].values / 1e3
         status = str(ds.attrs.get("status", "?"))
-        ok = status == "ok"
+        ok = status == Status.OK
         style = dict(color=f"C{i % 10}", marker="o" if ok else "s", ms=4, mfc=None if ok else "none")
         label = f"{ds.attrs.get('design_name', ds.attrs.get('shape'))} (μ {float(ds.attrs['tabor']):.2g}; {status})"
         axes[0].plot(P, ds["charged_area_fraction"].sel(branch="approach"), "-", label=label, **style)

@@ -31,6 +31,7 @@ from tengsim.study.progress import SweepProgress
 from tengsim.study.resume import append_log, check_resume, resolved_with_provenance, verify_points
 from tengsim.study.runner import PointRunner
 from tengsim.study.validate import validate
+from tengsim.status.levels import Status
 
 
 def run_study(study, out, *, workers=None, scheduler=None, client=None, resume=False, retry_failed=False,
@@ -72,7 +73,7 @@ def run_study(study, out, *, workers=None, scheduler=None, client=None, resume=F
                                             "message": msg, "contact": _contact_of(study, pid)})
         failures = sd.failures()
         # --retry-failed: every point not finished 'ok' (failed, or finished with another status)
-        redo = {pid for pid, st in statuses.items() if st != "ok"} if retry_failed else set()
+        redo = {pid for pid, st in statuses.items() if st != Status.OK} if retry_failed else set()
         todo = [pid for pid in valid if (pid not in done or pid in redo) and (pid not in failures or retry_failed)]
         n_total = len(valid) + len(invalid)
         n_failed = len((failures - done) - set(todo))
@@ -109,7 +110,7 @@ def status_counts(summary: dict) -> str:
     from tengsim.study.dataset import STATUSES
 
     return ", ".join(f"{summary.get(s, 0)} {s}" for s in STATUSES
-                     if s in ("ok", "failed") or summary.get(s, 0))
+                     if s in (Status.OK, "failed") or summary.get(s, 0))
 
 
 def _contact_of(study, pid):

@@ -27,6 +27,7 @@ from tengsim.errors import TengsimError, shown
 from tengsim.resources import check_count
 from tengsim.units import read_number
 from tengsim.study.observe import SCALARS
+from tengsim.status.levels import Status
 
 PENALTY = 1e6
 FAILED = 1e3 * PENALTY
@@ -47,7 +48,7 @@ def parse_accept(accept) -> tuple:
         if s not in ACCEPTABLE:
             raise TengsimError(f"--accept {s!r} is not a run status a candidate may have "
                                f"(choose from {', '.join(ACCEPTABLE)})")
-    return ("ok", *dict.fromkeys(names))
+    return (Status.OK, *dict.fromkeys(names))
 
 
 def parse_objective(study) -> dict:
@@ -246,7 +247,7 @@ def optimize_study(study, out, *, workers=None, scheduler=None, client=None, res
     if feasible:
         say(f"optimize: best {obj['name']} = {result['value']:.5g} at {where} (status {status}); "
             f"its {len(near)} nearest evaluated point(s): {near_text or 'none'}; wrote {sd.optimum}")
-        if any(q["status"] != "ok" for q in near) or status != "ok":
+        if any(q["status"] != Status.OK for q in near) or status != Status.OK:
             say("optimize: the optimum is or borders on points whose status is not ok: check them (refine dx "
                 "for under_resolved) before trusting it")
     else:
