@@ -156,7 +156,7 @@ def _kernel_form(kernel):
     """(periodic, padded shape, spectrum, pinned mean) of a kernel that multiplies in Fourier space."""
     if getattr(kernel, "comm", None) is not None:
         raise TengsimError("the jax solver runs on one device: a slab-distributed (MPI) kernel is CPU only")
-    if hasattr(kernel, "mirror") or type(kernel).__name__ == "MirrorKernel":
+    if hasattr(kernel, "mirror"):  # a symmetry-reduced kernel (tengsim.kernels.mirror) declares its mirror
         raise TengsimError("mirror kernel is CPU only (JAX has no DCT-I): use --symmetry off with the jax solver")
     from tengsim.registry import FourierKernelLike
 
