@@ -274,7 +274,8 @@ def main(argv=None):
     ap.add_argument("--replica-steps", type=int, default=8, help="steps of the numpy replica of Tamaas 2.9's "
                                                                   "update checked against its solver (0: none)")
     ap.add_argument("--tamaas-python", default="/work/venvs/tamaas/bin/python")
-    ap.add_argument("--out", default=None, help="a JSON file for the rows")
+    ap.add_argument("--out", default=None, help="a JSON file for the rows (each per-step series summarised)")
+    ap.add_argument("--series", action="store_true", help="write the per-step series whole in --out")
     ap.add_argument("--no-limit", action="store_true", help="skip the long hold (the relaxed limit)")
     ap.add_argument("--tamaas-child", nargs=3, help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
@@ -328,7 +329,7 @@ def main(argv=None):
                           "extrapolated": row.get("extrapolated", {}).get("diff")}), flush=True)
     if args.out:
         with open(args.out, "w") as f:
-            json.dump(rows, f, indent=1)
+            json.dump(rows if args.series else compact(rows), f, indent=1)
     report(rows)
     return 0
 
@@ -338,6 +339,27 @@ def _line(r, label, dt, steps, m, t, d):
     tcpu = f"{t['cpu']:.3g}" if t and t.get("cpu") else ""
     print(f"| {r['n']}² | {label} | {dt} | {steps} | {m['cpu']:.3g} | {tcpu} | {ratio} | "
           f"{d['max_area']:.1e} (t = {d['t_max_area']:g}) | {d['max_gap']:.1e} (t = {d['t_max_gap']:g}) |")
+
+
+SERIES = ("t", "p", "area", "mean_gap", "solve_error", "gap_spread_in_contact", "penetration")
+"""The per-step series of a run: summarised in --out unless --series."""
+
+
+def compact(x):
+    """``x`` (the rows) with each per-step series replaced by its length, ends and range: the comparison's numbers
+    stay, the file stays small."""
+    if isinstance(x, list):
+        return [compact(v) for v in x]
+    if not isinstance(x, dict):
+        return x
+    out = {}
+    for k, v in x.items():
+        if k in SERIES and isinstance(v, list) and len(v) > 2:
+            f = [float(a) for a in v]
+            out[k] = {"steps": len(f), "first": f[0], "last": f[-1], "min": min(f), "max": max(f)}
+        else:
+            out[k] = compact(v)
+    return out
 
 
 def report(rows):
