@@ -40,3 +40,28 @@ def test_missed_loads_round_trip():
               "retraction: load 0.5 not met: |F - target| = 0.2 > f_tol = 0.01 (D in [3, 4], bisection)"]
     assert misses_in({"load_not_met": joined_misses(misses)}) == misses
     assert misses_in({}) == [] and misses_in({"load_not_met": ""}) == []
+
+
+def test_reworded_keeps_the_type_and_its_parts():
+    import pickle
+
+    from tengsim.errors import BudgetExceeded
+    with pytest.raises(NumberError) as info:
+        read_number("1e+400", "pitch")
+    exc = info.value
+    framed = exc.reworded(prefix="[design] ", suffix=" (with the material of fit.nc)")
+    assert type(framed) is NumberError and framed.name == "pitch" and framed.reason == exc.reason
+    assert str(framed) == f"[design] {exc} (with the material of fit.nc)"
+    back = pickle.loads(pickle.dumps(framed))  # a worker's error reaches the parent whole
+    assert type(back) is NumberError and str(back) == str(framed) and back.text == "1e+400"
+    budget = pickle.loads(pickle.dumps(BudgetExceeded("over", budget_s=3.0).reworded(prefix="d1: ")))
+    assert budget.budget_s == 3.0 and str(budget) == "d1: over"
+
+
+def test_a_design_number_out_of_range_is_one_line(tmp_path, capsys):
+    from tengsim.cli.main import main
+    rc = main(["design", "pyramid", "--pitch", "1e+101um", "--base", "0.5um", "--height", "0.2um",
+               "--E-star", "1MPa", "--W", "0.05J/m^2", "--eps", "50nm", "--out", str(tmp_path / "o"), "--quiet"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert rc == 2 and err[-1].startswith("tengsim: error:") and "internal error" not in err[-1]
+    assert not (tmp_path / "o").exists()

@@ -4,6 +4,18 @@
 class TengsimError(ValueError):
     """Bad input or an unusable configuration; the message names the bad value."""
 
+    def reworded(self, prefix: str = "", suffix: str = "") -> "TengsimError":
+        """The same error (its type and its parts: a :class:`NumberError`'s name, a budget) with its message
+        framed by ``prefix`` and ``suffix`` (where in the file, which material): the caller adds its context
+        without rebuilding the error from its text, which a subclass with its own parts cannot take."""
+        err = self.__class__.__new__(self.__class__)
+        err.__dict__.update(self.__dict__)
+        err.args = (f"{prefix}{self}{suffix}",)
+        return err
+
+    def __reduce__(self):  # pickled whole (a worker's error reaches the parent with its parts and its words)
+        return _rebuilt, (self.__class__, self.args, dict(self.__dict__))
+
 
 class ConfigValueError(TengsimError):
     """A value of the wrong kind for its key (a unit on a dimensionless key, text for a number, a
@@ -71,6 +83,14 @@ class GeometryError(TengsimError):
         err = GeometryError(self.template, **self.lengths)
         err.args = (self.template.format(**{k: fmt(v * lateral) for k, v in self.lengths.items()}),)
         return err
+
+
+def _rebuilt(cls, args, state):
+    """A pickled :class:`TengsimError` back: its type, its message, its parts (no ``__init__`` re-run)."""
+    err = cls.__new__(cls)
+    err.__dict__.update(state)
+    err.args = args
+    return err
 
 
 SHOWN = 60

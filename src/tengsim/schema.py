@@ -107,7 +107,7 @@ class Field:
             except TengsimError as e:  # the check sees the number in SI: name the value as the user wrote it
                 if self.dim is None or not isinstance(value, str):
                     raise
-                raise type(e)(f"{e} (given as {shown(value)})") from None
+                raise e.reworded(suffix=f" (given as {shown(value)})") from None
         return v
 
     def _number(self, value, label):

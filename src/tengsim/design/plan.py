@@ -214,7 +214,7 @@ def plan_design(table: dict, where: str = "", material=None) -> DesignPlan:
         try:
             plan = _plan_design(merged, where)
         except TengsimError as exc:  # the design with the material's values: say both
-            raise type(exc)(f"{exc} (with the material of {material.where})") from None
+            raise exc.reworded(suffix=f" (with the material of {material.where})") from None
         return dataclasses.replace(plan, bands=plan_bands(merged, material, where))
     return _plan_design(table, where)
 
@@ -268,14 +268,14 @@ def _plan_design(table: dict, where: str) -> DesignPlan:
     try:
         area = check_definition(own["area"])
     except TengsimError as exc:
-        raise type(exc)(f"{where}{exc}") from None
+        raise exc.reworded(prefix=where) from None
     checked = dict(cfg)  # after the boundary's default
     if table.get("dx") not in (None, ""):  # the grid checked at the design's own first dx, not the default's
         checked["dx"] = table["dx"]
     try:
         plan = plan_contact(checked)
     except TengsimError as exc:
-        raise type(exc)(f"{where}{exc}") from None
+        raise exc.reworded(prefix=where) from None
     if plan.scaling is None:
         raise ConfigValueError(f"{where}a design is physical: give the sizes of {shape} with units and E_star, W")
     pressures = _pressures(own, where)

@@ -36,6 +36,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from tengsim import backend
+from tengsim.solvers.mixing import mixing_coefficients
 
 #: the fraction of the preconditioned gradient a contact step takes (M⁻¹ ≈ K⁻¹: 1 would be Newton's step in
 #: full contact; 0.4–0.8 alike on the Maugis–Dugdale path of benchmarks/md_path_pk.py at dx 0.2; 0.7 cycled on
@@ -76,41 +77,6 @@ def zone_residual(zone, u, p, contact, work) -> float:
     return float(work.max()) if work.size else 0.0
 
 
-class Anderson:
-    """Anderson mixing (type II, memory ``m``) of the fixed point x = G(x) of a cohesive zone's tractions (the
-    outer loop's, tengsim.solvers.pk.PKSolver._cohesive):
-    ``step(x, gx)`` moves x in place to x + f − (ΔX + ΔF) γ, γ the least-squares fit of f = G(x) − x
-    by the stored differences (m = 0: the plain update x = G(x)).  Memory is dropped when the residual
-    grows tenfold (a jump: the old differences describe another branch)."""
-
-    def __init__(self, n: int, m: int):
-        self.m, self.X, self.F = int(m), [], []
-        self.x_old = self.f_old = None
-        self.f_norm = math.inf
-
-    def step(self, x, gx):
-        f = gx - x
-        fn = float(np.dot(f, f))
-        if fn > 100.0 * self.f_norm:
-            self.X, self.F = [], []
-        self.f_norm = fn
-        if self.m and self.x_old is not None:
-            self.X.append(x - self.x_old)
-            self.F.append(f - self.f_old)
-            if len(self.X) > self.m:
-                self.X.pop(0)
-                self.F.pop(0)
-        self.x_old, self.f_old = x.copy(), f
-        if not self.F:
-            x += f
-            return
-        Fm = np.stack(self.F, axis=1)
-        A = Fm.T @ Fm                                  # the normal equations (m × m), scaled to unit diagonal
-        d = np.sqrt(np.maximum(np.diag(A), 1e-300))
-        gamma = np.linalg.lstsq(A / np.outer(d, d), (Fm.T @ f) / d, rcond=1e-10)[0] / d
-        x += f - (np.stack(self.X, axis=1) + Fm) @ gamma
-
-
 class _Mix:
     """Anderson mixing (type II, memory ``m``) of the iterates p of the whole solve (contact and zone): ``step(x,
     gx)`` turns gx, the map's image of x, into the mixed next iterate x + f − (ΔX + ΔF) γ, f = gx − x, γ the
@@ -147,8 +113,7 @@ class _Mix:
             return
         A = self.A[:cols, :cols]
         F = self.F[:, :cols]
-        d = np.sqrt(np.maximum(np.diag(A), 1e-300))
-        gamma = np.linalg.lstsq(A / np.outer(d, d), (F.T @ f) / d, rcond=1e-10)[0] / d
+        gamma = mixing_coefficients(A, F.T @ f)
         np.add(x, f, out=gx)
         gx -= self.X[:, :cols] @ gamma
         gx -= F @ gamma

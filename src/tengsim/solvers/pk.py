@@ -59,7 +59,8 @@ from tengsim import backend
 from tengsim.errors import TengsimError
 from tengsim.registry import SOLVERS
 from tengsim.solvers._pk_core import Convolution, constrained_cg, preconditioner
-from tengsim.solvers._pk_zone import Anderson as _Anderson, zone_inner, zone_residual
+from tengsim.solvers._pk_zone import zone_inner, zone_residual
+from tengsim.solvers.mixing import Anderson as _Anderson
 from tengsim.solvers.types import SOLVER_TOL, Equilibrium, Problem, State, check_settings
 
 #: the largest pixel snap number of a Maugis–Dugdale ramp (PKSolver._ramp)

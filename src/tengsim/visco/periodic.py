@@ -16,6 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from tengsim.solvers.mixing import Anderson
 from tengsim.visco.drive import DriveEnd, TimeDrive
 from tengsim.visco.history import History
 from tengsim.visco.memory import MaxwellMemory
@@ -91,12 +92,15 @@ def periodic_cycles(drive: TimeDrive, history: History, steps, tol: float = TOL,
     t_ref = schedule(history, steps)
     scale = max(float(np.max(res["area_fraction"])), 1e-12)
     like = end.memory
-    xs, gs = [np.zeros_like(_pack(like))], [_pack(end.memory)]  # x: a period's start memory, g = G(x) its end
+    x, g = np.zeros_like(_pack(like)), _pack(end.memory)  # x: a period's start memory, g = G(x) its end
+    mix = Anderson(x.size, depth)  # every evaluation (x, G(x)) recorded, plain or accelerated
     prev, last_plain, change, n = res, True, np.inf, 1
     best = (np.inf, res)
     while n < max_periods:
         accelerate = len(periods) >= plain and not (np.isfinite(change) and change <= tol and not last_plain)
-        x = _anderson(xs, gs, depth) if accelerate else gs[-1]
+        mixed = np.array(x, dtype=float)
+        mix.step(mixed, g)  # the next start memory mixed from the last ``depth`` + 1 evaluations
+        x = mixed if accelerate else g
         start = DriveEnd(_unpack(x, like), end.state, end.ratio, end.D)
         res, end = drive.run_from(history, steps, start=start)
         n += 1
@@ -110,20 +114,7 @@ def periodic_cycles(drive: TimeDrive, history: History, steps, tol: float = TOL,
             best = (change, res)
         if not accelerate and change <= tol:  # two periods driven one after the other repeat
             return PeriodicCycles(tuple(periods), res, change, float(tol), True, n)
-        xs.append(np.array(x))
-        gs.append(_pack(end.memory))
+        g = _pack(end.memory)
         prev, last_plain = res, not accelerate
     return PeriodicCycles(tuple(periods), best[1], float(best[0]), float(tol), False, n)
 
-
-def _anderson(xs, gs, depth: int) -> np.ndarray:
-    """The next start memory: Anderson's mixing of the last ``depth`` + 1 evaluations (x_k, G(x_k)) (type II,
-    the residuals f = G(x) − x combined by least squares); one evaluation: G(x)."""
-    m = min(depth, len(xs) - 1)
-    if m < 1:
-        return gs[-1]
-    f = [g - x for x, g in zip(xs[-m - 1:], gs[-m - 1:])]
-    dF = np.stack([f[i + 1] - f[i] for i in range(m)], axis=1)
-    dG = np.stack([gs[-m - 1 + i + 1] - gs[-m - 1 + i] for i in range(m)], axis=1)
-    gamma, *_ = np.linalg.lstsq(dF, f[-1], rcond=None)
-    return gs[-1] - dG @ gamma
