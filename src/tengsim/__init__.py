@@ -60,6 +60,12 @@ _WHERE = {  # public name -> the module defining it, imported on first use (PEP 
     "ResultStatusError": "tengsim.status",
     "Scaling": "tengsim.units",
     "parse_quantity": "tengsim.units",
+    "DevicePlan": "tengsim.cases.device_plan",
+    "plan_device": "tengsim.cases.device_plan",
+    "DeviceRun": "tengsim.cases.device_run",
+    "LoadSweepRun": "tengsim.cases.device_run",
+    "run_device": "tengsim.cases.device_run",
+    "write_device": "tengsim.cases.device_run",
 }
 
 
@@ -87,4 +93,5 @@ __all__ = [
     "PeriodicKernel", "Problem", "Pyramid", "Repulsive", "Sinusoid1D", "State", "TengsimError",
     "VSRSolver", "contact_length", "force", "parse_quantity", "random_rough",
     "repulsive_area", "resolve_contact", "run_contact", "run_path", "simulate", "simulate_pyramid", "__version__",
+    "DevicePlan", "plan_device", "DeviceRun", "LoadSweepRun", "run_device", "write_device",
 ]

@@ -1,19 +1,18 @@
 """``tengsim device``: the paper's dynamic cases (fig7, fig8), any configured device (run), load sweep, the device
 a design describes (design).
 
-A thin shell: the config tables are read by :func:`tengsim.schema.read_config` and typed by the schema
-of :mod:`tengsim.device.config`; the paper's devices come from :mod:`tengsim.cases.paper`.
+A thin shell, argv -> plan -> files: the config file is read by :func:`tengsim.schema.read_config`, the options
+gathered by :mod:`tengsim.cli.device_inputs`; :func:`tengsim.cases.device_plan.plan_device` checks them all,
+:func:`tengsim.cases.device_run.run_device` runs the plan and :func:`~tengsim.cases.device_run.write_device` writes
+it (imported when a case runs: ``import tengsim.cli.device`` imports no case).
 ``tengsim run FILE.toml`` with a [device] table calls :func:`run_config` with the whole file.
 """
 from __future__ import annotations
 
-import dataclasses
 import json
 import sys
-from pathlib import Path
 
 from tengsim.cli import device_inputs as given
-from tengsim.errors import TengsimError, require
 
 SUMMARY = 'dynamic TENG output (paper Section 5)'  # its line in `tengsim --help`
 
@@ -29,10 +28,6 @@ DESCRIPTION = (
     "changes the case's waveform), [run] (case, out, cycles, t_end, dt_out, quick), [solver] (method, rtol, "
     "atol, max_step) and [sweep] (r_min_ohm, r_max_ohm, points, steady). Every table given is used or "
     "refused by name; `tengsim device fields` lists every key with its unit and default. " + PRECEDENCE)
-DEFAULT_CYCLES = {"fig7": 5, "run": 5, "sweep": 3, "design": 5}
-MAX_SWEEP_POINTS = 10_000
-"""The most loads one sweep may hold (each is a multi-cycle device run)."""
-
 DESIGN_HELP = ("The device a design describes, in one step: `tengsim device design --area-from d1/design.nc "
                "--out dev.csv`. From the design it takes σ, ε_r, T, the rest gap d0 and A/S(P) (approach); what the "
                "design does not know (mass, stiffness, electrode area, load, waveform) comes from the options, the "
@@ -109,234 +104,42 @@ def register(subparsers) -> None:
     fl.set_defaults(func=_cmd_fields)
 
 
-# --- the one path every device run takes ---
+# --- argv -> plan -> run -> files ---
 
 def execute(case: str, cfg: dict, cli: dict | None = None, quiet: bool = False, source: str | None = None) -> int:
-    """Run device ``case`` (fig7, fig8, run, sweep) from config tables ``cfg`` and CLI values ``cli``."""
-    from tengsim.device import config as dc
+    """Run device ``case`` (fig7, fig8, run, sweep, design) from config tables ``cfg`` and CLI values ``cli``:
+    :func:`tengsim.cases.device_plan.plan_device`, :func:`tengsim.cases.device_run.run_device`, then
+    :func:`~tengsim.cases.device_run.write_device`; the plan's and the run's lines go to stderr."""
+    from tengsim.cases.device_plan import plan_device
+    from tengsim.cases.device_run import LoadSweepRun, run_device, write_device
 
-    cli = cli or {}
-    dc.check_device_tables(cfg, source or "config")
-    cfg = given.area_beside(cfg, source)
-    ignored = []  # keys of the other command (run <-> sweep) in a config that serves both
-    if "sweep" in cfg and case != "sweep":
-        if case != "run":
-            raise TengsimError(f"[sweep] is used only by the sweep case, not {case}")
-        ignored.append("[sweep]")
-    run = {**dc.parse_run(cfg.get("run", {}), case, ignored), **given.typed(dc.RUN_TABLE, cli.get("run", {}))}
-    if case == "sweep" and "load_ohm" in cfg.get("device", {}):
-        ignored.append("[device] load_ohm")
-        cfg = {**cfg, "device": {k: v for k, v in cfg["device"].items() if k != "load_ohm"}}
-    if ignored and not quiet:
-        other = "run" if case == "sweep" else "sweep"
-        print(f"tengsim: note: the {case} does not use {', '.join(ignored)} (used by `tengsim device {other}`)",
-              file=sys.stderr)
-    dev_cli = given.typed(dc.DEVICE_TABLE, cli.get("device", {}))
-    solver = dc.parse_solver(cfg.get("solver", {}))
-    out = given.out_path(run, case)
-    given.guard(out, cfg, cli, source)
-    given.warn_unconverged(cfg, cli, quiet)
-    if case == "sweep":
-        return _sweep(cfg, cli, run, dev_cli, solver, out, quiet, source)
-    designed = None
-    if case == "design":
-        designed = _designed(cfg, cli, dev_cli)
-        params, wf = designed.params, designed.waveform
-    else:
-        params, wf = _device_and_waveform(case, cfg, dev_cli)
-        params = _viscoelastic(case, cfg, cli, params, wf)
-    from tengsim.device import simulate
-    from tengsim.device.config import check_pressures
-
-    if case == "fig8":
-        from tengsim.cases.paper import fig8_area_table, fig8_summary
-
-        n = len(wf.amplitudes_Pa)
-        cycles = run.get("cycles", n)
-        require(cycles <= n, f"cycles = {cycles} but the staircase has {n} steps (give at most {n})")
-        wf = dataclasses.replace(wf, amplitudes_Pa=wf.amplitudes_Pa[:cycles])
-        check_pressures(params.area, wf, wf.duration, _area_source(cfg, cli))
-        _note_paper_device(case, cfg, dev_cli, quiet)  # after every check: an error stays one line
-        if "area" not in cfg.get("device", {}) and "area" not in dev_cli:  # the slow engine: after every check
-            params = params.replace(area=fig8_area_table(bool(run.get("quick", False))))
-        res = simulate(params, wf, wf.duration, dt_out=run.get("dt_out", 1e-4), options=solver, progress=not quiet)
-        summary = {"area_model": _area_model(params), **fig8_summary(res)}
-    else:
-        t_end = run.get("t_end")
-        if t_end is None:
-            per = wf.period or wf.duration
-            require(per is not None, "give --t-end (or [run] t_end) for a waveform with no period")
-            t_end = run.get("cycles", DEFAULT_CYCLES[case]) * per
-        check_pressures(params.area, wf, t_end, _area_source(cfg, cli),
-                        " (--pressure)" if designed is not None else "")
-        if designed is not None and not quiet:  # after every check: an error stays one line
-            for line in designed.lines():
-                print(f"tengsim: {line}", file=sys.stderr)
-        for line in (designed.warnings() if designed is not None else []):
-            print(f"tengsim: warning: {line}", file=sys.stderr)
-        _note_paper_device(case, cfg, dev_cli, quiet)
-        res = simulate(params, wf, t_end, dt_out=run.get("dt_out"), options=solver, progress=not quiet)
-        skip = 1 if (wf.period and t_end >= 2 * wf.period - 1e-12) else 0
-        if designed is not None:
-            from tengsim.design.device import rest_gap_voltage
-            from tengsim.io import jsonable
-
-            summary = jsonable({"area_model": designed.area_model, **res.summary(skip),
-                                **rest_gap_voltage(designed, res), "designed_device": designed.provenance()})
-        elif case == "fig7":
-            from tengsim.cases.paper import fig7_summary
-
-            summary = {"area_model": _area_model(params), **fig7_summary(res, skip)}
-        else:
-            from tengsim.io import jsonable
-
-            summary = jsonable({"area_model": _area_model(params), **res.summary(skip)})
-    from tengsim.cli import device_field
-
-    summary = {**summary, **device_field.field_summary(params, res, cli.get("air_pressure_Pa"))}
-    if not quiet and device_field.warning(summary):
-        print(device_field.warning(summary), file=sys.stderr)
-    return _write(res, out, summary, quiet, {"case": case, "config": cfg, "config_file": source})
-
-
-def _device_and_waveform(case, cfg, dev_cli):
-    """The case's device and waveform with the [device] and [waveform] tables and CLI values applied."""
-    from tengsim.device import config as dc
-
-    base_wf = None
-    if case in ("fig7", "sweep"):
-        from tengsim.cases.paper import fig7_params, fig7_waveform
-
-        params = dc.parse_device(cfg.get("device", {}), fig7_params(), dev_cli)
-        base_wf = fig7_waveform(area_m2=params.area_m2)
-    elif case == "fig8":
-        from tengsim.cases.paper import fig8_params, fig8_waveform
-        from tengsim.device import ConstantArea
-
-        params = dc.parse_device(cfg.get("device", {}), fig8_params(ConstantArea(1.0)), dev_cli)
-        base_wf = fig8_waveform()
-    else:
-        require("device" in cfg, "device run needs a config with [device] and [waveform] (--config FILE)")
-        params = dc.parse_device(cfg["device"], None, dev_cli)
-        require("waveform" in cfg, "device run needs a [waveform] table in its config (kind = square, ...)")
-    wf = dc.parse_waveform(cfg["waveform"], base_wf) if "waveform" in cfg else base_wf
-    if case == "fig8":
-        from tengsim.device import Staircase
-
-        require(isinstance(wf, Staircase), f"fig8 needs [waveform] kind = 'staircase', got {wf.to_dict()['kind']!r} "
-                "(use `tengsim device run` for other waveforms)")
-    if case == "sweep":
-        require(getattr(wf, "period", None) is not None, "a load sweep needs a periodic waveform")
-    return params, wf
-
-
-def _area_model(params) -> str:
-    """The summary's ``area_model``: which A the device used (:func:`tengsim.device.params.area_model_label`)."""
-    from tengsim.device.params import area_model_label
-
-    return area_model_label(params.area)
-
-
-def _viscoelastic(case, cfg, cli, params, wf):
-    """``params`` with the viscoelastic A(t) of a design result with cycles given as the area (--area-from, [device]
-    area), as `device design` takes it (:func:`tengsim.device.areas.area_cycle_for_waveform`): never its quasi-static
-    A(P) in silence; a waveform that is none of its recorded presses is one line."""
-    from tengsim.device.areas import area_cycle_for_waveform, design_visco_record
-
-    raw = (cli or {}).get("device", {}).get("area") or (cfg.get("device") or {}).get("area")
-    if not isinstance(raw, (str, Path)) or design_visco_record(raw) is None:
-        return params
-    rec = design_visco_record(raw)
-    if case == "fig8":  # its staircase is no press a design records
-        raise TengsimError(f"device fig8 --area-from {raw}: the design's viscoelastic cycles press to "
-                           f"{rec['p_max_Pa'] / 1e3:.4g} kPa only, the staircase to {len(wf.amplitudes_Pa)} pressures: "
-                           "run its square or sine press with `tengsim device design --area-from` (or `device run`), or "
-                           "give a design without --relaxation for the quasi-static A(P)")
-    cycle = area_cycle_for_waveform(raw, wf, float(params.area(rec["p_max_Pa"])),
-                                    where=f"device {case} --area-from {raw}")
-    return params.replace(area=cycle)
-
-
-def _area_source(cfg, cli) -> str:
-    """Where a run's area table came from, for its errors."""
-    raw = (cli or {}).get("device", {}).get("area") or (cfg.get("device") or {}).get("area")
-    return f"A/S(P) from {raw}" if isinstance(raw, str) else "the [device] area table"
-
-
-def _designed(cfg, cli, dev_cli):
-    """The designed device (:func:`tengsim.design.device.designed_device`) of ``device design``."""
-    from tengsim.design.device import designed_device
-    from tengsim.device import config as dc
-
-    raw = cli.get("device", {}).get("area") or (cfg.get("device") or {}).get("area")
-    require(isinstance(raw, str), "device design needs a design result: give --area-from DIR/design.nc (or [device] "
-                                  "area = 'DIR/design.nc')")
-    dev = {**dc.DEVICE_TABLE.parse({k: v for k, v in (cfg.get("device") or {}).items() if k != "area"},
-                                   defaults=False), **{k: v for k, v in dev_cli.items() if k != "area"}}
-    for opt in ("mass", "stiffness", "electrode_area"):
-        key = given.OPTIONS[opt][1]
-        if key in dev_cli and not dev_cli[key] > 0:
-            raise TengsimError(f"--{opt.replace('_', '-')} must be > 0, got {cli['device'][key]!r}")
-    wcli = given.typed(None, cli.get("waveform", {}))
-    for opt in ("pressure", "frequency"):
-        key = given.OPTIONS[opt][1]
-        if key in wcli and not wcli[key] > 0:
-            raise TengsimError(f"the {opt} must be > 0 {_unit_of(cli['waveform'][key], key)}, got "
-                               f"{_as_given(cli['waveform'][key], key)}")
-    return designed_device(raw, dev, cfg.get("waveform"), wcli.get("amplitude_Pa"), wcli.get("frequency_Hz"))
-
-
-def _unit_of(raw, key: str) -> str:
-    """The unit the user gave ``raw`` in ('-5kPa' → 'kPa'), or the key's SI unit for a bare number."""
-    import re
-
-    from tengsim.units import _NUM, _compact
-
-    m = re.fullmatch(f"({_NUM})(.*)", _compact(raw)) if isinstance(raw, str) else None
-    return m.group(2) if m and m.group(2) else key.rsplit("_", 1)[-1]
-
-
-def _as_given(raw, key: str) -> str:
-    """'-5 kPa' of '-5kPa': the value in the user's own unit."""
-    import re
-
-    from tengsim.units import _NUM, _compact
-
-    m = re.match(_NUM, _compact(raw)) if isinstance(raw, str) else None
-    return f"{m.group(0) if m else raw} {_unit_of(raw, key)}"
-
-
-def _note_paper_device(case, cfg, dev_cli, quiet):
-    """fig7/fig8/sweep with a design's area: the paper's device with the design's A/S, said once."""
-    raw = (cfg.get("device") or {}).get("area")
-    if quiet or case not in ("fig7", "fig8", "sweep") or not ("area" in dev_cli or isinstance(raw, str)):
-        return
-    print(f"tengsim: note: {case} is the paper's device (its σ, ε_r, T, rest gap, mass, spring and waveform) with "
-          "this A/S(P); `tengsim device design --area-from DIR/design.nc` runs the device the design describes",
-          file=sys.stderr)
-
-
-def _write(result, out: Path, summary: dict, quiet: bool, provenance: dict) -> int:
-    from tengsim.io import write_dataset, write_json
-
-    if out.suffix.lower() == ".nc":
-        ds = result.to_dataset()
-        ds.attrs["summary"] = json.dumps(summary)
-        ds.attrs["run"] = json.dumps(provenance, default=str)
-        write_dataset(ds, out)
-        where = f"{out}"
-    else:
-        result.write_csv(out)
-        side = out.with_suffix(".json")
-        write_json(side, {**result.header(), "summary": summary, "run": provenance})
-        where = f"{out} (+ {side.name})"
+    plan = plan_device(case, cfg, cli, source, quiet)
+    _say(plan.messages)
+    run = run_device(plan)
+    if isinstance(run, LoadSweepRun):
+        where = write_device(run)
+        _say(run.messages)
+        if not quiet:
+            sw, k_opt = run.sweep, run.optimum_row
+            what = "largest mean power in the range (at its edge)" if sw.optimum_at_edge else "optimum load"
+            print(f"{what}: R = {sw.optimum_ohm:.4g} ohm, "
+                  + power_line({"peak_power_W": sw.peak_power_W[k_opt], "average_power_W": sw.optimum_power_W}))
+            print(f"wrote {where}", file=sys.stderr)
+        return 0
+    _say(run.messages)
+    where = write_device(run)
     if not quiet:
-        print(json.dumps(summary, indent=1))
-        line = power_line(summary)
+        print(json.dumps(run.summary, indent=1))
+        line = power_line(run.summary)
         if line:
             print(line)
         print(f"wrote {where}", file=sys.stderr)
     return 0
+
+
+def _say(lines) -> None:
+    for line in lines:
+        print(line, file=sys.stderr)
 
 
 def power_line(summary: dict) -> str:
@@ -349,56 +152,6 @@ def power_line(summary: dict) -> str:
     if mean is None:
         return f"power: peak {format_si(peak, 'W')} ({peak:.4g} W); mean: no settled cycle"
     return f"power: peak {format_si(peak, 'W')}, mean {format_si(mean, 'W')} (W: {peak:.4g}, {mean:.4g})"
-
-
-def _sweep(cfg, cli, run, dev_cli, solver, out, quiet, source) -> int:
-    import numpy as np
-
-    from tengsim.device import config as dc
-    from tengsim.device import resistance_sweep
-    from tengsim.io import write_csv, write_json
-
-    sw_cfg = {**dc.SWEEP_TABLE.parse(cfg.get("sweep", {})), **given.typed(dc.SWEEP_TABLE, cli.get("sweep", {}))}
-    r_min, r_max, points = sw_cfg["r_min_ohm"], sw_cfg["r_max_ohm"], sw_cfg["points"]
-    require(0 < r_min < r_max, f"need 0 < r_min < r_max, got {r_min!r}, {r_max!r}")
-    require(points >= 2, f"points must be >= 2, got {points!r}")
-    from tengsim.resources import check_count
-
-    check_count(points, "the load sweep's points", MAX_SWEEP_POINTS)  # before a load array is made
-    cycles = run.get("cycles", DEFAULT_CYCLES["sweep"])
-    require(cycles >= 2, f"cycles must be >= 2 for a sweep (the first is dropped), got {cycles!r}")
-    params, wf = _device_and_waveform("sweep", cfg, dev_cli)
-    params = _viscoelastic("sweep", cfg, cli, params, wf)
-    loads = np.logspace(np.log10(r_min), np.log10(r_max), points)
-    from tengsim.device.config import check_pressures
-
-    check_pressures(params.area, wf, cycles * wf.period, _area_source(cfg, cli))
-    _note_paper_device("sweep", cfg, dev_cli, quiet)
-    sw = resistance_sweep(params, wf, loads, cycles=cycles, steady=sw_cfg["steady"], dt_out=run.get("dt_out"),
-                          options=solver, progress=not quiet)
-    from tengsim.io import jsonable
-
-    k_opt = int(np.nanargmax(sw.average_power_W))  # the optimum's row
-    head = jsonable({"area_model": _area_model(params), "params": params.to_dict(), "waveform": wf.to_dict(),
-                     "optimum_ohm": sw.optimum_ohm,
-                    "optimum_power_W": sw.optimum_power_W,
-                    "optimum_peak_power_W": float(sw.peak_power_W[k_opt]), "optimum_at_edge": sw.optimum_at_edge,
-                    "run": {"case": "sweep", "cycles": cycles, "config": cfg, "config_file": source}})
-    write_csv(out, {"R": sw.load_ohm, "energy_per_cycle": sw.energy_per_cycle_J, "average_power": sw.average_power_W,
-                    "peak_voltage": sw.peak_voltage_V, "peak_current": sw.peak_current_A,
-                    "peak_power": sw.peak_power_W}, head)
-    side = out.with_suffix(".json")
-    write_json(side, head)
-    if sw.optimum_at_edge:
-        print(f"tengsim: warning: the mean power is largest at the edge of the swept range (R = "
-              f"{sw.optimum_ohm:.4g} ohm): no optimum inside {r_min:.3g}..{r_max:.3g} ohm; widen the range",
-              file=sys.stderr)
-    if not quiet:
-        what = "largest mean power in the range (at its edge)" if sw.optimum_at_edge else "optimum load"
-        print(f"{what}: R = {sw.optimum_ohm:.4g} ohm, "
-              + power_line({"peak_power_W": sw.peak_power_W[k_opt], "average_power_W": sw.optimum_power_W}))
-        print(f"wrote {out} (+ {side.name})", file=sys.stderr)
-    return 0
 
 
 def _cmd_fields(args) -> int:
