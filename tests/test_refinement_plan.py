@@ -53,6 +53,7 @@ def test_design_checked_once_given_its_checked_plan(monkeypatch):
     with pytest.raises(RuntimeError) as given:
         _run.run_design(plan, refinement=checked)
     assert given.value.args[0] is checked and calls == []
+    assert checked.observe is not None and checked.maps_at == _run.map_pressures(plan)  # what the design judges
     with pytest.raises(RuntimeError) as planned:
         _run.run_design(plan)
     assert calls == [planned.value.args[0]] and planned.value.args[0].dx == checked.dx

@@ -66,9 +66,18 @@ def preflight(plan, progress=None):
     (:func:`run_design`'s ``refinement``)."""
     from tengsim.run import refine
 
-    refinement = refine.plan_refinement(choose_solver(plan, plan.contact_plan, progress), plan)
+    refinement = plan_refinement(plan, choose_solver(plan, plan.contact_plan, progress))
     refine.preflight(refinement)
     return refinement
+
+
+def plan_refinement(plan, cplan):
+    """The design's :class:`tengsim.run.refine.RefinementPlan` of ``cplan``: what it asks, its observers
+    (:func:`tengsim.design.walk.observers`) and its maps' pressures (none with ``maps = false``)."""
+    from tengsim.run.refine import plan_refinement as planned
+
+    observe, watch = observers(plan)
+    return planned(cplan, plan, observe, watch, map_pressures(plan) if plan.maps else ())
 
 
 def choose_solver(plan, cplan, progress=None):
@@ -95,19 +104,17 @@ def run_design(plan, progress=None, keep=None, refinement=None) -> DesignResult:
     from tengsim.design.curves import summarize
     from tengsim.design.write import to_dataset
     from tengsim.run.budget import RunClock
-    from tengsim.run.refine import Hooks, plan_refinement, preflight as check, refine
+    from tengsim.run.refine import Observer, preflight as check, refine
 
     started = RunClock.now()  # the budget counts the run's own CPU time from here (tengsim.run.budget)
     # the design's own floor first (the kept grids' identity, the maps' pressures, the solver, the first grid,
     # the observers); then one call to the run layer; then the design's numbers
     base = identity(plan)
-    maps_at = map_pressures(plan) if plan.maps else ()
     cplan = choose_solver(plan, plan.contact_plan, progress)
     if refinement is None:
-        refinement = plan_refinement(cplan, plan)
+        refinement = plan_refinement(plan, cplan)
         check(refinement)
-    observe, watch = observers(plan)
-    res = refine(refinement, Hooks(progress, observe, watch, maps_at, keep, base, kept_path(keep, base), started))
+    res = refine(refinement, Observer(progress, keep, base, kept_path(keep, base), started))
     maps, depths = (res, maps_asked(res, plan)) if plan.maps and res.maps else (None, {})
     summary, conv, notes = summarize(res, plan)
     summary["map_pressures_asked"] = tuple(depths.items())

@@ -60,17 +60,14 @@ def say_to(progress, text: str) -> None:
 
 
 @dataclass(frozen=True)
-class Hooks:
-    """What a refinement reports to and keeps: ``progress`` (called per path row; its ``say(text)`` gets the
-    lines), ``observe`` / ``watch`` (result -> {name: value}: judged / recorded per grid), ``maps_at`` (asked
-    pressures, Pa, where maps are kept), ``keep`` (the checkpoint file or None) under ``base`` (its identity),
-    ``later`` (the D range of a kept second pass, or None) and ``started`` (a :class:`tengsim.run.budget.RunClock`
-    made at the start, or a ``time.monotonic()`` value: the budget counts from it)."""
+class Observer:
+    """Who watches a refinement and where it keeps its grids, passed to :func:`refine`: ``progress`` (a
+    :class:`tengsim.progress.Progress`-like object: called per path row; its ``say(text)`` gets the lines), the
+    checkpoint file ``keep`` (or None) under the identity ``base``, ``later`` (the D range of a kept second pass,
+    or None) and ``started`` (a :class:`tengsim.run.budget.RunClock` made at the start, or a ``time.monotonic()``
+    value: the budget counts from it)."""
 
     progress: object = None
-    observe: object = None
-    watch: object = None
-    maps_at: tuple = ()
     keep: object = None
     base: str = ""
     later: float | None = None
@@ -86,7 +83,9 @@ class RefinementPlan:
     and ``retraction`` (false: the approach only); and its own numbers: the first grid's spacing ``dx`` (X units,
     the cell's), the refinement's ``grids`` (:class:`tengsim.run.grids.GridSequence` from ``dx``), the shortest
     path's time on the first grid (``shortest_s``, s), the finest grid the estimate counts (``finest``,
-    :func:`tengsim.run.budget.estimated_grids`) and its memory (``memory_bytes``).  Its only entry points:
+    :func:`tengsim.run.budget.estimated_grids`) and its memory (``memory_bytes``); what is judged per grid,
+    ``observe``, and recorded, ``watch`` (result -> {name: value}, or None), and the asked pressures where maps are
+    kept (``maps_at``, Pa).  Its only entry points:
     :func:`preflight`, :func:`estimate` and :func:`refine`."""
 
     cplan: object
@@ -101,6 +100,9 @@ class RefinementPlan:
     shortest_s: float
     finest: object
     memory_bytes: int
+    observe: object = None
+    watch: object = None
+    maps_at: tuple = ()
 
     def __post_init__(self):
         import math
@@ -125,9 +127,9 @@ class RefinementPlan:
         return self.cplan.tol
 
 
-def plan_refinement(cplan, ask) -> RefinementPlan:
+def plan_refinement(cplan, ask, observe=None, watch=None, maps_at=()) -> RefinementPlan:
     """The :class:`RefinementPlan` of ``cplan`` asked by ``ask`` (module doc; a size that does not fit the cell
-    said in the user's units).  Nothing is checked against the machine or the budget here: :func:`preflight`."""
+    said in the user's units), judging ``observe`` and recording ``watch`` per grid, maps kept at ``maps_at``.  Nothing is checked against the machine or the budget here: :func:`preflight`."""
     from tengsim.errors import GeometryError
     from tengsim.run.budget import estimated_grids, run_cost
     from tengsim.run.grids import GridSequence
@@ -143,7 +145,7 @@ def plan_refinement(cplan, ask) -> RefinementPlan:
         raise exc.in_metres(cplan.scaling.lateral, _metres) from None
     memory = estimate_bytes(finest.nx, finest.ny, cplan.boundary, cplan.solver)
     return RefinementPlan(cplan, ask.name, tuple(ask.pressures), ask.tol, ask.max_pixels, ask.budget_s,
-                          ask.retraction, dx, grids, shortest, finest, memory)
+                          ask.retraction, dx, grids, shortest, finest, memory, observe, watch, tuple(maps_at))
 
 
 def preflight(plan: RefinementPlan) -> None:
@@ -214,7 +216,7 @@ def find_range(plan: RefinementPlan, progress=None, guard=None):
     return find_d_max(plan.cplan, plan.dx, plan.p_max, height_eps(plan.cplan, plan.dx), extending, guard)
 
 
-def refine(plan: RefinementPlan, hooks: Hooks = Hooks()):
+def refine(plan: RefinementPlan, observer: Observer = Observer()):
     """The refined :class:`tengsim.results.ContactResult` of ``plan`` (checked by :func:`preflight`) whose approach
     reaches its last pressure (module doc); a :class:`tengsim.errors.TengsimError` before the refinement is solved
     where its expected time is over the budget."""
@@ -223,24 +225,24 @@ def refine(plan: RefinementPlan, hooks: Hooks = Hooks()):
     from tengsim.run.reach import resolve_to
 
     def said(text):
-        say_to(hooks.progress, text)
+        say_to(observer.progress, text)
 
     cplan = plan.cplan
     cpu = not on_gpu(cplan)  # the budget in the run's own CPU time (a GPU run's host waits: the wall time)
-    coarse_guard = deadline(None, plan, hooks.keep, hooks.started, cpu)
-    guard = deadline(hooks.progress, plan, hooks.keep, hooks.started, cpu)
+    coarse_guard = deadline(None, plan, observer.keep, observer.started, cpu)
+    guard = deadline(observer.progress, plan, observer.keep, observer.started, cpu)
     grids = plan.grids
     said(f"{plan.name}: Tabor number {cplan.tabor:.3g} (from eps = {cplan.scaling.eps * 1e9:.3g} nm), "
          f"lateral unit {cplan.scaling.lateral * 1e9:.3g} nm")
     if cplan.solver_note:
         said(cplan.solver_note)
 
-    d_max, coarse = find_range(plan, hooks.progress, coarse_guard)  # the path's range, on a cheap grid
+    d_max, coarse = find_range(plan, observer.progress, coarse_guard)  # the path's range, on a cheap grid
     est = estimate(plan, d_max, coarse)
     for line in est.lines():
         said(line)
-    if hooks.later is not None and hooks.later > d_max:  # killed in its second pass: go on on that pass's path
-        d_max = hooks.later
+    if observer.later is not None and observer.later > d_max:  # killed in its second pass: go on on that pass's path
+        d_max = observer.later
     cost = run_cost(cplan, d_max, coarse, plan.retraction)
     max_pixels = plan.max_pixels or budget_pixels(plan, cplan.shape, grids, cost)
     check_budget(plan, est, max_pixels)
@@ -249,5 +251,5 @@ def refine(plan: RefinementPlan, hooks: Hooks = Hooks()):
     def done(levels):  # after each finished (and kept) grid: its measured time and the next grid's expected one
         said(next_grid_line(cplan.shape, grids[:len(levels) + 1], levels[-1]["seconds"], cplan.scaling.lateral))
 
-    return resolve_to(cplan, plan.p_max, d_max, ResolveSettings(plan.tol, max_pixels, plan.dx), hooks.maps_at,
-                      hooks.observe, hooks.watch, guard, hooks.keep, hooks.base, done, said, plan.retraction)
+    return resolve_to(cplan, plan.p_max, d_max, ResolveSettings(plan.tol, max_pixels, plan.dx), plan.maps_at,
+                      plan.observe, plan.watch, guard, observer.keep, observer.base, done, said, plan.retraction)
