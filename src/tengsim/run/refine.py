@@ -249,7 +249,7 @@ def refine(plan: RefinementPlan, observer: Observer = Observer()):
     said(cap_line(cplan.shape, grids, cost, max_pixels))
 
     def done(levels):  # after each finished (and kept) grid: its measured time and the next grid's expected one
-        said(next_grid_line(cplan.shape, grids[:len(levels) + 1], levels[-1]["seconds"], cplan.scaling.lateral))
+        said(next_grid_line(cplan.shape, grids[:len(levels) + 1], levels[-1].seconds, cplan.scaling.lateral))
 
     return resolve_to(cplan, plan.p_max, d_max, ResolveSettings(plan.tol, max_pixels, plan.dx), plan.maps_at,
                       plan.observe, plan.watch, guard, observer.keep, observer.base, done, said, plan.retraction)
