@@ -129,7 +129,8 @@ class RefinementPlan:
 
 def plan_refinement(cplan, ask, observe=None, watch=None, maps_at=()) -> RefinementPlan:
     """The :class:`RefinementPlan` of ``cplan`` asked by ``ask`` (module doc; a size that does not fit the cell
-    said in the user's units), judging ``observe`` and recording ``watch`` per grid, maps kept at ``maps_at``.  Nothing is checked against the machine or the budget here: :func:`preflight`."""
+    said in the user's units), judging ``observe`` and recording ``watch`` per grid, maps kept at ``maps_at``.
+    Nothing is checked against the machine or the budget here: :func:`preflight`."""
     from tengsim.errors import GeometryError
     from tengsim.run.budget import estimated_grids, run_cost
     from tengsim.run.grids import GridSequence
@@ -251,5 +252,5 @@ def refine(plan: RefinementPlan, observer: Observer = Observer()):
     def done(levels):  # after each finished (and kept) grid: its measured time and the next grid's expected one
         said(next_grid_line(cplan.shape, grids[:len(levels) + 1], levels[-1].seconds, cplan.scaling.lateral))
 
-    return resolve_to(cplan, plan.p_max, d_max, ResolveSettings(plan.tol, max_pixels, plan.dx), plan.maps_at,
-                      plan.observe, plan.watch, guard, observer.keep, observer.base, done, said, plan.retraction)
+    return resolve_to(plan, d_max, ResolveSettings(plan.tol, max_pixels, plan.dx), guard, observer.keep,
+                      observer.base, done, said)
