@@ -29,14 +29,15 @@ def one(table, grid_index, tol):
     from tengsim.continuation import walker
     from tengsim.design import plan_design
     from tengsim.design import walk as _walk
-    from tengsim.run import grids as _grids
+    from tengsim.run import grids as _grids, refine as _refine
     from tengsim.design.curves import branch_curves
     from tengsim.run.plan import plan_contact
 
     plan = plan_design(table)
     cplan = dataclasses.replace(plan_contact(plan.contact_table), tol=tol)
-    dx = _walk.start_dx(plan, cplan)
-    d_max, _ = _walk.find_d_max(plan, cplan, dx)
+    refinement = _refine.plan_refinement(cplan, plan)
+    dx = refinement.dx
+    d_max, _ = _refine.find_range(refinement)
     g = _grids.refinement_grids(cplan.shape, dx, grid_index + 1)[grid_index]
     spent = []
     solve = walker.Walker.solve

@@ -192,8 +192,7 @@ def test_first_grid_is_the_default_refinements_first_fine_enough_one():
     for the issue's pyramid)."""
     from tengsim import status
     from tengsim.run.plan import plan_contact
-    from tengsim.design.walk import start_dx
-    from tengsim.run.refine import START_ZONE_PIXELS
+    from tengsim.run.refine import START_ZONE_PIXELS, first_dx
     from tengsim.run.grids import default_dx, refinement_grids
 
     from tengsim.design import read_design
@@ -204,13 +203,13 @@ def test_first_grid_is_the_default_refinements_first_fine_enough_one():
     zone = status.process_zone_estimate(cp.law, cp.tabor**1.5)
     dx0 = default_dx(cp.shape, cp.law, cp.tabor**1.5, cp.boundary)
     seq = refinement_grids(cp.shape, dx0)
-    dx = start_dx(plan, cp)
+    dx = first_dx(cp, plan)
     k = [g.nx for g in seq].index(cp.shape.grid(dx).nx)
     assert k > 0 and seq[k].dx <= zone / START_ZONE_PIXELS < seq[k - 1].dx
     assert [g.nx for g in seq[k:k + 3]] == [245, 385, 585]  # the last grids the pyramid converged on before
     given = plan_design(dict(read_design(str(Path(__file__).parent.parent / "examples" / "own_design" / "pyramid.toml")),
                              dx="100nm"))
-    assert start_dx(given, cp) * cp.scaling.lateral == pytest.approx(100e-9)  # a dx given is the first grid's
+    assert first_dx(cp, given) * cp.scaling.lateral == pytest.approx(100e-9)  # a dx given is the first grid's
 
 
 def test_maps_kept_during_the_finest_walk(small):
@@ -350,13 +349,13 @@ def test_budget_cap_is_the_last_refinement_grid_the_budget_pays_for():
 
     from tengsim.design import read_design
     from tengsim.run.budget import budget_pixels, run_cost
-    from tengsim.design.walk import start_dx
+    from tengsim.run.refine import first_dx
     from tengsim.run.reach import height_eps
     from tengsim.run.grids import GridSequence, refinement_grids
 
     plan = plan_design(read_design(str(Path(__file__).parent.parent / "examples" / "own_design" / "pyramid.toml")))
     cp = plan.contact_plan
-    dx = start_dx(plan, cp)
+    dx = first_dx(cp, plan)
     d_max = 1.2 * height_eps(cp, dx) + 2.0
     cost = run_cost(cp, d_max)
     cap = budget_pixels(plan, cp.shape, GridSequence(cp.shape, dx), cost)
@@ -377,8 +376,7 @@ def test_estimate_uses_the_backends_cost_and_names_it(monkeypatch):
     from pathlib import Path
 
     from tengsim.design import read_design
-    from tengsim.design import walk as _walk
-    from tengsim.run import budget as _budget
+    from tengsim.run import budget as _budget, refine as _refine
     from tengsim.resources import CPU_COST, GPU_COST
     from tengsim.run.plan import plan_contact
     from tengsim.solvers import choice
@@ -388,7 +386,7 @@ def test_estimate_uses_the_backends_cost_and_names_it(monkeypatch):
     assert cp.solver == "fast" and "no GPU" in cp.solver_note  # auto, on this machine
     from tengsim.run.grids import GridSequence
 
-    dx = _walk.start_dx(plan, cp)
+    dx = _refine.first_dx(cp, plan)
     seq = GridSequence(cp.shape, dx)
     cpu = _budget.estimate(plan, cp, seq, 25.0, _budget.run_cost(cp, 25.0))
     assert cpu.backend == CPU_COST.backend and "CPU" in cpu.lines()[1]
@@ -448,6 +446,7 @@ def test_the_designs_solver_tolerance_moves_its_numbers_far_less_than_tol():
 
     from tengsim.design import plan as _dplan, walk as _walk
     from tengsim.design.curves import branch_curves
+    from tengsim.run.refine import find_range, plan_refinement
     from tengsim.run.plan import plan_contact
 
     plan = plan_design(SMALL)
@@ -455,8 +454,8 @@ def test_the_designs_solver_tolerance_moves_its_numbers_far_less_than_tol():
     out = []
     for tol in (_dplan.solver_tol(plan), 1e-6):
         cplan = dataclasses.replace(plan_contact(plan.contact_table), tol=tol)
-        dx = _walk.start_dx(plan, cplan)
-        res = _walk._simulate(cplan, dx, _walk.find_d_max(plan, cplan, dx)[0])
+        refinement = plan_refinement(cplan, plan)
+        res = _walk._simulate(cplan, refinement.dx, find_range(refinement)[0])
         assert res.params["tol"] == tol and res.status == "ok"
         c = branch_curves(res, plan)
         out.append((np.concatenate([c["approach"]["area"], c["retraction"]["area"]]), res.pull_off_force,

@@ -228,7 +228,10 @@ def test_sweep_passes_resolve_and_reports_status_and_dx(tmp_path, study_client):
 def test_needed_dx_is_not_extrapolated_absurdly_far():
     """A change of 600 % between two grids (a jump on one grid only) extrapolates to a dx thousands of times
     finer; the message then says only 'below dx/8', not the absurd number."""
-    levels = [{"dx": 0.2, "obs": {"pull_off": 1.0}}, {"dx": 0.14, "obs": {"pull_off": 7.0}}]
+    from tengsim.run.judge import GridRecord
+
+    levels = [GridRecord(0.2, 5, 5, 1.0, 10, "ok", {"pull_off": 1.0}),
+              GridRecord(0.14, 7, 7, 2.0, 20, "ok", {"pull_off": 7.0})]
     rich = {"pull_off": {"order": 0.5, "rel_error": 6.0}}
     need = resolve._dx_needed(levels, rich, {"pull_off": 6.0}, 0.01)
     assert need < 0.14 / resolve.NEED_FLOOR  # the raw estimate is far below the floor

@@ -242,6 +242,7 @@ def run(args) -> int:
     from tengsim.design.run import preflight
     from tengsim.outfolder import folder_lock
 
+    refinements = []  # each design's checked refinement plan: checked once, here
     for (where, _), plan in zip(tables, plans):  # every design's grids, memory, budget, solver, before any runs
         seen = set()
         for k, p in enumerate((plan, *plan.bands)):  # the band points' designs too, each distinct one once
@@ -249,22 +250,25 @@ def run(args) -> int:
                 continue
             seen.add((p.E_star, p.W, p.eps))
             try:
-                preflight(p)
+                checked = preflight(p)
             except TengsimError as exc:
                 point = f"--material {args.material} [[uncertainty.point]] {k}: " if k else ""
                 raise TengsimError(f"{where}{point}{exc}") from None
+            if k == 0:
+                refinements.append(checked)
     with folder_lock(out, holder="tengsim design"):  # the whole run: no second run on this folder meanwhile
-        return _run_locked(args, plans, folders, out, relaxation)
+        return _run_locked(args, plans, folders, out, relaxation, refinements)
 
 
-def _run_locked(args, plans, folders, out, relaxation=None) -> int:
+def _run_locked(args, plans, folders, out, relaxation=None, refinements=None) -> int:
     from tengsim.design import predict_bands, run_design, write_bands, write_comparison, write_design
 
     say = _Say(args.quiet)
     results = []
     try:
         for k, plan in enumerate(plans):  # each finished grid kept in OUT: a killed run resumes from it
-            results.append(run_design(plan, progress=say, keep=out / f".design-{k}.resolve.nc"))
+            results.append(run_design(plan, progress=say, keep=out / f".design-{k}.resolve.nc",
+                                      refinement=refinements[k] if refinements else None))
     except KeyboardInterrupt:
         say.close()
         kept = [out / f".design-{k}.resolve.nc" for k in range(len(plans))]

@@ -6,13 +6,14 @@ The design's own floor says what is asked (the pressures, the tolerance, the bud
 definition, the maps) and reads the answer (:mod:`tengsim.design.curves`); everything between is one call to the
 run layer, :func:`tengsim.run.refine.refine`:
 
-1. **Checks.**  :func:`tengsim.run.refine.preflight` checks every bound from the sizes alone (the solver, the first
-   grid, the memory, the budget) before any array is allocated; :func:`choose_solver` puts a cohesive law with a
-   wall on 'pk'.
+1. **Checks.**  :func:`tengsim.run.refine.plan_refinement` plans the refinement once (a frozen
+   :class:`tengsim.run.refine.RefinementPlan`) and :func:`tengsim.run.refine.preflight` checks every bound from
+   its sizes alone (the solver, the first grid, the memory, the budget) before any array is allocated, once per
+   design (:func:`preflight`); :func:`choose_solver` puts a cohesive law with a wall on 'pk'.
 2. **Path.**  The first grid (:func:`tengsim.run.refine.first_dx`), the refinement's grids
    (:class:`tengsim.run.grids.GridSequence`) and the path's D range, found on a coarse grid
-   (:func:`tengsim.run.reach.find_d_max`).
-3. **Estimate.**  The grids, the memory and the expected time (:func:`tengsim.run.budget.estimate`), the worst
+   (:func:`tengsim.run.refine.find_range`).
+3. **Estimate.**  The grids, the memory and the expected time (:func:`tengsim.run.refine.estimate`), the worst
    case up to the budget's largest grid (:func:`tengsim.run.budget.cap_line`); an expected time over the
    budget is refused before the refinement is solved or anything written.
 4. **Refinement.**  :func:`tengsim.run.reach.resolve_to` on dx, dx/√2, ... (:mod:`tengsim.run.grids`) until the
@@ -61,12 +62,22 @@ class DesignResult:
 def preflight(plan, progress=None):
     """Every bound of a design checked from its sizes alone, before any array is allocated or anything is
     written (:func:`tengsim.run.refine.preflight`: the solver, the first grid, the memory, the shortest path's time
-    against the budget); the contact plan the run will use."""
-    from tengsim.run.refine import preflight as check
+    against the budget); the checked :class:`tengsim.run.refine.RefinementPlan` the run will use
+    (:func:`run_design`'s ``refinement``)."""
+    from tengsim.run import refine
 
-    cplan = choose_solver(plan, plan.contact_plan, progress)
-    check(cplan, plan)
-    return cplan
+    refinement = plan_refinement(plan, choose_solver(plan, plan.contact_plan, progress))
+    refine.preflight(refinement)
+    return refinement
+
+
+def plan_refinement(plan, cplan):
+    """The design's :class:`tengsim.run.refine.RefinementPlan` of ``cplan``: what it asks, its observers
+    (:func:`tengsim.design.walk.observers`) and its maps' pressures (none with ``maps = false``)."""
+    from tengsim.run.refine import plan_refinement as planned
+
+    observe, watch = observers(plan)
+    return planned(cplan, plan, observe, watch, map_pressures(plan) if plan.maps else ())
 
 
 def choose_solver(plan, cplan, progress=None):
@@ -83,24 +94,27 @@ def choose_solver(plan, cplan, progress=None):
     return cplan
 
 
-def run_design(plan, progress=None, keep=None) -> DesignResult:
+def run_design(plan, progress=None, keep=None, refinement=None) -> DesignResult:
     """Run one design (module doc).  ``progress``: a :class:`tengsim.progress.Progress`-like callable (the
     path's progress) and/or an object with ``say(text)``, which gets the lines said before and during the run
     (the Tabor number, the solver, the grids, memory and expected time).  ``keep`` (a file path, or None): where each
-    finished grid is kept (:func:`tengsim.design.keep.checkpoint`), so a killed run of the same design resumes from it."""
+    finished grid is kept (:func:`tengsim.design.keep.checkpoint`), so a killed run of the same design resumes from it.
+    ``refinement``: the design's plan already checked by :func:`preflight` (None: planned and checked here), so a
+    design is checked once."""
     from tengsim.design.curves import summarize
     from tengsim.design.write import to_dataset
     from tengsim.run.budget import RunClock
-    from tengsim.run.refine import Hooks, refine
+    from tengsim.run.refine import Observer, preflight as check, refine
 
     started = RunClock.now()  # the budget counts the run's own CPU time from here (tengsim.run.budget)
     # the design's own floor first (the kept grids' identity, the maps' pressures, the solver, the first grid,
     # the observers); then one call to the run layer; then the design's numbers
     base = identity(plan)
-    maps_at = map_pressures(plan) if plan.maps else ()
     cplan = choose_solver(plan, plan.contact_plan, progress)
-    observe, watch = observers(plan)
-    res = refine(cplan, plan, Hooks(progress, observe, watch, maps_at, keep, base, kept_path(keep, base), started))
+    if refinement is None:
+        refinement = plan_refinement(plan, cplan)
+        check(refinement)
+    res = refine(refinement, Observer(progress, keep, base, kept_path(keep, base), started))
     maps, depths = (res, maps_asked(res, plan)) if plan.maps and res.maps else (None, {})
     summary, conv, notes = summarize(res, plan)
     summary["map_pressures_asked"] = tuple(depths.items())

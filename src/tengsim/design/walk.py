@@ -1,23 +1,15 @@
 """A design's walk: the first grid, the path's D range and each grid's path, the maps kept on the way.
 
-The first dx is the user's (a length) or :func:`start_dx`: the first grid of the refinement's sequence
+The first dx is the user's (a length) or the run layer's (:func:`tengsim.run.refine.first_dx`): the first grid of the refinement's sequence
 (:mod:`tengsim.run.grids`) whose dx is at most the law's process zone over :data:`tengsim.run.refine.START_ZONE_PIXELS`.
 The path to p_max is the run layer's (:mod:`tengsim.run.reach`): an adaptive D walk from D = -1 ε to a d_max found on
-a grid twice as coarse as the default first grid (:func:`find_d_max`), each finer grid's walk ending a little past
+a grid twice as coarse as the default first grid (:func:`tengsim.run.refine.find_range`), each finer grid's walk ending a little past
 the D at which the grid before it reached p_max (:func:`grid_path`).  The design chooses where the pressure and gap
 maps are kept: at the asked pressures nearest 10 %, 50 % and 100 % of p_max (:func:`map_pressures`).
 """
 from __future__ import annotations
 
 from tengsim.run.reach import grid_path as reach_grid_path, map_depths as reach_depths, path_to
-
-
-def start_dx(plan, cplan) -> float:
-    """The design's first dx in X units (:func:`tengsim.run.refine.first_dx`: the plan's, or the refinement's first
-    grid whose dx is at most the law's process zone over :data:`tengsim.run.refine.START_ZONE_PIXELS`)."""
-    from tengsim.run.refine import first_dx
-
-    return first_dx(cplan, plan)
 
 
 def _simulate(cplan, dx, d_max, **kw):
@@ -27,13 +19,6 @@ def _simulate(cplan, dx, d_max, **kw):
     from tengsim.run.simulate import simulate_plan
 
     return simulate_plan(dataclasses.replace(cplan, dx=dx, grid=None, path=path_to(d_max)), **kw)
-
-
-def find_d_max(plan, cplan, dx, progress=None, guard=None):
-    """(d_max, the coarse result): the design's path range (:func:`tengsim.run.refine.find_range`)."""
-    from tengsim.run.refine import find_range
-
-    return find_range(cplan, plan, dx, progress, guard)
 
 
 MAP_FRACTIONS = (0.1, 0.5, 1.0)

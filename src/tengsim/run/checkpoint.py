@@ -38,6 +38,9 @@ class Checkpoint:
     def save(self, levels, phases, res) -> None:
         from tengsim import io
 
+        from tengsim.run.judge import GridRecord
+
+        levels = [GridRecord.of(lv).as_dict() for lv in levels]  # each finished grid as the file keeps it
         kept = {self.KEY: io.dumps({"digest": self.digest, "levels": levels, "phases": list(phases)})}
         dataclasses.replace(res, params={**res.params, **kept}).save(self.path)
 
@@ -73,10 +76,12 @@ class Checkpoint:
         if rec.get("digest") != self.digest:
             raise TengsimError(f"--resume: {self.path} was written by another run (its [contact] table "
                                "differs); delete it to start afresh")
+        from tengsim.run.judge import GridRecord
+
         levels = rec["levels"]
         for lv in levels:  # strict JSON wrote NaN as null
             lv["obs"] = {k: (math.nan if v is None else v) for k, v in lv["obs"].items()}
-        return levels, rec["phases"], res
+        return [GridRecord.of(lv) for lv in levels], rec["phases"], res
 
 
 def open_checkpoint(keep, key: str, d_max: float, say=None):

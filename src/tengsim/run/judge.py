@@ -4,12 +4,44 @@ short (the criteria and the formulas: :mod:`tengsim.run.resolve`'s module doc)."
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass, field
 
 P_MIN, P_MAX = 0.5, 4.0
 """Range the observed order is clipped to."""
 FLOORS = {"D": 1.0, "F": 0.01, "fraction": 0.01, "V": 0.01}
 """Absolute floor of the relative change of an observable by kind (D in ε, F of Eq. 10, A/S, V_OC in V):
 |Δf| <= tol · max(|f|, floor)."""
+
+
+@dataclass(frozen=True)
+class GridRecord:
+    """One finished grid of a refinement: its spacing ``dx`` (X units) and pixels, the wall ``seconds`` of its
+    walk, the ``convolutions`` it spent, its ``status``, its observables ``obs`` {name: value} and the names among
+    them recorded but not judged (``watched``).  Kept in a checkpoint as :meth:`as_dict` (:meth:`of` reads it
+    back)."""
+
+    dx: float
+    nx: int
+    ny: int
+    seconds: float
+    convolutions: int
+    status: str
+    obs: dict = field(default_factory=dict)
+    watched: tuple = ()
+
+    def as_dict(self) -> dict:
+        """The record as the checkpoint file keeps it."""
+        return {"dx": self.dx, "nx": self.nx, "ny": self.ny, "seconds": self.seconds,
+                "convolutions": self.convolutions, "status": self.status, "obs": dict(self.obs),
+                "watched": list(self.watched)}
+
+    @classmethod
+    def of(cls, rec) -> "GridRecord":
+        """``rec`` as a record (a :class:`GridRecord`, or the dict a checkpoint file kept)."""
+        if isinstance(rec, GridRecord):
+            return rec
+        return cls(rec["dx"], rec["nx"], rec["ny"], rec["seconds"], rec["convolutions"], rec["status"],
+                   dict(rec["obs"]), tuple(rec.get("watched", ())))
 
 
 def _kind(name: str) -> str:
@@ -83,19 +115,19 @@ def relative(name: str, delta: float, value: float) -> float:
 
 
 def _levels_table(levels: list, names: list) -> dict:
-    cols = {k: [lv[k] for lv in levels] for k in ("dx", "nx", "ny", "seconds", "convolutions", "status")}
+    cols = {k: [getattr(lv, k) for lv in levels] for k in ("dx", "nx", "ny", "seconds", "convolutions", "status")}
     for n in names:
-        cols[n] = [lv["obs"].get(n, math.nan) for lv in levels]
+        cols[n] = [lv.obs.get(n, math.nan) for lv in levels]
     return cols
 
 
 def _judge(levels: list, names: list, tol: float) -> tuple[bool, dict, dict]:
     """(converged, {name: relative change of the last two grids}, {name: richardson dict with 'rel_error'})."""
-    h = [lv["dx"] for lv in levels]
+    h = [lv.dx for lv in levels]
     changes, rich = {}, {}
-    ok = len(levels) >= 2 and levels[-1]["status"] != "under_resolved"  # other problems: refining cannot fix
+    ok = len(levels) >= 2 and levels[-1].status != "under_resolved"  # other problems: refining cannot fix
     for n in names:
-        f = [lv["obs"].get(n, math.nan) for lv in levels]
+        f = [lv.obs.get(n, math.nan) for lv in levels]
         if len(f) >= 2:
             a, b = f[-2], f[-1]
             if math.isnan(a) and math.isnan(b):
@@ -122,7 +154,7 @@ NEED_FLOOR = 8.0
 def _dx_needed(levels: list, rich: dict, changes: dict, tol: float) -> float:
     """dx at which every observable's error estimate and change between grids would be tol, both scaling as
     h^p (p the observed order, else 1): h·(tol/e)^(1/p) with e the larger of the two, the smallest dx of all."""
-    h = levels[-1]["dx"]
+    h = levels[-1].dx
     need = h
     for n, r in rich.items():
         e = max((x for x in (r.get("rel_error", math.nan), changes.get(n, math.nan)) if math.isfinite(x)),

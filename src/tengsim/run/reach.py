@@ -137,18 +137,20 @@ def grid_path(p_max: float, d_max: float, map_pressures=(), cut: bool = True, re
     return path_for
 
 
-def resolve_to(cplan, p_max: float, d_max: float, settings, map_pressures=(), observe=None, watch=None,
-               progress=None, keep=None, key: str = "", done=None, say=None, retract: bool = True):
+def resolve_to(plan, d_max: float, settings, progress=None, keep=None, key: str = "", done=None, say=None):
     """The refinement (:func:`tengsim.run.resolve.resolve_plan`, with ``settings``, a
-    :class:`tengsim.run.plan.ResolveSettings`) of ``cplan`` on the path to ``d_max`` (:func:`grid_path`), whose
-    finest grid must reach ``p_max``: if it does not (a finer grid is softer), d_max grows to 1.2 d_max + 2 ε and
-    the refinement runs again, once, every grid walking to d_max; else an error naming the pressure reached.
-    ``keep`` (a file, or None): each finished grid is kept there for the run ``key`` and path
-    (:func:`tengsim.run.checkpoint.open_checkpoint`, ``say`` told what it finds), and taken back by a run of the
-    same key and path.  ``done(levels)`` is called after each finished grid is kept; ``observe``, ``watch`` and
-    ``progress`` as for resolve_plan; ``retract`` false: each grid walks the approach only."""
+    :class:`tengsim.run.plan.ResolveSettings`) of ``plan`` (a :class:`tengsim.run.refine.RefinementPlan`: its
+    ``cplan``, ``p_max``, ``maps_at``, ``observe``, ``watch`` and ``retraction``) on the path to ``d_max``
+    (:func:`grid_path`), whose finest grid must reach ``p_max``: if it does not (a finer grid is softer), d_max
+    grows to 1.2 d_max + 2 ε and the refinement runs again, once, every grid walking to d_max; else an error naming
+    the pressure reached.  ``keep`` (a file, or None): each finished grid is kept there for the run ``key`` and
+    path (:func:`tengsim.run.checkpoint.open_checkpoint`, ``say`` told what it finds), and taken back by a run of
+    the same key and path.  ``done(levels)`` is called after each finished grid is kept; ``progress`` as for
+    resolve_plan; ``plan.retraction`` false: each grid walks the approach only."""
     from tengsim.run.checkpoint import open_checkpoint
     from tengsim.run.resolve import resolve_plan
+
+    cplan, p_max = plan.cplan, plan.p_max
 
     res = None
     for attempt in range(2):
@@ -160,15 +162,15 @@ def resolve_to(cplan, p_max: float, d_max: float, settings, map_pressures=(), ob
             if done is not None:
                 done(levels)
 
-        path_for = grid_path(p_max, d_max, map_pressures, attempt == 0, retract)
+        path_for = grid_path(p_max, d_max, plan.maps_at, attempt == 0, plan.retraction)
 
         def scaled_path_for(prev, path_for=path_for):  # a grid taken back from the file keeps its columns only
             if prev is not None and prev.scaling is None:
                 prev = dataclasses.replace(prev, scaling=cplan.scaling)
             return path_for(prev)
 
-        res = resolve_plan(cplan, observe=observe, watch=watch, settings=settings, path_for=scaled_path_for,
-                           progress=progress, checkpoint=after, start=found)
+        res = resolve_plan(cplan, observe=plan.observe, watch=plan.watch, settings=settings,
+                           path_for=scaled_path_for, progress=progress, checkpoint=after, start=found)
         if res.scaling is None:  # every grid taken back from the checkpoint file, which keeps the columns only
             res = dataclasses.replace(res, scaling=cplan.scaling)
         ok, D_hit, top, slope = reach(res, p_max)

@@ -59,7 +59,7 @@ from tengsim.run.checkpoint import Checkpoint
 from tengsim.run.grids import FACTOR, MIN_SIDE, default_dx, edge_phases, next_grid
 from tengsim.run.memory import default_max_pixels
 from tengsim.run.tolerance import DEFAULT_TOL
-from tengsim.run.judge import NEED_FLOOR, _dx_needed, _judge, _levels_table, _why, contact_observables
+from tengsim.run.judge import NEED_FLOOR, GridRecord, _dx_needed, _judge, _levels_table, _why, contact_observables
 from tengsim.solvers.types import SOLVER_TOL
 
 
@@ -107,13 +107,13 @@ def resolve_plan(plan, observe=None, full_length: float | None = None, progress=
     levels, names, res, seen, watched = [], [], None, set(), []
     stop, phases, done = None, (), False
     if start is not None:  # a refinement kept by its checkpoint: its grids are not computed again
-        levels, phases, res = [dict(lv) for lv in start[0]], tuple(start[1]), start[2]
+        levels, phases, res = [GridRecord.of(lv) for lv in start[0]], tuple(start[1]), start[2]
         for lv in levels:
-            names.extend(k for k in lv["obs"] if k not in names)
-            watched.extend(k for k in lv.get("watched", ()) if k not in watched)
-        seen = {(lv["nx"], lv["ny"]) for lv in levels}
+            names.extend(k for k in lv.obs if k not in names)
+            watched.extend(k for k in lv.watched if k not in watched)
+        seen = {(lv.nx, lv.ny) for lv in levels}
         done = _judge(levels, [n for n in names if n not in watched], tol)[0]
-        dx = levels[-1]["dx"] / FACTOR
+        dx = levels[-1].dx / FACTOR
     while not done:
         # keep the shape's edges where they fell in the first grid's pixels (module doc)
         grid = next_grid(shape, dx, phases if levels else None, seen, max_pixels)
@@ -136,10 +136,10 @@ def resolve_plan(plan, observe=None, full_length: float | None = None, progress=
         watched.extend(k for k in seen_watch if k not in watched)
         obs.update(seen_watch)
         names.extend(k for k in obs if k not in names)
-        levels.append({"dx": grid.dx, "nx": grid.nx, "ny": grid.ny, "seconds": time.perf_counter() - t0,
-                       "convolutions": int(res.params.get("n_conv_spent",
-                                                          np.nansum(np.asarray(res.table["n_conv"], dtype=float)))),
-                       "status": res.status, "obs": obs, "watched": list(seen_watch)})
+        levels.append(GridRecord(grid.dx, grid.nx, grid.ny, time.perf_counter() - t0,
+                                 int(res.params.get("n_conv_spent",
+                                                    np.nansum(np.asarray(res.table["n_conv"], dtype=float)))),
+                                 res.status, obs, tuple(seen_watch)))
         if checkpoint is not None:
             checkpoint(levels, phases, res)
         done, changes, rich = _judge(levels, [n for n in names if n not in watched], tol)
@@ -150,14 +150,14 @@ def resolve_plan(plan, observe=None, full_length: float | None = None, progress=
     _, w_changes, w_rich = _judge(levels, watched, tol)
     p = dict(res.params)  # the result's parameters, then the refinement's
     p.update(resolve="auto", resolve_tol=tol, max_pixels=int(max_pixels),
-             resolve_grids=[lv["dx"] for lv in levels], resolution=_levels_table(levels, names),
+             resolve_grids=[lv.dx for lv in levels], resolution=_levels_table(levels, names),
              richardson={n: {k: r[k] for k in ("order", "observed", "extrapolated", "error")}
                          | {"rel_error": r.get("rel_error", math.nan), "change": changes.get(n, math.nan)}
                          for n, r in rich.items()},
              watched={n: {k: r[k] for k in ("order", "observed", "extrapolated", "error")}
                       | {"rel_error": r.get("rel_error", math.nan), "change": w_changes.get(n, math.nan)}
                       for n, r in w_rich.items()},
-             resolve_seconds=sum(lv["seconds"] for lv in levels), resolve_edge_phases=list(phases))
+             resolve_seconds=sum(lv.seconds for lv in levels), resolve_edge_phases=list(phases))
     if stop is not None:
         msg = _stop_message(levels, rich, changes, tol, max_pixels, stop, p.get("lateral_m"))
         p["resolve_status"] = "under_resolved"
@@ -173,7 +173,7 @@ def _stop_message(levels, rich, changes, tol, max_pixels, stop, lateral) -> str:
     """The line of a refinement stopped by max_pixels: where it got, what moved most, the dx still needed
     (lengths in the run's units, nm or µm, when ``lateral`` (m per X unit) is given, else X units)."""
     need = _dx_needed(levels, rich, changes, tol)
-    floor = levels[-1]["dx"] / NEED_FLOOR
+    floor = levels[-1].dx / NEED_FLOOR
 
     def length(d, digits=3):
         if lateral:
@@ -185,8 +185,8 @@ def _stop_message(levels, rich, changes, tol, max_pixels, stop, lateral) -> str:
     need_text = (f"dx ≈ {length(need)} needed" if need >= floor else
                  f"dx below {length(floor)} needed (the grids so far converge too irregularly to extrapolate "
                  "further)")
-    return (f"under-resolved: refinement stopped by max_pixels = {max_pixels} at dx = {length(levels[-1]['dx'], 4)} "
-            f"({levels[-1]['nx']}×{levels[-1]['ny']}; next {stop.nx}×{stop.ny}); {_why(changes)}, "
+    return (f"under-resolved: refinement stopped by max_pixels = {max_pixels} at dx = {length(levels[-1].dx, 4)} "
+            f"({levels[-1].nx}×{levels[-1].ny}; next {stop.nx}×{stop.ny}); {_why(changes)}, "
             f"{need_text} for resolve_tol = {tol:g}")
 
 
