@@ -6,6 +6,11 @@ back, a 256² rough periodic surface solved cold), CPU time, best of ``--repeat`
 
 The JAX solver is run once before timing, so that its compilation is not counted.  Prints one line per
 (problem, solver): the best CPU seconds and the iterations (the same on every repeat).
+
+``--pk-set``: instead, the pk solver's set update after a CG step on a 512² field (the step, the projection
+p >= 0, the overlapping pixels entering), as the NumPy loop writes it (in place, tengsim.solvers._pk_core) and
+as an xp-generic function would (the JAX loop's selects, tengsim.solvers._pk_jax): why pk's is not shared
+(docs/extending.md, "One source for each algorithm").
 """
 from __future__ import annotations
 
@@ -53,11 +58,46 @@ def solvers(names):
     return out
 
 
+def pk_set_update(repeat):
+    import numpy as np
+    n = 512 * 512
+    rng = np.random.default_rng(0)
+    p0, u, t = np.maximum(rng.standard_normal(n), 0.0), rng.standard_normal(n), rng.standard_normal(n)
+    tau, work, S = 0.01, np.empty(n), np.empty(n, bool)
+
+    def in_place(p):  # _pk_core.constrained_cg
+        p -= tau * t
+        np.maximum(p, 0.0, out=p)
+        np.less(u, 0.0, out=S)
+        np.logical_and(S, p == 0, out=S)
+        if S.any():
+            np.multiply(u, S, out=work)
+            p -= tau * work
+
+    def generic(p, xp=np):  # _pk_jax's step, with xp = numpy
+        p = xp.maximum(p - tau * t, 0.0)
+        enter = (u < 0) & (p == 0)
+        return xp.where(enter, p - tau * u, p)
+
+    for name, f in (("in place", in_place), ("xp-generic", generic)):
+        best = float("inf")
+        for _ in range(max(repeat, 5)):
+            ps = [p0.copy() for _ in range(50)]
+            c = time.process_time()
+            for p in ps:
+                f(p)
+            best = min(best, (time.process_time() - c) / 50)
+        print(f"pk set update 512² {name:10s} {best * 1e3:7.3f} ms CPU", flush=True)
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--solvers", default="fast,jax")
+    ap.add_argument("--pk-set", action="store_true", help="time pk's set update instead (NumPy only)")
     a = ap.parse_args(argv)
+    if a.pk_set:
+        return pk_set_update(a.repeat)
     cases = {"md_sphere": (md_sphere, 1e-7, 20000), "rough_cold": (rough_cold, 1e-6, 5000)}
     for sname, make in solvers(a.solvers.split(",")).items():
         for cname, (fn, tol, it) in cases.items():
