@@ -10,7 +10,8 @@ import numpy as np
 
 from tengsim import backend
 from tengsim.laws.safe import safe
-from tengsim.solvers._constants import CURVATURE_EPS
+from tengsim.solvers import _algebra
+from tengsim.solvers._algebra import HOST
 from tengsim.solvers._kernelcall import takes_out
 from tengsim.solvers._linesearch import Ray, Trial, WolfeLineSearch, _energy_at
 from tengsim.solvers._reduce import for_kernel
@@ -242,7 +243,7 @@ class _Descent:
         dA, alpha = self.dA, due.alpha
         sy = dA * alpha * h[2]
         yy = dA * h[3]
-        if sy > CURVATURE_EPS * max(due.sks, 1e-300) and yy > 0:
+        if _algebra.stores_pair(HOST, sy, yy, due.sks):
             self.mem.confirm()
             return False
         self.mem.rollback()

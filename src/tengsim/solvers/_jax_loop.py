@@ -28,9 +28,8 @@ from jax import lax
 from jax.scipy.linalg import solve_triangular
 
 from tengsim.laws.safe import SafeLaw
-from tengsim.solvers import _jax_fft
-from tengsim.solvers._constants import (APPROX_SLOPE, C1, C2, CURVATURE_EPS, EPS_E, FIRST_MOVE, GROW, MAX_EVAL,
-                                        SAFEGUARD)
+from tengsim.solvers import _algebra, _jax_fft
+from tengsim.solvers._constants import C1, C2, FIRST_MOVE, MAX_EVAL
 
 F64 = jnp.float64
 
@@ -53,6 +52,11 @@ def row_products(M, v):
     if M.dtype == F64:
         return jnp.matmul(M, v)
     return jnp.sum(M.astype(F64) * v.astype(F64)[None, :], axis=1)
+
+
+def solve_upper(a, b, trans):
+    """x with U x = b (Uᵀ x = b when ``trans``), U the upper triangle of the small square array ``a``."""
+    return solve_triangular(jnp.triu(a), b, lower=False, trans=int(bool(trans)))
 
 
 def build(shape, padded, periodic, pinned, law_cls, law_fields, dtype, memory, resync, mesh=None):
@@ -119,18 +123,15 @@ def build(shape, padded, periodic, pinned, law_cls, law_fields, dtype, memory, r
             perm = jnp.argsort(age)
             act_p = act[perm]                                   # the first k entries are the active ones
             new = perm[jnp.maximum(k - 1, 0)]
-            yy = c["YY"][new, new]
-            gamma = jnp.where(yy > 0, c["SY"][new, new] / jnp.where(yy > 0, yy, 1.0), 1.0)
+            gamma = _algebra.newest_gamma(jnp, c["SY"][new, new], c["YY"][new, new])
             both = act_p[:, None] & act_p[None, :]
             SYa = jnp.where(both, c["SY"][perm][:, perm], jnp.eye(m, dtype=F64))
             YYa = jnp.where(both, c["YY"][perm][:, perm], 0.0)
             pS = jnp.where(act_p, c["pS"][perm], 0.0)
             pY = jnp.where(act_p, c["pY"][perm], 0.0)
-            R = jnp.triu(SYa)
-            u = solve_triangular(R, pS, lower=False)
-            top = solve_triangular(R, jnp.diag(SYa) * u + gamma * (YYa @ u) - gamma * pY, lower=False, trans=1)
+            top, cy = _algebra.compact_coefficients(jnp, solve_upper, SYa, YYa, pS, pY, gamma)
             cS = jnp.zeros(m, F64).at[perm].set(jnp.where(act_p, top, 0.0))
-            cY = jnp.zeros(m, F64).at[perm].set(jnp.where(act_p, -gamma * u, 0.0))
+            cY = jnp.zeros(m, F64).at[perm].set(jnp.where(act_p, cy, 0.0))
             gamma = jnp.where(k > 0, gamma, 1.0)
             return gamma, cS, cY
 
@@ -151,7 +152,7 @@ def build(shape, padded, periodic, pinned, law_cls, law_fields, dtype, memory, r
             return e, de, phis, total(Pt), gt, Pt
 
         def line_search(alpha0, g, P, Kd, qw, dw, dKd, E0, slope0, E_ref):
-            eps_E = EPS_E[dt.name] * jnp.maximum(1.0, jnp.abs(E0))
+            eps_E = _algebra.energy_slack(jnp, E0, dt.name)
             E_lo = jnp.minimum(E0, E_ref)
             ev = (g, P, Kd, qw, dw, dKd, slope0)
             z = jnp.zeros((), F64)
@@ -166,23 +167,17 @@ def build(shape, padded, periodic, pinned, law_cls, law_fields, dtype, memory, r
                 a = s["alpha"]
                 e, de, phis, sp, gt, Pt = evaluate(a, *ev)
                 fin = jnp.isfinite(e)
-                wolfe = (e <= E0 + C1 * a * slope0) & (jnp.abs(de) <= -C2 * slope0)
-                approx = (e <= E_lo + eps_E) & (C2 * slope0 <= de) & (de <= -APPROX_SLOPE * slope0)
-                acc = fin & (wolfe | approx)
+                acc = fin & _algebra.accepts(e, de, a, E0, E_lo, slope0, eps_E, C1, C2)
                 better = fin & (e <= E_lo + eps_E) & (~s["has_best"] | (jnp.abs(de) < s["best_de"]))
-                to_hi = ~fin | (e > E0 + C1 * a * slope0 + eps_E) | (de > 0)
+                to_hi = ~fin | _algebra.overshoots(e, de, a, E0, slope0, eps_E, C1)
                 hi = jnp.where(to_hi, a, s["hi"])
                 has_hi = s["has_hi"] | to_hi
-                dh_ok = fin & ((e <= E0 + eps_E) | (de > 0))
+                dh_ok = fin & _algebra.slope_usable(e, de, E0, eps_E)
                 de_hi = jnp.where(to_hi, de, s["de_hi"])
                 has_de_hi = jnp.where(to_hi, dh_ok, s["has_de_hi"])
                 lo = jnp.where(to_hi, s["lo"], a)
                 de_lo = jnp.where(to_hi, s["de_lo"], de)
-                width = hi - lo
-                sec = has_de_hi & (de_hi > de_lo)
-                cand = jnp.where(sec, lo - de_lo * width / jnp.where(sec, de_hi - de_lo, 1.0), lo + 0.5 * width)
-                nxt = jnp.where(has_hi, jnp.minimum(jnp.maximum(cand, lo + SAFEGUARD * width), hi - SAFEGUARD * width),
-                                GROW * a)
+                nxt = _algebra.next_trial(jnp, a, lo, de_lo, hi, de_hi, has_hi, has_de_hi)
                 return dict(i=s["i"] + 1, alpha=nxt, lo=lo, de_lo=de_lo, hi=hi, has_hi=has_hi, de_hi=de_hi,
                             has_de_hi=has_de_hi, best_de=jnp.where(better, jnp.abs(de), s["best_de"]),
                             best_a=jnp.where(better, a, s["best_a"]), has_best=s["has_best"] | better,
@@ -214,7 +209,7 @@ def build(shape, padded, periodic, pinned, law_cls, law_fields, dtype, memory, r
             c = dict(c, k=k)
             E_best = jnp.minimum(c["E_best"], c["E"])
             kmax = jnp.max(jnp.abs(Kd)).astype(F64)
-            first = jnp.where(kmax > FIRST_MOVE, FIRST_MOVE / jnp.where(kmax > 0, kmax, 1.0), 1.0)
+            first = _algebra.first_step(jnp, kmax, FIRST_MOVE)
             alpha0 = jnp.where(k == 0, first, 1.0)
             slope = dA * dr
             found, alpha, phis_t, sp_t, gt, Pt = line_search(alpha0, c["g"], c["P"], Kd, c["qw"], dw, dKd,
@@ -261,12 +256,12 @@ def build(shape, padded, periodic, pinned, law_cls, law_fields, dtype, memory, r
             # the memory's update (KMetricLBFGS.update)
             sy, yy = dA * alpha * dky, dA * yky
             sks = dA * alpha * alpha * jnp.abs(dKd)
-            store = (sy > CURVATURE_EPS * jnp.maximum(sks, 1e-300)) & (yy > 0)
+            store = _algebra.stores_pair(jnp, sy, yy, sks)
             k = c["k"]
             idx = jnp.arange(m)
             act = idx < k
             xs, xy = x[0::2], x[1::2]
-            dy = -(gamma * c["pY"] + cS @ c["SY"] + cY @ c["YY"])
+            dy = _algebra.new_pair_row(gamma, cS, cY, c["SY"], c["YY"], c["pY"])
             pS = jnp.where(act, c["pS"] + xs, c["pS"])
             pY = jnp.where(act, c["pY"] + xy, c["pY"])
             oldest = jnp.argmin(jnp.where(act, c["age"], jnp.iinfo(jnp.int32).max))

@@ -32,6 +32,7 @@ from __future__ import annotations
 import numpy as np
 
 from tengsim import backend
+from tengsim.solvers import _algebra
 
 
 class KMetricLBFGS:
@@ -87,19 +88,14 @@ class KMetricLBFGS:
         xp = backend.xp
         act = self._perm
         new = act[-1]
-        yy = self.YY[new, new]
-        # γ = <s, y>/<y, y> of the newest pair (1 if <y, y> <= 0: only an unconfirmed pair, taken back)
-        gamma = xp.where(yy > 0, self.SY[new, new] / xp.where(yy > 0, yy, 1.0), 1.0)
-        SYa = self.SY[act[:, None], act]
-        # R = upper triangle of SYa, positive diagonal (<s_i, y_i> > 0 for every stored pair); the
-        # triangular solve reads only the upper triangle (no triu copy needed)
-        u = backend.solve_upper(SYa, self.pS[act])
-        top = backend.solve_upper(SYa, xp.diag(SYa) * u + gamma * (self.YY[act[:, None], act] @ u)
-                                  - gamma * self.pY[act], trans=True)
+        gamma = _algebra.newest_gamma(xp, self.SY[new, new], self.YY[new, new])
+        # the pairs in age order; the triangular solve reads only SYa's upper triangle (no triu copy needed)
+        top, cy = _algebra.compact_coefficients(xp, backend.solve_upper, self.SY[act[:, None], act],
+                                                self.YY[act[:, None], act], self.pS[act], self.pY[act], gamma)
         cS = backend.empty(k)
         cY = backend.empty(k)
         cS[act] = top
-        cY[act] = -gamma * u
+        cY[act] = cy
         c = backend.empty(2 * k)
         c[0::2], c[1::2] = cS, cY
         self._last = (gamma, cS, cY)
@@ -130,8 +126,8 @@ class KMetricLBFGS:
             xs, xy = x[0::2], x[1::2]          # <s_i, y>, <y_i, y>
             gamma, cS, cY = self._last
             # <d, y_j> from d = −(γ G + Σ cS_i s_i + Σ cY_i y_i), with G the old gradient
-            dy = -(gamma * self.pY[:k] + cS @ self.SY[:k, :k] + cY @ self.YY[:k, :k]) if cS.size \
-                else -self.pY[:k]
+            dy = _algebra.new_pair_row(gamma, cS, cY, self.SY[:k, :k], self.YY[:k, :k], self.pY[:k]) \
+                if cS.size else -self.pY[:k]
             self.pS[:k] += xs
             self.pY[:k] += xy
         slot, held = self.next_slot()

@@ -20,8 +20,9 @@ from typing import NamedTuple
 import numpy as np
 
 from tengsim import backend
-from tengsim.solvers._constants import (APPROX_SLOPE, C1, C2, EPS_E, FIRST_MOVE, GROW, MAX_EVAL,
-                                        SAFEGUARD)
+from tengsim.solvers import _algebra
+from tengsim.solvers._algebra import HOST
+from tengsim.solvers._constants import C1, C2, FIRST_MOVE, MAX_EVAL
 
 
 class Ray(NamedTuple):
@@ -71,7 +72,7 @@ class WolfeLineSearch:
         m = max(hi, -lo)
         if self.red is not None:
             m = self.red.max(m)
-        return self.first_move / m if m > self.first_move else 1.0
+        return _algebra.first_step(HOST, m, self.first_move)
 
     def swap(self, g, P):
         """The accepted (g(α), P(α)); ``g``, ``P`` become the trial buffers."""
@@ -155,11 +156,11 @@ class WolfeLineSearch:
         :meth:`evaluate`'s answer at ``alpha0`` when the caller has swept it already (the trial
         buffers then hold g(α0), P(α0))."""
         E0, slope0, c1, c2 = ray.E0, ray.slope, self.c1, self.c2
-        eps_E = EPS_E["float64"] * max(1.0, abs(E0))
+        eps_E = _algebra.energy_slack(HOST, E0, "float64")
         E_lo = min(E0, E_ref)
         alpha = alpha0
         lo, de_lo = 0.0, slope0
-        hi, de_hi = None, None
+        hi, de_hi, has_hi, has_de_hi = 0.0, 0.0, False, False   # no upper end yet
         best = None
         for _ in range(self.max_eval):
             if first is not None:
@@ -167,27 +168,18 @@ class WolfeLineSearch:
             else:
                 e, de, phis, sp = self.evaluate(alpha, ray)
             if not np.isfinite(e):
-                hi, de_hi = alpha, None
+                hi, has_hi, has_de_hi = alpha, True, False
             else:
-                wolfe = e <= E0 + c1 * alpha * slope0 and abs(de) <= -c2 * slope0
-                approx = e <= E_lo + eps_E and c2 * slope0 <= de <= -APPROX_SLOPE * slope0
-                if wolfe or approx:
+                if _algebra.accepts(e, de, alpha, E0, E_lo, slope0, eps_E, c1, c2):
                     return Trial(alpha, e, phis, sp)
                 if e <= E_lo + eps_E and (best is None or abs(de) < best[0]):
                     best = (abs(de), alpha)
-                if e > E0 + c1 * alpha * slope0 + eps_E or de > 0:
-                    hi, de_hi = alpha, (de if e <= E0 + eps_E or de > 0 else None)
+                if _algebra.overshoots(e, de, alpha, E0, slope0, eps_E, c1):
+                    hi, de_hi, has_hi = alpha, de, True
+                    has_de_hi = _algebra.slope_usable(e, de, E0, eps_E)
                 else:
                     lo, de_lo = alpha, de
-            if hi is None:
-                alpha = GROW * alpha
-                continue
-            width = hi - lo
-            if de_hi is not None and de_hi > de_lo:
-                cand = lo - de_lo * width / (de_hi - de_lo)
-            else:
-                cand = lo + 0.5 * width
-            alpha = min(max(cand, lo + SAFEGUARD * width), hi - SAFEGUARD * width)
+            alpha = _algebra.next_trial(HOST, alpha, lo, de_lo, hi, de_hi, has_hi, has_de_hi)
         if best is not None:
             e, _, phis, sp = self.evaluate(best[1], ray)  # the buffers must hold the accepted point
             return Trial(best[1], e, phis, sp)
