@@ -14,7 +14,7 @@ from tengsim.errors import ConfigValueError, GeometryError, TengsimError, finite
 from tengsim.laws import LJ93, make_law
 from tengsim.continuation import PathSpec
 from tengsim.plugins import KERNELS
-from tengsim.run.tolerance import DEFAULT_TOL, check_tol  # noqa: F401
+from tengsim.run.tolerance import DEFAULT_TOL, check_tol
 from tengsim.run.keys import (ADAPTIVE_KEYS, LOAD_KEYS, common_fields, common_names, contact_keys,
                               contact_table, law_fields, law_keys, physical_triggers, shape_class)
 from tengsim.shapes.base import dimensionless_fields, physical_fields
