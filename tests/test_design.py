@@ -378,12 +378,13 @@ def test_estimate_uses_the_backends_cost_and_names_it(monkeypatch):
     from tengsim.design import read_design
     from tengsim.run import budget as _budget, refine as _refine
     from tengsim.resources import CPU_COST, GPU_COST
-    from tengsim.run.plan import plan_contact
+    from tengsim.run.plan import chosen_solver as plan_chosen, plan_contact
     from tengsim.solvers import choice
 
     plan = plan_design(read_design(str(Path(__file__).parent.parent / "examples" / "own_design" / "pyramid.toml")))
     cp = plan_contact(plan.contact_table)
-    assert cp.solver == "fast" and "no GPU" in cp.solver_note  # auto, on this machine
+    assert cp.solver == "auto"  # the plan stays pure: chosen on each grid solved
+    assert plan_chosen(cp)[0] == "fast" and "no GPU" in plan_chosen(cp)[1]  # on this machine
     from tengsim.run.grids import GridSequence
 
     dx = _refine.first_dx(cp, plan)
@@ -400,7 +401,7 @@ def test_estimate_uses_the_backends_cost_and_names_it(monkeypatch):
     assert gpu.cost.grid_seconds(cp.shape, g) == pytest.approx(rows_its * per_iteration)
     assert gpu.seconds < cpu.seconds
     assert (_budget.budget_pixels(plan, cp.shape, seq, _budget.run_cost(cp_gpu, 25.0))
-            > _budget.budget_pixels(plan, cp.shape, seq, _budget.run_cost(cp, 25.0)))
+            > _budget.budget_pixels(plan, cp.shape, seq, _budget.run_cost(dataclasses.replace(cp, solver="fast"), 25.0)))
 
 
 def test_auto_picks_the_gpu_where_jax_sees_one(monkeypatch):
@@ -517,7 +518,8 @@ def test_auto_keeps_the_cpu_below_the_gpus_break_even(monkeypatch):
     """On a GPU machine ``auto`` keeps the NumPy solver for a grid under the cost models' break-even (measured on an
     H200: the tiny-pyramid calibration ran slower on the GPU than on 2 CPU cores, docs/benchmarks.md) and says so."""
     from tengsim.resources import CPU_COST, GPU_COST, gpu_break_even_points
-    from tengsim.run.plan import plan_contact
+    from tengsim.run import budget as _budget
+    from tengsim.run.plan import chosen_solver, plan_contact
     from tengsim.solvers import choice
 
     even = gpu_break_even_points()
@@ -530,4 +532,7 @@ def test_auto_keeps_the_cpu_below_the_gpus_break_even(monkeypatch):
     assert choice.choose("gpu", points=9)[0] == "gpu"  # asked by name: taken as asked
     tiny = plan_contact({"shape": "pyramid", "N": 0.946, "cell": 3.78, "tabor": 0.5, "dx": 0.1, "d_max": 1.0,
                          "d_step": 0.2})
-    assert tiny.solver == "fast" and "break-even" in tiny.solver_note
+    assert tiny.solver == "auto" and chosen_solver(tiny)[0] == "fast" and "break-even" in chosen_solver(tiny)[1]
+    fine = dataclasses.replace(tiny, dx=0.01, grid=None)  # a finer grid of the same plan chooses again, on its own
+    assert fine.solver == "auto" and chosen_solver(fine)[0] == "gpu"
+    assert _budget.on_gpu(tiny) is False and _budget.on_gpu(tiny, fine.grid) is True

@@ -200,8 +200,10 @@ def test_design_chooses_pk_for_cohesive_laws(law, solver, expect):
         table["solver"] = solver
     plan = plan_design(table)
     said = _Said()
+    from tengsim.run.plan import chosen_solver
+
     cplan = choose_solver(plan, plan.contact_plan, said)
-    assert cplan.solver == expect
+    assert chosen_solver(cplan)[0] == expect  # 'auto' (LJ93) chosen on the grid solved: fast on this machine
     assert any("solver: pk" in line for line in said.lines) == (expect == "pk")
 
 

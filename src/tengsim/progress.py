@@ -10,6 +10,13 @@ import sys
 import time
 
 
+def say_to(progress, text: str) -> None:
+    """``text`` to ``progress.say`` where it has one (a run's own line: which solver 'auto' chose, a range
+    extended); nothing where the progress is None or only counts."""
+    if progress is not None and hasattr(progress, "say"):
+        progress.say(text)
+
+
 def _isatty(stream) -> bool:
     try:
         return bool(stream.isatty())

@@ -82,8 +82,11 @@ def run(args) -> int:
         run_contact(plan)
         return 0
     line = None if args.quiet or plan.scaling is None else f"tengsim: {physical_line(plan, 'eps' in cfg)}"
-    if plan.solver_note and not args.quiet:  # the solver 'auto' chose, said before the run
-        line = "\n".join(x for x in (line, f"tengsim: {plan.solver_note}") if x)
+    from tengsim.run.plan import chosen_solver
+
+    why = chosen_solver(plan)[1] if plan.resolve is None else ""  # a refinement says it per grid (bar.say)
+    if why and not args.quiet:  # the solver 'auto' chose on the grid solved, said before the run
+        line = "\n".join(x for x in (line, f"tengsim: {why}") if x)
     stream = open_stream(out, args.resume, args.quiet)
     res = run_streamed(lambda bar: run_contact(plan, progress=_Announced(bar, line), sink=stream), stream,
                        args.quiet)
@@ -111,6 +114,10 @@ class _Announced:
     def monitor(self, *args, **kwargs):
         self._say()
         return self.bar.monitor(*args, **kwargs)
+
+    def say(self, text):  # a refinement's own line (which solver 'auto' chose on a grid)
+        self._say()
+        print(f"tengsim: {text}", file=sys.stderr, flush=True)
 
 
 def physical_line(plan, eps_given: bool) -> str:

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import dataclasses
 
-from tengsim.run.refine import say_to as _say
+from tengsim.progress import say_to as _say
 
 def identity(plan) -> str:
     """What a design's kept grids belong to: the plan (every key as given but the budget), the content of every

@@ -307,7 +307,7 @@ def _plan_design(table: dict, where: str) -> DesignPlan:
     draft = DesignPlan("", shape, {}, sp, (), 0, 0, 0, 0, 0, None, None, 0, 0, 0, 0, 0)
     name = own["name"] or f"{shape} {draft.shape_text()}"
     own_solver = None if solver_given else constrained_solver(plan.law)
-    pk = {"solver": own_solver, "solver_note": ""} if own_solver else {}
+    pk = {"solver": own_solver} if own_solver else {}
     plan = dataclasses.replace(plan, tol=SOLVER_TOL_PER_TOL * tol, **pk)  # the plan the design runs
     return DesignPlan(name=name, shape=shape, contact_table=cfg, shape_params=sp, pressures=pressures,
                       sigma=own["sigma"], eps_r=own["eps_r"], T=own["T"], gap=own["gap"], tol=tol, dx=own["dx"],

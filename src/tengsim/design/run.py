@@ -36,7 +36,7 @@ from dataclasses import dataclass, field
 from tengsim.design.plan import constrained_solver
 from tengsim.design.keep import identity, kept_path
 from tengsim.design.walk import map_pressures, maps_asked, observers
-from tengsim.run.refine import say_to as _say
+from tengsim.progress import say_to as _say
 
 
 @dataclass(frozen=True)

@@ -60,15 +60,19 @@ class Cost:
         return self.rows * self.iterations * self.model.iteration_seconds(points)
 
 
-def on_gpu(cplan) -> bool:
-    """Whether the plan's solver runs on a GPU ('gpu', or 'jax' where JAX sees one)."""
+def on_gpu(cplan, grid=None) -> bool:
+    """Whether the plan's solver runs on a GPU on ``grid`` (None: the plan's own): 'gpu', 'jax' where JAX sees
+    one, or 'auto' where it chooses the GPU on that grid (:func:`tengsim.run.plan.chosen_solver`)."""
+    from tengsim.run.plan import chosen_solver
     from tengsim.solvers.choice import gpu_visible
 
     name = cplan.solver if isinstance(cplan.solver, str) else getattr(cplan.solver, "name", "")
+    if name.strip().lower() == "auto":
+        name = chosen_solver(cplan, grid)[0]
     return name == "gpu" or (name == "jax" and gpu_visible()) or getattr(cplan.solver, "device", "") == "gpu"
 
 
-def run_cost(cplan, d_max: float, coarse=None, retract: bool = True) -> Cost:
+def run_cost(cplan, d_max: float, coarse=None, retract: bool = True, grid=None) -> Cost:
     """The :class:`Cost` of a design's grids: rows from the path's D range (:data:`ROWS_PER_STEP`; half of them
     without the retraction, ``retract`` false), iterations per row from the coarse pre-run ``coarse``
     (× :data:`ITERATIONS_PER_COARSE`; 20 per row without one)."""
@@ -77,7 +81,7 @@ def run_cost(cplan, d_max: float, coarse=None, retract: bool = True) -> Cost:
         it = np.asarray(coarse.table.get("iterations", ()), dtype=float)
         if it.size and np.isfinite(it).all():
             its = float(np.mean(it))
-    gpu = on_gpu(cplan)
+    gpu = on_gpu(cplan, grid)  # on the finest grid a refinement expects (``grid``), which its time is mostly
     rows = ROWS_PER_STEP * (d_max - D_MIN) / D_STEP * (1.0 if retract else 0.5)
     return Cost(cost_model(gpu), rows, ITERATIONS_PER_COARSE * its, gpu)
 

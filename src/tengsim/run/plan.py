@@ -186,7 +186,8 @@ class ContactPlan:
     LJ93); ``boundary`` a registered kernel; ``solver`` a registered name or a solver object; ``grid`` the
     shape's grid of spacing about ``dx`` unless given (then the run's is the grid's); ``resolve`` the refinement
     settings (None: one grid); ``config`` the table the plan was read from (without out and plot), kept in
-    the result's parameters."""
+    the result's parameters.  The plan is pure: ``solver`` 'auto' stays 'auto' here, chosen for each grid that is
+    solved (:func:`chosen_solver`), never probed for on a grid a refinement may not solve."""
 
     shape: object
     tabor: float
@@ -204,19 +205,10 @@ class ContactPlan:
     symmetry: str = "auto"
     grid: object = None
     config: dict = field(default_factory=dict)
-    solver_note: str = ""
-    """Why the solver is the one it is when ``auto`` chose it (printed before the run); '' otherwise."""
 
     def __post_init__(self):
-        from tengsim.solvers.choice import choose
-
         mu = positive("tabor", self.tabor)
         grid = self.grid if self.grid is not None else self.shape.grid(self.dx)  # validates dx against the cell
-        # 'auto': gpu where JAX sees one and the grid gains from it, else fast; 'gpu' without one: refused
-        solver, note = choose(self.solver, points=grid.nx * grid.ny)
-        if note:
-            object.__setattr__(self, "solver", solver)
-            object.__setattr__(self, "solver_note", note)
         if self.scaling is not None and abs(self.scaling.mu - mu) > 1e-9 * mu:
             raise TengsimError(f"tabor = {mu:g} does not match the scaling's μ = {self.scaling.mu:g}")
         law = make_law(self.law) if isinstance(self.law, str) else (self.law or LJ93())
@@ -229,6 +221,17 @@ class ContactPlan:
     def coupling(self) -> float:
         """μ^{3/2}, the elastic coupling of Eq. (9)."""
         return coupling(self.tabor)
+
+
+def chosen_solver(plan: ContactPlan, grid=None) -> tuple:
+    """(the solver a run of ``plan`` on ``grid`` uses, the sentence that says why, '' unless 'auto' chose it):
+    'auto' chosen on that grid's points (:func:`tengsim.solvers.choice.choose`: the GPU above its break-even
+    where JAX sees one); ``grid`` None: the plan's own.  Every run of one grid asks here, and says the sentence
+    where it solves (one grid, or each grid of a refinement whose choice changes)."""
+    from tengsim.solvers.choice import choose
+
+    g = plan.grid if grid is None else grid
+    return choose(plan.solver, points=g.nx * g.ny)
 
 
 def as_plan(plan) -> ContactPlan:
@@ -408,8 +411,13 @@ def plan_contact(cfg: dict) -> ContactPlan:
 
     if kernel_params.get("thickness") is not None:  # a film thinner than its pixel allows: refused now
         film.check_film_pixels(kernel_params["thickness"], max(grid.dx, grid.dy), lateral)
-    check_memory(grid.nx, grid.ny, vals["boundary"], vals["solver"], maps=2 * len(path.maps_at))
     resolve = _resolve(vals, given, dx if raw_dx not in (None, "") else None, scaling)
+    if resolve is None:  # the plan's grid is the grid solved; a refinement checks each of its own grids
+        check_memory(grid.nx, grid.ny, vals["boundary"], vals["solver"], maps=2 * len(path.maps_at))
+    if isinstance(vals["solver"], str) and vals["solver"].strip().lower() == "gpu":
+        from tengsim.solvers.choice import choose
+
+        choose("gpu")  # asked for by name and absent here: refused before anything runs
     return ContactPlan(shape, tabor, dx, path, vals["boundary"], vals["solver"], tol, law, extra, scaling,
                        tuple(vals["observers"]), kernel_params, symmetry=vals["symmetry"], resolve=resolve,
                        grid=grid, config={k: v for k, v in cfg.items() if k not in ("out", "plot")})

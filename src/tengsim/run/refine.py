@@ -21,6 +21,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from tengsim.errors import TengsimError
+from tengsim.progress import say_to
 
 
 START_ZONE_PIXELS = 12.0
@@ -51,12 +52,6 @@ def _first_dx(cplan, ask) -> float:
     if ask.dx is not None:
         return ask.dx / cplan.scaling.lateral
     return start_dx(cplan.shape, cplan.law, cplan.coupling, cplan.boundary, START_ZONE_PIXELS)
-
-
-def say_to(progress, text: str) -> None:
-    """``text`` to ``progress.say`` where it has one (a :class:`tengsim.progress.Progress`-like object)."""
-    if progress is not None and hasattr(progress, "say"):
-        progress.say(text)
 
 
 @dataclass(frozen=True)
@@ -140,8 +135,8 @@ def plan_refinement(cplan, ask, observe=None, watch=None, maps_at=()) -> Refinem
     try:
         dx = _first_dx(cplan, ask)
         grids = GridSequence(cplan.shape, dx)  # the refinement's grids: its estimate, its budget, its lines
-        shortest = run_cost(cplan, 2.0, None, ask.retraction).grid_seconds(cplan.shape, grids[0])
         finest = estimated_grids(ask, grids)[-1]
+        shortest = run_cost(cplan, 2.0, None, ask.retraction, grids[0]).grid_seconds(cplan.shape, grids[0])
     except GeometryError as exc:  # a size that does not fit, said in the user's units
         raise exc.in_metres(cplan.scaling.lateral, _metres) from None
     memory = estimate_bytes(finest.nx, finest.ny, cplan.boundary, cplan.solver)
@@ -185,7 +180,7 @@ def estimate(plan: RefinementPlan, d_max: float, coarse=None):
     for the path's D range ``d_max`` found on the coarse pre-run ``coarse`` (:func:`find_range`)."""
     from tengsim.run import budget
 
-    cost = budget.run_cost(plan.cplan, d_max, coarse, plan.retraction)
+    cost = budget.run_cost(plan.cplan, d_max, coarse, plan.retraction, plan.finest)
     return budget.estimate(plan, plan.cplan, plan.grids, d_max, cost, plan.memory_bytes)
 
 
@@ -217,6 +212,17 @@ def find_range(plan: RefinementPlan, progress=None, guard=None):
     return find_d_max(plan.cplan, plan.dx, plan.p_max, height_eps(plan.cplan, plan.dx), extending, guard)
 
 
+def said_solver(cplan, first, finest, said) -> None:
+    """Which solver 'auto' takes on the refinement's grids (each grid chooses its own when it is solved,
+    :func:`tengsim.run.plan.chosen_solver`), said before the first: one line, or two where the first grid and
+    the finest expected choose differently (a GPU above its break-even); nothing for a solver asked by name."""
+    from tengsim.run.plan import chosen_solver
+
+    (a, why), (b, why_fine) = chosen_solver(cplan, first), chosen_solver(cplan, finest)
+    if why:
+        said(why if a == b else f"{why}; from {finest.nx}×{finest.ny} on: {why_fine}")
+
+
 def refine(plan: RefinementPlan, observer: Observer = Observer()):
     """The refined :class:`tengsim.results.ContactResult` of ``plan`` (checked by :func:`preflight`) whose approach
     reaches its last pressure (module doc); a :class:`tengsim.errors.TengsimError` before the refinement is solved
@@ -229,14 +235,13 @@ def refine(plan: RefinementPlan, observer: Observer = Observer()):
         say_to(observer.progress, text)
 
     cplan = plan.cplan
-    cpu = not on_gpu(cplan)  # the budget in the run's own CPU time (a GPU run's host waits: the wall time)
+    cpu = not on_gpu(cplan, plan.finest)  # the budget in the run's own CPU time (a GPU run's host waits: the wall time)
     coarse_guard = deadline(None, plan, observer.keep, observer.started, cpu)
     guard = deadline(observer.progress, plan, observer.keep, observer.started, cpu)
     grids = plan.grids
     said(f"{plan.name}: Tabor number {cplan.tabor:.3g} (from eps = {cplan.scaling.eps * 1e9:.3g} nm), "
          f"lateral unit {cplan.scaling.lateral * 1e9:.3g} nm")
-    if cplan.solver_note:
-        said(cplan.solver_note)
+    said_solver(cplan, grids[0], plan.finest, said)
 
     d_max, coarse = find_range(plan, observer.progress, coarse_guard)  # the path's range, on a cheap grid
     est = estimate(plan, d_max, coarse)
@@ -244,7 +249,7 @@ def refine(plan: RefinementPlan, observer: Observer = Observer()):
         said(line)
     if observer.later is not None and observer.later > d_max:  # killed in its second pass: go on on that pass's path
         d_max = observer.later
-    cost = run_cost(cplan, d_max, coarse, plan.retraction)
+    cost = run_cost(cplan, d_max, coarse, plan.retraction, plan.finest)
     max_pixels = plan.max_pixels or budget_pixels(plan, cplan.shape, grids, cost)
     check_budget(plan, est, max_pixels)
     said(cap_line(cplan.shape, grids, cost, max_pixels))

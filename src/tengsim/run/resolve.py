@@ -88,7 +88,8 @@ def resolve_plan(plan, observe=None, full_length: float | None = None, progress=
     first grid; e.g. the D at which its maps are kept, predicted from the coarser curve); default ``plan.path``.
     ``settings``: a :class:`tengsim.run.plan.ResolveSettings` used instead of ``plan.resolve`` (one plan serves
     every refinement pass of a caller: a ContactPlan is built per grid only)."""
-    from tengsim.run.plan import ResolveSettings
+    from tengsim.progress import say_to
+    from tengsim.run.plan import ResolveSettings, chosen_solver
     from tengsim.run.simulate import simulate_plan
 
     if settings is None:  # a caller's settings for this refinement (no plan built for them), else the plan's
@@ -104,7 +105,7 @@ def resolve_plan(plan, observe=None, full_length: float | None = None, progress=
     max_pixels = settings.max_pixels
     if max_pixels is None:  # what the machine's memory holds (tengsim.run.memory)
         max_pixels = default_max_pixels(plan.boundary, plan.solver if isinstance(plan.solver, str) else "fast")
-    levels, names, res, seen, watched = [], [], None, set(), []
+    levels, names, res, seen, watched, said_solver = [], [], None, set(), [], None
     stop, phases, done = None, (), False
     if start is not None:  # a refinement kept by its checkpoint: its grids are not computed again
         levels, phases, res = [GridRecord.of(lv) for lv in start[0]], tuple(start[1]), start[2]
@@ -128,7 +129,12 @@ def resolve_plan(plan, observe=None, full_length: float | None = None, progress=
         seen.add((grid.nx, grid.ny))
         t0 = time.perf_counter()
         this_path = plan.path if path_for is None else path_for(res)
-        res = simulate_plan(dataclasses.replace(plan, dx=grid.dx, grid=grid, path=this_path), progress=progress)
+        this = dataclasses.replace(plan, dx=grid.dx, grid=grid, path=this_path)
+        solver, why = chosen_solver(this)  # 'auto' chooses on each grid: said where the choice changes
+        if why and solver != said_solver:
+            say_to(progress, why)
+            said_solver = solver
+        res = simulate_plan(this, progress=progress)
         obs = contact_observables(res, full_length)
         if observe is not None:
             obs.update(observe(res))

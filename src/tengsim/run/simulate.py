@@ -5,7 +5,7 @@ from dataclasses import is_dataclass, replace
 
 from tengsim import status
 from tengsim._version import __version__
-from tengsim.run.plan import ContactPlan, as_plan
+from tengsim.run.plan import ContactPlan, as_plan, chosen_solver
 from tengsim.errors import TengsimError
 from tengsim.grid import Mirror
 from tengsim.shapes import Pyramid, Shape
@@ -70,7 +70,7 @@ def simulate_plan(plan: ContactPlan, progress=None, sink=None, throw: bool = Fal
     """The run of a :class:`tengsim.run.plan.ContactPlan` on its grid (one grid: ``plan.resolve`` is not read
     here); ``progress``, ``sink``, ``throw`` and ``check_memory_first`` as for :func:`simulate`."""
     shape, tabor, path, grid, boundary, law = plan.shape, plan.tabor, plan.path, plan.grid, plan.boundary, plan.law
-    solver, symmetry = plan.solver, plan.symmetry
+    solver, symmetry = chosen_solver(plan)[0], plan.symmetry  # 'auto' chosen on this grid (the caller says why)
     solver_obj = make_solver(solver, tol=plan.tol) if isinstance(solver, str) else solver
     if isinstance(solver_obj, MirrorSolver):
         solver_obj = solver_obj.inner
