@@ -10,8 +10,8 @@ times (1 + noise z), z standard normal from numpy's default_rng(seed) (default n
 Free: σ, W, ε (default bounds W 30–100 mJ/m², ε 250–550 nm; the run recorded used W 30–80 mJ/m², ε 280–500 nm:
 with W = 100 mJ/m² and ε = 250 nm one design of group C ran over 9 min at tol 0.02).  Designs at tol 0.02 (default),
 3 per axis, 2 zooms, 3 refinements.  Written: OUT/calibrate_paper/ (the calibration's files; its designs/ is a
-cache, not a result) and OUT/calibrate_paper.json (truth, best, intervals, the relative errors of W and σ, the
-words on ε).
+cache, not a result), OUT/calibrate_paper.json (truth, best, intervals, the relative errors of W and σ, the
+words on ε) and OUT/calibrate_paper_report.md (a copy of the calibration's report.md); ``--name`` renames all three.
 A rerun with the same options takes every design back from OUT/calibrate_paper/designs.
 """
 from __future__ import annotations
@@ -70,6 +70,7 @@ def main(argv=None):
     cal = calibrate(prob, out / a.name, n_nodes=a.nodes, zooms=a.zooms, refine=a.refine, expected_noise=a.noise,
                     progress=lambda s: print(f"  {s}", file=sys.stderr, flush=True))
     write_calibration(cal, out / a.name)
+    (out / f"{a.name}_report.md").write_text((out / a.name / "report.md").read_text())
     f = cal.fit
     res = {"truth": TRUE, "seed": a.seed, "noise": a.noise, "tol": a.tol, "nodes": a.nodes, "zooms": a.zooms,
            "free": a.free, "bounds": {"W": [a.W_lo, a.W_hi], "eps": [a.eps_lo, a.eps_hi]}, "best": f.best,

@@ -78,12 +78,12 @@ def run_tengsim(h, p_mean, rel_tol, repeat):
 
 
 def run_tengsim_nested(h, p_mean, rel_tol, repeat, coarsest=64):
-    """pk from the coarser grids' solutions (tengsim.multilevel.nested_solve, block prolongation, load control),
+    """pk from the coarser grids' solutions (tengsim.solvers.multilevel.nested_solve, block prolongation, load control),
     coarsest grid ``coarsest``² as ASPHER's nested solve; every level to the fine tolerance."""
     from tengsim.grid import Grid
     from tengsim.kernels import PeriodicKernel
     from tengsim.laws import Repulsive
-    from tengsim.multilevel import nested_solve
+    from tengsim.solvers.multilevel import nested_solve
     from tengsim.solvers.pk import PKSolver
 
     n = h.shape[0]

@@ -22,7 +22,7 @@ U0 = max(h) − h, periodic kernel (μ^{3/2} · 2/|q|), LJ 8-2 law, μ = 0.5.  D
 fraction of the surface overlaps rigidly (U0 < D): the contact state is comparable across sizes.
 
 Per size, in a fresh subprocess (so peak memory is that size's alone):
-* a nested-grid solve (``tengsim.multilevel.nested_solve``: coarse grids over the same cell first,
+* a nested-grid solve (``tengsim.solvers.multilevel.nested_solve``: coarse grids over the same cell first,
   down to ``--min-size``), its convolutions on the finest grid and in fine-grid equivalents;
 * for n <= ``--cold-max``: a cold equilibrium at D0 from the undeformed state and, for
   n <= ``--warm-max``, a warm one at D0 + ΔD from it (the per-step cost on a path);
@@ -123,7 +123,7 @@ def one_size(n, dx, mu, tol, overlap, dD, seed, cold=True, nested=True, min_size
     out = dict(n=n, N=n * n, dx=dx, L=L, mu=mu, tol=tol, rms_slope=slope, D0=D0, dD=dD, t_conv=t_conv,
                t_setup=t_setup, surface=surface)
     if nested:
-        from tengsim.multilevel import nested_solve
+        from tengsim.solvers.multilevel import nested_solve
 
         t0 = time.perf_counter()
         def progress(lv):  # one line per finished level, on stderr (kept if the size is cut)

@@ -3,7 +3,9 @@
 Reports points/hour of each (best of --repeat runs, and each run), the ratio, the co-running slowdown
 of the points themselves (Σ compute seconds two at a time / one at a time), and the scheduler + I/O
 overhead of each run.  Writes benchmarks/results/sweep_scaling.md and .json.
-python benchmarks/sweep_scaling.py --dx 0.025
+
+    python benchmarks/sweep_scaling.py --dx 0.025
+    python benchmarks/sweep_scaling.py --dx 0.025 --from-json benchmarks/results/sweep_scaling.json  # the .md again
 """
 import json
 import os
@@ -101,6 +103,11 @@ def main(out=Path(__file__).parent / "results", dx=0.045, repeat=3):
         for n in (1, 2):
             rows.append({"repeat": rep, **one_run(n, dx)})
             print({k: rows[-1][k] for k in ("repeat", "workers", "wall_s", "compute_s")}, file=sys.stderr)
+    write_outputs(out, rows, dx, repeat)
+
+
+def write_outputs(out, rows, dx, repeat):
+    """OUT/sweep_scaling.json (the rows and the ratios) and OUT/sweep_scaling.md (the table) from ``rows``."""
     one = [r for r in rows if r["workers"] == 1]
     two = [r for r in rows if r["workers"] == 2]
     per_rep = [b["points_per_hour"] / a["points_per_hour"] for a, b in zip(one, two)]
@@ -136,7 +143,7 @@ def main(out=Path(__file__).parent / "results", dx=0.045, repeat=3):
               "given as a fraction of Σ compute) and tail idle (waiting for the other worker's last point: "
               "load imbalance; submissions go longest first by an estimate, which equal-grid points do not "
               "separate).", "",
-              f"Machine: {os.cpu_count()} CPUs. A load average above the CPU count means other jobs shared "
+              f"Machine: {one[0].get('cpus', os.cpu_count())} CPUs. A load average above the CPU count means other jobs shared "
               "the cores: a second worker then gets no core of its own and the ratio measures the contention, "
               "not the sweep."]
     (out / "sweep_scaling.md").write_text("\n".join(lines) + "\n")
@@ -150,5 +157,11 @@ if __name__ == "__main__":
     ap.add_argument("--dx", type=float, default=0.045, help="grid spacing of the points (smaller: longer points)")
     ap.add_argument("--repeat", type=int, default=3, help="runs of each worker count (alternating)")
     ap.add_argument("--out", type=Path, default=Path(__file__).parent / "results")
+    ap.add_argument("--from-json", type=Path, default=None,
+                    help="write the .json and .md from the rows of an earlier run's sweep_scaling.json, running nothing")
     a = ap.parse_args()
-    main(a.out, a.dx, a.repeat)
+    if a.from_json is not None:
+        rows = json.loads(a.from_json.read_text())["rows"]
+        write_outputs(a.out, rows, a.dx, 1 + max(r["repeat"] for r in rows))
+    else:
+        main(a.out, a.dx, a.repeat)

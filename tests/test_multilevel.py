@@ -1,4 +1,4 @@
-"""Nested-grid start (tengsim.multilevel): resampling is exact for resolved harmonics, and the nested
+"""Nested-grid start (tengsim.solvers.multilevel): resampling is exact for resolved harmonics, and the nested
 solve lands on an equilibrium of the fine problem that satisfies Eq. (9) to the tolerance."""
 import numpy as np
 import pytest
@@ -8,7 +8,7 @@ from tengsim.shapes import random_rough
 from tengsim.grid import Grid, fourier_resample
 from tengsim.laws import LJ93
 from tengsim.kernels import FreeKernel, PeriodicKernel
-from tengsim.multilevel import coarse_levels, nested_solve
+from tengsim.solvers.multilevel import coarse_levels, nested_solve
 from tengsim.solvers import FastSolver, Problem, State
 
 

@@ -28,7 +28,7 @@ LOCAL_CLUSTER_CONFIG = {
 }
 """Dask settings of the LocalCluster a sweep starts.  With the defaults an idle 2-worker cluster burns
 about 3 CPU-seconds per 20 s (15 % of a core) in monitors, taken from the points it runs on a
-2-core machine; with these, 0.4 s (benchmarks/results/sweep_scaling.md).  Read when the cluster
+2-core machine; with these, 0.4 s (docs/benchmarks.md, "Design studies on Dask").  Read when the cluster
 starts; a cluster behind ``--scheduler`` keeps its own configuration."""
 
 

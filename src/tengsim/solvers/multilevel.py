@@ -18,6 +18,10 @@ Only the finest level's answer is returned, and it is judged like any other: by 
 on the given grid, so it is a stable equilibrium of the fine problem.  With adhesion a problem can
 have several; the nested start may settle in a different one from a cold start (both are local
 minima of the same energy; measured on the benchmark surface in docs/benchmarks.md).
+
+It sits with the solvers and, like them, never imports a kernel module: the periodic kernel is the one
+registered as ``"periodic"`` (``tengsim.registry.KERNELS``), and each coarse level's kernel is the given
+kernel's own class on the coarse grid, with the same coupling and film.
 """
 from __future__ import annotations
 
@@ -30,8 +34,8 @@ import numpy as np
 
 from tengsim.errors import TengsimError
 from tengsim.grid import Grid, fourier_resample
-from tengsim.kernels import PeriodicKernel
-from tengsim.solvers import Equilibrium, Problem, State
+from tengsim.registry import KERNELS
+from tengsim.solvers.types import Equilibrium, Problem, State
 
 
 @dataclass
@@ -95,7 +99,7 @@ def coarse_levels(shape: tuple[int, int], min_size: int = 128, levels: int | Non
     return out[::-1]
 
 
-def nested_solve(solver, g0: np.ndarray, law, kernel: PeriodicKernel, min_size: int = 128,
+def nested_solve(solver, g0: np.ndarray, law, kernel, min_size: int = 128,
                  levels: int | None = None, max_dx: float = 0.5, coarse_tol: float | None = 1e-3,
                  coarse_max_iter: int | None = 1000, on_level=None, load: float | None = None,
                  prolong: str = "fourier") -> NestedSolve:
@@ -114,12 +118,14 @@ def nested_solve(solver, g0: np.ndarray, law, kernel: PeriodicKernel, min_size: 
     ``on_level(stat)`` is called with each level's :class:`LevelStat` as it finishes (progress).
     ``load``: load control at that mean pressure (W/ε; the solver's ``solve_load``), None: displacement control.
     ``prolong``: ``"fourier"`` or ``"block"`` (module doc).
+    ``kernel``: the periodic kernel (``tengsim.kernels.PeriodicKernel`` or a subclass; half-space or film).
     """
     if prolong not in PROLONGATIONS:
         raise TengsimError(f"prolong must be one of {', '.join(PROLONGATIONS)}, got {prolong!r}")
     if load is not None and not hasattr(solver, "solve_load"):
         raise TengsimError(f"load control needs a solver with solve_load; {type(solver).__name__} has none")
-    if not isinstance(kernel, PeriodicKernel):
+    periodic = KERNELS.get("periodic") if "periodic" in KERNELS else None
+    if periodic is None or not isinstance(kernel, periodic):
         raise TengsimError("nested_solve needs a periodic kernel (the coarse grids resample the cell "
                            "by Fourier series)")
     g0 = np.asarray(g0, dtype=float)
@@ -136,7 +142,7 @@ def nested_solve(solver, g0: np.ndarray, law, kernel: PeriodicKernel, min_size: 
             k, g = kernel, g0
         else:
             cg = Grid(shape[0], shape[1], grid.lx / shape[0], grid.ly / shape[1])
-            k = PeriodicKernel(cg, kernel.coupling, **kernel.film_params())
+            k = type(kernel)(cg, kernel.coupling, **kernel.film_params())
             g = fourier_resample(g0, shape)
         n_conv = 0
         if q is None:
