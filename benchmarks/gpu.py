@@ -116,7 +116,10 @@ def rough_row(n, dtype, device, cpu_max, tol, max_iter, ref_cache):
 
 def path_row(label, runs, device):
     """Whole paths through the contact API: ``runs`` = [(N, cell, mu, dx, d_max, d_step)], jax vs fast."""
-    from tengsim.run.simulate import simulate_pyramid
+    from tengsim.continuation import PathSpec
+    from tengsim.run.plan import ContactPlan
+    from tengsim.run.simulate import simulate
+    from tengsim.shapes import Pyramid
     from tengsim.solvers.jax_fast import JaxSolver, compile_stats
 
     out = {}
@@ -126,8 +129,7 @@ def path_row(label, runs, device):
         it, F = 0, []
         for N, cell, mu, dx, d_max, d_step in runs:
             solver = "fast" if name == "fast" else JaxSolver(device=device)
-            res = simulate_pyramid(N, cell, mu, dx, d_min=-1.0, d_max=d_max, d_step=d_step, solver=solver,
-                                   symmetry="off")
+            res = simulate(ContactPlan(Pyramid(N, cell), mu, dx, PathSpec(-1.0, d_max, d_step), solver=solver, symmetry="off"))
             it += int(np.sum(res.table["iterations"]))
             F.append(np.asarray(res.table["F"]))
         wall = time.perf_counter() - t0

@@ -38,7 +38,9 @@ def main(argv=None):
     a = ap.parse_args(argv)
 
     from tengsim import kernels
-    from tengsim.run.simulate import simulate_pyramid
+    from tengsim.continuation import PathSpec
+    from tengsim.run.plan import ContactPlan
+    from tengsim.run.simulate import simulate
     from tengsim.shapes import Pyramid
 
     g = GROUPS[a.group]
@@ -52,8 +54,7 @@ def main(argv=None):
     prof = cProfile.Profile()
     t0 = time.perf_counter()
     prof.enable()
-    simulate_pyramid(g["N"], g["cell"], tabor=a.mu, dx=a.dx, d_min=a.d_min, d_max=d_max,
-                     d_step=a.d_step, boundary="free", solver="fast", tol=a.tol, refine_levels=0)
+    simulate(ContactPlan(Pyramid(g["N"], g["cell"]), a.mu, a.dx, PathSpec(a.d_min, d_max, a.d_step, refine_levels=0), boundary="free", solver="fast", tol=a.tol))
     prof.disable()
     wall = time.perf_counter() - t0
     cnt.restore()

@@ -11,12 +11,12 @@ warm-started step to step, to the same tolerance on the Eq. (9) residual max|r|.
 ``results.md`` / ``results.csv`` (the table) and ``curves_<group>.csv`` (F and Λc per step and
 solver) under ``--out``.
 
-* tengsim fast: ``simulate_pyramid(solver="fast")`` on the full path (``refine_levels`` 0 by
+* tengsim fast: ``simulate(ContactPlan(Pyramid(N, cell), ..., solver="fast"))`` on the full path (``refine_levels`` 0 by
   default so it solves exactly the peer's D steps; its secant predictor stays on).
 * tengsim VSR: by default *sampled*: every ``--vsr-every``-th step of the full path is solved by VSR
   from the very state the fast solver started that step from, and the fast solve of that step is
   timed alongside; the ratio is then per equilibrium (sum of VSR seconds / sum of fast seconds on the
-  same solves).  ``--vsr-mode full`` runs ``simulate_pyramid(solver="vsr")`` on the whole path;
+  same solves).  ``--vsr-mode full`` runs the same with ``solver="vsr"`` on the whole path;
   one mode per group is accepted (``--groups A C --vsr-mode full sampled``).
 * ContactMechanics/Adhesion (``benchmarks/peer_contactmechanics.py``): skipped with a note when the
   packages are not installed (``pip install -e .[bench]``).
@@ -54,7 +54,10 @@ GROUPS = {
 def _symmetric_fast(args, name, g, d_max, grid, reps, wall_fast, cpu_fast, fast_ref, log):
     """tengsim fast with symmetry = 'auto' (the X+Y block): its row, ratios to the full-grid fast run, and its
     largest |ΔF| from it relative to max|F|."""
-    from tengsim.run.simulate import simulate_pyramid
+    from tengsim.continuation import PathSpec
+    from tengsim.run.plan import ContactPlan
+    from tengsim.run.simulate import simulate
+    from tengsim.shapes import Pyramid
     from tengsim.grid import Mirror
     from tengsim.kernels import FreeKernel
     from tengsim.kernels.mirror import MirrorKernel, ReducedKernel
@@ -67,9 +70,7 @@ def _symmetric_fast(args, name, g, d_max, grid, reps, wall_fast, cpu_fast, fast_
         cnt = ConvCounter(FreeKernel, ReducedKernel)
         try:
             t0, c0 = time.perf_counter(), time.process_time()
-            res = simulate_pyramid(g["N"], g["cell"], tabor=args.mu, dx=args.dx, d_min=args.d_min, d_max=d_max,
-                                   d_step=args.d_step, boundary="free", solver="fast", tol=args.tol,
-                                   refine_levels=args.refine_levels, symmetry="auto")
+            res = simulate(ContactPlan(Pyramid(g["N"], g["cell"]), args.mu, args.dx, PathSpec(args.d_min, d_max, args.d_step, refine_levels=args.refine_levels), boundary="free", solver="fast", tol=args.tol, symmetry="auto"))
             wall, cpu = min(wall, time.perf_counter() - t0), min(cpu, time.process_time() - c0)
         finally:
             cnt.restore()
@@ -183,7 +184,9 @@ def run_group(name, args, log):
     from tengsim import kernels
     from tengsim.analysis import apex_index
     from tengsim.analysis import contact_length as ts_contact_length
-    from tengsim.run.simulate import simulate_pyramid
+    from tengsim.continuation import PathSpec
+    from tengsim.run.plan import ContactPlan
+    from tengsim.run.simulate import simulate
     from tengsim.shapes import Pyramid
     from tengsim.laws import LJ93
     from tengsim.solvers import Problem, State, make_solver
@@ -215,9 +218,7 @@ def run_group(name, args, log):
         try:
             t0 = time.perf_counter()
             c0 = time.process_time()
-            res = simulate_pyramid(g["N"], g["cell"], tabor=args.mu, dx=args.dx, d_min=args.d_min,
-                                   d_max=d_max, d_step=args.d_step, boundary="free", solver="fast",
-                                   tol=args.tol, refine_levels=args.refine_levels, symmetry="off")
+            res = simulate(ContactPlan(Pyramid(g["N"], g["cell"]), args.mu, args.dx, PathSpec(args.d_min, d_max, args.d_step, refine_levels=args.refine_levels), boundary="free", solver="fast", tol=args.tol, symmetry="off"))
             wall_fast = min(wall_fast, time.perf_counter() - t0)
             cpu_fast = min(cpu_fast, time.process_time() - c0)
         finally:
@@ -298,10 +299,7 @@ def run_group(name, args, log):
                 try:
                     t0 = time.perf_counter()
                     c0 = time.process_time()
-                    resv = simulate_pyramid(g["N"], g["cell"], tabor=args.mu, dx=args.dx, d_min=args.d_min,
-                                            d_max=d_max, d_step=args.d_step, boundary="free",
-                                            solver=vsr, tol=args.tol, refine_levels=args.refine_levels,
-                                            symmetry="off")   # the fast run's grid (not the mirror block's kernel)
+                    resv = simulate(ContactPlan(Pyramid(g["N"], g["cell"]), args.mu, args.dx, PathSpec(args.d_min, d_max, args.d_step, refine_levels=args.refine_levels), boundary="free", solver=vsr, tol=args.tol, symmetry="off"))   # the fast run's grid (not the mirror block's kernel)
                     t_v = min(t_v, time.perf_counter() - t0)
                     cpu_v = min(cpu_v, time.process_time() - c0)
                 finally:

@@ -22,6 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
+from tengsim.run.plan import ContactPlan
 import tengsim as ts
 from tengsim import status as st
 from tengsim.laws import make_law
@@ -106,7 +107,7 @@ def run_case(case) -> list[dict]:
         shape = make_shape(sname, fields)
         path = ts.PathSpec(d_min, d_max, d_step, refine_levels=levels)
         t0 = time.perf_counter()
-        res = ts.simulate(shape, mu, dx, path, boundary=boundary, law=law, observers=[OldZone()])
+        res = ts.simulate(ContactPlan(shape, mu, dx, path, boundary=boundary, law=law, observers=[OldZone()]))
         t = res.table
         pz = np.asarray(t["process_zone"], float)
         old = np.asarray(t["old_zone"], float)

@@ -31,7 +31,7 @@ import numpy as np
 
 from tengsim.continuation import walker as continuation
 from tengsim.run.plan import plan_contact
-from tengsim.run.simulate import run_contact
+from tengsim.run.simulate import simulate as run_contact
 from tengsim.kernels import make_kernel
 from tengsim.laws import LJ93
 from tengsim.shapes.rough import Rough

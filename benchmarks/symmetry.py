@@ -22,19 +22,20 @@ from pathlib import Path
 
 import numpy as np
 
+from tengsim.run.plan import ContactPlan
 from tengsim.cases.paper.contact import group_shape
 from tengsim.cases.paper.units import paper_scaling
-from tengsim.run.simulate import run_contact, simulate
+from tengsim.run.simulate import simulate
 from tengsim.continuation import PathSpec
 
 
 def _runner(group, dx, d_max, d_step, boundary, tol):
     if group == "issue":
         cfg = dict(shape="pyramid", N=0.946, cell=3.78, tabor=0.5, dx=0.05, d_min=-1.0, d_max=4.0, d_step=0.05)
-        return lambda sym: run_contact({**cfg, "symmetry": sym})
+        return lambda sym: simulate({**cfg, "symmetry": sym})
     shape, mu = group_shape(group), paper_scaling(group).mu
     spec = PathSpec(-1.0, d_max, d_step)
-    return lambda sym: simulate(shape, mu, dx, spec, boundary=boundary, tol=tol, symmetry=sym)
+    return lambda sym: simulate(ContactPlan(shape, mu, dx, spec, boundary=boundary, tol=tol, symmetry=sym))
 
 
 def _peak(fn):

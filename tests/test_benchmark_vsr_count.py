@@ -13,7 +13,10 @@ sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "benchmarks"))
 import run_benchmarks as rb  # noqa: E402
 
 from tengsim.kernels import FreeKernel  # noqa: E402
-from tengsim.run.simulate import simulate_pyramid  # noqa: E402
+from tengsim.continuation import PathSpec
+from tengsim.run.plan import ContactPlan
+from tengsim.run.simulate import simulate
+from tengsim.shapes import Pyramid  # noqa: E402
 from tengsim.solvers import make_solver  # noqa: E402
 
 
@@ -21,8 +24,7 @@ def test_vsr_full_run_counts_its_convolutions():
     vsr = make_solver("vsr", tol=1e-5, max_iter=20000)
     cnt = rb.ConvCounter(FreeKernel)
     try:
-        res = simulate_pyramid(2.0, 4.0, tabor=0.5, dx=0.25, d_min=-0.5, d_max=0.5, d_step=0.25, boundary="free",
-                               solver=vsr, tol=1e-5, refine_levels=0, symmetry="off")
+        res = simulate(ContactPlan(Pyramid(2.0, 4.0), 0.5, 0.25, PathSpec(-0.5, 0.5, 0.25, refine_levels=0), boundary="free", solver=vsr, tol=1e-5, symmetry="off"))
     finally:
         cnt.restore()
     nc = np.asarray(res.table["n_conv"])

@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 import xarray as xr
 
+from tengsim.run.plan import ContactPlan
 from tengsim.cli.main import main
 from tengsim.results.read import load_result
 
@@ -200,8 +201,7 @@ def test_dimensionless_run_with_observers_passes_the_cf_check(tmp_path, offline)
         def __call__(self, eq, ctx):
             return {"P_apex": eq.P[ctx.apex], "H_apex": eq.H[ctx.apex], "cells_x": 1.0}
 
-    res = ts.simulate(ts.Pyramid(0.946, 3.78), 0.5, 0.4, ts.PathSpec(-0.5, 0.5, 0.5, maps_at=(0.5,)),
-                      observers=[Apex()])
+    res = ts.simulate(ContactPlan(ts.Pyramid(0.946, 3.78), 0.5, 0.4, ts.PathSpec(-0.5, 0.5, 0.5, maps_at=(0.5,)), observers=[Apex()]))
     res.save(tmp_path / "o.nc")
     ds = xr.load_dataset(tmp_path / "o.nc")
     assert ds.sizes["map"] == 2 and ds["D"].attrs == {"long_name": "rigid approach D of the plate (Eq. 7)",
@@ -261,7 +261,7 @@ def test_device_nc_passes_the_cf_check(tmp_path, offline):
     from tengsim.cases.paper.device import fig7_params, fig7_waveform
     from tengsim.device.dynamics import simulate
 
-    r = simulate(fig7_params(), fig7_waveform(), 0.004, dt_out=1e-4)
+    r = simulate(ContactPlan(fig7_params(), fig7_waveform(), 0.004, dt_out=1e-4))
     r.to_dataset().to_netcdf(tmp_path / "d.nc", engine="h5netcdf")  # plain xarray writes it CF-clean too
     assert cf_check(tmp_path / "d.nc") == ([], {})
     ds = xr.load_dataset(tmp_path / "d.nc")

@@ -39,7 +39,7 @@ def test_import_tengsim_is_light_and_the_api_still_there():
     assert heavy == []
     import tengsim
 
-    assert tengsim.Pyramid.__name__ == "Pyramid" and callable(tengsim.run_contact)
+    assert tengsim.Pyramid.__name__ == "Pyramid" and callable(tengsim.resolve)
     assert set(tengsim.__all__) <= set(dir(tengsim))
     with pytest.raises(AttributeError):
         tengsim.no_such_name

@@ -255,7 +255,7 @@ def test_plot_curves_uses_physical_axes(tmp_path, monkeypatch):
     monkeypatch.setattr(plots, "save", lambda fig, path: figs.append(fig))
     plan_cfg = dict(shape="cube", half_width="0.3um", height="0.2um", pitch="1um", E_star="1MPa",
                     W="50mJ/m2", eps="20nm", dx=2, d_min=-0.5, d_max=0.5, d_step=0.5)
-    from tengsim.run.simulate import run_grid as run_contact
+    from tengsim.run.simulate import simulate as run_contact
 
     res = run_contact(plan_cfg)
     plots.plot_curves(res, tmp_path / "p.png")

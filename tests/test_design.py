@@ -7,6 +7,7 @@ import math
 import numpy as np
 import pytest
 
+from tengsim.run.plan import ContactPlan
 from tengsim.cli.main import main
 from tengsim.errors import TengsimError
 from tengsim.design import plan_design, run_design, write_design
@@ -42,8 +43,7 @@ def test_small_design_ok_and_within_1pct_of_a_grid_sqrt2_finer(small):
     res = small.finest
     cplan = plan_contact(small.plan.contact_table)
     path = PathSpec(res.params["d_min"], res.params["d_max"], res.params["d_step"], adaptive=True)
-    finer = simulate(cplan.shape, cplan.tabor, res.grid.dx / math.sqrt(2), path, law=cplan.law,
-                     scaling=cplan.scaling, extra_params=cplan.extra, boundary=cplan.boundary)
+    finer = simulate(ContactPlan(cplan.shape, cplan.tabor, res.grid.dx / math.sqrt(2), path, law=cplan.law, scaling=cplan.scaling, extra=cplan.extra, boundary=cplan.boundary))
     assert finer.grid.nx > res.grid.nx
     a = small.dataset["charged_area_fraction"].sel(branch="approach").values
     b = branch_curves(finer, small.plan)["approach"]["area"]

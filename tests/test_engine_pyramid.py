@@ -10,7 +10,10 @@ from functools import lru_cache
 import numpy as np
 import pytest
 
-from tengsim.run.simulate import simulate_pyramid
+from tengsim.continuation import PathSpec
+from tengsim.run.plan import ContactPlan
+from tengsim.run.simulate import simulate
+from tengsim.shapes import Pyramid
 
 GROUPS = {"A": (0.946, 3.78), "B": (2.37, 9.46), "C": (4.73, 18.9)}
 
@@ -18,7 +21,7 @@ GROUPS = {"A": (0.946, 3.78), "B": (2.37, 9.46), "C": (4.73, 18.9)}
 @lru_cache(maxsize=None)
 def run(group, dx, d_max, boundary="free"):
     N, cell = GROUPS[group]
-    return simulate_pyramid(N, cell, 0.5, dx, d_min=-1.0, d_max=d_max, d_step=0.05, boundary=boundary)
+    return simulate(ContactPlan(Pyramid(N, cell), 0.5, dx, PathSpec(-1.0, d_max, 0.05), boundary=boundary))
 
 
 def _on_grid(res, branch):

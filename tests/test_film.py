@@ -21,7 +21,7 @@ from scipy.special import j0
 
 from tengsim.kernels import film
 from tengsim.run.plan import plan_contact
-from tengsim.run.simulate import run_grid as run_contact
+from tengsim.run.simulate import simulate as run_contact
 from tengsim.errors import TengsimError
 from tengsim.grid import Grid
 from tengsim.kernels import FreeKernel, PeriodicKernel, make_kernel

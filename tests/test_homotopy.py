@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 from conftest import registered
 
+from tengsim.run.plan import ContactPlan
 from tengsim.run.simulate import simulate
 from tengsim.errors import TengsimError
 from tengsim.kernels import make_kernel
@@ -141,8 +142,8 @@ def test_simulate_with_the_homotopy_solver_runs_a_path():
     warm (plain fast solves)."""
     shape = Rough(cell=8.0, hurst=0.8, rms_slope=0.2, short_cutoff=2.0, seed=0)
     path = PathSpec(-0.5, 0.25, 0.25, refine_levels=1, retract=False)
-    res = simulate(shape, tabor=3.0, dx=0.5, path=path, boundary="periodic",
-                   solver=HomotopySolver(tol=1e-6, levels=1))
+    res = simulate(ContactPlan(shape, tabor=3.0, dx=0.5, path=path, boundary="periodic",
+                               solver=HomotopySolver(tol=1e-6, levels=1)))
     assert res.params["solver"] == "homotopy"
     assert np.all(np.asarray(res.table["converged"], dtype=bool)) and len(res.table["F"]) >= 4
     assert plan_stages(_rough(cell=8.0), None, 32) == [((21, 21), 1.0)]  # automatic: too small to coarsen

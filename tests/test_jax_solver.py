@@ -22,7 +22,9 @@ import pytest
 jax = pytest.importorskip("jax")
 
 from tengsim.cli.main import main  # noqa: E402
-from tengsim.run.simulate import simulate_pyramid  # noqa: E402
+from tengsim.continuation import PathSpec  # noqa: E402
+from tengsim.run.plan import ContactPlan  # noqa: E402
+from tengsim.run.simulate import simulate  # noqa: E402
 from tengsim.errors import TengsimError  # noqa: E402
 from tengsim.kernels import make_kernel  # noqa: E402
 from tengsim.laws import LJ93, Exponential, MaugisDugdale, Repulsive  # noqa: E402
@@ -56,12 +58,13 @@ def test_pyramid_group_paths_equal_the_numpy_solver(group):
     converged, F to 1e-10; one compile for the whole path."""
     N, cell, dx = GROUPS[group]
     d_max, d_step = (3.0, 0.05) if group == "A" else (2.0, 0.1)
-    kw = dict(d_min=-1.0, d_max=d_max, d_step=d_step, symmetry="off", tol=TIGHT)
-    ref = simulate_pyramid(N, cell, 0.5, dx, solver="fast", **kw).table
+    path = PathSpec(-1.0, d_max, d_step)
+    kw = dict(symmetry="off", tol=TIGHT)
+    ref = simulate(ContactPlan(Pyramid(N, cell), 0.5, dx, path, solver="fast", **kw)).table
     if group == "A":
         clear_cache()
     before = compile_stats()
-    got = simulate_pyramid(N, cell, 0.5, dx, solver="jax", **kw).table
+    got = simulate(ContactPlan(Pyramid(N, cell), 0.5, dx, path, solver="jax", **kw)).table
     stats = compile_stats()
     assert stats["calls"] - before["calls"] >= len(got["F"]) - 1  # every equilibrium of the path ...
     assert stats["compiles"] - before["compiles"] <= 1  # ... on one compiled loop (B and C: 47² both)

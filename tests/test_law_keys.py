@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 import xarray as xr
 
+from tengsim.run.plan import ContactPlan
 import tengsim as ts
 from tengsim.cli.main import main
 from tengsim.run.keys import contact_table, law_fields, law_keys
@@ -43,10 +44,8 @@ def _csv(path):
 
 @pytest.mark.parametrize("law, keys, obj", CASES, ids=[c[0] for c in CASES])
 def test_toml_and_cli_law_keys_give_the_api_numbers(law, keys, obj, tmp_path, capsys):
-    api = ts.simulate(Paraboloid(radius=RUN["radius"], cell=RUN["cell"]), 0.5, RUN["dx"],
-                      ts.PathSpec(RUN["d_min"], RUN["d_max"], RUN["d_step"]), law=obj)
-    default = ts.simulate(Paraboloid(radius=RUN["radius"], cell=RUN["cell"]), 0.5, RUN["dx"],
-                          ts.PathSpec(RUN["d_min"], RUN["d_max"], RUN["d_step"]), law=law)
+    api = ts.simulate(ContactPlan(Paraboloid(radius=RUN["radius"], cell=RUN["cell"]), 0.5, RUN["dx"], ts.PathSpec(RUN["d_min"], RUN["d_max"], RUN["d_step"]), law=obj))
+    default = ts.simulate(ContactPlan(Paraboloid(radius=RUN["radius"], cell=RUN["cell"]), 0.5, RUN["dx"], ts.PathSpec(RUN["d_min"], RUN["d_max"], RUN["d_step"]), law=law))
     assert np.abs(api.table["F"] - default.table["F"]).max() > 1e-4  # the keys change the answer
 
     toml, nc = tmp_path / "run.toml", tmp_path / "toml.nc"

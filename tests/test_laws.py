@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from tengsim.run.plan import ContactPlan
 from tengsim import references as ref
 from tengsim.references.axisym import maugis_sphere
 from tengsim.cli.main import main
@@ -128,8 +129,7 @@ def md_sphere(mu, dx, cell, d_min, d_max=0.5, **law):
     """2-D engine, MD law: (P̄ = −∬P/π at pull-off, wall-zone radius there, wall-zone radius at zero
     load on retraction (NaN if F never turns compressive))."""
     import tengsim
-    res = tengsim.simulate(tengsim.Paraboloid(1.0, cell), mu, dx, tengsim.PathSpec(d_min, d_max, 0.05),
-                           law=MaugisDugdale(**law), observers=[WallZone()])
+    res = tengsim.simulate(ContactPlan(tengsim.Paraboloid(1.0, cell), mu, dx, tengsim.PathSpec(d_min, d_max, 0.05), law=MaugisDugdale(**law), observers=[WallZone()]))
     assert res.all_converged
     r = res.branch("retraction")
     i = int(np.argmin(r["F"]))

@@ -6,6 +6,7 @@ from functools import lru_cache
 import numpy as np
 import pytest
 
+from tengsim.run.plan import ContactPlan
 import tengsim as ts
 from tengsim import references as ref
 from tengsim.kernels import FreeKernel
@@ -82,8 +83,7 @@ def test_load_jumps_and_pull_off():
 
 
 def test_simulate_dispatches_on_the_load_spec():
-    res = ts.simulate(ts.Pyramid(0.946, 3.78), 0.5, 0.4,
-                      LoadPathSpec(0.0, 0.5, 0.5, d_max=4.0, d_step=0.2, retract=False))
+    res = ts.simulate(ContactPlan(ts.Pyramid(0.946, 3.78), 0.5, 0.4, LoadPathSpec(0.0, 0.5, 0.5, d_max=4.0, d_step=0.2, retract=False)))
     on = res.table["on_grid"].astype(bool)
     assert np.allclose(res.table["F"][on], [0.0, 0.5], atol=1e-4)
     assert res.params["control"] == "load"
@@ -177,7 +177,7 @@ def group_a_load(maps_at=(), steps=None):
     old = loadpath._LoadBranch.max_root_steps
     loadpath._LoadBranch.max_root_steps = old if steps is None else steps
     try:
-        res = ts.simulate(shape, sc.mu, 0.4, spec, tol=1e-7)
+        res = ts.simulate(ContactPlan(shape, sc.mu, 0.4, spec, tol=1e-7))
     finally:
         loadpath._LoadBranch.max_root_steps = old
     return res, grid, spec

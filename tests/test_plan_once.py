@@ -1,5 +1,5 @@
 """Plan once (issue 28 item 1): a [contact] table becomes one frozen, validated ContactPlan, read once per run;
-everything downstream takes that plan (the refinement driver resolve_plan too, each grid a simulate_plan of it);
+everything downstream takes that plan (the refinement engine too, each grid a simulate run of it);
 each check lives in one place; the shape answers its full-contact length."""
 import dataclasses
 import math
@@ -51,7 +51,7 @@ def test_tengsim_run_of_a_toml_contact_table_plans_once(tmp_path, counted):
 
 
 def test_the_api_helper_plans_a_table_once_and_takes_a_plan_as_is(counted):
-    from tengsim.run.resolve import run_contact
+    from tengsim.run.simulate import simulate as run_contact
 
     res = run_contact(dict(CFG))
     assert len(counted) == 1 and res.params["config"] == CFG
@@ -135,11 +135,11 @@ def test_full_contact_lengths_of_the_built_in_shapes():
 
 
 def test_contact_plan_is_the_type_simulate_runs():
-    from tengsim.run.simulate import simulate, simulate_plan
+    from tengsim.run.simulate import simulate
 
     p = plan_contact(dict(CFG))
-    a = simulate_plan(p)
-    b = simulate(p.shape, p.tabor, p.dx, p.path)
+    a = simulate(p)
+    b = simulate(ContactPlan(p.shape, p.tabor, p.dx, p.path))
     assert list(a.table["F"]) == list(b.table["F"]) and isinstance(p, ContactPlan)
 
 
@@ -162,35 +162,35 @@ def test_shapes_answer_their_contact_family():
 
 @pytest.fixture
 def spied(monkeypatch):
-    """The plans the refinement driver (resolve_plan) and the one-grid run (simulate_plan) are given; both
+    """The plans the refinement engine (resolve._refine_grids) and the one-grid run (simulate) are given; both
     still run (every caller reaches them through their modules)."""
     from tengsim.run import resolve, simulate
 
     seen = {"resolve": [], "grids": []}
-    real_resolve, real_grid = resolve.resolve_plan, simulate.simulate_plan
+    real_resolve, real_grid = resolve._refine_grids, simulate.simulate
 
-    def resolving(plan, **kw):
+    def resolving(plan, how=resolve.Refining(), progress=None):
         seen["resolve"].append(plan)
-        seen.setdefault("settings", []).append(kw.get("settings") or plan.resolve)  # a pass's settings
-        return real_resolve(plan, **kw)
+        seen.setdefault("settings", []).append(how.settings or plan.resolve)  # a pass's settings
+        return real_resolve(plan, how, progress)
 
     def one_grid(plan, **kw):
         seen["grids"].append(plan)
         return real_grid(plan, **kw)
 
-    monkeypatch.setattr(resolve, "resolve_plan", resolving)
-    monkeypatch.setattr(simulate, "simulate_plan", one_grid)
+    monkeypatch.setattr(resolve, "_refine_grids", resolving)
+    monkeypatch.setattr(simulate, "simulate", one_grid)
     return seen
 
 
 def _refined_by_the_plan(seen, res, tol):
-    """Refinements of a ContactPlan whose settings are the run's, each of their grids a simulate_plan."""
+    """Refinements of a ContactPlan whose settings are the run's, each of their grids a simulate run."""
     assert seen["resolve"] and all(isinstance(p, ContactPlan) for p in seen["resolve"])
     assert all(isinstance(r, ResolveSettings) and r.tol == tol for r in seen["settings"])
     assert all(isinstance(p, ContactPlan) for p in seen["grids"])
     ran = [p.grid.dx for p in seen["grids"]]
     grids = res.params["resolve_grids"]
-    assert len(grids) >= 2  # the refinement's grids are the last simulate_plan runs, in order
+    assert len(grids) >= 2  # the refinement's grids are the last simulate runs, in order
     assert ran[-len(grids):] == pytest.approx(grids, rel=1e-12)
 
 
@@ -232,10 +232,10 @@ def test_a_design_builds_a_contact_plan_once_per_grid_and_per_refinement_pass(mo
                         "maps": False})
     assert isinstance(plan.contact_plan, ContactPlan) and plan.contact_plan.tol == solver_tol(plan)
     built, grids, passes = [], [], []
-    real_post, real_run, real_resolve = ContactPlan.__post_init__, sim.simulate_plan, resolve.resolve_plan
+    real_post, real_run, real_resolve = ContactPlan.__post_init__, sim.simulate, resolve._refine_grids
     monkeypatch.setattr(ContactPlan, "__post_init__", lambda self: (built.append(1), real_post(self))[1])
-    monkeypatch.setattr(sim, "simulate_plan", lambda p, **kw: (grids.append(p.grid.nx), real_run(p, **kw))[1])
-    monkeypatch.setattr(resolve, "resolve_plan", lambda p, **kw: (passes.append(1), real_resolve(p, **kw))[1])
+    monkeypatch.setattr(sim, "simulate", lambda p, **kw: (grids.append(p.grid.nx), real_run(p, **kw))[1])
+    monkeypatch.setattr(resolve, "_refine_grids", lambda p, *a: (passes.append(1), real_resolve(p, *a))[1])
     res = run_design(plan)
     assert res.status == "ok" and len(grids) >= 3 and passes
     assert len(built) <= len(grids), (len(built), grids, len(passes))  # at most one per grid solved

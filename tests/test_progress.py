@@ -3,6 +3,7 @@ import io
 
 import pytest
 
+from tengsim.run.plan import ContactPlan
 from tengsim.progress import Progress
 
 
@@ -70,12 +71,11 @@ def test_simulate_reports_inside_long_solves(monkeypatch):
     monkeypatch.setattr(contact, "MONITOR_MIN_POINTS", 0)
     s = io.StringIO()
     bar = Progress(stream=s, line_interval=0.0)
-    contact.simulate(Paraboloid(1.0, 6.0), 1.0, 0.3, PathSpec(-0.5, 0.0, 0.5), progress=bar)
+    contact.simulate(ContactPlan(Paraboloid(1.0, 6.0), 1.0, 0.3, PathSpec(-0.5, 0.0, 0.5)), progress=bar)
     text = s.getvalue()
     assert "tengsim: solve: iteration" in text and "\r" not in text
     # a plain callable (no .monitor) still works, and small grids are not monitored by default
     monkeypatch.setattr(contact, "MONITOR_MIN_POINTS", 1024**2)
     s2 = io.StringIO()
-    contact.simulate(Paraboloid(1.0, 6.0), 1.0, 0.3, PathSpec(-0.5, 0.0, 0.5),
-                     progress=Progress(stream=s2, line_interval=0.0))
+    contact.simulate(ContactPlan(Paraboloid(1.0, 6.0), 1.0, 0.3, PathSpec(-0.5, 0.0, 0.5)), progress=Progress(stream=s2, line_interval=0.0))
     assert "solve:" not in s2.getvalue()

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 import xarray as xr
 
+from tengsim.run.plan import ContactPlan
 import tengsim as ts
 from tengsim import registry
 from tengsim import plugins
@@ -52,10 +53,8 @@ def test_a_new_registration_reaches_every_name_list():
         assert plan_contact(dict(N=0.946, cell=3.78, boundary="periodic_copy")).boundary == "periodic_copy"
         with pytest.raises(TengsimError, match="periodic_copy"):
             make_kernel("x", ts.Grid.square(3.0, 0.5), 0.3)
-        res = ts.simulate(ts.Pyramid(0.946, 3.78), 0.5, 0.3, ts.PathSpec(-1, 0, 0.5, retract=False),
-                          boundary="periodic_copy")
-        ref = ts.simulate(ts.Pyramid(0.946, 3.78), 0.5, 0.3, ts.PathSpec(-1, 0, 0.5, retract=False),
-                          boundary="periodic")
+        res = ts.simulate(ContactPlan(ts.Pyramid(0.946, 3.78), 0.5, 0.3, ts.PathSpec(-1, 0, 0.5, retract=False), boundary="periodic_copy"))
+        ref = ts.simulate(ContactPlan(ts.Pyramid(0.946, 3.78), 0.5, 0.3, ts.PathSpec(-1, 0, 0.5, retract=False), boundary="periodic"))
         np.testing.assert_allclose(res.table["F"], ref.table["F"], rtol=1e-12)
         assert res.params["boundary"] == "periodic_copy"
     finally:
@@ -98,7 +97,7 @@ class PApex:
 
 def test_observers_append_columns_to_table_csv_and_netcdf(tmp_path):
     spec = ts.PathSpec(-0.5, 0.5, 0.5, maps_at=(0.5,))
-    res = ts.simulate(ts.Pyramid(0.946, 3.78), 0.5, 0.3, spec, observers=[PApex()])
+    res = ts.simulate(ContactPlan(ts.Pyramid(0.946, 3.78), 0.5, 0.3, spec, observers=[PApex()]))
     t = res.table
     assert res.columns[-2:] == ["P_apex", "H_apex"]
     for m in res.maps:  # the observer saw the same state as the maps
@@ -131,11 +130,11 @@ def test_observer_errors_are_named():
             return {"b": 0.0}
 
     with pytest.raises(TengsimError, match="'F' is already"):
-        ts.simulate(ts.Pyramid(0.946, 3.78), 0.5, 0.3, spec, observers=[Clash()])
+        ts.simulate(ContactPlan(ts.Pyramid(0.946, 3.78), 0.5, 0.3, spec, observers=[Clash()]))
     with pytest.raises(TengsimError, match="Wrong"):
-        ts.simulate(ts.Pyramid(0.946, 3.78), 0.5, 0.3, spec, observers=[Wrong()])
+        ts.simulate(ContactPlan(ts.Pyramid(0.946, 3.78), 0.5, 0.3, spec, observers=[Wrong()]))
     with pytest.raises(TengsimError, match="unknown observer 'nope'"):
-        ts.simulate(ts.Pyramid(0.946, 3.78), 0.5, 0.3, spec, observers=["nope"])
+        ts.simulate(ContactPlan(ts.Pyramid(0.946, 3.78), 0.5, 0.3, spec, observers=["nope"]))
 
 
 def test_paper_study_uses_an_observer_not_a_monkeypatch():
@@ -228,13 +227,12 @@ def test_user_plugin_via_api_toml_and_cli(plugin, tmp_path, capsys):
 
     # the API: registered names (the module is now imported)
     Tent = SHAPES.get("tent")
-    res = ts.simulate(Tent(slope=1.5, tip=0.3), 0.5, 0.3, ts.PathSpec(-0.5, 0.5, 0.5), law="half_lj",
-                      observers=["p_apex"])
+    res = ts.simulate(ContactPlan(Tent(slope=1.5, tip=0.3), 0.5, 0.3, ts.PathSpec(-0.5, 0.5, 0.5), law="half_lj", observers=["p_apex"]))
     F_cli = np.array([float(r["F"]) for r in rows])
     np.testing.assert_allclose(res.table["F"], F_cli, rtol=1e-12)
     np.testing.assert_allclose(res.table["P_apex"], [float(r["P_apex"]) for r in rows], rtol=1e-12)
     # the law is really half the paper's: at the same state the pressures are halved
-    full = ts.simulate(Tent(slope=1.5, tip=0.3), 0.5, 0.3, ts.PathSpec(-0.5, 0.5, 0.5), observers=["p_apex"])
+    full = ts.simulate(ContactPlan(Tent(slope=1.5, tip=0.3), 0.5, 0.3, ts.PathSpec(-0.5, 0.5, 0.5), observers=["p_apex"]))
     assert not np.allclose(full.table["F"], res.table["F"])
 
     # a TOML run
@@ -262,7 +260,7 @@ out = "{out2}"
 
     # the new law's own field is a key of the CLI, TOML and help, with the law's default
     HalfLJ = LAWS.get("half_lj")
-    api = ts.simulate(Tent(slope=1.5, tip=0.3), 0.5, 0.3, ts.PathSpec(-0.5, 0.5, 0.5), law=HalfLJ(factor=0.25))
+    api = ts.simulate(ContactPlan(Tent(slope=1.5, tip=0.3), 0.5, 0.3, ts.PathSpec(-0.5, 0.5, 0.5), law=HalfLJ(factor=0.25)))
     assert not np.allclose(api.table["F"], res.table["F"])
     out3 = tmp_path / "factor.csv"
     assert main(["contact", "tent", "--slope", "1.5", "--tip", "0.3", "--law", "half_lj", "--factor", "0.25",

@@ -12,7 +12,7 @@ import math
 import numpy as np
 import pytest
 
-from tengsim.run import judge, resolve
+from tengsim.run import judge, resolve, simulate
 from tengsim.cli.main import main
 from tengsim.errors import TengsimError
 from tengsim.results.read import load_result
@@ -78,7 +78,7 @@ def test_cheap_refinement_reaches_ok(refined):
         r = p["richardson"][name]
         assert r["rel_error"] <= 0.01 and r["change"] <= 0.01, name
     # the curves are exactly those of a plain run on the finest grid
-    from tengsim.run.simulate import run_grid as run_contact
+    from tengsim.run.simulate import simulate as run_contact
 
     plain = run_contact({k: v for k, v in PYR_CFG.items() if k != "resolve"} | {"dx": grids[-1]})
     np.testing.assert_allclose(res.table["F"], plain.table["F"], rtol=0, atol=1e-9)
@@ -133,14 +133,18 @@ def test_max_pixels_stops_with_under_resolved_and_one_line(tmp_path, capsys):
     assert 0.01 < need < 0.18  # extrapolated from the observed convergence: finer than reached
 
 
-def test_api_resolve_contact_and_the_first_grid_above_max_pixels():
-    from tengsim import PathSpec, Pyramid, resolve_contact
+def test_api_resolve_and_the_first_grid_above_max_pixels():
+    from tengsim import ContactPlan, PathSpec, Pyramid, ResolveSettings, resolve as refined
 
-    res = resolve_contact(Pyramid(0.946, 3.78), 0.5, PathSpec(-1.0, 2.0, 0.1), dx=0.4, max_pixels=13 * 13)
+    def plan(max_pixels):
+        return ContactPlan(Pyramid(0.946, 3.78), 0.5, 0.4, PathSpec(-1.0, 2.0, 0.1),
+                           resolve=ResolveSettings(max_pixels=max_pixels, dx=0.4))
+
+    res = refined(plan(13 * 13))
     assert res.status == "under_resolved" and len(res.params["resolve_grids"]) == 2
     assert res.params["richardson"]["pull_off_F"]["observed"] is False  # two grids: order 1 assumed
     with pytest.raises(TengsimError, match="below the first grid's 9×9"):
-        resolve_contact(Pyramid(0.946, 3.78), 0.5, PathSpec(-1.0, 2.0, 0.1), dx=0.4, max_pixels=50)
+        refined(plan(50))
 
 
 def test_default_start_and_max_pixels():
@@ -184,9 +188,9 @@ def test_bad_values_are_refused_with_one_line(tmp_path, capsys, extra, words):
 
 
 def test_one_grid_run_contact_refuses_resolve_auto():
-    from tengsim.run.simulate import run_grid as run_contact
+    from tengsim.run.simulate import simulate as run_contact
 
-    with pytest.raises(TengsimError, match="tengsim.run.resolve.run_contact"):
+    with pytest.raises(TengsimError, match="run it with tengsim.resolve"):
         run_contact({**PYR_CFG, "d_max": 0.0})
 
 
@@ -263,7 +267,7 @@ def test_resolve_pressures_are_judged_and_written(tmp_path, capsys):
 def test_area_observer_is_nan_outside_the_run_and_for_dimensionless():
     from tengsim.run.area import area_at, area_name
 
-    res = resolve.run_contact({**PYR_CFG, "resolve": "off", "dx": 0.2})
+    res = simulate.simulate({**PYR_CFG, "resolve": "off", "dx": 0.2})
     assert math.isnan(area_at([1e4])(res)[area_name(1e4)])  # no physical scale
     assert area_name(1e4) == "A_S_at_10000Pa" and area_name(2.5e3) == "A_S_at_2500Pa"
 
@@ -292,9 +296,9 @@ def test_the_api_converges_a_s_at_resolve_pressures_without_any_hook(monkeypatch
     from tengsim.run import simulate
     from tengsim.run.area import area_name
 
-    one_grid = resolve.run_contact({**PYR_CFG, "resolve": "off", "dx": 0.4})
-    monkeypatch.setattr(simulate, "simulate_plan", lambda plan, **k: one_grid)  # every grid: no solve
-    res = resolve.run_contact({"shape": "pyramid", "E_star": "0.59MPa", "W": "54mJ/m2", "eps": "0.37um",
+    one_grid = simulate.simulate({**PYR_CFG, "resolve": "off", "dx": 0.4})
+    monkeypatch.setattr(simulate, "simulate", lambda plan, **k: one_grid)  # every grid: no solve
+    res = resolve.resolve({"shape": "pyramid", "E_star": "0.59MPa", "W": "54mJ/m2", "eps": "0.37um",
                                "pitch": "5um", "base": "2.5um", "height": "1.75um", "d_min": -1, "d_max": 2,
                                "d_step": 0.5, "resolve": "auto", "resolve_pressures": "10kPa",
                                "max_pixels": 40 * 40})
@@ -367,6 +371,6 @@ def test_finer_grids_keep_a_shapes_edges_where_they_fell_in_the_first_grids_pixe
 
 
 def test_a_refinement_records_its_edge_phases():
-    res = resolve.run_contact({**PYR_CFG, "max_pixels": 13 * 13})
+    res = resolve.resolve({**PYR_CFG, "max_pixels": 13 * 13})
     assert res.params["resolve_edge_phases"] == pytest.approx([0.2524], abs=1e-3)
     assert res.params["resolution"]["nx"] == [9, 13]

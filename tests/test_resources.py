@@ -6,6 +6,7 @@ import sys
 
 import pytest
 
+from tengsim.run.plan import ContactPlan
 from tengsim import resources
 from tengsim.run import memory
 from tengsim.cli.main import main
@@ -13,6 +14,7 @@ from tengsim.errors import TengsimError
 
 _PEAK = r"""
 import json, resource, sys
+from tengsim.run.plan import ContactPlan
 from tengsim.run.simulate import simulate
 from tengsim.shapes import Pyramid
 from tengsim.continuation import PathSpec
@@ -28,8 +30,8 @@ boundary, solver, n = sys.argv[1], sys.argv[2], int(sys.argv[3])
 shape = Pyramid(0.946, 3.78)
 grid = shape.grid(3.78 / n)
 base = rss()
-simulate(shape, 0.5, 3.78 / n, PathSpec(-1.0, 0.0, 0.5), boundary=boundary, solver=solver, tol=1e-5,
-         symmetry="off")  # the estimate is the full grid's (a symmetric run checks its block's)
+simulate(ContactPlan(shape, 0.5, 3.78 / n, PathSpec(-1.0, 0.0, 0.5), boundary=boundary, solver=solver, tol=1e-5,
+                     symmetry="off"))  # the estimate is the full grid's (a symmetric run checks its block's)
 print(json.dumps([grid.nx, grid.ny, rss() - base]))
 """
 
@@ -125,6 +127,6 @@ def test_simulate_checks_memory_before_any_kernel_is_built(monkeypatch, symmetry
     shape = Pyramid(0.946, 3.78)
     g = shape.grid(3.78 / 61)
     with pytest.raises(TengsimError) as err:
-        sim.simulate(shape, 0.5, g.dx, PathSpec(-1.0, 0.0, 0.5), symmetry=symmetry)
+        sim.simulate(ContactPlan(shape, 0.5, g.dx, PathSpec(-1.0, 0.0, 0.5), symmetry=symmetry))
     n = (g.nx + 1) // 2 if symmetry == "auto" else g.nx  # the block of the odd grid, mirrored in X and Y
     assert g.nx % 2 == 1 and f"a {n}×{n} grid (free boundary, fast solver) needs about" in str(err.value)

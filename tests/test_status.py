@@ -14,6 +14,7 @@ from functools import lru_cache
 import numpy as np
 import pytest
 
+from tengsim.run.plan import ContactPlan
 import tengsim as ts
 from tengsim import references as ref
 from tengsim import status as st
@@ -30,7 +31,7 @@ S0 = 16 / (9 * np.sqrt(3))  # LJ 9-3 tensile peak stress
 @lru_cache(maxsize=None)
 def sphere(mu, dx, cell, d_min, throw=False):
     path = ts.PathSpec(d_min, 0.5, 0.25, refine_levels=1)
-    return ts.simulate(ts.Paraboloid(1.0, cell), mu, dx, path, throw=throw)
+    return ts.simulate(ContactPlan(ts.Paraboloid(1.0, cell), mu, dx, path), throw=throw)
 
 
 def pulloff(res) -> float:
@@ -323,7 +324,7 @@ def test_snapping_run_is_under_resolved_with_its_own_line(tmp_path):
     limit was s = 1); at dx 0.07 (s = 0.57; +0.9 % from the finest) it is ok."""
     from tengsim.laws import MaugisDugdale
 
-    res = ts.simulate(ts.Paraboloid(1.0, 3.0), 3.0, 0.09, ts.PathSpec(-1.0, 0.5, 0.25), law=MaugisDugdale())
+    res = ts.simulate(ContactPlan(ts.Paraboloid(1.0, 3.0), 3.0, 0.09, ts.PathSpec(-1.0, 0.5, 0.25), law=MaugisDugdale()))
     s = res.params["pixel_snap_number"]
     assert s > 3
     assert res.status == "under_resolved"
@@ -336,11 +337,11 @@ def test_snapping_run_is_under_resolved_with_its_own_line(tmp_path):
     res.save(f)
     back = load_result(f)[1]
     assert back.status == "under_resolved" and st.warning_lines(back) == [line]
-    soft = ts.simulate(ts.Paraboloid(1.0, 6.0), 1.0, 0.1, ts.PathSpec(-1.0, 1.0, 0.25), law=MaugisDugdale())
+    soft = ts.simulate(ContactPlan(ts.Paraboloid(1.0, 6.0), 1.0, 0.1, ts.PathSpec(-1.0, 1.0, 0.25), law=MaugisDugdale()))
     assert 0.6 < soft.params["pixel_snap_number"] < 1 and soft.status == "under_resolved"
     (line,) = st.warning_lines(soft)
     assert "snap" in line and "process zone" not in line
-    finer = ts.simulate(ts.Paraboloid(1.0, 6.0), 1.0, 0.07, ts.PathSpec(-1.0, 1.0, 0.25), law=MaugisDugdale())
+    finer = ts.simulate(ContactPlan(ts.Paraboloid(1.0, 6.0), 1.0, 0.07, ts.PathSpec(-1.0, 1.0, 0.25), law=MaugisDugdale()))
     assert finer.params["pixel_snap_number"] < 0.6 and finer.status == "ok"
     assert np.isfinite(finer.table["process_zone"]).sum() > 10  # rows with an edge were judged
 
@@ -448,7 +449,7 @@ def test_row_status_thresholds():
 
 
 def _pulloff_run(shape, mu, dx, path, boundary="free", law=None):
-    res = ts.simulate(shape, mu, dx, ts.PathSpec(*path[:3], refine_levels=path[3]), boundary=boundary, law=law)
+    res = ts.simulate(ContactPlan(shape, mu, dx, ts.PathSpec(*path[:3], refine_levels=path[3]), boundary=boundary, law=law))
     return res
 
 

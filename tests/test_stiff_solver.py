@@ -10,6 +10,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+from tengsim.run.plan import ContactPlan
 from tengsim.run.plan import plan_contact
 from tengsim.continuation.walker import PERSIST_FACTOR, Walker, persist
 from tengsim.kernels import make_kernel
@@ -126,8 +127,8 @@ def test_simulate_continues_capped_solves_also_on_the_mirror_block():
     from tengsim.shapes.axisymmetric import Paraboloid
     shape = Paraboloid(radius=1.0, cell=6.0)
     path = PathSpec(d_min=-1.0, d_max=0.5, d_step=0.5)
-    ref = simulate(shape, 1.0, 0.25, path, boundary="free", solver=FastSolver(tol=1e-8))
-    capped = simulate(shape, 1.0, 0.25, path, boundary="free", solver=FastSolver(tol=1e-8, max_iter=15))
+    ref = simulate(ContactPlan(shape, 1.0, 0.25, path, boundary="free", solver=FastSolver(tol=1e-8)))
+    capped = simulate(ContactPlan(shape, 1.0, 0.25, path, boundary="free", solver=FastSolver(tol=1e-8, max_iter=15)))
     assert str(capped.params["symmetry"]).startswith("x")  # the mirror block was used
     assert bool(np.all(capped.table["converged"])) and int(np.max(capped.table["iterations"])) > 15
     F0, F1 = np.asarray(ref.table["F"]), np.asarray(capped.table["F"])

@@ -122,7 +122,7 @@ def test_area_fraction_per_shape_family():
 
 def test_physical_scale_of_any_shape_from_its_columns():
     """Any physical run: Pa per unit F from pressure_Pa (or F_N / cell area), metres per unit D = eps_m."""
-    from tengsim.run.simulate import run_grid as run_contact
+    from tengsim.run.simulate import simulate as run_contact
     from tengsim.run.area import physical_scale
 
     res = run_contact({"shape": "cone", "slope": 1.0, "pitch": "2um", "height": "0.4um", "E_star": "1MPa",

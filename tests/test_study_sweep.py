@@ -14,7 +14,7 @@ import xarray as xr
 from tengsim.cli.main import main
 from tengsim import plugins
 from tengsim.run.plan import plan_contact
-from tengsim.run.simulate import run_grid as run_contact
+from tengsim.run.simulate import simulate as run_contact
 from tengsim.errors import TengsimError
 from tengsim.status import SEVERITY
 from tengsim.study import parse_study, run_study
@@ -113,7 +113,7 @@ def test_failure_at_compute_is_recorded(monkeypatch):
     def boom(cfg, progress=None):
         raise FloatingPointError("overflow in the solver")
 
-    monkeypatch.setattr(tengsim.run.simulate, "run_grid", boom)
+    monkeypatch.setattr(tengsim.run.simulate, "simulate", boom)
     r = compute_point(dict(TINY), "abc")
     assert r["status"] == "failed" and "FloatingPointError: overflow in the solver" in r["message"]
     assert r["data"] is None

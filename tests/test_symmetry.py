@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 from conftest import registered
 
+from tengsim.run.plan import ContactPlan
 from tengsim.cases.paper.contact import group_shape
 from tengsim.cases.paper.units import paper_scaling
 from tengsim.cli.main import main
@@ -32,8 +33,8 @@ REL = 1e-9
 
 
 def _pair(shape, tabor, dx, path, **kw):
-    on = simulate(shape, tabor, dx, path, symmetry="auto", tol=kw.pop("tol", TOL), **kw)
-    off = simulate(shape, tabor, dx, path, symmetry="off", tol=on.params["tol"], **kw)
+    on = simulate(ContactPlan(shape, tabor, dx, path, symmetry="auto", tol=kw.pop("tol", TOL), **kw))
+    off = simulate(ContactPlan(shape, tabor, dx, path, symmetry="off", tol=on.params["tol"], **kw))
     return on, off
 
 
@@ -128,8 +129,7 @@ def test_one_mirror_line_equal_full_grid():
     n = shape.grid(0.25).nx
     assert (on.params["block_nx"], on.params["block_ny"]) == ((n + 1) // 2, n)
     _same_curve(on, off)
-    both = simulate(Line(half_width=1.0, height=2.0, cell=4.0), 1.0, 0.25, PathSpec(-0.5, 0.0, 0.5),
-                    boundary="periodic")
+    both = simulate(ContactPlan(Line(half_width=1.0, height=2.0, cell=4.0), 1.0, 0.25, PathSpec(-0.5, 0.0, 0.5), boundary="periodic"))
     assert both.params["symmetry"] == "x+y"  # the ridge is uniform along Y: its Y mirror is used too
 
 
@@ -142,7 +142,7 @@ def test_one_axis_chosen_where_the_gap_has_only_one():
 
 def test_falls_back_to_the_full_grid():
     scat = Array("pyramid", K=2, scatter_height=0.05, seed=1, N=0.946, cell=3.78)
-    res = simulate(scat, 0.5, 0.2, PathSpec(-1.0, 0.0, 0.5), boundary="periodic")
+    res = simulate(ContactPlan(scat, 0.5, 0.2, PathSpec(-1.0, 0.0, 0.5), boundary="periodic"))
     assert res.params["symmetry"] == "none (shape has no mirror)" and "block_nx" not in res.params
     plain = Array("pyramid", K=2, N=0.946, cell=3.78)
     assert plain.mirror_axes == (0, 1)
@@ -264,9 +264,10 @@ import sys, tracemalloc
 from tengsim.cases.paper.contact import group_shape
 from tengsim.cases.paper.units import paper_scaling
 from tengsim.continuation import PathSpec
+from tengsim.run.plan import ContactPlan
 from tengsim.run.simulate import simulate
 shape, mu = group_shape("B"), paper_scaling("B").mu
-run = lambda sym: simulate(shape, mu, 0.1, PathSpec(-1.0, 4.0, 0.25), symmetry=sym)
+run = lambda sym: simulate(ContactPlan(shape, mu, 0.1, PathSpec(-1.0, 4.0, 0.25), symmetry=sym))
 run(sys.argv[1])  # imports, FFT plans
 tracemalloc.start()
 run(sys.argv[1])
@@ -373,7 +374,7 @@ def test_n_conv_spent_counts_every_solve(kw):
     jump it exceeds the rows' own n_conv."""
     shape, mu = _group("A")
     solver = _Counting(make_solver("fast"))
-    res = simulate(shape, mu, 0.2, PathSpec(-1.0, 3.0, 0.5, **kw), solver=solver, symmetry="off")
+    res = simulate(ContactPlan(shape, mu, 0.2, PathSpec(-1.0, 3.0, 0.5, **kw), solver=solver, symmetry="off"))
     assert res.params["n_conv_spent"] == solver.total
     rows = int(np.sum(res.table["n_conv"]))
     assert solver.calls >= len(res.table["D"]) - 1
@@ -384,6 +385,5 @@ def test_n_conv_spent_counts_every_solve(kw):
 def test_load_path_counts_its_root_finding():
     shape, mu = _group("A")
     solver = _Counting(make_solver("fast"))
-    res = simulate(shape, mu, 0.2, LoadPathSpec(f_min=-0.2, f_max=0.5, f_step=0.1, d_max=5.0), solver=solver,
-                   symmetry="off")
+    res = simulate(ContactPlan(shape, mu, 0.2, LoadPathSpec(f_min=-0.2, f_max=0.5, f_step=0.1, d_max=5.0), solver=solver, symmetry="off"))
     assert res.params["n_conv_spent"] == solver.total > int(np.sum(res.table["n_conv"]))

@@ -10,7 +10,7 @@ import pytest
 from tengsim.cli.main import main
 from tengsim.run.keys import X_UNIT_KEYS
 from tengsim.run.plan import plan_contact
-from tengsim.run.simulate import run_grid as run_contact
+from tengsim.run.simulate import simulate as run_contact
 from tengsim.errors import ConfigValueError, TengsimError
 from tengsim.plugins import SHAPES
 from tengsim.shapes.base import physical_fields

@@ -4,6 +4,7 @@ import math
 import numpy as np
 import pytest
 
+from tengsim.run.plan import ContactPlan
 from tengsim.analysis import tensile_peak_offset
 from tengsim.errors import TengsimError
 from tengsim.continuation import PathSpec
@@ -68,8 +69,7 @@ def test_periodic_overcompression_is_flagged():
     """Periodic cell pressed far beyond flattening: gaps leave the law's range and are flagged."""
     import tengsim as ts
 
-    res = ts.simulate(ts.Pyramid(0.946, 3.78), 0.5, 0.3, ts.PathSpec(-1, 4, 0.5, retract=False),
-                      boundary="periodic")
+    res = ts.simulate(ContactPlan(ts.Pyramid(0.946, 3.78), 0.5, 0.3, ts.PathSpec(-1, 4, 0.5, retract=False), boundary="periodic"))
     flags = res.table["in_law_range"]
     D = res.table["D"]
     assert flags[D <= 1.0].all()          # before the cell flattens, everything is physical

@@ -8,6 +8,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from tengsim.run.plan import ContactPlan
 from tengsim.laws import LJ93
 from tengsim.relaxation import Prony, sls
 from tengsim.shapes import Paraboloid
@@ -53,7 +54,7 @@ def test_jumps_are_located_in_time_where_the_static_path_has_them():
     from tengsim import PathSpec, simulate
     from tengsim.visco import FixedTimeSteps
 
-    st = simulate(SHAPE, 2.0, 0.25, PathSpec(-1.5, 1.0, 0.25))
+    st = simulate(ContactPlan(SHAPE, 2.0, 0.25, PathSpec(-1.5, 1.0, 0.25)))
     tab = st.table
     static = [float(d) for d, j in zip(np.asarray(tab["D"]), np.asarray(tab["jump"])) if j]
     r = simulate_history(SHAPE, 2.0, 0.25, Prony(1.0), History((0, 1, 2), (-1.5, 1.0, -1.5)), FixedTimeSteps(0.1),

@@ -13,6 +13,7 @@ from functools import lru_cache
 import numpy as np
 import pytest
 
+from tengsim.run.plan import ContactPlan
 from tengsim import PathSpec, simulate
 from tengsim.laws import LJ93, Repulsive
 from tengsim.references import hertz_force
@@ -122,7 +123,7 @@ ADH = Paraboloid(1.0, 8.0)
 def static_rows(E_rel, Ds, dx=0.25):
     """The static path (tengsim.simulate) of the adhesive sphere at the modulus E_rel × E_ref."""
     tabor = (0.5 ** 1.5 / E_rel) ** (2 / 3)
-    res = simulate(ADH, tabor, dx, PathSpec(-1.0, 3.0, 0.25))
+    res = simulate(ContactPlan(ADH, tabor, dx, PathSpec(-1.0, 3.0, 0.25)))
     tab = res.table
     app = np.asarray(tab["branch"]) == "approach"
     cols = [np.asarray(tab[k])[app] for k in ("D", "F", "charged_fraction")]

@@ -1,5 +1,5 @@
 """``tengsim contact``: one approach–retraction run (a thin shell: options → one plan, :func:`tengsim.run.plan.plan_contact`
-→ :func:`tengsim.run.resolve.run_contact` → files)."""
+→ :func:`tengsim.run.simulate.simulate`, or :func:`tengsim.run.resolve.resolve` for ``--resolve auto`` → files)."""
 from __future__ import annotations
 
 import argparse
@@ -76,8 +76,10 @@ def run(args) -> int:
     if args.plot:
         check_output(args.plot, cfg.values(), what="--plot")
     from tengsim import parallel
-    from tengsim.run.resolve import run_contact
+    from tengsim.run.resolve import resolve
+    from tengsim.run.simulate import simulate
 
+    run_contact = simulate if plan.resolve is None else resolve  # one grid, or refined until converged
     if not parallel.is_root():  # mpiexec -n N: every process solves its slab, rank 0 alone writes and reports
         run_contact(plan)
         return 0

@@ -62,9 +62,11 @@ def run(args) -> int:
 def _contact(section, args) -> int:
     from tengsim.cli.contact import open_stream, run_streamed, write_contact
     from tengsim.run.plan import plan_contact
-    from tengsim.run.resolve import run_contact
+    from tengsim.run.resolve import resolve
+    from tengsim.run.simulate import simulate
 
     plan = plan_contact(section)  # every key checked before anything is written; the one plan of the run
+    run_contact = simulate if plan.resolve is None else resolve  # one grid, or refined until converged
     out = section.get("out")
     if not out:
         raise TengsimError("[contact] needs out = 'FILE.csv' or 'FILE.nc'")

@@ -16,9 +16,9 @@ def _simulate(cplan, dx, d_max, **kw):
     """``cplan`` on the grid of spacing ``dx``, walked from D_MIN to ``d_max``."""
     import dataclasses
 
-    from tengsim.run.simulate import simulate_plan
+    from tengsim.run.simulate import simulate
 
-    return simulate_plan(dataclasses.replace(cplan, dx=dx, grid=None, path=path_to(d_max)), **kw)
+    return simulate(dataclasses.replace(cplan, dx=dx, grid=None, path=path_to(d_max), resolve=None), **kw)
 
 
 MAP_FRACTIONS = (0.1, 0.5, 1.0)

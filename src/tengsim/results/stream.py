@@ -61,7 +61,7 @@ class RowStream:
     """Writes a contact run's rows to ``OUT.partial.csv`` as each equilibrium finishes, so a run that is
     killed (even by SIGKILL) keeps every finished equilibrium.
 
-    Pass it as ``sink`` to :func:`tengsim.run.simulate.simulate` / ``run_grid``.  The first row writes the
+    Pass it as ``sink`` to :func:`tengsim.run.simulate.simulate`.  The first row writes the
     file, whole (atomically): the header (``# complete: false``, ``# partial_of``, ``# run_digest`` and the
     run's parameters given to :meth:`begin`, as '# key: json' lines) and the column names, so a run that
     fails before its first equilibrium leaves nothing; each row is then appended as one CSV line (the

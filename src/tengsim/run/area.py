@@ -333,7 +333,7 @@ def area_name(pressure_Pa: float) -> str:
 
 def area_at(pressures, cfg: dict | None = None, definition: str = "contact", shape=None):
     """The observer ``res -> {area_name(P): A/S at P}`` that automatic refinement (``resolve_pressures``,
-    :func:`tengsim.run.resolve.run_contact`) also converges: the charged-area fraction of Eq. (12) at each
+    :func:`tengsim.run.resolve.resolve`) also converges: the charged-area fraction of Eq. (12) at each
     nominal pressure P (Pa) on the approach (linear in F between loaded states; NaN outside the states the
     run reaches or for a run without a physical scale).  V_OC (Eq. 12) is σT/(ε_r ε0) × A/S, so its relative
     change is A/S's.  ``shape``: the run's shape object, which the paper's A/S asks (:func:`patch`); without it,

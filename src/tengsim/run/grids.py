@@ -5,7 +5,7 @@ fine enough for a process zone of a given number of pixels (a design's start).  
 after a spacing ``dx``: the plain grid of the cell at ``dx`` moved, for a shape with kinks, to the first
 FFT-friendly grid whose edges fall where the first grid's did (:func:`aligned`; why: :mod:`tengsim.run.resolve`,
 "Edges kept in place"), skipping a pixel count already walked.  :func:`grid_sequence` gives the sequence (:func:`refinement_grids` its first grids), so
-whoever plans a refinement (its cost, its budget) plans on the grids :func:`tengsim.run.resolve.resolve_plan`
+whoever plans a refinement (its cost, its budget) plans on the grids :func:`tengsim.run.resolve.resolve`
 walks.
 """
 from __future__ import annotations

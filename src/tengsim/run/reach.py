@@ -64,14 +64,14 @@ def find_d_max(cplan, dx, p_max: float, height: float, extending=None, guard=Non
     height (ε).  ``extending(top, d_max)`` is told each extension (the highest pressure reached, Pa, and the D
     range walked); ``guard`` (called per path row) may stop it."""
     from tengsim.run.grids import default_dx
-    from tengsim.run.simulate import simulate_plan
+    from tengsim.run.simulate import simulate
 
     # the default grid's (the cell over 9 pixels at most): cheap, whatever the first grid (a given dx too)
     coarse = 2 * max(dx, default_dx(cplan.shape, cplan.law, cplan.coupling, cplan.boundary))
     d_max = 1.2 * height + 2.0
     kw = {} if guard is None else {"progress": guard}
     for _ in range(EXTEND_TRIES):
-        res = simulate_plan(dataclasses.replace(cplan, dx=coarse, grid=None, path=path_to(d_max)), **kw)
+        res = simulate(dataclasses.replace(cplan, dx=coarse, grid=None, path=path_to(d_max), resolve=None), **kw)
         ok, D_hit, top, slope = reach(res, p_max)
         if ok:
             return 1.1 * D_hit + 1.0, res
@@ -112,7 +112,7 @@ def map_depths(res, map_pressures) -> dict:
 
 
 def grid_path(p_max: float, d_max: float, map_pressures=(), cut: bool = True, retract: bool = True):
-    """``path_for`` of the refinement (:func:`tengsim.run.resolve.resolve_plan`): the first grid walks to
+    """``path_for`` of the refinement (:func:`tengsim.run.resolve.resolve`): the first grid walks to
     ``d_max`` (:func:`find_d_max`); each finer grid to the D at which the grid before it reached ``p_max``, plus
     :data:`D_MARGIN` (on the path's lattice, never beyond ``d_max``).  Each finer grid's path also keeps the
     pressure and gap maps at the D where the grid before it reached ``map_pressures`` (:func:`map_depths`), so the
@@ -138,7 +138,7 @@ def grid_path(p_max: float, d_max: float, map_pressures=(), cut: bool = True, re
 
 
 def resolve_to(plan, d_max: float, settings, progress=None, keep=None, key: str = "", done=None, say=None):
-    """The refinement (:func:`tengsim.run.resolve.resolve_plan`, with ``settings``, a
+    """The refinement (:func:`tengsim.run.resolve.resolve`, with ``settings``, a
     :class:`tengsim.run.plan.ResolveSettings`) of ``plan`` (a :class:`tengsim.run.refine.RefinementPlan`: its
     ``cplan``, ``p_max``, ``maps_at``, ``observe``, ``watch`` and ``retraction``) on the path to ``d_max``
     (:func:`grid_path`), whose finest grid must reach ``p_max``: if it does not (a finer grid is softer), d_max
@@ -146,9 +146,9 @@ def resolve_to(plan, d_max: float, settings, progress=None, keep=None, key: str 
     the pressure reached.  ``keep`` (a file, or None): each finished grid is kept there for the run ``key`` and
     path (:func:`tengsim.run.checkpoint.open_checkpoint`, ``say`` told what it finds), and taken back by a run of
     the same key and path.  ``done(levels)`` is called after each finished grid is kept; ``progress`` as for
-    resolve_plan; ``plan.retraction`` false: each grid walks the approach only."""
+    :func:`tengsim.run.resolve.resolve`; ``plan.retraction`` false: each grid walks the approach only."""
     from tengsim.run.checkpoint import open_checkpoint
-    from tengsim.run.resolve import resolve_plan
+    from tengsim.run.resolve import Refining, _refine_grids
 
     cplan, p_max = plan.cplan, plan.p_max
 
@@ -169,8 +169,9 @@ def resolve_to(plan, d_max: float, settings, progress=None, keep=None, key: str 
                 prev = dataclasses.replace(prev, scaling=cplan.scaling)
             return path_for(prev)
 
-        res = resolve_plan(cplan, observe=plan.observe, watch=plan.watch, settings=settings,
-                           path_for=scaled_path_for, progress=progress, checkpoint=after, start=found)
+        how = Refining(settings, plan.observe, watch=plan.watch, path_for=scaled_path_for, checkpoint=after,
+                       start=found)
+        res = _refine_grids(cplan, how, progress)
         if res.scaling is None:  # every grid taken back from the checkpoint file, which keeps the columns only
             res = dataclasses.replace(res, scaling=cplan.scaling)
         ok, D_hit, top, slope = reach(res, p_max)

@@ -1,6 +1,6 @@
 """Automatic grid refinement (``resolve = "auto"``): a contact run repeated on finer grids until it is converged.
 
-:func:`resolve_plan` runs a :class:`tengsim.run.plan.ContactPlan`'s path on grids dx0, dx0/√2, dx0/2, ...
+:func:`resolve` runs a :class:`tengsim.run.plan.ContactPlan`'s path on grids dx0, dx0/√2, dx0/2, ...
 (:data:`FACTOR` = √2 in dx, twice the pixels per level) and stops when
 
 (a) no equilibrium of the finest grid is ``under_resolved`` (:mod:`tengsim.status`; a run whose rows are
@@ -56,42 +56,74 @@ import numpy as np
 
 from tengsim.errors import TengsimError
 from tengsim.run.checkpoint import Checkpoint
-from tengsim.run.grids import FACTOR, MIN_SIDE, default_dx, edge_phases, next_grid
+from tengsim.run.grids import FACTOR, default_dx, edge_phases, next_grid
 from tengsim.run.memory import default_max_pixels
-from tengsim.run.tolerance import DEFAULT_TOL
 from tengsim.run.judge import NEED_FLOOR, GridRecord, _dx_needed, _judge, _levels_table, _why, contact_observables
-from tengsim.solvers.types import SOLVER_TOL
 
 
-def resolve_plan(plan, observe=None, full_length: float | None = None, progress=None, checkpoint=None, start=None,
-                 watch=None, path_for=None, settings=None):
-    """Run the :class:`tengsim.run.plan.ContactPlan` ``plan`` on finer and finer grids until converged (module
-    doc): each grid is :func:`tengsim.run.simulate.simulate_plan` of the plan with that grid and its path.
+@dataclasses.dataclass(frozen=True)
+class Refining:
+    """How a refinement runs beyond its plan, given to the engine under :func:`resolve` and
+    :func:`tengsim.run.refine.refine` (:func:`_refine_grids`): ``settings`` a :class:`tengsim.run.plan.ResolveSettings`
+    used instead of ``plan.resolve`` (one plan serves every refinement pass of a caller: a ContactPlan is built per
+    grid only); ``observe(result) -> dict`` more observables to converge; ``full_length`` the shape's full-contact
+    Λc (for transition_D); ``watch(result) -> dict`` observables recorded per grid, with their change and Richardson
+    error, but not judged (they do not decide when to stop: numbers a caller reports how converged they are, e.g.
+    a design's hysteresis); ``path_for(result) -> path`` the path of the next grid from the grid before it (None on
+    the first grid; e.g. the D at which its maps are kept, predicted from the coarser curve; default
+    ``plan.path``); ``checkpoint(levels, phases, result)`` called after each finished grid (to keep it: a killed
+    refinement keeps every grid it finished, :class:`Checkpoint`); ``start = (levels, phases, result)`` continues a
+    refinement from such a record instead of computing those grids again."""
+
+    settings: object = None
+    observe: object = None
+    full_length: float | None = None
+    watch: object = None
+    path_for: object = None
+    checkpoint: object = None
+    start: tuple | None = None
+
+
+def resolve(plan, progress=None, sink=None):
+    """The run of ``plan`` (a :class:`tengsim.run.plan.ContactPlan`, or a [contact] table planned here once) on
+    finer and finer grids until converged (module doc): the run layer's second entry point (one grid is
+    :func:`tengsim.run.simulate.simulate`, a refinement to a pressure :func:`tengsim.run.refine.refine`).
 
     The refinement's settings are ``plan.resolve`` (a :class:`tengsim.run.plan.ResolveSettings`, checked when
     built; None: its defaults): ``tol`` the relative tolerance, ``max_pixels`` the largest grid nx·ny (None:
     :func:`default_max_pixels`), ``dx`` the first grid's spacing (None: :func:`default_dx`; ``plan.dx`` and
     ``plan.grid`` are the one-grid run's and not read here) and ``pressures`` (Pa), at which A/S
-    (:func:`tengsim.run.area.area_at`) converges too.  ``observe(result) -> dict``: more observables to
-    converge; ``full_length`` the shape's full-contact Λc (for transition_D).  Returns the finest grid's
+    (:func:`tengsim.run.area.area_at`) converges too; transition_D is judged with the shape's own full-contact
+    length.  ``progress`` as for ``simulate``; ``sink``: a row stream whose file keeps each finished grid (its
+    checkpoint, :meth:`Checkpoint.of`: a killed refinement started again takes them back), not given the rows
+    (the grids would mix in one file: the result is written whole at the end).  Returns the finest grid's
     ContactResult with ``params['resolution']`` (the table: one row per grid), ``params['richardson']``,
-    ``resolve``, ``resolve_tol``, ``max_pixels``, ``resolve_grids``, ``resolve_status`` and, if stopped by
-    ``max_pixels``, ``resolve_message``.
+    ``resolve``, ``resolve_tol``, ``max_pixels``, ``resolve_grids``, ``resolve_status``, ``config`` (the table,
+    when planned from one) and, if stopped by ``max_pixels``, ``resolve_message``."""
+    from tengsim.run.plan import as_plan
 
-    ``checkpoint(levels, phases, result)``, if given, is called after each finished grid (to keep it: a
-    killed refinement keeps every grid it finished, :class:`Checkpoint`); ``start = (levels, phases,
-    result)`` continues a refinement from such a record instead of computing those grids again.
+    plan = as_plan(plan)
+    ck = Checkpoint.of(sink, plan.config)
+    full = getattr(plan.shape, "full_contact_length", None)
+    how = Refining(full_length=None if full is None else full(), checkpoint=None if ck is None else ck.save,
+                   start=None if ck is None else ck.load())
+    res = _refine_grids(plan, how, progress)
+    params = {k: v for k, v in res.params.items() if k != Checkpoint.KEY}
+    if plan.config:
+        params["config"] = dict(plan.config)
+    return dataclasses.replace(res, params=params)
 
-    ``watch(result) -> dict``: observables recorded per grid, with their change and Richardson error, but not
-    judged (they do not decide when to stop: numbers a caller reports how converged they are, e.g. a design's
-    hysteresis).  ``path_for(result) -> path``: the path of the next grid from the grid before it (None on the
-    first grid; e.g. the D at which its maps are kept, predicted from the coarser curve); default ``plan.path``.
-    ``settings``: a :class:`tengsim.run.plan.ResolveSettings` used instead of ``plan.resolve`` (one plan serves
-    every refinement pass of a caller: a ContactPlan is built per grid only)."""
+
+def _refine_grids(plan, how: Refining = Refining(), progress=None):
+    """The refinement engine under :func:`resolve` and :func:`tengsim.run.reach.resolve_to`: ``plan`` on finer and
+    finer grids until converged (module doc), each grid :func:`tengsim.run.simulate.simulate` of the plan with that
+    grid and its path, run as ``how`` says (:class:`Refining`); the result as for :func:`resolve`."""
     from tengsim.progress import say_to
     from tengsim.run.plan import ResolveSettings, chosen_solver
-    from tengsim.run.simulate import simulate_plan
+    from tengsim.run.simulate import simulate
 
+    observe, watch, path_for, full_length = how.observe, how.watch, how.path_for, how.full_length
+    checkpoint, start, settings = how.checkpoint, how.start, how.settings
     if settings is None:  # a caller's settings for this refinement (no plan built for them), else the plan's
         settings = plan.resolve if plan.resolve is not None else ResolveSettings()
     tol = settings.tol
@@ -129,12 +161,12 @@ def resolve_plan(plan, observe=None, full_length: float | None = None, progress=
         seen.add((grid.nx, grid.ny))
         t0 = time.perf_counter()
         this_path = plan.path if path_for is None else path_for(res)
-        this = dataclasses.replace(plan, dx=grid.dx, grid=grid, path=this_path)
+        this = dataclasses.replace(plan, dx=grid.dx, grid=grid, path=this_path, resolve=None)
         solver, why = chosen_solver(this)  # 'auto' chooses on each grid: said where the choice changes
         if why and solver != said_solver:
             say_to(progress, why)
             said_solver = solver
-        res = simulate_plan(this, progress=progress)
+        res = simulate(this, progress=progress)
         obs = contact_observables(res, full_length)
         if observe is not None:
             obs.update(observe(res))
@@ -194,46 +226,3 @@ def _stop_message(levels, rich, changes, tol, max_pixels, stop, lateral) -> str:
     return (f"under-resolved: refinement stopped by max_pixels = {max_pixels} at dx = {length(levels[-1].dx, 4)} "
             f"({levels[-1].nx}×{levels[-1].ny}; next {stop.nx}×{stop.ny}); {_why(changes)}, "
             f"{need_text} for resolve_tol = {tol:g}")
-
-
-def resolve_contact(shape, tabor: float, path, dx: float | None = None, law=None, boundary: str = "free",
-                    resolve_tol: float = DEFAULT_TOL, max_pixels: int | None = None, observe=None,
-                    full_length: float | None = None, progress=None, checkpoint=None, start=None,
-                    watch=None, path_for=None, solver="fast", tol: float = SOLVER_TOL, extra_params: dict | None = None,
-                    observers=(), scaling=None, kernel_params: dict | None = None, symmetry: str = "auto"):
-    """The API form of :func:`resolve_plan`, as :func:`tengsim.run.simulate.simulate` is of ``simulate_plan``:
-    builds the :class:`tengsim.run.plan.ContactPlan` of these pieces (``resolve_tol``, ``max_pixels`` and
-    ``dx``, the first grid's spacing, as its :class:`tengsim.run.plan.ResolveSettings`; ``solver``, ``tol``,
-    ``extra_params``, ``observers``, ``scaling``, ``kernel_params``, ``symmetry`` as for ``simulate``) and
-    refines it; the other keywords and the result as for :func:`resolve_plan`."""
-    from tengsim.run.plan import ContactPlan, ResolveSettings
-
-    settings = ResolveSettings(resolve_tol, max_pixels, dx)
-    first = settings.dx if settings.dx is not None else float(shape.cell) / MIN_SIDE  # the plan's one grid
-    plan = ContactPlan(shape, tabor, first, path, boundary, solver, tol, law, extra_params or {}, scaling, observers,
-                       kernel_params or {}, resolve=settings, symmetry=symmetry)
-    return resolve_plan(plan, observe=observe, full_length=full_length, progress=progress, checkpoint=checkpoint,
-                        start=start, watch=watch, path_for=path_for)
-
-
-def run_contact(plan, progress=None, sink=None, observe=None):
-    """Run a :class:`tengsim.run.plan.ContactPlan` (or a [contact] table, planned here once): one grid
-    (:func:`tengsim.run.simulate.run_grid`), or refined automatically when its ``resolve`` settings say so
-    (:func:`resolve_plan`, transition_D judged with the shape's own full-contact length).
-
-    The refinement's grids each stream their rows to ``sink`` would mix grids in one file, so a sink is not
-    given rows of a refined run (its result is written whole at the end).  ``observe(result) -> dict``: more
-    observables to converge, beside A/S at the plan's ``resolve.pressures`` (Pa; :func:`tengsim.run.area.area_at`)."""
-    from tengsim.run import simulate as contact
-    from tengsim.run.plan import as_plan
-
-    plan = as_plan(plan)
-    if plan.resolve is None:  # one grid
-        kw = {k: v for k, v in (("progress", progress), ("sink", sink)) if v is not None}
-        return contact.run_grid(plan, **kw)
-    ck = Checkpoint.of(sink, plan.config)
-    full = getattr(plan.shape, "full_contact_length", None)
-    res = resolve_plan(plan, observe=observe, full_length=None if full is None else full(), progress=progress,
-                       checkpoint=None if ck is None else ck.save, start=None if ck is None else ck.load())
-    params = {k: v for k, v in res.params.items() if k != Checkpoint.KEY}
-    return dataclasses.replace(res, params={**params, "config": dict(plan.config)})

@@ -1,26 +1,22 @@
-"""One entry point composing shape, law, kernel, solver and path into a contact run."""
+"""One grid's contact run: shape, law, kernel, solver and path of a plan composed and walked (:func:`simulate`)."""
 from __future__ import annotations
 
 from dataclasses import is_dataclass, replace
 
 from tengsim import status
 from tengsim._version import __version__
-from tengsim.run.plan import ContactPlan, as_plan, chosen_solver
+from tengsim.run.plan import as_plan, chosen_solver
 from tengsim.errors import TengsimError
 from tengsim.grid import Mirror
-from tengsim.shapes import Pyramid, Shape
-from tengsim.laws import Law
 from tengsim.kernels import make_kernel
 from tengsim.kernels.distributed import SlabPeriodicKernel, check_split
 from tengsim.kernels.mirror import MirrorKernel, choose_symmetry
-from tengsim.continuation import LoadPathSpec, run_load_path
-from tengsim.continuation import PathSpec, run_path
+from tengsim.continuation import LoadPathSpec, run_load_path, run_path
 from tengsim.run.memory import MAP_WORK, check_memory
 from tengsim.solvers import make_solver
 from tengsim.solvers.mirror import MirrorSolver
 from tengsim.solvers.distributed import SlabSolver
 from tengsim import parallel
-from tengsim.solvers.types import SOLVER_TOL
 
 MONITOR_MIN_POINTS = 1024**2  # grids from this size on report progress inside each solve
 #: full-grid arrays a block run still holds beside the block's workspace (U0, g0, the unfolded H and P the
@@ -28,47 +24,32 @@ MONITOR_MIN_POINTS = 1024**2  # grids from this size on report progress inside e
 MIRROR_FULL_ARRAYS = 12
 
 
-def simulate(shape: Shape, tabor: float, dx: float, path: PathSpec, boundary: str = "free",
-             solver="fast", tol: float = SOLVER_TOL, law: Law | str | None = None, progress=None,
-             grid=None, extra_params: dict | None = None, observers=(), scaling=None,
-             kernel_params: dict | None = None, throw: bool = False, check_memory_first: bool = True,
-             sink=None, symmetry: str = "auto"):
-    """Approach–retraction run of ``shape`` against a rigid flat plate (paper Eq. 9).
+def simulate(plan, progress=None, sink=None, throw: bool = False):
+    """The approach–retraction run of ``plan`` on one grid (paper Eq. 9): a :class:`tengsim.run.plan.ContactPlan`
+    (build one from API objects: ``ContactPlan(shape, tabor, dx, path, boundary=..., solver=..., law=...)``) or a
+    [contact] table, planned here once (:func:`tengsim.run.plan.plan_contact`; the table kept in
+    ``params['config']``).  The run layer's first entry point; a refinement is :func:`tengsim.run.resolve.resolve`,
+    a refinement to a pressure :func:`tengsim.run.refine.refine` (docs/extending.md, "The run layer").
 
-    ``tabor`` is μ (the elastic coupling is μ^{3/2}); ``dx`` the grid spacing in X units;
-    ``boundary`` a registered kernel name ('free', 'periodic'); ``solver`` a registered name
-    ('fast', 'vsr') or a solver object; ``law`` a law object or registered name (default the
-    paper's LJ93).  ``kernel_params`` go to the kernel's factory (e.g. a film: ``thickness`` in X
-    units, ``substrate``, ``poisson``; see :mod:`tengsim.kernels`).  ``observers`` (registered names
-    or objects) add columns to the table; with a ``scaling`` (:class:`tengsim.units.Scaling`) the
-    table also gets F_N, pressure_Pa and contact_length_m and the units metadata of that scaling.
-    Returns a ContactResult whose ``status`` (and per-row ``status`` column) says ok /
-    not_converged / out_of_law_range / under_resolved (:mod:`tengsim.status`); with ``throw=True``
-    a status other than 'ok' raises :class:`tengsim.status.ResultStatusError`, which carries the
-    result.  The grid's memory is checked once, before anything is built (``check_memory_first=False``:
-    the caller has checked it, as :func:`run_grid` does through :func:`tengsim.run.plan.plan_contact`).
-    ``grid``: the grid to solve on (then ``dx`` is the grid's); None: the shape's grid of spacing ``dx``.
+    ``progress`` (a :class:`tengsim.progress.Progress`-like object or None) is called per path row; ``sink`` (a
+    callable or None) receives each equilibrium as it is recorded, ``sink(row, maps)``
+    (:class:`tengsim.continuation.Recorder`); if it has a ``begin(params)`` method, that is called first, before
+    any solve, with the run's parameters known then (all but the recorded pixel snap number and the status):
+    :class:`tengsim.results.RowStream` writes them as its header, or refuses a file to resume that another run
+    wrote.  Returns a ContactResult whose ``status`` (and per-row ``status`` column) says ok / not_converged /
+    out_of_law_range / under_resolved (:mod:`tengsim.status`); with ``throw=True`` a status other than 'ok' raises
+    :class:`tengsim.status.ResultStatusError`, which carries the result.  The grid's memory is checked once, before
+    anything is built.  ``plan.resolve`` is not read: a refinement gives each of its grids to this function.
 
-    ``sink`` (a callable or None) receives each equilibrium as it is recorded, ``sink(row, maps)``
-    (:class:`tengsim.continuation.Recorder`); if it has a ``begin(params)`` method, that is called first,
-    before any solve, with the run's parameters known then (all but the recorded pixel snap number and
-    the status): :class:`tengsim.results.RowStream` writes them as its header, or refuses a file to
-    resume that another run wrote.
-
-    ``symmetry``: 'auto' solves on the irreducible quarter (or half) of the cell when the shape declares
+    ``plan.symmetry``: 'auto' solves on the irreducible quarter (or half) of the cell when the shape declares
     mirrors its gap has on the grid, the kernel is 'free' or 'periodic' and the solver 'fast' or 'vsr'
     (:func:`choose_symmetry`; the same answer, to round-off); 'off' the full grid.  ``params['symmetry']``
     says what was used ('x+y', 'x', 'y', 'off' or 'none (why)'), ``block_nx``, ``block_ny`` the block.
     """
-    plan = ContactPlan(shape, tabor, dx, path, boundary, solver, tol, law, extra_params or {}, scaling, observers,
-                       kernel_params or {}, symmetry=symmetry, grid=grid)
-    return simulate_plan(plan, progress=progress, sink=sink, throw=throw, check_memory_first=check_memory_first)
-
-
-def simulate_plan(plan: ContactPlan, progress=None, sink=None, throw: bool = False,
-                  check_memory_first: bool = True):
-    """The run of a :class:`tengsim.run.plan.ContactPlan` on its grid (one grid: ``plan.resolve`` is not read
-    here); ``progress``, ``sink``, ``throw`` and ``check_memory_first`` as for :func:`simulate`."""
+    plan = as_plan(plan)
+    if plan.resolve is not None:  # refinement is the layer above's: never run one grid silently instead
+        raise TengsimError("this plan asks for a refinement (resolve = 'auto'): run it with tengsim.resolve, "
+                           "not tengsim.simulate (one grid)")
     shape, tabor, path, grid, boundary, law = plan.shape, plan.tabor, plan.path, plan.grid, plan.boundary, plan.law
     solver, symmetry = chosen_solver(plan)[0], plan.symmetry  # 'auto' chosen on this grid (the caller says why)
     solver_obj = make_solver(solver, tol=plan.tol) if isinstance(solver, str) else solver
@@ -92,10 +73,9 @@ def simulate_plan(plan: ContactPlan, progress=None, sink=None, throw: bool = Fal
     elif mirror is not None:
         solver_obj = MirrorSolver(solver_obj)
     # the run's pieces chosen, the memory is checked right before the first large allocation it guards: the kernel
-    if check_memory_first:  # one clear error, needed vs available (the block's)
-        full_arrays = MAP_WORK * 2 * len(path.maps_at) + (MIRROR_FULL_ARRAYS if mirror else 0)
-        check_memory(bnx, bny, boundary, getattr(solver_obj, "name", ""), getattr(solver_obj, "memory", 10),
-                     maps=-(-full_arrays * grid.nx * grid.ny // (MAP_WORK * bnx * bny)))
+    full_arrays = MAP_WORK * 2 * len(path.maps_at) + (MIRROR_FULL_ARRAYS if mirror else 0)  # one clear error,
+    check_memory(bnx, bny, boundary, getattr(solver_obj, "name", ""), getattr(solver_obj, "memory", 10),
+                 maps=-(-full_arrays * grid.nx * grid.ny // (MAP_WORK * bnx * bny)))  # needed vs available
     if comm is not None:
         kernel = SlabPeriodicKernel(grid, plan.coupling, comm, **plan.kernel_params)
     elif mirror is None:
@@ -142,30 +122,8 @@ def simulate_plan(plan: ContactPlan, progress=None, sink=None, throw: bool = Fal
         res = replace(res, params={**res.params, "warning": res.params.get("warning", "") + (
             "; the film is incompressible (poisson = 0.5), so its mean mode has no compliance either: give "
             "poisson < 0.5 (PDMS ≈ 0.49) and small D steps, or drive it by load")})
+    if plan.config:
+        res = replace(res, params={**res.params, "config": dict(plan.config)})
     if throw:
         res.raise_for_status()
     return res
-
-
-def simulate_pyramid(N: float, cell: float, tabor: float = 0.5, dx: float = 0.05,
-                     d_min: float = -1.0, d_max: float = 4.0, d_step: float = 0.05,
-                     boundary: str = "free", solver="fast", tol: float = SOLVER_TOL,
-                     maps_at=(), progress=None, symmetry: str = "auto", **path_kw):
-    """The paper's pyramid unit cell (Eq. 11) with N = n/(2ε) and L̄ = ``cell`` (``symmetry`` as in :func:`simulate`)."""
-    shape = Pyramid(N, cell)
-    spec = PathSpec(d_min, d_max, d_step, maps_at=tuple(maps_at), **path_kw)
-    return simulate(shape, tabor, dx, spec, boundary=boundary, solver=solver, tol=tol, progress=progress,
-                    symmetry=symmetry)
-
-
-def run_grid(plan, progress=None, sink=None):
-    """Run a :class:`tengsim.run.plan.ContactPlan` (or a [contact] table, planned here) on one grid; returns a
-    ContactResult with the table in ``params['config']``.  ``sink``: as for :func:`simulate` (the config is not
-    among the parameters it is given: a CLI run and a TOML run of the same settings spell it differently, and
-    resume only cares about what is solved)."""
-    plan = as_plan(plan)
-    if plan.resolve is not None:  # refinement is the layer above's: never run one grid silently instead
-        raise TengsimError("resolve = 'auto' runs through tengsim.run.resolve.run_contact (tengsim.run_contact), "
-                           "not tengsim.run.simulate.run_grid")
-    res = simulate_plan(plan, progress=progress, sink=sink, check_memory_first=False)  # plan_contact checked it
-    return replace(res, params={**res.params, "config": dict(plan.config)})

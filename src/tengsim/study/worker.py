@@ -52,10 +52,13 @@ def compute_point(contact: dict, pid: str, plugins: str = "", expect: dict | Non
         if expect is not None and prov != expect:
             raise TengsimError(f"the worker on {info['host']} would compute this point with other code or "
                                f"input than the client's ({provenance_difference(expect, prov)}); not computed")
-        from tengsim.run.resolve import run_contact  # resolve = 'auto': refined until converged
-        
+        from tengsim.run.plan import plan_contact
+        from tengsim.run.resolve import resolve
+        from tengsim.run.simulate import simulate
+
         c0 = time.perf_counter()
-        res = run_contact(dict(contact))
+        plan = plan_contact(dict(contact))
+        res = (simulate if plan.resolve is None else resolve)(plan)  # resolve = 'auto': refined until converged
     except Exception as exc:  # noqa: BLE001 - recorded as a failed point, the others go on
         msg = str(exc) if isinstance(exc, TengsimError) else \
             f"{type(exc).__name__}: {exc}\n{traceback.format_exc(limit=-3)}"

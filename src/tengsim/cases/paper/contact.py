@@ -9,6 +9,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from tengsim.run.plan import ContactPlan
 from tengsim.run.simulate import simulate
 from tengsim.device.params import AreaTable
 from tengsim.errors import TengsimError
@@ -56,9 +57,9 @@ def run_group(group: str, settings: RunSettings = RunSettings(), progress=None):
     last = float(PathSpec(settings.d_min, settings.d_max, settings.d_step).targets()[-1])
     spec = PathSpec(settings.d_min, settings.d_max, settings.d_step,
                     maps_at=tuple(d for d in FIG3_D if d <= last + 1e-9))
-    res = simulate(group_shape(group), sc.mu, settings.dx, spec, boundary=settings.boundary,
-                   solver=settings.solver, tol=settings.tol, progress=progress,
-                   extra_params={"group": group, **sc.params()}, scaling=sc)
+    res = simulate(ContactPlan(group_shape(group), sc.mu, settings.dx, spec, boundary=settings.boundary,
+                               solver=settings.solver, tol=settings.tol, extra={"group": group, **sc.params()},
+                               scaling=sc), progress=progress)
     return res
 
 
@@ -99,9 +100,9 @@ def run_group_load(group: str, f_max: float, settings: RunSettings = RunSettings
     n_loads = min(max(n_loads, int(np.ceil(sc.pressure(f_max - f_min) / settings.p_step_Pa - 1e-9))), 400)
     spec = LoadPathSpec(f_min, f_max, (f_max - f_min) / n_loads, d_min=settings.d_min,
                         d_max=settings.d_max + 2 * settings.d_step, d_step=settings.d_step, retract=False)
-    return simulate(group_shape(group), sc.mu, settings.dx, spec, boundary=settings.boundary,
-                    solver=settings.solver, tol=settings.tol, progress=progress,
-                    extra_params={"group": group, **sc.params()}, scaling=sc)
+    return simulate(ContactPlan(group_shape(group), sc.mu, settings.dx, spec, boundary=settings.boundary,
+                                solver=settings.solver, tol=settings.tol, extra={"group": group, **sc.params()},
+                                scaling=sc), progress=progress)
 
 
 def area_table_from_load_result(res, group: str) -> AreaTable:
