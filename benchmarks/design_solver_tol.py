@@ -34,7 +34,7 @@ def one(table, grid_index, tol):
     from tengsim.run.plan import plan_contact
 
     plan = plan_design(table)
-    cplan = dataclasses.replace(plan_contact(plan.contact_table), tol=tol)
+    cplan = dataclasses.replace(plan_contact(plan.contact_table), solver_tol=tol)
     refinement = _refine.plan_refinement(cplan, plan)
     dx = refinement.dx
     d_max, _ = _refine.find_range(refinement)

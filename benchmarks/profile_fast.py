@@ -54,7 +54,7 @@ def main(argv=None):
     prof = cProfile.Profile()
     t0 = time.perf_counter()
     prof.enable()
-    simulate(ContactPlan(Pyramid(g["N"], g["cell"]), a.mu, a.dx, PathSpec(a.d_min, d_max, a.d_step, refine_levels=0), boundary="free", solver="fast", tol=a.tol))
+    simulate(ContactPlan(Pyramid(g["N"], g["cell"]), a.mu, a.dx, PathSpec(a.d_min, d_max, a.d_step, refine_levels=0), boundary="free", solver="fast", solver_tol=a.tol))
     prof.disable()
     wall = time.perf_counter() - t0
     cnt.restore()

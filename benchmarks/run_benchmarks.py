@@ -70,7 +70,7 @@ def _symmetric_fast(args, name, g, d_max, grid, reps, wall_fast, cpu_fast, fast_
         cnt = ConvCounter(FreeKernel, ReducedKernel)
         try:
             t0, c0 = time.perf_counter(), time.process_time()
-            res = simulate(ContactPlan(Pyramid(g["N"], g["cell"]), args.mu, args.dx, PathSpec(args.d_min, d_max, args.d_step, refine_levels=args.refine_levels), boundary="free", solver="fast", tol=args.tol, symmetry="auto"))
+            res = simulate(ContactPlan(Pyramid(g["N"], g["cell"]), args.mu, args.dx, PathSpec(args.d_min, d_max, args.d_step, refine_levels=args.refine_levels), boundary="free", solver="fast", solver_tol=args.tol, symmetry="auto"))
             wall, cpu = min(wall, time.perf_counter() - t0), min(cpu, time.process_time() - c0)
         finally:
             cnt.restore()
@@ -218,7 +218,7 @@ def run_group(name, args, log):
         try:
             t0 = time.perf_counter()
             c0 = time.process_time()
-            res = simulate(ContactPlan(Pyramid(g["N"], g["cell"]), args.mu, args.dx, PathSpec(args.d_min, d_max, args.d_step, refine_levels=args.refine_levels), boundary="free", solver="fast", tol=args.tol, symmetry="off"))
+            res = simulate(ContactPlan(Pyramid(g["N"], g["cell"]), args.mu, args.dx, PathSpec(args.d_min, d_max, args.d_step, refine_levels=args.refine_levels), boundary="free", solver="fast", solver_tol=args.tol, symmetry="off"))
             wall_fast = min(wall_fast, time.perf_counter() - t0)
             cpu_fast = min(cpu_fast, time.process_time() - c0)
         finally:
@@ -299,7 +299,7 @@ def run_group(name, args, log):
                 try:
                     t0 = time.perf_counter()
                     c0 = time.process_time()
-                    resv = simulate(ContactPlan(Pyramid(g["N"], g["cell"]), args.mu, args.dx, PathSpec(args.d_min, d_max, args.d_step, refine_levels=args.refine_levels), boundary="free", solver=vsr, tol=args.tol, symmetry="off"))   # the fast run's grid (not the mirror block's kernel)
+                    resv = simulate(ContactPlan(Pyramid(g["N"], g["cell"]), args.mu, args.dx, PathSpec(args.d_min, d_max, args.d_step, refine_levels=args.refine_levels), boundary="free", solver=vsr, solver_tol=args.tol, symmetry="off"))   # the fast run's grid (not the mirror block's kernel)
                     t_v = min(t_v, time.perf_counter() - t0)
                     cpu_v = min(cpu_v, time.process_time() - c0)
                 finally:

@@ -35,7 +35,7 @@ def _runner(group, dx, d_max, d_step, boundary, tol):
         return lambda sym: simulate({**cfg, "symmetry": sym})
     shape, mu = group_shape(group), paper_scaling(group).mu
     spec = PathSpec(-1.0, d_max, d_step)
-    return lambda sym: simulate(ContactPlan(shape, mu, dx, spec, boundary=boundary, tol=tol, symmetry=sym))
+    return lambda sym: simulate(ContactPlan(shape, mu, dx, spec, boundary=boundary, solver_tol=tol, symmetry=sym))
 
 
 def _peak(fn):

@@ -43,6 +43,7 @@ from pathlib import Path
 import numpy as np
 
 from tengsim.run.plan import plan_contact
+from tengsim.run.plan import ContactPlan
 from tengsim.run.simulate import simulate
 from tengsim.device.formulas import voc_polymer
 from tengsim.grid import Grid
@@ -75,10 +76,7 @@ def run_case(eps, dx, rms, d_step=2.0, d_min=-30.0, log=print):
     # maps at every target (10, 80, 150 kPa lie on the 70 kPa lattice; 50 and 100 become extra targets)
     path = dataclasses.replace(plan.path, retract=False, maps_at=tuple(k * f_of_kpa for k in TARGETS_KPA))
     t0 = time.perf_counter()
-    res = simulate(plan.shape, plan.tabor, plan.dx, path, boundary=plan.boundary, solver=plan.solver, tol=plan.tol,
-                   law=plan.law, extra_params=plan.extra, observers=plan.observers, scaling=sc,
-                   kernel_params=plan.kernel_params, check_memory_first=False,
-                   sink=lambda row, maps: log(f"    {time.perf_counter() - t0:6.1f} s  D = {row['D']:8.2f}  "
+    res = simulate(ContactPlan(plan.shape, plan.tabor, plan.dx, path, boundary=plan.boundary, solver=plan.solver, solver_tol=plan.solver_tol, law=plan.law, extra=plan.extra, observers=plan.observers, scaling=sc, kernel_params=plan.kernel_params), sink=lambda row, maps: log(f"    {time.perf_counter() - t0:6.1f} s  D = {row['D']:8.2f}  "
                                               f"P = {sc.pressure(row['F']) / 1e3:8.2f} kPa  conv {row['converged']}"))
     secs = time.perf_counter() - t0
     t, g = res.table, res.grid

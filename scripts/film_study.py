@@ -23,6 +23,7 @@ import numpy as np
 
 from tengsim import io
 from tengsim.kernels import film
+from tengsim.run.plan import ContactPlan
 from tengsim.run.simulate import simulate
 from tengsim.device.formulas import voc_polymer
 from tengsim.shapes import Pyramid
@@ -39,8 +40,7 @@ def run(group, dx, d_max, d_step, thickness_m=None, poisson=0.49, substrate="bon
     kp = {}
     if thickness_m is not None:
         kp = {"thickness": thickness_m / sc.lateral, "poisson": poisson, "substrate": substrate}
-    res = simulate(Pyramid(sc.N, sc.cell), sc.mu, dx, PathSpec(d_min, d_max, d_step), boundary=boundary,
-                   tol=tol, kernel_params=kp, extra_params=sc.params(), scaling=None)
+    res = simulate(ContactPlan(Pyramid(sc.N, sc.cell), sc.mu, dx, PathSpec(d_min, d_max, d_step), boundary=boundary, solver_tol=tol, kernel_params=kp, extra=sc.params(), scaling=None))
     return sc, res
 
 

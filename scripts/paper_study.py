@@ -40,6 +40,7 @@ os.environ.setdefault("TENGSIM_FFT_WORKERS", "1")
 import numpy as np  # noqa: E402
 
 from tengsim.analysis import tensile_peak_offset  # noqa: E402
+from tengsim.run.plan import ContactPlan
 from tengsim.run.simulate import simulate  # noqa: E402
 from tengsim.shapes import HeightMap, Pyramid  # noqa: E402
 from tengsim.continuation import PathSpec  # noqa: E402
@@ -109,8 +110,7 @@ def run_case(case):
     shape, grid, N, floor = make_shape(case["group"], case.get("variant", ""), case["dx"])
     spec = PathSpec(case["d_min"], case["d_max"], case["d_step"])
     sizes = ContactSizes(floor)
-    res = simulate(shape, case["mu"], case["dx"], spec, boundary=case["boundary"], tol=case["tol"],
-                   grid=grid, observers=[sizes])
+    res = simulate(ContactPlan(shape, case["mu"], case["dx"], spec, boundary=case["boundary"], solver_tol=case["tol"], grid=grid, observers=[sizes]))
     t = res.table
     rows = {k: np.asarray(t[k]) for k in ("branch", "D", "F", "contact_length", "on_grid", "jump",
                                           "converged", "min_gap")}

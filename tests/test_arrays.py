@@ -23,8 +23,8 @@ def _rows(path):
 def test_zero_scatter_array_equals_the_single_periodic_cell():
     """K = 2 without scatter is the periodic cell repeated: force per cell equal to 1e-8."""
     spec = tengsim.PathSpec(-1.0, 1.0, 0.5, retract=False)
-    one = tengsim.simulate(ContactPlan(tengsim.Pyramid(**A), 0.5, 0.2, spec, boundary="periodic", tol=1e-11))
-    arr = tengsim.simulate(ContactPlan(Array("pyramid", K=2, **A), 0.5, 0.2, spec, boundary="periodic", tol=1e-11, observers=["array_area"]))
+    one = tengsim.simulate(ContactPlan(tengsim.Pyramid(**A), 0.5, 0.2, spec, boundary="periodic", solver_tol=1e-11))
+    arr = tengsim.simulate(ContactPlan(Array("pyramid", K=2, **A), 0.5, 0.2, spec, boundary="periodic", solver_tol=1e-11, observers=["array_area"]))
     assert arr.params["nx"] == 2 * one.params["nx"]
     assert len(arr.table["F"]) == len(one.table["F"])
     assert np.abs(arr.table["F"] / 4 - one.table["F"]).max() < 1e-8

@@ -24,7 +24,7 @@ def test_vsr_full_run_counts_its_convolutions():
     vsr = make_solver("vsr", tol=1e-5, max_iter=20000)
     cnt = rb.ConvCounter(FreeKernel)
     try:
-        res = simulate(ContactPlan(Pyramid(2.0, 4.0), 0.5, 0.25, PathSpec(-0.5, 0.5, 0.25, refine_levels=0), boundary="free", solver=vsr, tol=1e-5, symmetry="off"))
+        res = simulate(ContactPlan(Pyramid(2.0, 4.0), 0.5, 0.25, PathSpec(-0.5, 0.5, 0.25, refine_levels=0), boundary="free", solver=vsr, solver_tol=1e-5, symmetry="off"))
     finally:
         cnt.restore()
     nc = np.asarray(res.table["n_conv"])

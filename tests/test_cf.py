@@ -261,7 +261,7 @@ def test_device_nc_passes_the_cf_check(tmp_path, offline):
     from tengsim.cases.paper.device import fig7_params, fig7_waveform
     from tengsim.device.dynamics import simulate
 
-    r = simulate(ContactPlan(fig7_params(), fig7_waveform(), 0.004, dt_out=1e-4))
+    r = simulate(fig7_params(), fig7_waveform(), 0.004, dt_out=1e-4)
     r.to_dataset().to_netcdf(tmp_path / "d.nc", engine="h5netcdf")  # plain xarray writes it CF-clean too
     assert cf_check(tmp_path / "d.nc") == ([], {})
     ds = xr.load_dataset(tmp_path / "d.nc")

@@ -454,7 +454,7 @@ def test_the_designs_solver_tolerance_moves_its_numbers_far_less_than_tol():
     assert _dplan.solver_tol(plan) == pytest.approx(1e-4)
     out = []
     for tol in (_dplan.solver_tol(plan), 1e-6):
-        cplan = dataclasses.replace(plan_contact(plan.contact_table), tol=tol)
+        cplan = dataclasses.replace(plan_contact(plan.contact_table), solver_tol=tol)
         refinement = plan_refinement(cplan, plan)
         res = _walk._simulate(cplan, refinement.dx, find_range(refinement)[0])
         assert res.params["tol"] == tol and res.status == "ok"
@@ -462,8 +462,8 @@ def test_the_designs_solver_tolerance_moves_its_numbers_far_less_than_tol():
         out.append((np.concatenate([c["approach"]["area"], c["retraction"]["area"]]), res.pull_off_force,
                     res.hysteresis))
     (a, f, h), (a0, f0, h0) = out
-    assert np.max(np.abs(a - a0) / np.maximum(np.abs(a0), 0.01)) < plan.tol / 20
-    assert abs(f - f0) < plan.tol / 20 * abs(f0) and abs(h - h0) <= plan.tol / 20 * abs(h0) + 1e-12
+    assert np.max(np.abs(a - a0) / np.maximum(np.abs(a0), 0.01)) < plan.rel_tol / 20
+    assert abs(f - f0) < plan.rel_tol / 20 * abs(f0) and abs(h - h0) <= plan.rel_tol / 20 * abs(h0) + 1e-12
 
 
 def test_estimate_on_a_busy_machine_says_the_longer_time(monkeypatch):
@@ -501,7 +501,7 @@ def test_approach_only_design_gives_the_full_designs_approach_and_says_the_rest_
                                    small.dataset["charged_area_fraction"].sel(branch="approach").values,
                                    rtol=1e-12, equal_nan=True)
     else:  # a refinement judging fewer numbers may stop a grid earlier: within the tolerance
-        np.testing.assert_allclose(one.summary["area_at_p_max"], small.summary["area_at_p_max"], rtol=2 * small.plan.tol)
+        np.testing.assert_allclose(one.summary["area_at_p_max"], small.summary["area_at_p_max"], rtol=2 * small.plan.rel_tol)
     assert np.all(np.isnan(one.dataset["charged_area_fraction"].sel(branch="retraction").values))
     for k in ("pull_off_N", "pull_off_Pa", "hysteresis_J_m2", "area_hysteresis", "voc_hysteresis_V"):
         assert math.isnan(one.summary[k]) and one.summary["reasons"][k] == NOT_RETRACTED, k

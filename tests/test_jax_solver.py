@@ -59,7 +59,7 @@ def test_pyramid_group_paths_equal_the_numpy_solver(group):
     N, cell, dx = GROUPS[group]
     d_max, d_step = (3.0, 0.05) if group == "A" else (2.0, 0.1)
     path = PathSpec(-1.0, d_max, d_step)
-    kw = dict(symmetry="off", tol=TIGHT)
+    kw = dict(symmetry="off", solver_tol=TIGHT)
     ref = simulate(ContactPlan(Pyramid(N, cell), 0.5, dx, path, solver="fast", **kw)).table
     if group == "A":
         clear_cache()

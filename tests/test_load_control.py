@@ -177,7 +177,7 @@ def group_a_load(maps_at=(), steps=None):
     old = loadpath._LoadBranch.max_root_steps
     loadpath._LoadBranch.max_root_steps = old if steps is None else steps
     try:
-        res = ts.simulate(ContactPlan(shape, sc.mu, 0.4, spec, tol=1e-7))
+        res = ts.simulate(ContactPlan(shape, sc.mu, 0.4, spec, solver_tol=1e-7))
     finally:
         loadpath._LoadBranch.max_root_steps = old
     return res, grid, spec

@@ -137,7 +137,7 @@ def _sig(plan) -> dict:
     """What a run is built from: the gap on its grid and everything else the plan holds."""
     g = plan.shape.grid(plan.dx)
     return {"grid": (g.nx, g.ny, g.dx, g.dy), "U0": plan.shape.gap(g), "tabor": plan.tabor, "path": plan.path,
-            "boundary": plan.boundary, "solver": plan.solver, "tol": plan.tol, "law": repr(plan.law),
+            "boundary": plan.boundary, "solver": plan.solver, "tol": plan.solver_tol, "law": repr(plan.law),
             "symmetry": plan.symmetry,
             "observers": plan.observers, "kernel": plan.kernel_params, "resolve": plan.resolve,
             "scaling": None if plan.scaling is None else plan.scaling.params()}

@@ -63,12 +63,12 @@ def test_the_api_helper_plans_a_table_once_and_takes_a_plan_as_is(counted):
 
 def test_the_plan_is_frozen_and_its_resolve_settings_typed():
     p = plan_contact({**CFG, "resolve": "auto", "resolve_tol": 0.05, "max_pixels": 400})
-    assert p.resolve == ResolveSettings(tol=0.05, max_pixels=400, dx=0.5)
+    assert p.resolve == ResolveSettings(rel_tol=0.05, max_pixels=400, dx=0.5)
     assert plan_contact(dict(CFG)).resolve is None
     with pytest.raises(dataclasses.FrozenInstanceError):
         p.tabor = 1.0
     with pytest.raises(dataclasses.FrozenInstanceError):
-        p.resolve.tol = 0.5
+        p.resolve.rel_tol = 0.5
     assert p.grid == p.shape.grid(0.5) and p.dx == 0.5  # the grid is built once, in the plan
     assert p.coupling == pytest.approx(0.5**1.5)
     assert "out" not in plan_contact({**CFG, "out": "x.csv"}).config
@@ -186,7 +186,7 @@ def spied(monkeypatch):
 def _refined_by_the_plan(seen, res, tol):
     """Refinements of a ContactPlan whose settings are the run's, each of their grids a simulate run."""
     assert seen["resolve"] and all(isinstance(p, ContactPlan) for p in seen["resolve"])
-    assert all(isinstance(r, ResolveSettings) and r.tol == tol for r in seen["settings"])
+    assert all(isinstance(r, ResolveSettings) and r.rel_tol == tol for r in seen["settings"])
     assert all(isinstance(p, ContactPlan) for p in seen["grids"])
     ran = [p.grid.dx for p in seen["grids"]]
     grids = res.params["resolve_grids"]
@@ -230,7 +230,7 @@ def test_a_design_builds_a_contact_plan_once_per_grid_and_per_refinement_pass(mo
     plan = plan_design({"shape": "pyramid", "pitch": "1um", "base": "0.5um", "height": "0.2um", "E_star": "5MPa",
                         "W": "20mJ/m2", "eps": "50nm", "p_max": "20kPa", "p_step": "10kPa", "tol": 0.05,
                         "maps": False})
-    assert isinstance(plan.contact_plan, ContactPlan) and plan.contact_plan.tol == solver_tol(plan)
+    assert isinstance(plan.contact_plan, ContactPlan) and plan.contact_plan.solver_tol == solver_tol(plan)
     built, grids, passes = [], [], []
     real_post, real_run, real_resolve = ContactPlan.__post_init__, sim.simulate, resolve._refine_grids
     monkeypatch.setattr(ContactPlan, "__post_init__", lambda self: (built.append(1), real_post(self))[1])

@@ -16,10 +16,10 @@ def test_plan_holds_the_refinements_numbers_and_is_frozen():
     plan = plan_design(SMALL)
     r = _refine.plan_refinement(plan.contact_plan, plan)
     assert r.dx == _refine.first_dx(plan.contact_plan, plan) and r.grids[0] == plan.contact_plan.shape.grid(r.dx)
-    assert r.p_max == plan.pressures[-1] and r.tol == plan.tol and r.solver_tol == plan.contact_plan.tol
+    assert r.p_max == plan.pressures[-1] and r.rel_tol == plan.rel_tol and r.solver_tol == plan.contact_plan.solver_tol
     assert r.finest.nx >= r.grids[0].nx and r.memory_bytes > 0 and r.shortest_s > 0
     with pytest.raises(dataclasses.FrozenInstanceError):
-        r.tol = 0.5
+        r.rel_tol = 0.5
     with pytest.raises(TengsimError, match="increasing"):
         dataclasses.replace(r, pressures=(2e3, 1e3))
     with pytest.raises(TengsimError, match="dx"):

@@ -30,7 +30,7 @@ boundary, solver, n = sys.argv[1], sys.argv[2], int(sys.argv[3])
 shape = Pyramid(0.946, 3.78)
 grid = shape.grid(3.78 / n)
 base = rss()
-simulate(ContactPlan(shape, 0.5, 3.78 / n, PathSpec(-1.0, 0.0, 0.5), boundary=boundary, solver=solver, tol=1e-5,
+simulate(ContactPlan(shape, 0.5, 3.78 / n, PathSpec(-1.0, 0.0, 0.5), boundary=boundary, solver=solver, solver_tol=1e-5,
                      symmetry="off"))  # the estimate is the full grid's (a symmetric run checks its block's)
 print(json.dumps([grid.nx, grid.ny, rss() - base]))
 """

@@ -33,8 +33,8 @@ REL = 1e-9
 
 
 def _pair(shape, tabor, dx, path, **kw):
-    on = simulate(ContactPlan(shape, tabor, dx, path, symmetry="auto", tol=kw.pop("tol", TOL), **kw))
-    off = simulate(ContactPlan(shape, tabor, dx, path, symmetry="off", tol=on.params["tol"], **kw))
+    on = simulate(ContactPlan(shape, tabor, dx, path, symmetry="auto", solver_tol=kw.pop("tol", TOL), **kw))
+    off = simulate(ContactPlan(shape, tabor, dx, path, symmetry="off", solver_tol=on.params["tol"], **kw))
     return on, off
 
 

@@ -357,7 +357,7 @@ def warnings(prob, f, err, expected=None) -> tuple:
 def _tol_hint(prob, scale) -> str:
     """Where the designs' tol (their A/S to about that fraction) exceeds a relative noise: neighbouring designs then
     differ by their discretisation more than the data do, which no number of designs removes."""
-    tols = [float(getattr(pl, "tol", 0.0) or 0.0) for pl in getattr(prob, "plans", ())]
+    tols = [float(getattr(pl, "rel_tol", 0.0) or 0.0) for pl in getattr(prob, "plans", ())]
     tol = max(tols) if tols else 0.0
     if prob.known_errors or prob.noise != "relative" or not tol > scale:
         return ""

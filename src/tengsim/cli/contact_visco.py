@@ -86,7 +86,7 @@ def run(args, plan) -> int:
     history = _history(args, sc)
     steps = FixedTimeSteps(parse_quantity(args.dt, "time", "--dt")) if args.dt else SegmentSteps(32)
     res = simulate_history(plan.shape, plan.tabor, plan.grid.dx, material, history, steps, boundary=plan.boundary,
-                           law=plan.law, solver=plan.solver, tol=plan.tol, kernel_params=plan.kernel_params,
+                           law=plan.law, solver=plan.solver, tol=plan.solver_tol, kernel_params=plan.kernel_params,
                            grid=plan.grid)
     ds = res.to_xarray()
     ds["approach_m"] = ds["D"] * sc.eps

@@ -271,7 +271,7 @@ def summarize(res, plan) -> tuple[dict, dict, list]:
         "voc_eq17_at_p_max_V": float(app["voc_eq17"][-1]),
         "voc_finite_at_p_max_V": _finite_voc(plan, float(app["voc_eq17"][-1])),
         "grids": _grids_text(res),
-        "tolerance": plan.tol,
+        "tolerance": plan.rel_tol,
         "charged_area_definition": r.definition,
         "seconds": float(res.params.get("resolve_seconds", res.seconds)),
     }

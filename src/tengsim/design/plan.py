@@ -132,8 +132,8 @@ class DesignPlan:
     eps_r: float
     T: float
     gap: float
-    tol: float
-    dx: float | None
+    rel_tol: float
+    dx_m: float | None
     max_pixels: int | None
     budget_s: float
     E_star: float
@@ -308,9 +308,9 @@ def _plan_design(table: dict, where: str) -> DesignPlan:
     name = own["name"] or f"{shape} {draft.shape_text()}"
     own_solver = None if solver_given else constrained_solver(plan.law)
     pk = {"solver": own_solver} if own_solver else {}
-    plan = dataclasses.replace(plan, tol=SOLVER_TOL_PER_TOL * tol, **pk)  # the plan the design runs
+    plan = dataclasses.replace(plan, solver_tol=SOLVER_TOL_PER_TOL * tol, **pk)  # the plan the design runs
     return DesignPlan(name=name, shape=shape, contact_table=cfg, shape_params=sp, pressures=pressures,
-                      sigma=own["sigma"], eps_r=own["eps_r"], T=own["T"], gap=own["gap"], tol=tol, dx=own["dx"],
+                      sigma=own["sigma"], eps_r=own["eps_r"], T=own["T"], gap=own["gap"], rel_tol=tol, dx_m=own["dx"],
                       max_pixels=own["max_pixels"], budget_s=own["budget"], E_star=sc.E_star,
                       W=sc.W, eps=sc.eps, tabor=sc.mu, maps=bool(own["maps"]), area=area,
                       retraction=bool(own["retraction"]), boundary=str(plan.boundary), boundary_given=boundary_given, solver_given=solver_given,
@@ -340,4 +340,4 @@ def _pressures(own: dict, where: str) -> tuple:
 
 def solver_tol(plan) -> float:
     """The solver's tolerance of a design (:data:`SOLVER_TOL_PER_TOL`)."""
-    return SOLVER_TOL_PER_TOL * plan.tol
+    return SOLVER_TOL_PER_TOL * plan.rel_tol

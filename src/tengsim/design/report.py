@@ -81,7 +81,7 @@ def _nearfield_line(result) -> str:
 def report_text(result, figures) -> str:
     p, s = result.plan, result.summary
     lines = [f"# Design: {p.name}", "",
-             f"**Status: {s['status']}**, grids: {s['grids']}; tolerance {100 * p.tol:g} % "
+             f"**Status: {s['status']}**, grids: {s['grids']}; tolerance {100 * p.rel_tol:g} % "
              f"(the grid is refined by √2 until the numbers below change by at most that between the last two "
              f"grids); {s['seconds']:.0f} s of solving.", "",
              f"Shape {p.shape} ({p.shape_text()}); "

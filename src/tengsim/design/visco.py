@@ -101,7 +101,7 @@ def visco_cycles(plan, material: Prony, frequencies=FREQUENCIES, pixels: int = 4
     lat = plan.contact_plan.scaling.lateral if cp.scaling is not None else 1.0
     p_max = plan.pressures[-1]
     cycles, table, steady = [], [], []
-    kw = dict(boundary=cp.boundary, law=cp.law, solver=cp.solver, tol=cp.tol, kernel_params=cp.kernel_params,
+    kw = dict(boundary=cp.boundary, law=cp.law, solver=cp.solver, tol=cp.solver_tol, kernel_params=cp.kernel_params,
               grid=grid)
 
     def cycle(f, kind, r, press=1):

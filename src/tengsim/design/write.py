@@ -78,7 +78,7 @@ def to_dataset(res, plan, summary: dict):
         "design_name": plan.name, "E_star_Pa": plan.E_star, "W_J_m2": plan.W, "eps_m": plan.eps,
         "tabor": float(summary["tabor"]), "sigma_C_m2": plan.sigma, "eps_r": plan.eps_r, "thickness_m": plan.T,
         "gap_m": plan.gap, "status": str(summary["status"]), "grids": str(summary["grids"]),
-        "tolerance": float(plan.tol), "solver_tolerance_eps": float(res.params.get("tol", math.nan)),
+        "tolerance": float(plan.rel_tol), "solver_tolerance_eps": float(res.params.get("tol", math.nan)),
         "charged_area_definition": str(summary["charged_area_definition"]),
         "area_definition": str(getattr(plan, "area", "contact")), "boundary": str(getattr(plan, "boundary", "")),
         "branches_solved": "approach and retraction" if getattr(plan, "retraction", True) else "approach",
@@ -191,7 +191,7 @@ def write_design(result, out_dir, figures: bool = True) -> list:
     ds = result.dataset
     write_dataset(ds, out / "design.nc")
     header = {"design": result.plan.name, "status": result.status, "grids": result.summary["grids"],
-              "tolerance": result.plan.tol, "charged_area_definition": result.summary["charged_area_definition"],
+              "tolerance": result.plan.rel_tol, "charged_area_definition": result.summary["charged_area_definition"],
               # the loop energy (J/m2) and its uncertainty: 0 where within it (tengsim.results.hysteresis)
               **{k: _finite(result.summary.get(k)) for k in ("hysteresis_J_m2", "hysteresis_bound_J_m2")}}
     write_text(out / "design.csv", csv_text(csv_columns(ds), header, missing=""))

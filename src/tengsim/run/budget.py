@@ -225,7 +225,7 @@ def check_budget(ask, est: Estimate, fit_pixels: int | None = None) -> None:
         what = f"--max-pixels {fit_pixels} (the grids that fit the budget), {what}"
     raise BudgetExceeded(f"this design is expected to take {time_text(est.seconds)} on {est.backend.split(' (')[0]}, "
                          f"over the budget of {time_text(ask.budget_s)}: give {what}, a coarser --tol (now "
-                         f"{ask.tol:g}) or a larger --budget", ask.budget_s)
+                         f"{ask.rel_tol:g}) or a larger --budget", ask.budget_s)
 
 class BudgetSpent(BudgetExceeded):
     """A design stopped at its time budget (what finished is kept; the message says how to go on)."""

@@ -159,17 +159,17 @@ DEFAULT_RESOLVE_TOL = DEFAULT_TOL
 class ResolveSettings:
     """The automatic refinement of a run (``resolve = 'auto'``, :mod:`tengsim.run.resolve`), checked when built.
 
-    ``tol`` the relative tolerance of the observables; ``max_pixels`` the largest grid nx·ny (None: what the
+    ``rel_tol`` the relative tolerance of the observables; ``max_pixels`` the largest grid nx·ny (None: what the
     free memory holds); ``dx`` the first grid's spacing in X units (None: a coarse default); ``pressures`` the
     nominal pressures (Pa) at which A/S must converge too (physical runs; () if none)."""
 
-    tol: float = DEFAULT_RESOLVE_TOL
+    rel_tol: float = DEFAULT_RESOLVE_TOL
     max_pixels: int | None = None
     dx: float | None = None
     pressures: tuple = ()
 
     def __post_init__(self):
-        object.__setattr__(self, "tol", check_tol(self.tol))
+        object.__setattr__(self, "rel_tol", check_tol(self.rel_tol))
         if self.max_pixels is not None:
             object.__setattr__(self, "max_pixels", check_max_pixels(self.max_pixels))
         if self.dx is not None:
@@ -195,7 +195,7 @@ class ContactPlan:
     path: object  # PathSpec or tengsim.continuation.load.LoadPathSpec
     boundary: str = "free"
     solver: object = "fast"
-    tol: float = SOLVER_TOL
+    solver_tol: float = SOLVER_TOL
     law: object = None
     extra: dict = field(default_factory=dict)
     scaling: Scaling | None = None

@@ -1,9 +1,9 @@
 """A refinement asked to reach a pressure: planned, checked, estimated, budgeted and solved, on the run layer.
 
 ``ask`` is what was asked: any object with ``name``, ``pressures`` (Pa, increasing; the path must reach the last),
-``tol`` (the refinement's), ``max_pixels`` (or None), ``budget_s`` (s), ``dx`` (the first grid's spacing, m, or
+``rel_tol`` (the refinement's), ``max_pixels`` (or None), ``budget_s`` (s), ``dx_m`` (the first grid's spacing, m, or
 None: :func:`first_dx`) and ``retraction`` (false: the approach only) — a :class:`tengsim.design.plan.DesignPlan`.
-``cplan`` is the :class:`tengsim.run.plan.ContactPlan` it solves (its ``tol`` the solver's).
+``cplan`` is the :class:`tengsim.run.plan.ContactPlan` it solves (its ``solver_tol`` the solver's).
 
 1. :func:`plan_refinement` builds the frozen :class:`RefinementPlan` once: what was asked and the refinement's own
    numbers (the first grid's dx in cell units, the grid sequence, the shortest path's time, the finest grid the
@@ -33,7 +33,7 @@ would converge on a coarser grid pays for one or two grids finer than it needs."
 
 
 def first_dx(cplan, ask) -> float:
-    """The first grid's dx in X units: ``ask.dx`` (a length, m) where given, else the refinement's first grid
+    """The first grid's dx in X units: ``ask.dx_m`` (a length, m) where given, else the refinement's first grid
     whose dx is at most the law's process zone over :data:`START_ZONE_PIXELS` (:func:`tengsim.run.grids.start_dx`);
     a size that does not fit the cell is said in the user's units."""
     from tengsim.errors import GeometryError
@@ -49,8 +49,8 @@ def _first_dx(cplan, ask) -> float:
     """:func:`first_dx` in X units, a size that does not fit the cell raised as it is (in X units)."""
     from tengsim.run.grids import start_dx
 
-    if ask.dx is not None:
-        return ask.dx / cplan.scaling.lateral
+    if ask.dx_m is not None:
+        return ask.dx_m / cplan.scaling.lateral
     return start_dx(cplan.shape, cplan.law, cplan.coupling, cplan.boundary, START_ZONE_PIXELS)
 
 
@@ -72,9 +72,9 @@ class Observer:
 @dataclass(frozen=True)
 class RefinementPlan:
     """A refinement asked to reach a pressure, planned once (:func:`plan_refinement`) before anything is solved:
-    the :class:`tengsim.run.plan.ContactPlan` it solves (``cplan``, whose ``tol`` is the solver's,
+    the :class:`tengsim.run.plan.ContactPlan` it solves (``cplan``, whose ``solver_tol`` is the solver's,
     :attr:`solver_tol`) and what was asked of it, ``name``, ``pressures`` (Pa, increasing; the path must reach the
-    last, :attr:`p_max`), ``tol`` (the refinement's relative tolerance), ``max_pixels`` (or None), ``budget_s`` (s)
+    last, :attr:`p_max`), ``rel_tol`` (the refinement's relative tolerance), ``max_pixels`` (or None), ``budget_s`` (s)
     and ``retraction`` (false: the approach only); and its own numbers: the first grid's spacing ``dx`` (X units,
     the cell's), the refinement's ``grids`` (:class:`tengsim.run.grids.GridSequence` from ``dx``), the shortest
     path's time on the first grid (``shortest_s``, s), the finest grid the estimate counts (``finest``,
@@ -86,7 +86,7 @@ class RefinementPlan:
     cplan: object
     name: str
     pressures: tuple
-    tol: float
+    rel_tol: float
     max_pixels: int | None
     budget_s: float
     retraction: bool
@@ -106,7 +106,7 @@ class RefinementPlan:
             raise TengsimError(f"{self.name[:80]}: a refinement's pressures must be given in increasing order")
         if not (math.isfinite(self.dx) and self.dx > 0) or self.grids.dx != self.dx:
             raise TengsimError(f"{self.name[:80]}: the first grid's dx must be > 0 and the grids' first")
-        if not self.tol > 0 or not self.budget_s > 0:
+        if not self.rel_tol > 0 or not self.budget_s > 0:
             raise TengsimError(f"{self.name[:80]}: a refinement's tol and budget must be > 0")
         if self.max_pixels is not None and self.max_pixels < 1:
             raise TengsimError(f"{self.name[:80]}: max_pixels must be at least 1")
@@ -119,7 +119,7 @@ class RefinementPlan:
     @property
     def solver_tol(self) -> float:
         """The solver's tolerance on each equilibrium (the contact plan's)."""
-        return self.cplan.tol
+        return self.cplan.solver_tol
 
 
 def plan_refinement(cplan, ask, observe=None, watch=None, maps_at=()) -> RefinementPlan:
@@ -140,7 +140,7 @@ def plan_refinement(cplan, ask, observe=None, watch=None, maps_at=()) -> Refinem
     except GeometryError as exc:  # a size that does not fit, said in the user's units
         raise exc.in_metres(cplan.scaling.lateral, _metres) from None
     memory = estimate_bytes(finest.nx, finest.ny, cplan.boundary, cplan.solver)
-    return RefinementPlan(cplan, ask.name, tuple(ask.pressures), ask.tol, ask.max_pixels, ask.budget_s,
+    return RefinementPlan(cplan, ask.name, tuple(ask.pressures), ask.rel_tol, ask.max_pixels, ask.budget_s,
                           ask.retraction, dx, grids, shortest, finest, memory, observe, watch, tuple(maps_at))
 
 
@@ -170,7 +170,7 @@ def preflight(plan: RefinementPlan) -> None:
         if plan.shortest_s > plan.budget_s:
             raise BudgetExceeded(f"{plan.name[:80]}: {first} alone is estimated at {time_text(plan.shortest_s)}, "
                                  f"over the budget of {time_text(plan.budget_s)}: give a coarser --dx, a coarser "
-                                 f"--tol (now {plan.tol:g}) or a larger --budget", plan.budget_s)
+                                 f"--tol (now {plan.rel_tol:g}) or a larger --budget", plan.budget_s)
     except GeometryError as exc:  # a size that does not fit, said in the user's units
         raise exc.in_metres(lateral, _metres) from None
 
@@ -190,7 +190,7 @@ def check_solver(cplan) -> None:
     naming the solvers that can."""
     from tengsim.solvers import make_solver
 
-    solver = make_solver(cplan.solver, tol=cplan.tol)
+    solver = make_solver(cplan.solver, tol=cplan.solver_tol)
     if hasattr(solver, "solves") and not solver.solves(cplan.law):
         from tengsim.solvers.pk import PKSolver, limit_of
 
@@ -257,5 +257,5 @@ def refine(plan: RefinementPlan, observer: Observer = Observer()):
     def done(levels):  # after each finished (and kept) grid: its measured time and the next grid's expected one
         said(next_grid_line(cplan.shape, grids[:len(levels) + 1], levels[-1].seconds, cplan.scaling.lateral))
 
-    return resolve_to(plan, d_max, ResolveSettings(plan.tol, max_pixels, plan.dx), guard, observer.keep,
+    return resolve_to(plan, d_max, ResolveSettings(plan.rel_tol, max_pixels, plan.dx), guard, observer.keep,
                       observer.base, done, said)

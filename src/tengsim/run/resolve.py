@@ -90,7 +90,7 @@ def resolve(plan, progress=None, sink=None):
     :func:`tengsim.run.simulate.simulate`, a refinement to a pressure :func:`tengsim.run.refine.refine`).
 
     The refinement's settings are ``plan.resolve`` (a :class:`tengsim.run.plan.ResolveSettings`, checked when
-    built; None: its defaults): ``tol`` the relative tolerance, ``max_pixels`` the largest grid nx·ny (None:
+    built; None: its defaults): ``rel_tol`` the relative tolerance, ``max_pixels`` the largest grid nx·ny (None:
     :func:`default_max_pixels`), ``dx`` the first grid's spacing (None: :func:`default_dx`; ``plan.dx`` and
     ``plan.grid`` are the one-grid run's and not read here) and ``pressures`` (Pa), at which A/S
     (:func:`tengsim.run.area.area_at`) converges too; transition_D is judged with the shape's own full-contact
@@ -126,7 +126,7 @@ def _refine_grids(plan, how: Refining = Refining(), progress=None):
     checkpoint, start, settings = how.checkpoint, how.start, how.settings
     if settings is None:  # a caller's settings for this refinement (no plan built for them), else the plan's
         settings = plan.resolve if plan.resolve is not None else ResolveSettings()
-    tol = settings.tol
+    tol = settings.rel_tol
     shape = plan.shape
     if settings.pressures:
         from tengsim.run.area import area_at

@@ -52,7 +52,7 @@ def simulate(plan, progress=None, sink=None, throw: bool = False):
                            "not tengsim.simulate (one grid)")
     shape, tabor, path, grid, boundary, law = plan.shape, plan.tabor, plan.path, plan.grid, plan.boundary, plan.law
     solver, symmetry = chosen_solver(plan)[0], plan.symmetry  # 'auto' chosen on this grid (the caller says why)
-    solver_obj = make_solver(solver, tol=plan.tol) if isinstance(solver, str) else solver
+    solver_obj = make_solver(solver, tol=plan.solver_tol) if isinstance(solver, str) else solver
     if isinstance(solver_obj, MirrorSolver):
         solver_obj = solver_obj.inner
     U0 = shape.gap(grid)

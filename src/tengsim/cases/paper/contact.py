@@ -58,7 +58,7 @@ def run_group(group: str, settings: RunSettings = RunSettings(), progress=None):
     spec = PathSpec(settings.d_min, settings.d_max, settings.d_step,
                     maps_at=tuple(d for d in FIG3_D if d <= last + 1e-9))
     res = simulate(ContactPlan(group_shape(group), sc.mu, settings.dx, spec, boundary=settings.boundary,
-                               solver=settings.solver, tol=settings.tol, extra={"group": group, **sc.params()},
+                               solver=settings.solver, solver_tol=settings.tol, extra={"group": group, **sc.params()},
                                scaling=sc), progress=progress)
     return res
 
@@ -101,7 +101,7 @@ def run_group_load(group: str, f_max: float, settings: RunSettings = RunSettings
     spec = LoadPathSpec(f_min, f_max, (f_max - f_min) / n_loads, d_min=settings.d_min,
                         d_max=settings.d_max + 2 * settings.d_step, d_step=settings.d_step, retract=False)
     return simulate(ContactPlan(group_shape(group), sc.mu, settings.dx, spec, boundary=settings.boundary,
-                                solver=settings.solver, tol=settings.tol, extra={"group": group, **sc.params()},
+                                solver=settings.solver, solver_tol=settings.tol, extra={"group": group, **sc.params()},
                                 scaling=sc), progress=progress)
 
 
