@@ -126,10 +126,10 @@ def test_warnings_say_when_the_fitted_noise_or_the_interpolations_error_is_too_l
     w = warnings(rel, fit, 0.05, None)
     assert len(w) == 1 and "interpolation's own error (5 % of V_OC" in w[0] and "exceeds the fitted noise" in w[0]
     assert "tol" not in w[0]  # designs without a tol said: no advice on it
-    coarse = SimpleNamespace(**vars(rel), plans=[SimpleNamespace(tol=0.05)])  # designs coarser than the 2 % noise
+    coarse = SimpleNamespace(**vars(rel), plans=[SimpleNamespace(rel_tol=0.05)])  # designs coarser than the 2 % noise
     w = warnings(coarse, fit, 0.05, None)
     assert "The designs' tol 0.05 (A/S to about 5 %) exceeds that noise" in w[0] and "tol = 0.01" in w[0]
-    fine = SimpleNamespace(**vars(rel), plans=[SimpleNamespace(tol=0.01)])
+    fine = SimpleNamespace(**vars(rel), plans=[SimpleNamespace(rel_tol=0.01)])
     assert "tol" not in warnings(fine, fit, 0.05, None)[0]
     assert len(warnings(rel, SimpleNamespace(scale=0.15, dev_min=0.0), 0.01, None)) == 1  # large with none expected
     known = SimpleNamespace(known_errors=True, noise="relative", n_points=60, free=("sigma", "W"))
