@@ -75,8 +75,8 @@ def test_the_plan_is_frozen_and_its_resolve_settings_typed():
 
 
 @pytest.mark.parametrize("kw, words", [
-    ({"tol": 0.0}, "resolve_tol must be > 0 and < 0.5, got 0.0"),
-    ({"tol": True}, "resolve_tol must be > 0 and < 0.5, got True"),
+    ({"rel_tol": 0.0}, "resolve_tol must be > 0 and < 0.5, got 0.0"),
+    ({"rel_tol": True}, "resolve_tol must be > 0 and < 0.5, got True"),
     ({"max_pixels": 8}, "max_pixels must be >= 9"),
     ({"max_pixels": 10.5}, "max_pixels must be >= 9"),
     ({"dx": -1.0}, "dx must be finite and > 0, got -1.0"),
