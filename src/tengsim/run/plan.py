@@ -180,7 +180,7 @@ class ResolveSettings:
 @dataclass(frozen=True)
 class ContactPlan:
     """Everything a contact run needs, validated: built once from a [contact] table (:func:`plan_contact`) or
-    from API objects (:func:`tengsim.run.simulate.simulate`); nothing downstream reads a config dict.
+    directly from API objects (``ContactPlan(shape, tabor, dx, path, ...)``); nothing downstream reads a config dict.
 
     ``tabor`` μ (> 0; :attr:`coupling` is μ^{3/2}); ``law`` an object or registered name (None: the paper's
     LJ93); ``boundary`` a registered kernel; ``solver`` a registered name or a solver object; ``grid`` the

@@ -39,7 +39,8 @@ def simulate(plan, progress=None, sink=None, throw: bool = False):
     wrote.  Returns a ContactResult whose ``status`` (and per-row ``status`` column) says ok / not_converged /
     out_of_law_range / under_resolved (:mod:`tengsim.status`); with ``throw=True`` a status other than 'ok' raises
     :class:`tengsim.status.ResultStatusError`, which carries the result.  The grid's memory is checked once, before
-    anything is built.  ``plan.resolve`` is not read: a refinement gives each of its grids to this function.
+    anything is built.  A plan that asks for a refinement (``plan.resolve`` set) is refused in one line: a
+    refinement gives each of its grids to this function with ``resolve=None``.
 
     ``plan.symmetry``: 'auto' solves on the irreducible quarter (or half) of the cell when the shape declares
     mirrors its gap has on the grid, the kernel is 'free' or 'periodic' and the solver 'fast' or 'vsr'
