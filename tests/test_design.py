@@ -405,15 +405,16 @@ def test_estimate_uses_the_backends_cost_and_names_it(monkeypatch):
 
 
 def test_auto_picks_the_gpu_where_jax_sees_one(monkeypatch):
+    from tengsim.run import choice as run_choice
     from tengsim.solvers import choice
 
-    assert choice.choose("fast") == ("fast", "")
+    assert run_choice.choose("fast") == ("fast", "")
     monkeypatch.setattr(choice, "gpu_visible", lambda: False)
-    assert choice.choose("auto")[0] == "fast" and "no GPU" in choice.choose("auto")[1]
+    assert run_choice.choose("auto")[0] == "fast" and "no GPU" in run_choice.choose("auto")[1]
     with pytest.raises(TengsimError, match="no GPU"):
-        choice.choose("gpu")
+        run_choice.choose("gpu")
     monkeypatch.setattr(choice, "gpu_visible", lambda: True)
-    assert choice.choose("auto")[0] == "gpu"
+    assert run_choice.choose("auto")[0] == "gpu"
 
 
 def test_solver_gpu_without_a_gpu_one_line_exit_2_nothing_written(tmp_path, capsys):
@@ -520,16 +521,17 @@ def test_auto_keeps_the_cpu_below_the_gpus_break_even(monkeypatch):
     from tengsim.resources import CPU_COST, GPU_COST, gpu_break_even_points
     from tengsim.run import budget as _budget
     from tengsim.run.plan import chosen_solver, plan_contact
+    from tengsim.run import choice as run_choice
     from tengsim.solvers import choice
 
     even = gpu_break_even_points()
     assert even == pytest.approx(GPU_COST.floor / (CPU_COST.per_point - GPU_COST.per_point))
     assert CPU_COST.iteration_seconds(even) == pytest.approx(GPU_COST.iteration_seconds(even))
     monkeypatch.setattr(choice, "gpu_visible", lambda: True)
-    small, why = choice.choose("auto", points=81 * 81)
+    small, why = run_choice.choose("auto", points=81 * 81)
     assert small == "fast" and "break-even" in why and "6561" in why
-    assert choice.choose("auto", points=351 * 351)[0] == "gpu"
-    assert choice.choose("gpu", points=9)[0] == "gpu"  # asked by name: taken as asked
+    assert run_choice.choose("auto", points=351 * 351)[0] == "gpu"
+    assert run_choice.choose("gpu", points=9)[0] == "gpu"  # asked by name: taken as asked
     tiny = plan_contact({"shape": "pyramid", "N": 0.946, "cell": 3.78, "tabor": 0.5, "dx": 0.1, "d_max": 1.0,
                          "d_step": 0.2})
     assert tiny.solver == "auto" and chosen_solver(tiny)[0] == "fast" and "break-even" in chosen_solver(tiny)[1]

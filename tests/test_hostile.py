@@ -370,7 +370,7 @@ def test_c08_a_refinement_killed_after_two_grids_keeps_them_and_resumes(tmp_path
     from tengsim.results import checkpoint_path
 
     out = tmp_path / "r.csv"
-    real = contact.simulate
+    real = contact._one_grid
     grids = []
 
     def killed_at_third(*a, **k):
@@ -379,7 +379,7 @@ def test_c08_a_refinement_killed_after_two_grids_keeps_them_and_resumes(tmp_path
             raise KeyboardInterrupt
         return real(*a, **k)
 
-    monkeypatch.setattr(contact, "simulate", killed_at_third)
+    monkeypatch.setattr(contact, "_one_grid", killed_at_third)
     assert main([*RESOLVE, "--out", str(out)]) == 130
     assert "finished grids are kept" in capsys.readouterr().err
     assert checkpoint_path(out).is_file() and not out.exists()
@@ -390,7 +390,7 @@ def test_c08_a_refinement_killed_after_two_grids_keeps_them_and_resumes(tmp_path
     # without --resume the kept grids are not overwritten
     assert "--resume" in refused(capsys, [*RESOLVE, "--out", str(out)])
     grids.clear()
-    monkeypatch.setattr(contact, "simulate", lambda *a, **k: (grids.append(a[0].grid.nx), real(*a, **k))[1])
+    monkeypatch.setattr(contact, "_one_grid", lambda *a, **k: (grids.append(a[0].grid.nx), real(*a, **k))[1])
     assert main([*RESOLVE, "--out", str(out), "--resume"]) == 0
     assert len(grids) == 1  # only the third grid is computed
     assert not checkpoint_path(out).exists()

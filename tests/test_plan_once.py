@@ -167,7 +167,7 @@ def spied(monkeypatch):
     from tengsim.run import resolve, simulate
 
     seen = {"resolve": [], "grids": []}
-    real_resolve, real_grid = resolve._refine_grids, simulate.simulate
+    real_resolve, real_grid = resolve._refine_grids, simulate._one_grid
 
     def resolving(plan, how=resolve.Refining(), progress=None):
         seen["resolve"].append(plan)
@@ -179,7 +179,7 @@ def spied(monkeypatch):
         return real_grid(plan, **kw)
 
     monkeypatch.setattr(resolve, "_refine_grids", resolving)
-    monkeypatch.setattr(simulate, "simulate", one_grid)
+    monkeypatch.setattr(simulate, "_one_grid", one_grid)
     return seen
 
 
@@ -232,9 +232,9 @@ def test_a_design_builds_a_contact_plan_once_per_grid_and_per_refinement_pass(mo
                         "maps": False})
     assert isinstance(plan.contact_plan, ContactPlan) and plan.contact_plan.solver_tol == solver_tol(plan)
     built, grids, passes = [], [], []
-    real_post, real_run, real_resolve = ContactPlan.__post_init__, sim.simulate, resolve._refine_grids
+    real_post, real_run, real_resolve = ContactPlan.__post_init__, sim._one_grid, resolve._refine_grids
     monkeypatch.setattr(ContactPlan, "__post_init__", lambda self: (built.append(1), real_post(self))[1])
-    monkeypatch.setattr(sim, "simulate", lambda p, **kw: (grids.append(p.grid.nx), real_run(p, **kw))[1])
+    monkeypatch.setattr(sim, "_one_grid", lambda p, **kw: (grids.append(p.grid.nx), real_run(p, **kw))[1])
     monkeypatch.setattr(resolve, "_refine_grids", lambda p, *a: (passes.append(1), real_resolve(p, *a))[1])
     res = run_design(plan)
     assert res.status == "ok" and len(grids) >= 3 and passes

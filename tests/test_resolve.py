@@ -297,7 +297,7 @@ def test_the_api_converges_a_s_at_resolve_pressures_without_any_hook(monkeypatch
     from tengsim.run.area import area_name
 
     one_grid = simulate.simulate({**PYR_CFG, "resolve": "off", "dx": 0.4})
-    monkeypatch.setattr(simulate, "simulate", lambda plan, **k: one_grid)  # every grid: no solve
+    monkeypatch.setattr(simulate, "_one_grid", lambda plan, **k: one_grid)  # every grid: no solve
     res = resolve.resolve({"shape": "pyramid", "E_star": "0.59MPa", "W": "54mJ/m2", "eps": "0.37um",
                                "pitch": "5um", "base": "2.5um", "height": "1.75um", "d_min": -1, "d_max": 2,
                                "d_step": 0.5, "resolve": "auto", "resolve_pressures": "10kPa",

@@ -8,6 +8,7 @@ import dataclasses
 import pytest
 
 from tengsim.run.plan import chosen_solver, plan_contact
+from tengsim.run import choice as run_choice
 from tengsim.solvers import choice
 
 TINY = {"shape": "pyramid", "N": 0.946, "cell": 3.78, "tabor": 0.5, "dx": 0.1, "d_max": 1.0, "d_step": 0.2}
@@ -16,7 +17,7 @@ TINY = {"shape": "pyramid", "N": 0.946, "cell": 3.78, "tabor": 0.5, "dx": 0.1, "
 def test_a_plan_keeps_auto_and_each_grid_chooses(monkeypatch):
     plan = plan_contact(TINY)
     assert plan.solver == "auto"
-    assert chosen_solver(plan) == ("fast", choice.choose("auto", points=plan.grid.nx * plan.grid.ny)[1])
+    assert chosen_solver(plan) == ("fast", run_choice.choose("auto", points=plan.grid.nx * plan.grid.ny)[1])
     monkeypatch.setattr(choice, "gpu_visible", lambda: True)
     coarse, fine = plan.grid, dataclasses.replace(plan, dx=0.01, grid=None).grid
     assert chosen_solver(plan, coarse)[0] == "fast" and chosen_solver(plan, fine)[0] == "gpu"

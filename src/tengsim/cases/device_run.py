@@ -54,30 +54,36 @@ def run_device(plan: DevicePlan):
 
         params = params.replace(area=fig8_area_table(plan.area_engine_quick))
     res = simulate(params, wf, plan.t_end, dt_out=plan.dt_out, options=plan.solver, progress=progress)
-    if plan.case == "fig8":
-        from tengsim.cases.paper import fig8_summary
-
-        summary = {"area_model": _area_model(params), **fig8_summary(res)}
-    else:
-        from tengsim.io import jsonable
-
-        skip = 1 if (wf.period and plan.t_end >= 2 * wf.period - 1e-12) else 0
-        if plan.designed is not None:
-            from tengsim.design.device import rest_gap_voltage
-
-            d = plan.designed
-            summary = jsonable({"area_model": d.area_model, **res.summary(skip), **rest_gap_voltage(d, res),
-                                "designed_device": d.provenance()})
-        elif plan.case == "fig7":
-            from tengsim.cases.paper import fig7_summary
-
-            summary = {"area_model": _area_model(params), **fig7_summary(res, skip)}
-        else:
-            summary = jsonable({"area_model": _area_model(params), **res.summary(skip)})
-    summary = {**summary, **field_summary(params, res, plan.air_pressure_Pa)}
+    field = field_summary(params, res, plan.air_pressure_Pa)  # the device's field, then the run's own numbers
+    summary = {**_summary(plan, params, res), **field}
     said = (warning(summary),) if not plan.quiet and warning(summary) else ()
     return DeviceRun(plan, params, res, summary, {"case": plan.case, "config": plan.tables,
                                                   "config_file": plan.source}, said)
+
+
+def _summary(plan: DevicePlan, params, res) -> dict:
+    """The run's own numbers of ``res`` (the field's are added by :func:`tengsim.cases.device_field.field_summary`):
+    the case's summary, strict JSON where the run writes it as such (every case but the paper's figures)."""
+    from tengsim.io import jsonable
+
+    area = _area_model(params)
+    if plan.case == "fig8":
+        from tengsim.cases.paper import fig8_summary
+
+        return {"area_model": area, **fig8_summary(res)}
+    skip = 1 if (plan.waveform.period and plan.t_end >= 2 * plan.waveform.period - 1e-12) else 0
+    if plan.case == "fig7":
+        from tengsim.cases.paper import fig7_summary
+
+        return {"area_model": area, **fig7_summary(res, skip)}
+    if plan.designed is not None:
+        from tengsim.design.device import rest_gap_voltage
+
+        d = plan.designed
+        made = d.provenance()  # the design it came from, asked first (the design's floor, then the device's)
+        return jsonable({"area_model": d.area_model, **res.summary(skip), **rest_gap_voltage(d, res),
+                         "designed_device": made})
+    return jsonable({"area_model": area, **res.summary(skip)})
 
 
 def _area_model(params) -> str:
@@ -97,7 +103,8 @@ def _sweep(plan: DevicePlan) -> LoadSweepRun:
     sw = resistance_sweep(params, wf, np.asarray(s.loads_ohm, dtype=float), cycles=s.cycles, steady=s.steady,
                           dt_out=plan.dt_out, options=plan.solver, progress=not plan.quiet)
     k_opt = int(np.nanargmax(sw.average_power_W))  # the optimum's row
-    head = jsonable({"area_model": _area_model(params), "params": params.to_dict(), "waveform": wf.to_dict(),
+    area = _area_model(params)
+    head = jsonable({"area_model": area, "params": params.to_dict(), "waveform": wf.to_dict(),
                      "optimum_ohm": sw.optimum_ohm, "optimum_power_W": sw.optimum_power_W,
                      "optimum_peak_power_W": float(sw.peak_power_W[k_opt]), "optimum_at_edge": sw.optimum_at_edge,
                      "run": {"case": "sweep", "cycles": s.cycles, "config": plan.tables,

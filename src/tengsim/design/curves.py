@@ -80,13 +80,14 @@ def branch_curves(res, plan) -> dict:
     out = {}
     for b, s in states(res, plan).items():
         A = np.clip(at_pressures(s["P"], s["area"], ps), 0.0, 1.0)
+        R = at_pressures(s["P"], s["repulsive"], ps)
         V12 = voc_polymer(A, plan.sigma, plan.eps_r, plan.T)
         V17 = voc_apart(plan.sigma, A, plan.gap, 1.0)
         dV = np.full(len(ps), np.nan)
         ok = np.flatnonzero(np.isfinite(V12))
         if len(ok) >= 2:
             dV[ok] = np.gradient(V12[ok], ps[ok])
-        out[b] = {"area": A, "repulsive": at_pressures(s["P"], s["repulsive"], ps), "voc_eq12": V12, "voc_eq17": V17,
+        out[b] = {"area": A, "repulsive": R, "voc_eq12": V12, "voc_eq17": V17,
                   "dvoc_dp": dV}
     return out
 
@@ -236,12 +237,13 @@ def summarize(res, plan) -> tuple[dict, dict, list]:
     a = res.branch("approach")
     col = CHARGED_COLUMN if area_definition(plan) == "contact" and CHARGED_COLUMN in a else "contact_length"
     back = solved_back(plan)
+    jump_in = snap_in(k_p * np.asarray(a["F"], float), a[col], (plan.pressures[0], plan.pressures[-1]))
+    status_now = design_status(res, plan.pressures[-1])
     r = read(res, plan)  # the layers below asked once
     app, ret = r.curves["approach"], r.curves["retraction"]
     st, full, numbers = r.states["approach"], r.full, r.sensor
     notes = [physical_message(str(res.params["resolve_message"]), sc.lateral)] if res.params.get("resolve_message") \
         else []
-    jump_in = snap_in(k_p * np.asarray(a["F"], float), a[col], (plan.pressures[0], plan.pressures[-1]))
     full_P = math.nan
     if math.isfinite(full):
         full_P = crossing(st["P"], st["area"], FULL_CONTACT_AREA_FRACTION * full)
@@ -255,7 +257,7 @@ def summarize(res, plan) -> tuple[dict, dict, list]:
     if pull >= 0:  # the retraction never pulls (a law without tension): no pull-off, not the least push
         notes.append("no pull-off: the retraction carries no tensile load")
     summary = {
-        "status": design_status(res, plan.pressures[-1]),
+        "status": status_now,
         "tabor": sc.mu,
         "jump_in_Pa": jump_in,
         "pull_off_N": sc.force(pull) if pull < 0 else math.nan,

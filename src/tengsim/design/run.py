@@ -76,8 +76,9 @@ def plan_refinement(plan, cplan):
     (:func:`tengsim.design.walk.observers`) and its maps' pressures (none with ``maps = false``)."""
     from tengsim.run.refine import plan_refinement as planned
 
+    at = map_pressures(plan) if plan.maps else ()
     observe, watch = observers(plan)
-    return planned(cplan, plan, observe, watch, map_pressures(plan) if plan.maps else ())
+    return planned(cplan, plan, observe, watch, at)
 
 
 def choose_solver(plan, cplan, progress=None):

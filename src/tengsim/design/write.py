@@ -73,6 +73,7 @@ def to_dataset(res, plan, summary: dict):
             arr[i, :len(v)] = v
         data[name] = (("branch", STATE_DIM), arr, {"units": units, "long_name": long})
     ds = xr.Dataset(data, coords=coords)
+    _by_grid(ds, res, plan)  # the refinement's record and its change_* attributes (kept after the others below)
     attrs = {
         "shape": plan.shape, "shape_params": json.dumps(plan.shape_params, sort_keys=True),
         "design_name": plan.name, "E_star_Pa": plan.E_star, "W_J_m2": plan.W, "eps_m": plan.eps,
@@ -103,8 +104,7 @@ def to_dataset(res, plan, summary: dict):
             attrs[k] = float(v) if v is not None and math.isfinite(float(v)) else f"n/a: {why}" if why else "n/a"
     if sensor is not None:
         _sensor_regions(ds, sensor)
-    ds.attrs = attrs
-    _by_grid(ds, res, plan)
+    ds.attrs = {**attrs, **ds.attrs}
     ds["branch"].encoding["dtype"] = "S1"  # a char array: CF's checker cannot judge a string coordinate variable
     return cf_conventions(ds, f"tengsim design: {plan.name}")
 

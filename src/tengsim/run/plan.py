@@ -225,10 +225,10 @@ class ContactPlan:
 
 def chosen_solver(plan: ContactPlan, grid=None) -> tuple:
     """(the solver a run of ``plan`` on ``grid`` uses, the sentence that says why, '' unless 'auto' chose it):
-    'auto' chosen on that grid's points (:func:`tengsim.solvers.choice.choose`: the GPU above its break-even
+    'auto' chosen on that grid's points (:func:`tengsim.run.choice.choose`: the GPU above its break-even
     where JAX sees one); ``grid`` None: the plan's own.  Every run of one grid asks here, and says the sentence
     where it solves (one grid, or each grid of a refinement whose choice changes)."""
-    from tengsim.solvers.choice import choose
+    from tengsim.run.choice import choose
 
     g = plan.grid if grid is None else grid
     return choose(plan.solver, points=g.nx * g.ny)
@@ -415,7 +415,7 @@ def plan_contact(cfg: dict) -> ContactPlan:
     if resolve is None:  # the plan's grid is the grid solved; a refinement checks each of its own grids
         check_memory(grid.nx, grid.ny, vals["boundary"], vals["solver"], maps=2 * len(path.maps_at))
     if isinstance(vals["solver"], str) and vals["solver"].strip().lower() == "gpu":
-        from tengsim.solvers.choice import choose
+        from tengsim.run.choice import choose
 
         choose("gpu")  # asked for by name and absent here: refused before anything runs
     return ContactPlan(shape, tabor, dx, path, vals["boundary"], vals["solver"], tol, law, extra, scaling,

@@ -64,14 +64,14 @@ def find_d_max(cplan, dx, p_max: float, height: float, extending=None, guard=Non
     height (ε).  ``extending(top, d_max)`` is told each extension (the highest pressure reached, Pa, and the D
     range walked); ``guard`` (called per path row) may stop it."""
     from tengsim.run.grids import default_dx
-    from tengsim.run.simulate import simulate
+    from tengsim.run.simulate import _one_grid
 
     # the default grid's (the cell over 9 pixels at most): cheap, whatever the first grid (a given dx too)
     coarse = 2 * max(dx, default_dx(cplan.shape, cplan.law, cplan.coupling, cplan.boundary))
     d_max = 1.2 * height + 2.0
     kw = {} if guard is None else {"progress": guard}
     for _ in range(EXTEND_TRIES):
-        res = simulate(dataclasses.replace(cplan, dx=coarse, grid=None, path=path_to(d_max), resolve=None), **kw)
+        res = _one_grid(dataclasses.replace(cplan, dx=coarse, grid=None, path=path_to(d_max), resolve=None), **kw)
         ok, D_hit, top, slope = reach(res, p_max)
         if ok:
             return 1.1 * D_hit + 1.0, res

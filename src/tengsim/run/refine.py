@@ -249,13 +249,14 @@ def refine(plan: RefinementPlan, observer: Observer = Observer()):
         said(line)
     if observer.later is not None and observer.later > d_max:  # killed in its second pass: go on on that pass's path
         d_max = observer.later
-    cost = run_cost(cplan, d_max, coarse, plan.retraction, plan.finest)
-    max_pixels = plan.max_pixels or budget_pixels(plan, cplan.shape, grids, cost)
-    check_budget(plan, est, max_pixels)
-    said(cap_line(cplan.shape, grids, cost, max_pixels))
 
     def done(levels):  # after each finished (and kept) grid: its measured time and the next grid's expected one
         said(next_grid_line(cplan.shape, grids[:len(levels) + 1], levels[-1].seconds, cplan.scaling.lateral))
 
+    cost = run_cost(cplan, d_max, coarse, plan.retraction, plan.finest)
+    max_pixels = plan.max_pixels or budget_pixels(plan, cplan.shape, grids, cost)
+    worst = cap_line(cplan.shape, grids, cost, max_pixels)
+    check_budget(plan, est, max_pixels)  # refused before the worst case is said or anything solved
+    said(worst)
     return resolve_to(plan, d_max, ResolveSettings(plan.rel_tol, max_pixels, plan.dx), guard, observer.keep,
                       observer.base, done, said)

@@ -120,7 +120,7 @@ def _refine_grids(plan, how: Refining = Refining(), progress=None):
     grid and its path, run as ``how`` says (:class:`Refining`); the result as for :func:`resolve`."""
     from tengsim.progress import say_to
     from tengsim.run.plan import ResolveSettings, chosen_solver
-    from tengsim.run.simulate import simulate
+    from tengsim.run.simulate import _one_grid
 
     observe, watch, path_for, full_length = how.observe, how.watch, how.path_for, how.full_length
     checkpoint, start, settings = how.checkpoint, how.start, how.settings
@@ -166,7 +166,7 @@ def _refine_grids(plan, how: Refining = Refining(), progress=None):
         if why and solver != said_solver:
             say_to(progress, why)
             said_solver = solver
-        res = simulate(this, progress=progress)
+        res = _one_grid(this, progress=progress)
         obs = contact_observables(res, full_length)
         if observe is not None:
             obs.update(observe(res))

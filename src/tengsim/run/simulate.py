@@ -5,7 +5,7 @@ from dataclasses import is_dataclass, replace
 
 from tengsim import status
 from tengsim._version import __version__
-from tengsim.run.plan import as_plan, chosen_solver
+from tengsim.run.plan import ContactPlan, as_plan, chosen_solver
 from tengsim.errors import TengsimError
 from tengsim.grid import Mirror
 from tengsim.kernels import make_kernel
@@ -47,7 +47,12 @@ def simulate(plan, progress=None, sink=None, throw: bool = False):
     (:func:`choose_symmetry`; the same answer, to round-off); 'off' the full grid.  ``params['symmetry']``
     says what was used ('x+y', 'x', 'y', 'off' or 'none (why)'), ``block_nx``, ``block_ny`` the block.
     """
-    plan = as_plan(plan)
+    return _one_grid(as_plan(plan), progress, sink, throw)
+
+
+def _one_grid(plan: ContactPlan, progress=None, sink=None, throw: bool = False):
+    """:func:`simulate` of a :class:`tengsim.run.plan.ContactPlan` (never a table: the run layer's own callers hold
+    planned values, so nothing is parsed again under a refinement)."""
     if plan.resolve is not None:  # refinement is the layer above's: never run one grid silently instead
         raise TengsimError("this plan asks for a refinement (resolve = 'auto'): run it with tengsim.resolve, "
                            "not tengsim.simulate (one grid)")

@@ -1,10 +1,9 @@
-"""The solver ``auto``: the JAX solver (float64) where JAX sees a GPU and the grid is large enough to gain from it,
-the NumPy fast solver everywhere else.
+"""The solver ``auto``: the JAX solver (float64) where JAX sees a GPU, the NumPy fast solver everywhere else.
 
-:func:`choose` turns a solver name into the one a run uses and the sentence that says why (printed before the
-run); ``auto`` is the default of every contact run and design.  Whether JAX sees a GPU is asked without
-importing JAX where no GPU plugin of JAX is installed (a CPU-only machine pays nothing); where one is,
-JAX is imported and asked for its GPU devices (once per process).
+Which one a run uses on the grid it solves (the GPU only above its break-even) is the run layer's choice, said
+where it is made (:func:`tengsim.run.choice.choose`); ``auto`` is the default of every contact run and design.
+Whether JAX sees a GPU is asked without importing JAX where no GPU plugin of JAX is installed (a CPU-only
+machine pays nothing); where one is, JAX is imported and asked for its GPU devices (once per process).
 """
 from __future__ import annotations
 
@@ -44,35 +43,14 @@ def _has_module(name: str) -> bool:
         return False
 
 
-def choose(name, points=None) -> tuple:
-    """(the solver a run uses, why): ``auto`` → 'gpu' when :func:`gpu_visible` and the run's grid has at least
-    :func:`tengsim.resources.gpu_break_even_points` ``points`` (None: any size), else 'fast'; any other name
-    (or a solver object) unchanged."""
-    if not isinstance(name, str) or name.strip().lower() != "auto":
-        if isinstance(name, str) and name.strip().lower() == "gpu" and not gpu_visible():
-            from tengsim.errors import SolverUnavailable
-
-            raise SolverUnavailable("--solver gpu: JAX sees no GPU here (install JAX for CUDA: pip install "
-                               "'tengsim[gpu]', CUDA 12 driver); use --solver auto or fast")
-        return name, ""
-    if gpu_visible():
-        from tengsim.resources import gpu_break_even_points
-
-        even = gpu_break_even_points()
-        if points is not None and points < even:
-            return "fast", (f"solver: fast (auto: JAX sees a GPU, but a grid of {int(points)} points is below its "
-                            f"break-even of about {even:.0f}; the NumPy fast solver on the CPU)")
-        return "gpu", "solver: gpu (auto: JAX sees a GPU; the fast solver compiled with JAX, float64)"
-    return "fast", "solver: fast (auto: JAX sees no GPU; the NumPy fast solver on the CPU)"
-
-
 def auto_solver(tol: float = SOLVER_TOL, **kw):
-    """The solver :func:`choose` picks for 'auto', made with ``tol`` (API: ``make_solver('auto')``)."""
-    return SOLVERS.get(choose("auto")[0])(tol=tol, **kw)
+    """The solver 'auto' is on a grid of any size, made with ``tol`` (API: ``make_solver('auto')``): 'gpu' where
+    :func:`gpu_visible`, else 'fast'.  A run chooses on the grid it solves (:func:`tengsim.run.choice.choose`)."""
+    return SOLVERS.get("gpu" if gpu_visible() else "fast")(tol=tol, **kw)
 
 
 SOLVERS.register("auto", auto_solver, summary="the jax solver on a GPU when JAX sees one (float64) and the grid is over "
                  "its break-even (≈ 109²), else fast (the default; the choice is printed before the run)")
 
 
-__all__ = ["GPU_PLUGINS", "auto_solver", "choose", "gpu_visible"]
+__all__ = ["GPU_PLUGINS", "auto_solver", "gpu_visible"]
