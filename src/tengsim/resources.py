@@ -112,7 +112,7 @@ one H200's cold rough solves at 1024²–8192² (docs/benchmarks.md, "GPU")."""
 def gpu_break_even_points() -> float:
     """Grid points from which an iteration costs less on the GPU than on the CPU by the two cost models (the
     GPU's floor over the CPU's extra per point): about 11 800 (≈ 109²).  Below it the solver ``auto`` keeps the
-    CPU (tengsim.solvers.choice)."""
+    CPU (tengsim.run.choice)."""
     return GPU_COST.floor / (CPU_COST.per_point - GPU_COST.per_point)
 
 
