@@ -6,6 +6,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+from tengsim.results.result import TRANSITION_LENGTH_FRACTION
+
 P_MIN, P_MAX = 0.5, 4.0
 """Range the observed order is clipped to."""
 FLOORS = {"D": 1.0, "F": 0.01, "fraction": 0.01, "V": 0.01}
@@ -58,7 +60,8 @@ def floor_of(name: str) -> float:
     return FLOORS[_kind(name)]
 
 
-def contact_observables(res, full_length: float | None = None, fraction: float = 0.95) -> dict:
+def contact_observables(res, full_length: float | None = None,
+                        fraction: float = TRANSITION_LENGTH_FRACTION) -> dict:
     """{name: value} judged by the refinement: pull_off_F, jump_in_D, jump_out_D, and transition_D when the
     shape's full-contact length ``full_length`` is given (NaN where a run has none)."""
     out = {"pull_off_F": res.pull_off_force}
