@@ -64,9 +64,10 @@ def test_pyramid_group_paths_equal_the_numpy_solver(group):
     if group == "A":
         clear_cache()
     before = compile_stats()
-    got = simulate(ContactPlan(Pyramid(N, cell), 0.5, dx, path, solver="jax", **kw)).table
+    run = simulate(ContactPlan(Pyramid(N, cell), 0.5, dx, path, solver="jax", **kw))
+    got, copied = run.table, run.params["retraction_rows_copied"]  # rows taken from the approach: not solved
     stats = compile_stats()
-    assert stats["calls"] - before["calls"] >= len(got["F"]) - 1  # every equilibrium of the path ...
+    assert stats["calls"] - before["calls"] >= len(got["F"]) - 1 - copied  # every solved equilibrium ...
     assert stats["compiles"] - before["compiles"] <= 1  # ... on one compiled loop (B and C: 47² both)
     if group == "A":
         assert stats["compiles"] == 1 and stats["compile_seconds"] > 0

@@ -35,7 +35,8 @@ def group_a(adaptive: bool):
     spec = (PathSpec(-1.0, 4.6, 0.8, refine_levels=7, adaptive=True) if adaptive
             else PathSpec(-1.0, 4.6, 0.1))
     solver = Counting(ts.FastSolver(1e-6))
-    res = run_path(shape.gap(grid), ts.LJ93(), FreeKernel(grid, sc.mu**1.5), solver, spec)
+    # every retraction row solved (retrace=False): the step control's own count of solves is compared
+    res = run_path(shape.gap(grid), ts.LJ93(), FreeKernel(grid, sc.mu**1.5), solver, spec, retrace=False)
     return res, solver.solves
 
 
@@ -92,11 +93,14 @@ MAPS = (-1.3, 0.1, IN_JUMP_IN, IN_JUMP_OUT, 0.25)
 
 
 @lru_cache(maxsize=None)
-def sphere_mu1(maps_at=(), adaptive=False, d_step=0.25):
+def sphere_mu1(maps_at=(), adaptive=False, d_step=0.25, retrace=False):
+    """The walk's own rows (``retrace`` False: every retraction row solved, so the rows of a run with and without
+    maps are compared state for state; tests/test_retrace.py compares the retraced path with this one)."""
     shape = ts.Paraboloid(1.0, 8.0)
     grid = shape.grid(0.4)
     spec = PathSpec(-2.0, 0.5, d_step, adaptive=adaptive, maps_at=maps_at)
-    return run_path(shape.gap(grid), ts.LJ93(), FreeKernel(grid, 1.0), ts.FastSolver(1e-8), spec), grid
+    return run_path(shape.gap(grid), ts.LJ93(), FreeKernel(grid, 1.0), ts.FastSolver(1e-8), spec,
+                    retrace=retrace), grid
 
 
 @pytest.mark.parametrize("adaptive", [False, True])

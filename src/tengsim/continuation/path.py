@@ -13,9 +13,12 @@ d_step/2^refine_levels the smallest.  Both branches are walked by the one
 """
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from tengsim.continuation.recorder import Recorder, spent
+from tengsim.continuation.retrace import Retrace
 from tengsim.continuation.specs import _D_TOL, BRANCHES, PathSpec
 from tengsim.continuation.steps import AdaptiveSteps, FixedSteps
 from tengsim.continuation.walker import Walker
@@ -24,13 +27,15 @@ from tengsim.solvers import State
 
 
 def run_path(U0, law, kernel, solver, spec: PathSpec, start: State | None = None,
-             progress=None, keep_states: bool = False, observers=(), sink=None):
+             progress=None, keep_states: bool = False, observers=(), sink=None, retrace: bool = True):
     """Solve the approach–retraction path; returns a :class:`tengsim.results.ContactResult`.
 
     ``progress(branch, D, done, total)`` is called after each row on the D grid.  ``observers``
     (registered names or objects, see :mod:`tengsim.observers`) add their columns to every row.
     ``sink(row, maps)`` is called with each row as it is recorded (:class:`tengsim.continuation.Recorder`).
-    A load-controlled path is :func:`tengsim.continuation.run_load_path`.
+    ``retrace``: the retraction's rows on the approach's branch are the approach's, not solved again
+    (:mod:`tengsim.continuation.retrace`; ``params['retraction_rows_copied']`` counts them); False solves
+    every row.  A load-controlled path is :func:`tengsim.continuation.run_load_path`.
     """
     if not isinstance(spec, PathSpec):
         raise TengsimError(f"run_path walks a PathSpec (rigid approach D); got {type(spec).__name__} "
@@ -41,26 +46,69 @@ def run_path(U0, law, kernel, solver, spec: PathSpec, start: State | None = None
     U0 = rec.U0
     # the zero start is made in the first solve's call: not held for the whole walk (a full-grid pair beside
     # a mirror block's states)
-
     walkers = []  # whatever solved: the branches and the map rows (their convolutions, for n_conv_spent)
+    trace = Retrace(rec, keep_states) if retrace and spec.retract else None
 
     def rows(branch):  # the Recorder's callback, with the extra rows at the maps_at D between the walk's rows
+        record = rec.on_row(branch)
+        if trace is not None:
+            record = trace.wrap(record) if branch == "approach" else trace.watch(record)
         if not spec.maps_at:
-            return rec.on_row(branch)
-        walkers.append(_MapRows(rec.on_row(branch), spec.maps_at, U0, law, kernel, solver, spec.jump_h))
+            return record
+        walkers.append(_MapRows(record, spec.maps_at, U0, law, kernel, solver, spec.jump_h))
         return walkers[-1]
 
     steps = AdaptiveSteps.of(spec) if spec.adaptive else FixedSteps(spec.refine_levels, spec.predictor)
     eq = None  # handed from branch to branch: the walker holds the current equilibrium, not this frame
     for branch, Ds in tuple(zip(BRANCHES, (targets, targets[::-1])))[:2 if spec.retract else 1]:
-        walker = Walker(U0, law, kernel, solver, steps, rows(branch), spec.jump_h)
+        callback = rows(branch)
+        walker = Walker(U0, law, kernel, solver, steps, callback, spec.jump_h)
         walkers.append(walker)
         walker.begin(Ds[0], eq if eq is not None else
                      walker.solve(Ds[0], start if start is not None else State.zero(kernel.grid.shape)))
         eq = None
-        walker.walk(Ds[1:])
+        if branch == "retraction" and trace is not None:
+            _retrace(walker, trace, Ds, callback if spec.maps_at else None)
+        else:
+            walker.walk(Ds[1:])
         eq = walker.take()
-    return spent(rec.result(eq.state if keep_states else None), walkers)
+    final = None
+    if keep_states:  # a retraction that ended on rows copied from the approach ends in the approach's first state
+        final = eq.state if eq is not None else trace.state(0)
+    res = rec.result(final)
+    if trace is not None:
+        res = replace(res, params={**res.params, "retraction_rows_copied": trace.copied})
+    return spent(res, walkers)
+
+
+def _retrace(walker, trace, Ds, maprows):
+    """Walk the retraction (``Ds``, D down) from the walker's first row, copying the approach's rows where it
+    is on the approach's branch (:mod:`tengsim.continuation.retrace`); the walker's last equilibrium is the
+    retraction's, unless the retraction ends on copied rows (then the walker holds nothing)."""
+    end = Ds[-1]
+    while True:
+        pos, trace.hit = trace.hit, None
+        if pos is not None:
+            low = trace.copy(pos)
+            D = trace.D(low)
+            if low == 0 or D <= end + _D_TOL:
+                walker.take()
+                if maprows is not None:
+                    maprows.skip(D, None)
+                return
+            eq = walker.solve(D, trace.state(low))  # the approach's state at its jump, restored
+            walker.reset(D, eq)
+            if maprows is not None:
+                maprows.skip(D, eq)
+        else:  # the walk goes on where it stopped (a step control starts from one state)
+            walker.reset(walker.hist[-1][0], walker.eq)
+        D = walker.hist[-1][0]
+        stops = [d for d in Ds if d < D - _D_TOL]
+        if not stops:
+            return
+        walker.walk(stops, until=lambda: trace.hit is not None)
+        if walker.hist[-1][0] <= end + _D_TOL and trace.hit is None:
+            return
 
 
 class _MapRows:
@@ -79,6 +127,14 @@ class _MapRows:
     def spent(self) -> int:
         """Convolutions of the extra rows' solves."""
         return self.walker.spent
+
+    def skip(self, D, eq) -> None:
+        """The rows down to ``D`` were recorded without this object (copied from the approach): the asked D
+        they passed are done, and the walk goes on from ``eq`` at D."""
+        if self.last is not None:
+            lo, hi = sorted((self.last[0], D))
+            self.wanted = [m for m in self.wanted if not lo - _D_TOL <= m <= hi + _D_TOL]
+        self.last = None if eq is None else (D, eq)
 
     def _hit(self, D):
         return next((m for m in self.wanted if abs(D - m) <= _D_TOL * max(1.0, abs(m))), None)

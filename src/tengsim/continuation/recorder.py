@@ -99,6 +99,29 @@ class Recorder:
                 self.sink(self.rows[-1], list(self.maps[n_maps:]))
         return record
 
+    def copy_row(self, index, branch) -> None:
+        """Record the row ``index`` again as a row of ``branch``: the same equilibrium, not solved again
+        (:mod:`tengsim.continuation.retrace`; its iterations, convolutions and seconds 0, no jump into it);
+        the map kept at its D, if any, is kept for ``branch`` too (the same arrays)."""
+        src = self.rows[index]
+        row = dict(src, branch=branch, jump=False, iterations=0, n_conv=0, seconds=0.0)
+        n_maps = len(self.maps)
+        D = float(src["D"])
+        for m in self.maps_at:
+            tol = self.map_tol * max(1.0, abs(m)) + 1e-9
+            if abs(D - m) <= tol and (branch, m) not in self._map_keys:
+                kept = next((mp for mp in self.maps if mp["branch"] == src["branch"] and mp["D"] == D), None)
+                if kept is not None:
+                    self._map_keys.add((branch, m))
+                    self.maps.append(dict(kept, branch=branch))
+        self.rows.append(row)
+        if row["on_grid"]:
+            self.done += 1
+            if self.progress:
+                self.progress(branch, D, self.done, self.total)
+        if self.sink is not None:
+            self.sink(row, list(self.maps[n_maps:]))
+
     def maps_missing(self, branches) -> list:
         """[(branch, value)] of the ``maps_at`` entries with no map kept on those branches (a load path:
         a load with no state on a branch)."""

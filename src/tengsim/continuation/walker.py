@@ -149,11 +149,12 @@ class Walker:
             eqb = self.solve(Db, eqa.state)  # confirm without the predictor
         return eqb, self.jumped(eqa, eqb, Db - Da)
 
-    def walk(self, stops, on_grid: bool = True, start=None):
+    def walk(self, stops, on_grid: bool = True, start=None, until=None):
         """From the current equilibrium (or ``start`` = (D, eq), the history kept as it is) through
         ``stops`` (the D the walk must visit, in path order, the last its end), the steps chosen by
         ``self.steps``; returns the last equilibrium, also the walker's current one.
-        ``on_grid``: whether the stops are rows of the path's grid."""
+        ``on_grid``: whether the stops are rows of the path's grid.  ``until()`` (optional), asked after
+        each accepted step: True ends the walk there (its held-back rows recorded)."""
         D_from, eq = start if start is not None else (self.hist[-1][0], self.eq)
         plan = self.steps.plan(self, eq, D_from, stops, on_grid)
         Da = D_from
@@ -173,6 +174,8 @@ class Walker:
                 self.hist = (self.hist + [(d, e.state) for d, e in inner] + [(Db, eqb.state)])[-2:]
             Da, eq = Db, eqb
             self.eq = eq
+            if until is not None and until():
+                break
         for row in plan.finish():
             self.on_row(*row)
         return eq

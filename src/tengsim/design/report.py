@@ -107,10 +107,13 @@ def report_text(result, figures) -> str:
         lines += ["", "| grid | dx | solve time | status |", "|---|---|---|---|"]
         lines += [f"| {nx}×{ny} | {length_text(dx * lat)} | {sec:.1f} s | {st} |" for nx, ny, dx, sec, st in
                   zip(tab["nx"], tab["ny"], tab["dx"], tab["seconds"], tab["status"])]
+        copied = int(result.finest.params.get("retraction_rows_copied", 0))
+        same = (f"; {copied} of the retraction's are the approach's, where it retraces the approach's branch "
+                "(taken, not solved again)" if copied else "")
         lines += ["", f"The finest grid's path: {len(result.finest.table['D'])} equilibria ("
                   f"{'approach and retraction' if result.plan.retraction else 'the approach only'}), "
                   f"each solved to max|r| ≤ {result.finest.params.get('tol', float('nan')):.2g} ε (the gap's "
-                  "residual; 0.01 × the tolerance)."]
+                  f"residual; 0.01 × the tolerance){same}."]
     lines += ["", "The per-design numbers below are read from the finest grid's curves; those from A/S (full "
               "contact, sensitivity, linear range, V_OC) move as A/S does.", "",
               "## Numbers", "", "| number | value |", "|---|---|"]
