@@ -116,3 +116,42 @@ def test_a_row_of_another_branch_is_not_taken_for_the_approachs():
     assert tr.lower(3) == 1
     tr.kept.clear()
     assert tr.lower(3) is None
+
+
+def test_approach_stops_past_its_force():
+    """``PathSpec(stop_force=...)``: the approach's rows are the full path's up to the step after its first row
+    past the force (every map's D passed first), the retraction walks back from there, the progress ends at its
+    total, and the lattice rows keep ``on_grid``."""
+    shape = ts.Paraboloid(1.0, 8.0)
+    grid = shape.grid(0.4)
+    seen = []
+
+    def run(stop, maps_at=()):
+        spec = PathSpec(-2.0, 4.0, 0.25, adaptive=True, maps_at=maps_at, stop_force=stop)
+        return run_path(shape.gap(grid), ts.LJ93(), FreeKernel(grid, 1.0), ts.FastSolver(1e-8), spec,
+                        progress=lambda b, D, done, total: seen.append((done, total)))
+
+    full = run(None)
+    a_full = full.branch("approach")
+    stop = 0.5 * float(np.max(a_full["F"]))
+    assert stop > 0
+    seen.clear()
+    res = run(stop)
+    a = res.branch("approach")
+    k = int(np.flatnonzero(a["F"] >= stop)[0])
+    assert len(a["D"]) == k + 2 < len(a_full["D"])  # the row past the force, and the step after it
+    np.testing.assert_array_equal(a["D"][:k + 1], a_full["D"][:k + 1])
+    np.testing.assert_array_equal(a["F"][:k + 1], a_full["F"][:k + 1])
+    r = res.branch("retraction")
+    assert r["D"][0] == a["D"][-1] and r["F"][0] == a["F"][-1] and r["D"][-1] == -2.0
+    assert res.all_converged
+    assert seen[-1][0] == seen[-1][1]  # the progress ends at its own total
+    lattice = np.isclose(((r["D"] + 2.0) / 0.25) % 1.0, 0.0) | np.isclose(((r["D"] + 2.0) / 0.25) % 1.0, 1.0)
+    np.testing.assert_array_equal(r["on_grid"].astype(bool), lattice)
+    # a map asked above the force's D: the approach goes on to it
+    late = float(a_full["D"][-3])
+    res2 = run(stop, (late,))
+    assert np.max(res2.branch("approach")["D"]) >= late
+    assert sorted((m["branch"], float(m["D"])) for m in res2.maps) == [("approach", late), ("retraction", late)]
+    with pytest.raises(ts.TengsimError, match="stop_force"):
+        PathSpec(-2.0, 2.0, 0.25, stop_force=float("nan"))

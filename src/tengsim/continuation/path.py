@@ -60,15 +60,26 @@ def run_path(U0, law, kernel, solver, spec: PathSpec, start: State | None = None
 
     steps = AdaptiveSteps.of(spec) if spec.adaptive else FixedSteps(spec.refine_levels, spec.predictor)
     eq = None  # handed from branch to branch: the walker holds the current equilibrium, not this frame
-    for branch, Ds in tuple(zip(BRANCHES, (targets, targets[::-1])))[:2 if spec.retract else 1]:
+    top = None  # the D the approach ended at, when it stopped at spec.stop_force
+    for branch in BRANCHES[:2 if spec.retract else 1]:
+        Ds = targets if branch == "approach" else _down_from(targets, top)
         callback = rows(branch)
         walker = Walker(U0, law, kernel, solver, steps, callback, spec.jump_h)
         walkers.append(walker)
         walker.begin(Ds[0], eq if eq is not None else
-                     walker.solve(Ds[0], start if start is not None else State.zero(kernel.grid.shape)))
+                     walker.solve(Ds[0], start if start is not None else State.zero(kernel.grid.shape)),
+                     on_grid=top is None or _on_lattice(targets, top))
         eq = None
         if branch == "retraction" and trace is not None:
             _retrace(walker, trace, Ds, callback if spec.maps_at else None)
+        elif branch == "approach" and spec.stop_force is not None:
+            walker.walk(Ds[1:], until=_reached(rec, spec))
+            top = walker.hist[-1][0]
+            if top < targets[-1] - _D_TOL:  # stopped short of d_max: the progress counts the rows left
+                left = len(_down_from(targets, top)) - (0 if _on_lattice(targets, top) else 1)
+                rec.total = rec.done + (left if spec.retract else 0)
+            else:
+                top = None
         else:
             walker.walk(Ds[1:])
         eq = walker.take()
@@ -79,6 +90,28 @@ def run_path(U0, law, kernel, solver, spec: PathSpec, start: State | None = None
     if trace is not None:
         res = replace(res, params={**res.params, "retraction_rows_copied": trace.copied})
     return spent(res, walkers)
+
+
+def _on_lattice(targets, D) -> bool:
+    return bool(np.any(np.abs(targets - D) <= _D_TOL * np.maximum(1.0, np.abs(targets))))
+
+
+def _down_from(targets, top):
+    """The retraction's stops: from ``top`` (None: the lattice's last D) down the lattice."""
+    if top is None:
+        return targets[::-1]
+    return np.concatenate(([top], [t for t in targets[::-1] if t < top - _D_TOL * max(1.0, abs(t))]))
+
+
+def _reached(rec, spec):
+    """The approach's stop (``spec.stop_force``): its last recorded row's F reached it, past every map's D."""
+    last_map = max(spec.maps_at, default=-np.inf)
+
+    def until():
+        row = rec.rows[-1]
+        return row["branch"] == "approach" and row["F"] >= spec.stop_force and row["D"] >= last_map
+
+    return until
 
 
 def _retrace(walker, trace, Ds, maprows):

@@ -46,6 +46,10 @@ class PathSpec:
     above a fixed run's and d_step eight times its d_step, the smallest steps (and so the jump
     resolution) agree.  How closely the defaults (adapt_tol = 0.15, adapt_h = 0.5) reproduce the fixed
     curve, and with how many fewer solves: docs/validation.md, "Continuation".
+
+    ``stop_force`` (F's units, None: none): the approach ends at the step after its first row whose F reaches
+    it (once past every ``maps_at`` D), short of d_max; the retraction walks back from there (its first row is
+    off the lattice unless that D is on it).  A design's grids stop there at p_max (tengsim.run.reach).
     """
 
     d_min: float
@@ -59,9 +63,12 @@ class PathSpec:
     adaptive: bool = False
     adapt_tol: float = 0.15
     adapt_h: float = 0.5
+    stop_force: float | None = None
 
     def __post_init__(self):
         finite("d_min", self.d_min)
+        if self.stop_force is not None:
+            finite("stop_force", self.stop_force)
         finite("d_max", self.d_max)
         positive("d_step", self.d_step)
         if not self.d_max > self.d_min:
@@ -85,9 +92,10 @@ class PathSpec:
 
     def extra_params(self) -> dict:
         """Path parameters beyond d_min, d_max, d_step, refine_levels, jump_h (none for fixed steps)."""
+        out = {"stop_force": float(self.stop_force)} if self.stop_force is not None else {}
         if not self.adaptive:
-            return {}
-        return {"adaptive": True, "adapt_tol": self.adapt_tol, "adapt_h": self.adapt_h}
+            return out
+        return {"adaptive": True, "adapt_tol": self.adapt_tol, "adapt_h": self.adapt_h, **out}
 
     def targets(self) -> np.ndarray:
         k = int(np.floor((self.d_max - self.d_min) / self.d_step + 1e-9))

@@ -115,10 +115,10 @@ class Walker:
         """Accept (D, state) as the newest of the predictor's history."""
         self.hist = (self.hist + [(D, state)])[-2:]
 
-    def begin(self, D, eq) -> None:
-        """The branch's first row: ``eq`` at D (on the grid), the history started there."""
+    def begin(self, D, eq, on_grid: bool = True) -> None:
+        """The branch's first row: ``eq`` at D, the history started there."""
         self.reset(D, eq)
-        self.on_row(D, eq, True, False)
+        self.on_row(D, eq, on_grid, False)
 
     def predict(self, D, c_max: float = 1.5, c_min: float = 0.0):
         """(start, predicted): the secant start at D from the last two accepted states when D lies

@@ -22,12 +22,13 @@ D_STEP = 0.4
 EXTEND_TRIES = 6
 
 
-def path_to(d_max: float, maps_at=(), retract: bool = True):
+def path_to(d_max: float, maps_at=(), retract: bool = True, stop_force: float | None = None):
     """The adaptive D walk from :data:`D_MIN` to ``d_max`` (maps kept at ``maps_at``) and back (``retract`` false:
-    the approach only)."""
+    the approach only); ``stop_force`` (ε units of F): the approach ends just past it (``PathSpec.stop_force``)."""
     from tengsim.continuation import PathSpec
 
-    return PathSpec(D_MIN, d_max, D_STEP, adaptive=True, maps_at=tuple(maps_at), retract=retract)
+    return PathSpec(D_MIN, d_max, D_STEP, adaptive=True, maps_at=tuple(maps_at), retract=retract,
+                    stop_force=stop_force)
 
 
 def height_eps(cplan, dx) -> float:
@@ -111,14 +112,16 @@ def map_depths(res, map_pressures) -> dict:
     return out
 
 
-def grid_path(p_max: float, d_max: float, map_pressures=(), cut: bool = True, retract: bool = True):
+def grid_path(p_max: float, d_max: float, map_pressures=(), cut: bool = True, retract: bool = True,
+              stop_force: float | None = None):
     """``path_for`` of the refinement (:func:`tengsim.run.resolve.resolve`): the first grid walks to
     ``d_max`` (:func:`find_d_max`); each finer grid to the D at which the grid before it reached ``p_max``, plus
     :data:`D_MARGIN` (on the path's lattice, never beyond ``d_max``).  Each finer grid's path also keeps the
     pressure and gap maps at the D where the grid before it reached ``map_pressures`` (:func:`map_depths`), so the
     finest grid's maps are recorded during its own walk (an extra row at each such D, solved from the rows around
     it: the walk's other rows are unchanged).  ``cut`` false: every grid walks to ``d_max``; ``retract`` false: the
-    approach only."""
+    approach only.  ``stop_force`` (the force of p_max, ε units): every grid's approach ends at the step after its
+    first row past it, short of that D when it gets there first (the rows beyond p_max are never read)."""
 
     def on_lattice(D):
         return D_MIN + math.ceil((D - D_MIN) / D_STEP - 1e-9) * D_STEP
@@ -132,7 +135,7 @@ def grid_path(p_max: float, d_max: float, map_pressures=(), cut: bool = True, re
             if map_pressures:
                 last = D_MIN + math.floor((top - D_MIN) / D_STEP + 1e-9) * D_STEP
                 depths = tuple(sorted(D for D in map_depths(prev, map_pressures) if D_MIN <= D <= last))
-        return path_to(top, depths, retract)
+        return path_to(top, depths, retract, stop_force)
 
     return path_for
 
@@ -162,7 +165,8 @@ def resolve_to(plan, d_max: float, settings, progress=None, keep=None, key: str 
             if done is not None:
                 done(levels)
 
-        path_for = grid_path(p_max, d_max, plan.maps_at, attempt == 0, plan.retraction)
+        stop = p_max / cplan.scaling.pressure(1.0) * (1.0 + 1e-9)  # p_max's force: each grid's approach ends past it
+        path_for = grid_path(p_max, d_max, plan.maps_at, attempt == 0, plan.retraction, stop)
 
         def scaled_path_for(prev, path_for=path_for):  # a grid taken back from the file keeps its columns only
             if prev is not None and prev.scaling is None:
