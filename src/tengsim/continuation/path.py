@@ -130,7 +130,7 @@ def _retrace(walker, trace, Ds, maprows):
                     maprows.skip(D, None)
                 return
             eq = walker.solve(D, trace.state(low))  # the approach's state at its jump, restored
-            walker.reset(D, eq)
+            walker.reset(D, eq, trace.before(low))
             if maprows is not None:
                 maprows.skip(D, eq)
         else:  # the walk goes on where it stopped (a step control starts from one state)

@@ -8,7 +8,9 @@ approach jump are the approach's rows: :meth:`Retrace.copy` records them again o
 and convolutions 0; a map the approach kept at such a row is kept for the retraction too), and nothing is
 solved.  At an approach jump the retraction must solve: it goes on from the approach's state at the jump's
 upper row, kept while the approach was walked (:data:`MAX_KEPT` of the latest jumps; one solve from it, which
-finds it converged, restores the equilibrium).
+finds it converged, restores the equilibrium), with the state of the row above it, so that the walk below goes on
+with the secant history it would have had had it solved its way down (a fold's landing below is sensitive to the
+start the walk brings).
 
 Back on the approach's branch: a solved retraction row at the D of an approach row is that row's equilibrium
 when their energies agree to :data:`ENERGY_MATCH` (relative), their forces to :data:`FORCE_MATCH` of the
@@ -45,6 +47,7 @@ class Retrace:
         self.rows: list = []   # recorder indices of the approach's rows, in path order (D up)
         self.by_D: dict = {}   # round(D, 9) -> position in self.rows
         self.kept: dict = {}   # position -> State, at rows whose step from the row before jumped
+        self.above: dict = {}  # position -> State of the row above a kept one (the predictor's second state)
         self.hit = None        # position of the approach row the retraction's last row is, if it can copy on
         self.copied = 0
 
@@ -54,10 +57,14 @@ class Retrace:
             pos = len(self.rows)
             self.rows.append(len(self.rec.rows) - 1)
             self.by_D[round(float(D), 9)] = pos
+            if pos - 1 in self.kept and pos - 1 > 0:
+                self.above[pos - 1] = eq.state.copy()
             if (jump and pos > 0) or (pos == 0 and self.keep_first):  # the first: a copied retraction's end state
                 self.kept[pos] = eq.state.copy()
                 while sum(k > 0 for k in self.kept) > MAX_KEPT:
-                    self.kept.pop(next(k for k in self.kept if k > 0))
+                    k = next(k for k in self.kept if k > 0)
+                    self.kept.pop(k)
+                    self.above.pop(k, None)
         return on_approach
 
     def watch(self, record):
@@ -105,6 +112,14 @@ class Retrace:
     def state(self, pos) -> State:
         """The approach's state kept at ``pos``."""
         return self.kept[pos]
+
+    def before(self, pos):
+        """(D, State, F) of the approach's row above the kept ``pos``: the state a retraction walked down to
+        ``pos`` would have as its predictor's older one; None where it was not kept (the approach's last row)."""
+        if pos not in self.above:
+            return None
+        row = self._row(pos + 1)
+        return float(row["D"]), self.above[pos], float(row["F"])
 
     def D(self, pos) -> float:
         return float(self._row(pos)["D"])

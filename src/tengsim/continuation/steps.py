@@ -107,6 +107,12 @@ class _AdaptivePlan:
         self.j_end = int(round((D_to - ctl.d_min) / self.h_min))
         self.hist_F = [force(eq.P, self.grid)]  # F of the states in walker.hist
         self.level = 0  # the first step has no error estimate: the look-back of the second judges it
+        if len(walker.hist) == 2 and getattr(walker, "F_before", None) is not None:
+            # going on from a history given to the walker (a retraction restored at an approach jump): the
+            # step of that history's level first, as a walk that came down through it would take
+            (D0, _), (D1, _) = walker.hist
+            self.hist_F.insert(0, float(walker.F_before))
+            self.level = int(np.clip(L - round(np.log2(max(abs(D1 - D0), self.h_min) / self.h_min)), 0, L))
         self.pending = None
 
     def next(self):

@@ -90,6 +90,7 @@ class Walker:
         self._U0s = U0 if fold is None else fold(U0, kernel)
         self.on_row, self.jump_h = on_row, jump_h
         self.hist: list = []
+        self.F_before = None  # the force of hist[0] where reset() was given it
         self.eq = None  # the current (last accepted) equilibrium; the walker holds it, not its caller
         self.spent = 0
 
@@ -102,9 +103,15 @@ class Walker:
         self.spent += int(eq.n_conv)
         return eq
 
-    def reset(self, D, eq) -> None:
-        """Start afresh at the accepted ``eq`` at D: the predictor's history and the current equilibrium."""
+    def reset(self, D, eq, before=None) -> None:
+        """Start afresh at the accepted ``eq`` at D: the predictor's history and the current equilibrium.
+        ``before`` = (D0, state0, F0): the accepted state before it on the same branch and its force (the
+        history then has two states; a step control's plan reads F0 as :attr:`F_before`)."""
         self.hist, self.eq = [(D, eq.state)], eq
+        self.F_before = None
+        if before is not None:
+            D0, s0, self.F_before = before
+            self.hist = [(D0, s0), (D, eq.state)]
 
     def take(self):
         """The current equilibrium, handed over: the walker keeps no reference to it."""

@@ -7,6 +7,7 @@ A :class:`ContactResult` is frozen and complete when it is made; a changed one i
 from __future__ import annotations
 
 import dataclasses
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -27,7 +28,8 @@ load): three questions, each with its own name; the values are those their resul
 
 @dataclass(frozen=True)
 class Jump:
-    """A discontinuity on a branch: the state jumped between D_before and D_after."""
+    """A discontinuity on a branch: the state jumped between D_before and D_after.  ``area_before`` and
+    ``area_after``: the charged area fraction on each side (NaN where the table has none)."""
 
     branch: str
     D_before: float
@@ -36,12 +38,22 @@ class Jump:
     F_after: float
     length_before: float
     length_after: float
+    area_before: float = float("nan")
+    area_after: float = float("nan")
 
     @property
     def kind(self) -> str:
+        """'jump-in' (the approach's contact grew), 'jump-out' (the retraction's shrank), else 'jump'.  The
+        contact is the charged area where the table has it: the 2-D area does not depend on how a state
+        whose symmetry the jump broke lies in the cell, while the contact length (measured along the row
+        through the apex) does; the contact length otherwise."""
+        if math.isfinite(self.area_before) and math.isfinite(self.area_after):
+            before, after = self.area_before, self.area_after
+        else:
+            before, after = self.length_before, self.length_after
         if self.branch == "approach":
-            return "jump-in" if self.length_after >= self.length_before else "jump"
-        return "jump-out" if self.length_after <= self.length_before else "jump"
+            return "jump-in" if after >= before else "jump"
+        return "jump-out" if after <= before else "jump"
 
 
 @dataclass(frozen=True)
@@ -135,9 +147,11 @@ class ContactResult:
         for i in np.flatnonzero(t["jump"]):
             if i == 0 or t["branch"][i - 1] != t["branch"][i]:
                 continue
+            area = t.get("charged_fraction")
             out.append(Jump(str(t["branch"][i]), float(t["D"][i - 1]), float(t["D"][i]),
                             float(t["F"][i - 1]), float(t["F"][i]),
-                            float(t["contact_length"][i - 1]), float(t["contact_length"][i])))
+                            float(t["contact_length"][i - 1]), float(t["contact_length"][i]),
+                            *((float(area[i - 1]), float(area[i])) if area is not None else ())))
         return out
 
     @property

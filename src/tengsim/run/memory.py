@@ -13,8 +13,8 @@ before anything is allocated.
   pair until its successor is confirmed);
 * VSR solver: ~14 n (state, trial state, pressures, energies, residuals);
 * the path: U0 and g0, and up to three equilibria alive (q, w, H, P each): 14 n, and the states the
-  retraction takes back at the approach's jumps (q and w, :data:`tengsim.continuation.retrace.MAX_KEPT` of
-  them): 6 n; every saved map 2 n, and 2 n more while the result is written.
+  retraction takes back at the approach's jumps and at the rows above them (q and w, two for each of
+  :data:`tengsim.continuation.retrace.MAX_KEPT` jumps): 12 n; every saved map 2 n, and 2 n more while the result is written.
 
 The run's peak is the larger of the kernel build and the solve (the build's temporaries are freed
 before the solve).  tests/test_resources.py checks it against the peak RSS of whole runs.
@@ -32,7 +32,7 @@ KERNEL_BUILD_FREE = 10.5     # floats per padded point at the free kernel's buil
 KERNEL_BUILD_PERIODIC = 6.0  # floats per half-spectrum point while the periodic multiplier is built
 FAST_WORK = 16               # work arrays of the fast solver besides its L-BFGS rows
 VSR_WORK = 14
-PATH_WORK = 14 + 2 * MAX_KEPT  # U0, g0, three equilibria (q, w, H, P) and the kept states (q, w)
+PATH_WORK = 14 + 4 * MAX_KEPT  # U0, g0, three equilibria (q, w, H, P) and the kept states (q, w; two per jump)
 MAP_WORK = 4                 # P and H kept, and stacked once more for the file
 
 
