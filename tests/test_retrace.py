@@ -105,7 +105,7 @@ def test_a_row_of_another_branch_is_not_taken_for_the_approachs():
         rec.rows.append(row(D, -1.0 + k, -5.0 + k, 0.1 * k, jump=(k == 1)))
         tr.rows.append(len(rec.rows) - 1)
         tr.by_D[round(D, 9)] = k
-    tr.kept[1] = object()
+    tr.kept.put(1, ts.State(np.arange(4.0), -np.arange(4.0)))
     same = row(0.3, 2.0 + 1e-5, -2.0 * (1 + 1e-9), 0.3)
     assert tr._same(same, 3)
     assert not tr._same(row(0.3, 2.0, -2.0 * (1 + 1e-5), 0.3), 3)
@@ -114,8 +114,28 @@ def test_a_row_of_another_branch_is_not_taken_for_the_approachs():
     assert not tr._same(row(0.3, 2.0, float("nan"), 0.3), 3)
     # from the top it copies down to the jump's row (position 1, its state kept), not past it
     assert tr.lower(3) == 1
-    tr.kept.clear()
+    tr.kept.pop(1)
     assert tr.lower(3) is None
+
+
+def test_the_kept_states_come_back_from_disk_bit_for_bit_in_reused_slots():
+    from tengsim.continuation.retrace import Spill
+
+    rng = np.random.default_rng(0)
+    spill = Spill()
+    states = {k: ts.State(rng.standard_normal((5, 7)), rng.standard_normal((5, 7)).astype(np.float32))
+              for k in range(4)}
+    for k in (0, 1, 2):
+        spill.put(k, states[k])
+    spill.pop(1)
+    spill.put(("above", 3), states[3])  # takes the freed slot
+    assert 1 not in spill and ("above", 3) in spill and 0 in spill
+    for key, k in ((0, 0), (2, 2), (("above", 3), 3)):
+        got = spill.get(key)
+        assert got.q.dtype == states[k].q.dtype and got.w.dtype == np.float32
+        np.testing.assert_array_equal(got.q, states[k].q)
+        np.testing.assert_array_equal(got.w, states[k].w)
+    assert spill._file.seek(0, 2) == 3 * 35 * (8 + 4)  # three slots: the freed one was reused
 
 
 def test_approach_stops_past_its_force():

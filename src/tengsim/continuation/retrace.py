@@ -7,7 +7,8 @@ the lower row's equilibrium.  So while the retraction is on the approach's branc
 approach jump are the approach's rows: :meth:`Retrace.copy` records them again on the retraction (iterations
 and convolutions 0; a map the approach kept at such a row is kept for the retraction too), and nothing is
 solved.  At an approach jump the retraction must solve: it goes on from the approach's state at the jump's
-upper row, kept while the approach was walked (:data:`MAX_KEPT` of the latest jumps; one solve from it, which
+upper row, kept while the approach was walked (:data:`MAX_KEPT` of the latest jumps, in a temporary file, not in
+memory: :class:`Spill`; one solve from it, which
 finds it converged, restores the equilibrium), with the state of the row above it, so that the walk below goes on
 with the secant history it would have had had it solved its way down (a fold's landing below is sensitive to the
 start the walk brings).
@@ -25,15 +26,62 @@ solves every retraction row (the reference the tests compare with).
 """
 from __future__ import annotations
 
+import tempfile
+
 import numpy as np
 
 from tengsim.solvers import State
 
 MAX_KEPT = 3
-"""States (q and w) kept at the approach's latest jumps (tengsim.run.memory counts them)."""
+"""Approach jumps whose states (q and w, and the row above's) are kept, the latest ones (in a :class:`Spill`)."""
 ENERGY_MATCH = 1e-7
 FORCE_MATCH = 1e-3
 AREA_MATCH = 1e-3
+
+
+class Spill:
+    """States kept in an unnamed temporary file, not in memory: ``put(key, state)``, ``get(key)`` (the arrays
+    read back bit for bit), ``pop(key)``, ``key in spill``.  A popped state's slot is reused (all states of a path
+    have one size; a slot is reused only by a state of its size), so the file holds at most as many states as are
+    kept at once."""
+
+    def __init__(self):
+        self._file, self._at, self._free = None, {}, []
+
+    def put(self, key, state: State) -> None:
+        q, w = np.ascontiguousarray(state.q), np.ascontiguousarray(state.w)
+        if self._file is None:
+            self._file = tempfile.TemporaryFile()
+        if key in self._at:
+            self.pop(key)
+        size = q.nbytes + w.nbytes
+        slot = next((i for i, (_, n) in enumerate(self._free) if n == size), None)
+        off = self._free.pop(slot)[0] if slot is not None else self._file.seek(0, 2)
+        self._file.seek(off)
+        self._file.write(q.tobytes())
+        self._file.write(w.tobytes())
+        self._at[key] = (off, q.shape, q.dtype, w.shape, w.dtype, size)
+
+    def get(self, key) -> State:
+        off, qs, qd, ws, wd, _ = self._at[key]
+        self._file.seek(off)
+        out = []
+        for shape, dtype in ((qs, qd), (ws, wd)):
+            a = np.empty(shape, dtype)
+            self._file.readinto(memoryview(a).cast("B"))
+            out.append(a)
+        return State(*out)
+
+    def pop(self, key) -> None:
+        at = self._at.pop(key, None)
+        if at is not None:
+            self._free.append((at[0], at[-1]))
+
+    def __contains__(self, key) -> bool:
+        return key in self._at
+
+    def keys(self):
+        return list(self._at)
 
 
 class Retrace:
@@ -46,8 +94,8 @@ class Retrace:
         self.rec, self.keep_first = rec, keep_first
         self.rows: list = []   # recorder indices of the approach's rows, in path order (D up)
         self.by_D: dict = {}   # round(D, 9) -> position in self.rows
-        self.kept: dict = {}   # position -> State, at rows whose step from the row before jumped
-        self.above: dict = {}  # position -> State of the row above a kept one (the predictor's second state)
+        self.kept = Spill()    # position -> State, at rows whose step from the row before jumped; ("above",
+        # position) -> the State of the row above a kept one (the predictor's second state)
         self.hit = None        # position of the approach row the retraction's last row is, if it can copy on
         self.copied = 0
 
@@ -57,14 +105,14 @@ class Retrace:
             pos = len(self.rows)
             self.rows.append(len(self.rec.rows) - 1)
             self.by_D[round(float(D), 9)] = pos
-            if pos - 1 in self.kept and pos - 1 > 0:
-                self.above[pos - 1] = eq.state.copy()
+            if pos - 1 > 0 and pos - 1 in self.kept:
+                self.kept.put(("above", pos - 1), eq.state)
             if (jump and pos > 0) or (pos == 0 and self.keep_first):  # the first: a copied retraction's end state
-                self.kept[pos] = eq.state.copy()
-                while sum(k > 0 for k in self.kept) > MAX_KEPT:
-                    k = next(k for k in self.kept if k > 0)
+                self.kept.put(pos, eq.state)
+                jumps = sorted(k for k in self.kept.keys() if isinstance(k, int) and k > 0)
+                for k in jumps[:max(len(jumps) - MAX_KEPT, 0)]:
                     self.kept.pop(k)
-                    self.above.pop(k, None)
+                    self.kept.pop(("above", k))
         return on_approach
 
     def watch(self, record):
@@ -111,15 +159,15 @@ class Retrace:
 
     def state(self, pos) -> State:
         """The approach's state kept at ``pos``."""
-        return self.kept[pos]
+        return self.kept.get(pos)
 
     def before(self, pos):
         """(D, State, F) of the approach's row above the kept ``pos``: the state a retraction walked down to
         ``pos`` would have as its predictor's older one; None where it was not kept (the approach's last row)."""
-        if pos not in self.above:
+        if ("above", pos) not in self.kept:
             return None
         row = self._row(pos + 1)
-        return float(row["D"]), self.above[pos], float(row["F"])
+        return float(row["D"]), self.kept.get(("above", pos)), float(row["F"])
 
     def D(self, pos) -> float:
         return float(self._row(pos)["D"])

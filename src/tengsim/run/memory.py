@@ -12,9 +12,10 @@ before anything is allocated.
   memory: s, y and their images K s, K y, 4·(memory + 1) rows of n (the 4 spare rows keep an evicted
   pair until its successor is confirmed);
 * VSR solver: ~14 n (state, trial state, pressures, energies, residuals);
-* the path: U0 and g0, and up to three equilibria alive (q, w, H, P each): 14 n, and the states the
-  retraction takes back at the approach's jumps and at the rows above them (q and w, two for each of
-  :data:`tengsim.continuation.retrace.MAX_KEPT` jumps): 12 n; every saved map 2 n, and 2 n more while the result is written.
+* the path: U0 and g0, and up to three equilibria alive (q, w, H, P each): 14 n; every saved map
+  2 n, and 2 n more while the result is written.  The states the retraction takes back at the approach's
+  jumps are in a temporary file, not in memory (:class:`tengsim.continuation.retrace.Spill`: on disk, 4 n
+  for each of :data:`tengsim.continuation.retrace.MAX_KEPT` jumps, read back one at a time).
 
 The run's peak is the larger of the kernel build and the solve (the build's temporaries are freed
 before the solve).  tests/test_resources.py checks it against the peak RSS of whole runs.
@@ -24,7 +25,6 @@ from __future__ import annotations
 import os
 
 from tengsim import resources
-from tengsim.continuation.retrace import MAX_KEPT
 from tengsim.errors import MemoryRefused
 
 _F64 = 8
@@ -32,7 +32,7 @@ KERNEL_BUILD_FREE = 10.5     # floats per padded point at the free kernel's buil
 KERNEL_BUILD_PERIODIC = 6.0  # floats per half-spectrum point while the periodic multiplier is built
 FAST_WORK = 16               # work arrays of the fast solver besides its L-BFGS rows
 VSR_WORK = 14
-PATH_WORK = 14 + 4 * MAX_KEPT  # U0, g0, three equilibria (q, w, H, P) and the kept states (q, w; two per jump)
+PATH_WORK = 14               # U0, g0 and three equilibria (q, w, H, P); the retraction's kept states: on disk
 MAP_WORK = 4                 # P and H kept, and stacked once more for the file
 
 
