@@ -8,10 +8,9 @@ approach jump are the approach's rows: :meth:`Retrace.copy` records them again o
 and convolutions 0; a map the approach kept at such a row is kept for the retraction too), and nothing is
 solved.  At an approach jump the retraction must solve: it goes on from the approach's state at the jump's
 upper row, kept while the approach was walked (:data:`MAX_KEPT` of the latest jumps, in a temporary file, not in
-memory: :class:`Spill`; one solve from it, which
-finds it converged, restores the equilibrium), with the state of the row above it, so that the walk below goes on
-with the secant history it would have had had it solved its way down (a fold's landing below is sensitive to the
-start the walk brings).
+memory: :class:`Spill`; one solve from it, which finds it converged, restores the equilibrium), with the state of
+the row above it, so that the walk below goes on with the secant history it would have had had it solved its way
+down (a fold's landing below is sensitive to the start the walk brings).
 
 Back on the approach's branch: a solved retraction row at the D of an approach row is that row's equilibrium
 when their energies agree to :data:`ENERGY_MATCH` (relative), their forces to :data:`FORCE_MATCH` of the
@@ -58,8 +57,8 @@ class Spill:
         slot = next((i for i, (_, n) in enumerate(self._free) if n == size), None)
         off = self._free.pop(slot)[0] if slot is not None else self._file.seek(0, 2)
         self._file.seek(off)
-        self._file.write(q.tobytes())
-        self._file.write(w.tobytes())
+        self._file.write(memoryview(q).cast("B"))  # the array's own bytes, no copy
+        self._file.write(memoryview(w).cast("B"))
         self._at[key] = (off, q.shape, q.dtype, w.shape, w.dtype, size)
 
     def get(self, key) -> State:
